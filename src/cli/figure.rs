@@ -1,0 +1,58 @@
+//! `tapsim figure`: regenerate the paper's figures as CSV, PNG and SVG.
+
+use super::args::number;
+use crate::contact::hybrid::JumpIn;
+use crate::error::{Error, Result};
+use crate::figures::{self, FigureOptions};
+use clap::Args;
+use std::path::PathBuf;
+
+/// Regenerate a figure of the paper (CSV data + PNG + SVG plot).
+///
+/// FIGURE is 1 (JKR cycle, eqs. 5, 8, 9), 3 (jump-in separation vs μ, eqs. 14-17),
+/// 4 (hysteresis vs μ, eq. 18), 5 (cycle with a compliant support, eqs. 22-26),
+/// 6 (hysteresis vs support stiffness, eqs. 26-27), or `all`.
+/// Figure 2 needs the full Lennard-Jones solution (not in this build).
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct FigureArgs {
+    /// Figure number (1, 3, 4, 5, 6) or `all`.
+    figure: String,
+    /// Output directory (created if missing).
+    #[arg(long, default_value = "results")]
+    out: PathBuf,
+    /// Tabor parameter μ of figure 5.
+    #[arg(long, value_parser = number, default_value_t = 5.0)]
+    mu: f64,
+    /// Support stiffness k̂ of figure 5.
+    #[arg(long, value_parser = number, default_value_t = 2.0)]
+    k_hat: f64,
+    /// Jump-in variant for figures 4-6.
+    #[arg(long, value_enum, default_value_t = JumpIn::Fit)]
+    jump_in: JumpIn,
+}
+
+/// Run the subcommand.
+pub fn run(args: FigureArgs) -> Result<()> {
+    let numbers: Vec<u32> = if args.figure.eq_ignore_ascii_case("all") {
+        figures::AVAILABLE.to_vec()
+    } else {
+        vec![args.figure.trim().parse().map_err(|_| Error::Parse {
+            name: "figure",
+            text: args.figure.clone(),
+            reason: "expected a figure number (1-6) or `all`".into(),
+        })?]
+    };
+    let opts = FigureOptions {
+        fig5_mu: args.mu,
+        fig5_k_hat: args.k_hat,
+        jump_in: args.jump_in,
+    };
+    for n in numbers {
+        let chart = figures::figure(n, &opts)?;
+        for path in chart.write_all(&args.out)? {
+            println!("{}", path.display());
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,45 @@
+//! The `tapsim` command line: parse, call the library, print. Each subcommand lives in
+//! its own module.
+
+mod args;
+mod figure;
+mod hysteresis;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// tapsim — tapping-mode AFM with adhesion hysteresis done right.
+///
+/// Implements Ciavarella, Greenwood & Barber, "Effect of Tabor parameter on hysteresis
+/// losses during adhesive contact". Dimensionless quantities carry hats: force
+/// T̂ = T/(RΔγ), separation α̂ = α/(με), contact radius â = βa/R, energy Ŵ = W/(μεRΔγ),
+/// support stiffness k̂ = μεk/(RΔγ). SI inputs accept unit suffixes (10nm, 1GPa,
+/// 50mJ/m^2, 40N/m); bare numbers are SI base units.
+#[derive(Debug, Parser)]
+#[command(name = "tapsim", version, propagate_version = true)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    Hysteresis(hysteresis::HysteresisArgs),
+    Figure(figure::FigureArgs),
+}
+
+/// Run the command line with the process arguments; the exit code to return.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let outcome = match cli.command {
+        Command::Hysteresis(args) => hysteresis::run(args),
+        Command::Figure(args) => figure::run(args),
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

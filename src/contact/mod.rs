@@ -1,0 +1,13 @@
+//! Tip–sample contact mechanics of a sphere on a flat: the paper's closed forms.
+//!
+//! - [`jkr`]: the JKR curve and its jump points, eqs. (3)–(9);
+//! - [`semi_rigid`]: Greenwood's semi-rigid jump-in, eqs. (11)–(17);
+//! - [`hybrid`]: the hybrid hysteresis loss, eq. (18);
+//! - [`spring`]: a support of finite stiffness, eqs. (22)–(27);
+//! - [`length_scale`]: the adhesive length scale, eqs. (19)–(21).
+
+pub mod hybrid;
+pub mod jkr;
+pub mod length_scale;
+pub mod semi_rigid;
+pub mod spring;

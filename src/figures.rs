@@ -1,0 +1,325 @@
+//! The data of the paper's figures, as [`Chart`]s: Fig. 1 (JKR cycle), Fig. 3 (jump-in
+//! separation), Fig. 4 (hysteresis vs μ), Fig. 5 (cycle with a finite-stiffness
+//! support), Fig. 6 (hysteresis vs k̂). Figure 2 needs the full Lennard-Jones solution.
+
+use crate::contact::hybrid::{self, JumpIn};
+use crate::contact::jkr::{self, JkrPoint};
+use crate::contact::semi_rigid::{self, EighthPower};
+use crate::contact::spring;
+use crate::error::{Error, Result};
+use crate::quasistatic::{self, Segment};
+use crate::report::chart::{Axis, Chart, Corner, Label, Series, Style};
+
+/// The figure numbers this build can draw.
+pub const AVAILABLE: [u32; 5] = [1, 3, 4, 5, 6];
+
+/// Tabor parameters of the curves of Fig. 6.
+pub const FIG6_MUS: [f64; 4] = [2.0, 5.0, 10.0, 20.0];
+
+/// The paper's numerical hysteresis at μ = 5 (Section 3), quoted for comparison.
+pub const PAPER_W_HAT_LJ_MU5: f64 = 3.2482;
+
+/// `n` points from `lo` to `hi`, evenly spaced (geometrically when `log`).
+fn grid(lo: f64, hi: f64, n: usize, log: bool) -> impl Iterator<Item = f64> {
+    (0..n).map(move |i| {
+        let t = i as f64 / (n - 1) as f64;
+        if log {
+            lo * (hi / lo).powf(t)
+        } else {
+            lo + (hi - lo) * t
+        }
+    })
+}
+
+fn label(text: &str, x: f64, y: f64) -> Label {
+    Label {
+        text: text.into(),
+        x,
+        y,
+    }
+}
+
+/// Options of the figures that have free parameters.
+#[derive(Debug, Clone, Copy)]
+pub struct FigureOptions {
+    /// Tabor parameter of Fig. 5.
+    pub fig5_mu: f64,
+    /// Support stiffness k̂ of Fig. 5.
+    pub fig5_k_hat: f64,
+    /// Jump-in variant for Figs. 4–6.
+    pub jump_in: JumpIn,
+}
+
+impl Default for FigureOptions {
+    fn default() -> Self {
+        Self {
+            fig5_mu: 5.0,
+            fig5_k_hat: 2.0,
+            jump_in: JumpIn::Fit,
+        }
+    }
+}
+
+/// Build figure `number`.
+pub fn figure(number: u32, opts: &FigureOptions) -> Result<Chart> {
+    match number {
+        1 => Ok(fig1()),
+        2 => Err(Error::NotApplicable(
+            "figure 2 needs the full Lennard-Jones numerical solution, which this build \
+             does not have yet; figures 1, 3, 4, 5 and 6 are available"
+                .into(),
+        )),
+        3 => fig3(),
+        4 => fig4(opts.jump_in),
+        5 => fig5(opts.fig5_mu, opts.fig5_k_hat, opts.jump_in),
+        6 => fig6(opts.jump_in),
+        n => Err(Error::NotApplicable(format!(
+            "the paper has figures 1 to 6; there is no figure {n}"
+        ))),
+    }
+}
+
+/// Fig. 1: the JKR force–separation curve (5) with the rigid-grip cycle O→B→C→D→O.
+pub fn fig1() -> Chart {
+    let b = jkr::point_b();
+    let c = jkr::point_c();
+    let deepest = 2.4;
+    let pts = |lo: f64, hi: f64| -> Vec<(f64, f64)> {
+        grid(lo, hi, 400, false)
+            .map(JkrPoint::at)
+            .map(|p| (p.alpha_hat, p.t_hat))
+            .collect()
+    };
+    let d = (c.alpha_hat, 0.0);
+    Chart {
+        name: "fig1_jkr_cycle".into(),
+        title: "Fig. 1  JKR loading and unloading (rigid grips)".into(),
+        x: Axis::linear("separation α/(με)", "alpha_hat"),
+        y: Axis::linear("force T/(RΔγ)  (tensile > 0)", "t_hat"),
+        series: vec![
+            Series::new(
+                "JKR stable branch (5)",
+                pts(c.a_hat, deepest),
+                Style::Line,
+                0,
+            ),
+            Series::new(
+                "JKR unstable branch (5)",
+                pts(0.0, c.a_hat),
+                Style::Dashed,
+                0,
+            ),
+            Series::new(
+                "approach and retract (T = 0)",
+                vec![(2.2, 0.0), (0.0, 0.0)],
+                Style::Line,
+                2,
+            ),
+            Series::new(
+                "jump-in O→B",
+                vec![(0.0, 0.0), (0.0, b.t_hat)],
+                Style::Dotted,
+                1,
+            ),
+            Series::new(
+                "jump-out C→D",
+                vec![(c.alpha_hat, c.t_hat), d],
+                Style::Dotted,
+                1,
+            ),
+            Series::new(
+                "O, B, C, D (8)",
+                vec![(0.0, 0.0), (0.0, b.t_hat), (c.alpha_hat, c.t_hat), d],
+                Style::Markers,
+                1,
+            ),
+        ],
+        labels: vec![
+            label("O", 0.05, -0.25),
+            label("B", 0.05, b.t_hat + 0.35),
+            label("C", c.alpha_hat + 0.05, c.t_hat + 0.35),
+            label("D", c.alpha_hat + 0.05, -0.25),
+        ],
+        legend: Corner::UpperLeft,
+    }
+}
+
+/// Fig. 3: jump-in separation α̂_A vs μ — the exact semi-rigid turning point (14)–(15),
+/// the closed form (16) and the fit (17).
+pub fn fig3() -> Result<Chart> {
+    let mus: Vec<f64> = grid(1.0, 10.0, 181, false).collect();
+    let exact = mus
+        .iter()
+        .map(|&mu| {
+            semi_rigid::jump_in_exact(mu, EighthPower::Keep).map(|a| a.map(|a| (mu, a.alpha_hat)))
+        })
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect();
+    let of = |f: fn(f64) -> f64| mus.iter().map(|&mu| (mu, f(mu))).collect();
+    Ok(Chart {
+        name: "fig3_jump_in".into(),
+        title: "Fig. 3  Separation at the jump-in point A".into(),
+        x: Axis::linear("Tabor parameter μ", "tabor_mu"),
+        y: Axis::linear("jump-in separation α_A/(με)", "alpha_hat_a"),
+        series: vec![
+            Series::new(
+                "semi-rigid turning point (14), (15)",
+                exact,
+                Style::Dashed,
+                0,
+            ),
+            Series::new(
+                "closed form (16)",
+                of(semi_rigid::alpha_hat_a_closed_form),
+                Style::Dotted,
+                2,
+            ),
+            Series::new("fit (17)", of(semi_rigid::alpha_hat_a_fit), Style::Line, 1),
+        ],
+        labels: vec![],
+        legend: Corner::UpperRight,
+    })
+}
+
+/// Fig. 4: hysteresis Ŵ vs μ — the hybrid theory (18) and the JKR level (9), with the
+/// paper's numerical value at μ = 5 for reference.
+pub fn fig4(jump_in: JumpIn) -> Result<Chart> {
+    let mu_min = hybrid::min_hysteretic_mu(jump_in)?;
+    let hybrid_line = std::iter::once(mu_min)
+        .chain(grid(mu_min * 1.0001, 1000.0, 300, true))
+        .map(|mu| Ok((mu, hybrid::hysteresis(mu, jump_in)?.w_hat)))
+        .collect::<Result<Vec<_>>>()?;
+    let w_jkr = jkr::w_hat_jkr();
+    Ok(Chart {
+        name: "fig4_hysteresis_vs_mu".into(),
+        title: "Fig. 4  Hysteresis loss per cycle vs Tabor parameter".into(),
+        x: Axis::log("Tabor parameter μ", "tabor_mu").with_range(1.0, 1000.0),
+        y: Axis::linear("hysteresis loss W/(μεRΔγ)", "w_hat").with_range(0.0, 8.0),
+        series: vec![
+            Series::new(
+                &format!("hybrid theory (18), jump-in {jump_in}"),
+                hybrid_line,
+                Style::Line,
+                0,
+            ),
+            Series::new(
+                "JKR (9): 7.092",
+                vec![(1.0, w_jkr), (1000.0, w_jkr)],
+                Style::Dashed,
+                1,
+            ),
+            Series::new(
+                "paper's numerical LJ value at μ = 5",
+                vec![(5.0, PAPER_W_HAT_LJ_MU5)],
+                Style::Markers,
+                2,
+            ),
+        ],
+        labels: vec![],
+        legend: Corner::LowerRight,
+    })
+}
+
+/// Fig. 5: the loading–unloading path A→B→C→D for a support of stiffness k̂,
+/// support separation α̂_S (22) vs force.
+pub fn fig5(tabor_mu: f64, k_hat: f64, jump_in: JumpIn) -> Result<Chart> {
+    let cycle = quasistatic::cycle(tabor_mu, k_hat, jump_in, 400)?;
+    let segment = |seg: Segment| -> Vec<(f64, f64)> {
+        cycle
+            .points
+            .iter()
+            .filter(|p| p.segment == seg)
+            .map(|p| (p.support_alpha_hat, p.t_hat))
+            .collect()
+    };
+    let h = &cycle.hysteresis;
+    let b = h
+        .landing
+        .expect("cycle() succeeds only with a landing point");
+    let a = (h.alpha_hat_a.unwrap_or(b.alpha_hat), 0.0);
+    let b = (spring::support_separation_hat(&b, k_hat), b.t_hat);
+    let c = (h.support_alpha_hat_c, h.jump_out.t_hat);
+    let d = (h.support_alpha_hat_c, 0.0);
+    let mut approach = segment(Segment::Approach);
+    approach.extend(segment(Segment::Retract));
+    approach.sort_by(|p, q| p.0.total_cmp(&q.0));
+    Ok(Chart {
+        name: "fig5_finite_stiffness_cycle".into(),
+        title: format!(
+            "Fig. 5  Cycle with a compliant support: μεk/(RΔγ) = {k_hat}, μ = {tabor_mu}"
+        ),
+        x: Axis::linear(
+            "support separation (α + T/k)/(με)  (22)",
+            "support_alpha_hat",
+        ),
+        y: Axis::linear("force T/(RΔγ)  (tensile > 0)", "t_hat"),
+        series: vec![
+            Series::new(
+                "contact branch (5), (22)",
+                segment(Segment::Unloading),
+                Style::Line,
+                0,
+            ),
+            Series::new("force-free approach/retract", approach, Style::Line, 2),
+            Series::new("jump-in A→B", vec![a, b], Style::Dotted, 1),
+            Series::new("jump-out C→D", vec![c, d], Style::Dotted, 1),
+            Series::new("A, B, C, D", vec![a, b, c, d], Style::Markers, 1),
+        ],
+        labels: vec![
+            label("A", a.0 + 0.04, a.1 - 0.2),
+            label("B", b.0 + 0.04, b.1 + 0.35),
+            label("C", c.0 + 0.04, c.1 + 0.35),
+            label("D", d.0 + 0.04, d.1 - 0.2),
+            label(
+                &format!("W/(μεRΔγ) = {:.4}  (26)", h.w_hat),
+                a.0 - 0.3,
+                -2.5,
+            ),
+        ],
+        legend: Corner::LowerLeft,
+    })
+}
+
+/// Fig. 6: hysteresis Ŵ(k̂) (26) for μ = 2, 5, 10, 20, with the soft-support asymptote
+/// (27) and the rigid-grip levels (18).
+pub fn fig6(jump_in: JumpIn) -> Result<Chart> {
+    let (k_lo, k_hi) = (1e-2, 1e3);
+    let mut series = Vec::new();
+    for (i, &mu) in FIG6_MUS.iter().enumerate() {
+        let line = grid(k_lo, k_hi, 200, true)
+            .map(|k| Ok((k, spring::hysteresis(mu, k, jump_in)?.w_hat)))
+            .collect::<Result<Vec<_>>>()?;
+        let rigid = hybrid::hysteresis(mu, jump_in)?.w_hat;
+        series.push(Series::new(
+            &format!("μ = {mu} (26)"),
+            line,
+            Style::Line,
+            i + 1,
+        ));
+        series.push(Series::new(
+            &format!("μ = {mu}, rigid support (18)"),
+            vec![(k_lo, rigid), (k_hi, rigid)],
+            Style::Dashed,
+            i + 1,
+        ));
+    }
+    series.push(Series::new(
+        "soft-support limit (27)",
+        grid(k_lo, k_hi, 2, true)
+            .map(|k| (k, spring::w_hat_soft_limit(k)))
+            .collect(),
+        Style::Dashed,
+        0,
+    ));
+    Ok(Chart {
+        name: "fig6_hysteresis_vs_stiffness".into(),
+        title: "Fig. 6  Hysteresis loss vs support stiffness".into(),
+        x: Axis::log("support stiffness μεk/(RΔγ)", "k_hat").with_range(k_lo, k_hi),
+        y: Axis::log("hysteresis loss W/(μεRΔγ)", "w_hat").with_range(1.0, 2e3),
+        series,
+        labels: vec![],
+        legend: Corner::UpperRight,
+    })
+}

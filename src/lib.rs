@@ -1,0 +1,21 @@
+//! tapsim: tapping-mode AFM with adhesion hysteresis done right.
+//!
+//! The physics follows Ciavarella, Greenwood & Barber, "Effect of Tabor parameter on
+//! hysteresis losses during adhesive contact"; equation numbers in the documentation
+//! are that paper's. Data flows one way: [`params`] → [`contact`] (force laws) →
+//! [`quasistatic`] → [`figures`] → [`report`].
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod cli;
+pub mod contact;
+pub mod error;
+pub mod figures;
+pub mod numeric;
+pub mod params;
+pub mod quasistatic;
+pub mod report;
+pub mod units;
+
+pub use error::{Error, Result};

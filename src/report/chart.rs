@@ -1,0 +1,171 @@
+//! A chart described as data — axes, series, point labels — independent of how it is
+//! drawn. [`super::plot`] renders it to PNG and SVG; [`Chart::to_csv`] writes its data.
+
+use crate::error::{Error, Result};
+use serde::Serialize;
+use std::path::Path;
+
+/// Linear or logarithmic axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Scale {
+    /// Linear axis.
+    Linear,
+    /// Base-10 logarithmic axis (positive data only).
+    Log,
+}
+
+/// One axis of a chart.
+#[derive(Debug, Clone, Serialize)]
+pub struct Axis {
+    /// Label shown on the plot, with symbol and unit.
+    pub label: String,
+    /// Column name in the CSV file.
+    pub column: String,
+    /// Scale.
+    pub scale: Scale,
+    /// Fixed range; the data's range (padded) when `None`.
+    pub range: Option<(f64, f64)>,
+}
+
+impl Axis {
+    /// A linear axis with automatic range.
+    pub fn linear(label: &str, column: &str) -> Self {
+        Self {
+            label: label.into(),
+            column: column.into(),
+            scale: Scale::Linear,
+            range: None,
+        }
+    }
+
+    /// A logarithmic axis with automatic range.
+    pub fn log(label: &str, column: &str) -> Self {
+        Self {
+            scale: Scale::Log,
+            ..Self::linear(label, column)
+        }
+    }
+
+    /// The same axis with a fixed range.
+    pub fn with_range(mut self, lo: f64, hi: f64) -> Self {
+        self.range = Some((lo, hi));
+        self
+    }
+}
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Style {
+    /// Solid line.
+    Line,
+    /// Dashed line.
+    Dashed,
+    /// Dotted line (jumps, guides).
+    Dotted,
+    /// Circles at the points, no line.
+    Markers,
+}
+
+/// A named set of (x, y) points.
+#[derive(Debug, Clone, Serialize)]
+pub struct Series {
+    /// Legend entry.
+    pub name: String,
+    /// The data.
+    pub points: Vec<(f64, f64)>,
+    /// How it is drawn.
+    pub style: Style,
+    /// Palette index of its colour.
+    pub color: usize,
+}
+
+impl Series {
+    /// A series with the given style and palette colour.
+    pub fn new(name: &str, points: Vec<(f64, f64)>, style: Style, color: usize) -> Self {
+        Self {
+            name: name.into(),
+            points,
+            style,
+            color,
+        }
+    }
+}
+
+/// Where the legend sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum Corner {
+    /// Upper left.
+    UpperLeft,
+    /// Upper right.
+    #[default]
+    UpperRight,
+    /// Lower left.
+    LowerLeft,
+    /// Lower right.
+    LowerRight,
+}
+
+/// A text label placed next to a data point (e.g. the letters of the paper's figures).
+#[derive(Debug, Clone, Serialize)]
+pub struct Label {
+    /// The text.
+    pub text: String,
+    /// Abscissa of the point.
+    pub x: f64,
+    /// Ordinate of the point.
+    pub y: f64,
+}
+
+/// A complete chart.
+#[derive(Debug, Clone, Serialize)]
+pub struct Chart {
+    /// File stem for the outputs (`<name>.csv`, `.png`, `.svg`).
+    pub name: String,
+    /// Title drawn above the plot.
+    pub title: String,
+    /// Horizontal axis.
+    pub x: Axis,
+    /// Vertical axis.
+    pub y: Axis,
+    /// Data series, drawn in order.
+    pub series: Vec<Series>,
+    /// Point labels.
+    pub labels: Vec<Label>,
+    /// Legend position.
+    pub legend: Corner,
+}
+
+impl Chart {
+    /// The chart's data as CSV in long form: one row per point, columns
+    /// `series`, x column, y column.
+    pub fn to_csv(&self) -> Result<Vec<u8>> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let fail = |e: csv::Error| Error::Output {
+            path: format!("{}.csv", self.name).into(),
+            reason: e.to_string(),
+        };
+        w.write_record(["series", &self.x.column, &self.y.column])
+            .map_err(fail)?;
+        for s in &self.series {
+            for &(x, y) in &s.points {
+                w.write_record([s.name.clone(), x.to_string(), y.to_string()])
+                    .map_err(fail)?;
+            }
+        }
+        w.into_inner().map_err(|e| Error::Output {
+            path: format!("{}.csv", self.name).into(),
+            reason: e.to_string(),
+        })
+    }
+
+    /// Write `<dir>/<name>.csv`, `.png` and `.svg`; returns the paths written.
+    pub fn write_all(&self, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
+        let csv_path = dir.join(format!("{}.csv", self.name));
+        super::output::write_bytes(&csv_path, &self.to_csv()?)?;
+        let png = dir.join(format!("{}.png", self.name));
+        let svg = dir.join(format!("{}.svg", self.name));
+        super::plot::render_png(self, &png)?;
+        super::plot::render_svg(self, &svg)?;
+        Ok(vec![csv_path, png, svg])
+    }
+}
