@@ -32,29 +32,29 @@ pub fn number(s: &str) -> std::result::Result<f64, String> {
 #[derive(Debug, Clone, Args)]
 pub struct ContactArgs {
     /// Tip radius R [m; e.g. 10nm].
-    #[arg(long, value_parser = length, help_heading = "Contact (SI)")]
+    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Contact (SI)")]
     pub radius: Option<f64>,
     /// Composite modulus E* [Pa; e.g. 1GPa]. Or give --tip-modulus/--sample-modulus.
-    #[arg(long, value_parser = pressure, help_heading = "Contact (SI)",
+    #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)",
           conflicts_with_all = ["tip_modulus", "sample_modulus"])]
     pub modulus: Option<f64>,
     /// Young's modulus of the tip [Pa; e.g. 169GPa for silicon].
-    #[arg(long, value_parser = pressure, requires = "sample_modulus", help_heading = "Contact (SI)")]
+    #[arg(long, allow_hyphen_values = true, value_parser = pressure, requires = "sample_modulus", help_heading = "Contact (SI)")]
     pub tip_modulus: Option<f64>,
     /// Poisson ratio of the tip.
-    #[arg(long, value_parser = number, default_value_t = 0.28, help_heading = "Contact (SI)")]
+    #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 0.28, help_heading = "Contact (SI)")]
     pub tip_poisson: f64,
     /// Young's modulus of the sample [Pa; e.g. 1GPa].
-    #[arg(long, value_parser = pressure, requires = "tip_modulus", help_heading = "Contact (SI)")]
+    #[arg(long, allow_hyphen_values = true, value_parser = pressure, requires = "tip_modulus", help_heading = "Contact (SI)")]
     pub sample_modulus: Option<f64>,
     /// Poisson ratio of the sample.
-    #[arg(long, value_parser = number, default_value_t = 0.4, help_heading = "Contact (SI)")]
+    #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 0.4, help_heading = "Contact (SI)")]
     pub sample_poisson: f64,
     /// Work of adhesion Δγ [J/m²; e.g. 50mJ/m^2].
-    #[arg(long, value_parser = surface_energy, help_heading = "Contact (SI)")]
+    #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, help_heading = "Contact (SI)")]
     pub work_of_adhesion: Option<f64>,
     /// Range ε of the Lennard-Jones law (10), the equilibrium gap [m; e.g. 0.3nm].
-    #[arg(long, value_parser = length, help_heading = "Contact (SI)")]
+    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Contact (SI)")]
     pub range: Option<f64>,
 }
 

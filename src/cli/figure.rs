@@ -22,10 +22,10 @@ pub struct FigureArgs {
     #[arg(long, default_value = "results")]
     out: PathBuf,
     /// Tabor parameter μ of figure 5.
-    #[arg(long, value_parser = number, default_value_t = 5.0)]
+    #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 5.0)]
     mu: f64,
     /// Support stiffness k̂ of figure 5.
-    #[arg(long, value_parser = number, default_value_t = 2.0)]
+    #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 2.0)]
     k_hat: f64,
     /// Jump-in variant for figures 4-6.
     #[arg(long, value_enum, default_value_t = JumpIn::Fit)]

@@ -24,16 +24,16 @@ pub const DEFAULT_MU: f64 = 5.0;
 #[command(verbatim_doc_comment)]
 pub struct HysteresisArgs {
     /// Tabor parameter μ, eq. (2) [dimensionless, > 0]. Default 5 without SI inputs.
-    #[arg(long, value_parser = number, conflicts_with_all =
+    #[arg(long, allow_hyphen_values = true, value_parser = number, conflicts_with_all =
           ["radius", "modulus", "tip_modulus", "sample_modulus", "work_of_adhesion", "range"])]
     mu: Option<f64>,
     #[command(flatten)]
     contact: ContactArgs,
     /// Dimensionless support stiffness k̂ = μεk/(RΔγ), eq. (22) [> 0].
-    #[arg(long, value_parser = number, conflicts_with = "stiffness")]
+    #[arg(long, allow_hyphen_values = true, value_parser = number, conflicts_with = "stiffness")]
     k_hat: Option<f64>,
     /// Support (cantilever) stiffness k [N/m]; needs the SI contact inputs.
-    #[arg(long, value_parser = stiffness)]
+    #[arg(long, allow_hyphen_values = true, value_parser = stiffness)]
     stiffness: Option<f64>,
     /// Jump-in separation α̂_A: the fit (17), the closed form (16), or the exact
     /// turning point of the semi-rigid separation (14)-(15).

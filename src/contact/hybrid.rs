@@ -83,13 +83,13 @@ pub fn hysteresis(tabor_mu: f64, jump_in: JumpIn) -> Result<HybridHysteresis> {
     let no_hysteresis_reason = match (alpha_hat_a, landing) {
         (_, Some(_)) => None,
         (None, _) => Some(format!(
-            "no jump-in instability at mu = {tabor_mu} with the {jump_in} jump-in: \
+            "no jump-in instability at mu = {tabor_mu:.4} with the {jump_in} jump-in: \
              the hybrid theory predicts no hysteresis (it needs mu > {:.3})",
             min_hysteretic_mu(jump_in)?
         )),
         (Some(a), None) => Some(format!(
             "jump-in separation alpha_hat_A = {a:.4} is not below the jump-out separation \
-             alpha_hat_C = {:.4} at mu = {tabor_mu}: the hybrid theory predicts no hysteresis \
+             alpha_hat_C = {:.4} at mu = {tabor_mu:.4}: the hybrid theory predicts no hysteresis \
              (it needs mu > {:.3} with the {jump_in} jump-in)",
             c.alpha_hat,
             min_hysteretic_mu(jump_in)?

@@ -91,12 +91,12 @@ pub fn hysteresis(tabor_mu: f64, k_hat: f64, jump_in: JumpIn) -> Result<SpringHy
     let no_hysteresis_reason = match (alpha_hat_a, landing) {
         (_, Some(_)) => None,
         (None, _) => Some(format!(
-            "no jump-in instability at mu = {tabor_mu} with the {jump_in} jump-in: \
+            "no jump-in instability at mu = {tabor_mu:.4} with the {jump_in} jump-in: \
              no hysteresis"
         )),
         (Some(a), None) => Some(format!(
             "jump-in separation alpha_hat_A = {a:.4} is not below the support separation \
-             at jump-out, {support_alpha_hat_c:.4}, at k_hat = {k_hat}: no hysteresis"
+             at jump-out, {support_alpha_hat_c:.4}, at k_hat = {k_hat:.4}: no hysteresis"
         )),
     };
     Ok(SpringHysteresis {

@@ -1,0 +1,321 @@
+//! The `tapsim` command line, run as a user would.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn tapsim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = tapsim(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("exactly one JSON object on stdout")
+}
+
+fn num(v: &serde_json::Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("key {key} missing or not a number in {v}"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tapsim-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn hysteresis_json_has_the_documented_keys() {
+    let v = json(&["hysteresis", "--mu", "5", "--json"]);
+    for key in [
+        "tabor_mu",
+        "alpha_hat_a",
+        "a_hat_a",
+        "alpha_hat_c",
+        "a_hat_c",
+        "t_hat_c",
+        "w_hat_hybrid",
+        "w_hat_jkr",
+    ] {
+        num(&v, key);
+    }
+    assert_eq!(num(&v, "tabor_mu"), 5.0);
+    assert!((num(&v, "w_hat_jkr") - 7.0922).abs() < 5e-5);
+    assert!((num(&v, "w_hat_hybrid") - 3.2062).abs() < 5e-4);
+    assert!(v.get("k_hat").is_none() && v.get("w_joule").is_none());
+}
+
+#[test]
+fn hysteresis_with_stiffness_adds_the_spring_keys() {
+    let v = json(&["hysteresis", "--mu", "5", "--k-hat", "2", "--json"]);
+    for key in ["k_hat", "a_hat_b_spring", "a_hat_c_spring", "w_hat_spring"] {
+        num(&v, key);
+    }
+    assert!(num(&v, "w_hat_spring") > num(&v, "w_hat_hybrid"));
+}
+
+#[test]
+fn si_inputs_derive_mu_and_give_joules() {
+    // R = 10 nm, E* = 1 GPa, Δγ = 50 mJ/m², ε = 0.3 nm, k = 40 N/m.
+    let v = json(&[
+        "hysteresis",
+        "--radius",
+        "10nm",
+        "--modulus",
+        "1GPa",
+        "--work-of-adhesion",
+        "50mJ/m^2",
+        "--range",
+        "0.3nm",
+        "--stiffness",
+        "40N/m",
+        "--json",
+    ]);
+    let mu = (10e-9f64 * 0.05 * 0.05 / 1e18).cbrt() / 0.3e-9;
+    assert!((num(&v, "tabor_mu") - mu).abs() < 1e-12 * mu);
+    let k_hat = mu * 0.3e-9 * 40.0 / (10e-9 * 0.05);
+    assert!((num(&v, "k_hat") - k_hat).abs() < 1e-9 * k_hat);
+    let scale = mu * 0.3e-9 * 10e-9 * 0.05;
+    assert!(
+        (num(&v, "w_joule") - num(&v, "w_hat_spring") * scale).abs() < 1e-12 * num(&v, "w_joule")
+    );
+    assert!((num(&v, "w_ev") * 1.602_176_634e-19 - num(&v, "w_joule")).abs() < 1e-30);
+    // Same result with plain SI numbers.
+    let plain = json(&[
+        "hysteresis",
+        "--radius",
+        "1e-8",
+        "--modulus",
+        "1e9",
+        "--work-of-adhesion",
+        "0.05",
+        "--range",
+        "3e-10",
+        "--stiffness",
+        "40",
+        "--json",
+    ]);
+    assert!((num(&plain, "w_joule") - num(&v, "w_joule")).abs() < 1e-9 * num(&v, "w_joule"));
+}
+
+#[test]
+fn tip_and_sample_moduli_combine() {
+    let v = json(&[
+        "hysteresis",
+        "--radius",
+        "10nm",
+        "--tip-modulus",
+        "169GPa",
+        "--tip-poisson",
+        "0.28",
+        "--sample-modulus",
+        "2GPa",
+        "--sample-poisson",
+        "0.4",
+        "--work-of-adhesion",
+        "0.05",
+        "--range",
+        "0.3nm",
+        "--json",
+    ]);
+    let e_star = 1.0 / ((1.0 - 0.28f64.powi(2)) / 169e9 + (1.0 - 0.4f64.powi(2)) / 2e9);
+    assert!((num(&v, "modulus_pa") - e_star).abs() < 1e-6 * e_star);
+}
+
+#[test]
+fn small_mu_reports_no_hysteresis_with_a_reason() {
+    let v = json(&["hysteresis", "--mu", "0.8", "--json"]);
+    assert_eq!(v["hysteresis"], serde_json::Value::Bool(false));
+    assert_eq!(num(&v, "w_hat_hybrid"), 0.0);
+    assert!(v["a_hat_a"].is_null());
+    assert!(v["note"].as_str().unwrap().contains("no hysteresis"));
+    let text = tapsim(&["hysteresis", "--mu", "0.8"]);
+    assert!(text.status.success());
+    assert!(String::from_utf8_lossy(&text.stdout).contains("no hysteresis"));
+}
+
+#[test]
+fn default_run_uses_mu_5_and_says_so() {
+    let out = tapsim(&["hysteresis"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("5.000000  (default"), "{text}");
+    assert!(text.contains("7.092196"), "{text}");
+}
+
+#[test]
+fn bad_input_is_a_clear_error_not_a_panic() {
+    let cases: &[&[&str]] = &[
+        &["hysteresis", "--mu", "0"],
+        &["hysteresis", "--mu", "-2"],
+        &["hysteresis", "--mu", "NaN"],
+        &["hysteresis", "--mu", "five"],
+        &["hysteresis", "--mu", "5", "--k-hat", "0"],
+        &["hysteresis", "--mu", "5", "--k-hat", "-1"],
+        &["hysteresis", "--mu", "5", "--stiffness", "40"],
+        &[
+            "hysteresis",
+            "--radius",
+            "-10nm",
+            "--modulus",
+            "1GPa",
+            "--work-of-adhesion",
+            "0.05",
+            "--range",
+            "0.3nm",
+        ],
+        &[
+            "hysteresis",
+            "--radius",
+            "0",
+            "--modulus",
+            "1GPa",
+            "--work-of-adhesion",
+            "0.05",
+            "--range",
+            "0.3nm",
+        ],
+        &["hysteresis", "--radius", "10nm", "--modulus", "1GPa"],
+        &[
+            "hysteresis",
+            "--radius",
+            "10 parsecs",
+            "--modulus",
+            "1GPa",
+            "--work-of-adhesion",
+            "0.05",
+            "--range",
+            "0.3nm",
+        ],
+        &["hysteresis", "--mu", "5", "--radius", "10nm"],
+        &["figure", "2", "--out", "/tmp/tapsim-never-written"],
+        &["figure", "9"],
+        &["figure", "seven"],
+    ];
+    for args in cases {
+        let out = tapsim(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains("error"), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(out.stdout.is_empty(), "{args:?} printed to stdout");
+    }
+    assert!(!std::path::Path::new("/tmp/tapsim-never-written").exists());
+}
+
+#[test]
+fn negative_values_are_refused_with_the_reason() {
+    for (args, needle) in [
+        (
+            &["hysteresis", "--mu", "-2"][..],
+            "mu = -2: must be greater than zero",
+        ),
+        (
+            &["hysteresis", "--mu", "5", "--k-hat", "-1"][..],
+            "k_hat = -1: must be greater than zero",
+        ),
+        (
+            &[
+                "hysteresis",
+                "--radius",
+                "-10nm",
+                "--modulus",
+                "1GPa",
+                "--work-of-adhesion",
+                "0.05",
+                "--range",
+                "0.3nm",
+            ][..],
+            "radius",
+        ),
+    ] {
+        let out = tapsim(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.contains(needle) && stderr.contains("greater than zero"),
+            "{args:?}: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn figure_all_writes_csv_png_svg_for_each_figure() {
+    let dir = scratch("figures");
+    let out = tapsim(&["figure", "all", "--out", dir.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let listed: Vec<PathBuf> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(PathBuf::from)
+        .collect();
+    assert_eq!(listed.len(), 15);
+    for path in &listed {
+        let bytes = std::fs::read(path).unwrap();
+        assert!(!bytes.is_empty(), "{path:?} empty");
+        match path.extension().and_then(|e| e.to_str()) {
+            Some("png") => assert_eq!(&bytes[1..4], b"PNG"),
+            Some("svg") => assert!(String::from_utf8_lossy(&bytes).contains("<svg")),
+            Some("csv") => {
+                let mut r = csv::Reader::from_reader(bytes.as_slice());
+                assert_eq!(r.headers().unwrap().len(), 3);
+                let rows = r.records().map(|r| r.unwrap()).collect::<Vec<_>>();
+                assert!(rows.len() > 5);
+                for row in rows {
+                    row[1].parse::<f64>().unwrap();
+                    row[2].parse::<f64>().unwrap();
+                }
+            }
+            other => panic!("unexpected file {other:?}"),
+        }
+    }
+    // No temporary files are left behind.
+    let names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 15, "{names:?}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn fig6_csv_holds_the_curves_of_eq_26() {
+    let dir = scratch("fig6");
+    let out = tapsim(&["figure", "6", "--out", dir.to_str().unwrap()]);
+    assert!(out.status.success());
+    let mut r = csv::Reader::from_path(dir.join("fig6_hysteresis_vs_stiffness.csv")).unwrap();
+    let mut checked = 0;
+    for row in r.records() {
+        let row = row.unwrap();
+        if row[0].starts_with("μ = 5 (26)") {
+            let (k, w): (f64, f64) = (row[1].parse().unwrap(), row[2].parse().unwrap());
+            let expect = tapsim::contact::spring::hysteresis(5.0, k, Default::default())
+                .unwrap()
+                .w_hat;
+            assert!((w - expect).abs() <= 1e-12 * expect);
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 200);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn help_teaches_units_and_equations() {
+    let out = tapsim(&["hysteresis", "--help"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for needle in ["eq. (2)", "(22)", "N/m", "--json", "w_hat_spring"] {
+        assert!(text.contains(needle), "help lacks {needle}");
+    }
+}
