@@ -242,6 +242,11 @@ pub fn fig5(tabor_mu: f64, k_hat: f64, jump_in: JumpIn) -> Result<Chart> {
     let b = (spring::support_separation_hat(&b, k_hat), b.t_hat);
     let c = (h.support_alpha_hat_c, h.jump_out.t_hat);
     let d = (h.support_alpha_hat_c, 0.0);
+    let left = cycle
+        .points
+        .iter()
+        .map(|p| p.support_alpha_hat)
+        .fold(f64::INFINITY, f64::min);
     let mut approach = segment(Segment::Approach);
     approach.extend(segment(Segment::Retract));
     approach.sort_by(|p, q| p.0.total_cmp(&q.0));
@@ -274,11 +279,11 @@ pub fn fig5(tabor_mu: f64, k_hat: f64, jump_in: JumpIn) -> Result<Chart> {
             label("D", d.0 + 0.04, d.1 - 0.2),
             label(
                 &format!("W/(μεRΔγ) = {:.4}  (26)", h.w_hat),
-                a.0 - 0.3,
-                -2.5,
+                left,
+                0.9 * jkr::PULL_OFF_T_HAT,
             ),
         ],
-        legend: Corner::LowerLeft,
+        legend: Corner::LowerRight,
     })
 }
 

@@ -44,6 +44,8 @@ pub struct SiSection {
     pub separation_scale_m: f64,
     /// Energy scale μεRΔγ in J.
     pub energy_scale_j: f64,
+    /// Energy scale μεRΔγ in eV.
+    pub energy_scale_ev: f64,
     /// Adhesive length scale s₀ in m, eq. (20).
     pub s0_m: f64,
     /// Support stiffness in N/m, if given.
@@ -189,6 +191,7 @@ impl HysteresisReport {
                     force_scale_n: contact.force_scale_n(),
                     separation_scale_m: contact.separation_scale_m(),
                     energy_scale_j: scale,
+                    energy_scale_ev: scale / ELECTRONVOLT_J,
                     s0_m: contact.s0_m(),
                     stiffness_n_m: match support {
                         Support::NewtonsPerMetre(k) => Some(k),

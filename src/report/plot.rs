@@ -182,8 +182,15 @@ where
                     }
                     .map_err(|e| err(&e))?;
                     if i == 0 {
+                        let solid = series.style == Style::Line;
                         anno.label(series.name.as_str()).legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 20, y)], style)
+                            let (d, g) = if solid { (24, 0) } else { (dash, gap) };
+                            plotters::element::DashedPathElement::new(
+                                vec![(x, y), (x + 24, y)],
+                                d,
+                                g,
+                                style,
+                            )
                         });
                     }
                 }
