@@ -10,8 +10,10 @@
 
 pub mod cli;
 pub mod contact;
+pub mod dynamics;
 pub mod error;
 pub mod figures;
+pub mod law;
 pub mod numeric;
 pub mod params;
 pub mod quasistatic;

@@ -65,15 +65,28 @@ pub fn work_hat(a_hat: f64) -> f64 {
     8.0 * a5 / 15.0 + PI * a2 - 4.0 * SQRT_2PI * (a5 * a2).sqrt() / 3.0
 }
 
+/// â_B = ∛(2π), eq. (8) (as a literal so hot paths need no cube root; a test checks it).
+pub const A_HAT_B: f64 = 1.845_270_148_644_028_4;
+/// â_C = π^{1/3}/2, eq. (8).
+pub const A_HAT_C: f64 = 0.732_295_943_780_761_6;
+/// α̂_C = 3π^{2/3}/4, eq. (8).
+pub const ALPHA_HAT_C: f64 = 1.608_772_047_833_269_2;
+/// T̂_C = 5π/6, eq. (8).
+pub const T_HAT_C: f64 = 5.0 * PI / 6.0;
+
 /// Jump-in point B under displacement control (α̂_B = 0): â_B = ∛(2π), T̂_B = 4π/3, eq. (8).
 pub fn point_b() -> JkrPoint {
-    JkrPoint::at((2.0 * PI).cbrt())
+    JkrPoint::at(A_HAT_B)
 }
 
 /// Jump-out point C under displacement control (dα̂/dT̂ = 0): â_C = π^{1/3}/2,
 /// α̂_C = 3π^{2/3}/4, T̂_C = 5π/6, eq. (8).
 pub fn point_c() -> JkrPoint {
-    JkrPoint::at(PI.cbrt() / 2.0)
+    JkrPoint {
+        a_hat: A_HAT_C,
+        alpha_hat: ALPHA_HAT_C,
+        t_hat: T_HAT_C,
+    }
 }
 
 /// Load-control pull-off point (dT̂/dâ = 0): â = (9π/8)^{1/3}, T̂ = 3π/2, the maximum
@@ -153,6 +166,16 @@ pub fn a_hat_from_force(t_hat: f64, branch: ForceBranch) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn literal_constants_match_eq_8() {
+        assert!((A_HAT_B - (2.0 * PI).cbrt()).abs() < 4e-16);
+        assert!((A_HAT_C - PI.cbrt() / 2.0).abs() < 2e-16);
+        // Literals from a 30-digit evaluation; f64 formulas agree to a few ulp.
+        assert!((ALPHA_HAT_C - separation_hat(PI.cbrt() / 2.0)).abs() < 1e-15);
+        assert!((ALPHA_HAT_C - 0.75 * PI.powf(2.0 / 3.0)).abs() < 1e-15);
+        assert!((T_HAT_C - force_hat(A_HAT_C)).abs() < 1e-15);
+    }
 
     #[test]
     fn inverse_separation_round_trips() {

@@ -1,0 +1,10 @@
+//! Tapping-mode dynamics: a point-mass cantilever against a hysteretic tip–sample force
+//! law, with located branch switches, steady-state detection and the observables of one
+//! steady cycle (DESIGN.md §2).
+
+pub mod free;
+pub mod model;
+pub mod numeric;
+pub mod observables;
+pub mod setup;
+pub mod steady;

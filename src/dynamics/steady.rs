@@ -1,0 +1,341 @@
+//! Cycle-by-cycle integration to the steady state.
+//!
+//! Each drive period is integrated as a chain of segments, one per branch: closed-form
+//! free flight where the law is force-free out of contact (and the oscillator is
+//! force-driven and underdamped), Dopri5 otherwise; every branch switch is located and the
+//! next segment restarts from the located state. The carried integrals give the energies,
+//! Fourier projections, mean force and virial of each cycle.
+
+use super::free::FreeFlight;
+use super::model::{
+    Coupling, E_DAMP, E_DRIVE, E_TS, F_INT, Oscillator, SC, SS, State, V, VIRIAL, X,
+};
+use super::numeric::{self, Crossing, StepEnd, StepObserver, Tolerances, hermite};
+use crate::error::Result;
+use crate::law::{Branch, ForceLaw};
+
+/// Where the oscillator is: time, deflection, velocity and contact branch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Phase {
+    /// τ.
+    pub tau: f64,
+    /// Deflection x.
+    pub x: f64,
+    /// Velocity x'.
+    pub v: f64,
+    /// Contact branch.
+    pub branch: Branch,
+    /// First trial step for the next numerical segment (0: solver's choice).
+    pub h_next: f64,
+}
+
+/// The integrals and extremes of one drive period (dimensionless).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CycleIntegrals {
+    /// Drive period in τ.
+    pub period: f64,
+    /// Energy dissipated in the contact, ∮ −f_ts dα, summed from the branch work functions
+    /// between the located switches (exact for the computed path).
+    pub e_ts: f64,
+    /// The same integral carried as an ODE state (a check on the integration).
+    pub e_ts_ode: f64,
+    /// Energy dissipated by damping.
+    pub e_damp: f64,
+    /// Energy put in by the drive.
+    pub e_drive: f64,
+    /// Change of the oscillator's energy ½(x² + x'²) over the period.
+    pub delta_mechanical: f64,
+    /// ∮ x cos Ωτ dτ.
+    pub sc: f64,
+    /// ∮ x sin Ωτ dτ.
+    pub ss: f64,
+    /// ∮ f_ts dτ.
+    pub f_int: f64,
+    /// ∮ f_ts x dτ.
+    pub virial_int: f64,
+    /// Time spent on the contact branch.
+    pub contact_time: f64,
+    /// Smallest separation α̂ met.
+    pub min_alpha_hat: f64,
+    /// Largest (most repulsive) f_ts met.
+    pub max_force: f64,
+    /// Smallest (most attractive) f_ts met.
+    pub min_force: f64,
+    /// Number of jumps into contact.
+    pub jumps_in: u32,
+    /// Number of jumps out of contact.
+    pub jumps_out: u32,
+}
+
+impl CycleIntegrals {
+    /// Amplitude of the fundamental (units of L).
+    pub fn amplitude(&self) -> f64 {
+        2.0 / self.period * self.sc.hypot(self.ss)
+    }
+
+    /// Phase lag φ of the fundamental, z ≈ A cos(ωt − φ), in radians.
+    pub fn phase(&self) -> f64 {
+        self.ss.atan2(self.sc)
+    }
+}
+
+/// Tracks extremes of the separation and force over accepted steps, then passes each
+/// step on.
+struct Tracker<'a, O: StepObserver> {
+    osc: &'a Oscillator,
+    cpl: &'a Coupling,
+    inner: &'a mut O,
+    min_alpha: f64,
+    max_f: f64,
+    min_f: f64,
+}
+
+impl<O: StepObserver> StepObserver for Tracker<'_, O> {
+    fn step(&mut self, a: &StepEnd, b: &StepEnd, branch: Branch) {
+        let alpha = |tau: f64, x: f64| self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
+        let mut lowest = alpha(b.tau, b.y[X]);
+        // A turning point inside the step: the Hermite cubic's minimum (its derivative is
+        // a quadratic in the step fraction).
+        if a.y[V] < 0.0 && b.y[V] > 0.0 {
+            let mut lo = a.tau;
+            let mut hi = b.tau;
+            for _ in 0..40 {
+                let mid = 0.5 * (lo + hi);
+                let eps = 1e-7 * (b.tau - a.tau);
+                if hermite(a, b, X, mid + eps) < hermite(a, b, X, mid - eps) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let t = 0.5 * (lo + hi);
+            lowest = lowest.min(alpha(t, hermite(a, b, X, t)));
+        }
+        self.min_alpha = self.min_alpha.min(lowest);
+        self.max_f = self.max_f.max(b.dy[F_INT]);
+        self.min_f = self.min_f.min(b.dy[F_INT]);
+        self.inner.step(a, b, branch);
+    }
+
+    fn free_flight(&mut self, flight: &FreeFlight, from: f64, to: f64) {
+        self.max_f = self.max_f.max(0.0);
+        self.min_f = self.min_f.min(0.0);
+        self.inner.free_flight(flight, from, to);
+    }
+}
+
+/// A law, an oscillator, its coupling to the contact and the integrator settings.
+#[derive(Debug, Clone, Copy)]
+pub struct Simulation<'a, L: ForceLaw> {
+    /// Tip–sample force law.
+    pub law: &'a L,
+    /// The oscillator.
+    pub osc: Oscillator,
+    /// Coupling to the contact.
+    pub cpl: Coupling,
+    /// Integrator settings.
+    pub tol: Tolerances,
+}
+
+impl<L: ForceLaw> Simulation<'_, L> {
+    /// The branch a state at rest separation α̂ starts on: in contact if the tip is already
+    /// below the jump-in separation.
+    pub fn branch_at(&self, tau: f64, x: f64) -> Branch {
+        let alpha = self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
+        if alpha <= self.law.jump_in_alpha_hat() {
+            Branch::Contact
+        } else {
+            Branch::Free
+        }
+    }
+
+    /// The force-driven free steady state at τ = 0 (or rest for a base drive).
+    pub fn free_steady_start(&self) -> Phase {
+        let (x, v) = FreeFlight::steady(&self.osc)
+            .map(|(a, b)| (a, b * self.osc.omega))
+            .unwrap_or((0.0, 0.0));
+        Phase {
+            tau: 0.0,
+            x,
+            v,
+            branch: self.branch_at(0.0, x),
+            h_next: 0.0,
+        }
+    }
+
+    /// Integrate one drive period from `phase`, updating it.
+    pub fn cycle<O: StepObserver>(
+        &self,
+        phase: &mut Phase,
+        observer: &mut O,
+    ) -> Result<CycleIntegrals> {
+        let period = self.osc.period();
+        let tau_end = phase.tau + period;
+        let mut y = State::zeros();
+        y[X] = phase.x;
+        y[V] = phase.v;
+        let mechanical = |y: &State| 0.5 * (y[X] * y[X] + y[V] * y[V]);
+        let e0 = mechanical(&y);
+        let mut tracker = Tracker {
+            osc: &self.osc,
+            cpl: &self.cpl,
+            inner: observer,
+            min_alpha: f64::INFINITY,
+            max_f: f64::NEG_INFINITY,
+            min_f: f64::INFINITY,
+        };
+        let (mut contact_time, mut jumps_in, mut jumps_out) = (0.0, 0, 0);
+        // E_ts = (RΔγ/(kL))/(L/(με)) ∫ T̂ dα̂ in units of kL².
+        let work_scale = self.cpl.f_scale / self.cpl.a1;
+        let mut e_ts = 0.0;
+        let mut tau = phase.tau;
+        let closed_form = self.law.free_branch_is_force_free();
+        // Stop when the remaining time is round-off.
+        while tau_end - tau > 1e-12 * period {
+            let flight = (phase.branch == Branch::Free && closed_form)
+                .then(|| FreeFlight::new(&self.osc, tau, y[X], y[V]))
+                .flatten();
+            if let Some(flight) = flight {
+                let level = self.cpl.x_at(self.law.jump_in_alpha_hat());
+                let (hit, min_x) = flight.first_fall_to(level, tau, tau_end, period / 8.0);
+                let stop = hit.unwrap_or(tau_end);
+                flight.advance(&mut y, tau, stop);
+                tracker.free_flight(&flight, tau, stop);
+                tracker.min_alpha = tracker.min_alpha.min(self.cpl.alpha_hat(min_x, 0.0));
+                tau = stop;
+                if hit.is_some() {
+                    phase.branch = Branch::Contact;
+                    jumps_in += 1;
+                }
+                continue;
+            }
+            let (level, crossing) = match phase.branch {
+                Branch::Free => (self.law.jump_in_alpha_hat(), Crossing::Down),
+                Branch::Contact => (self.law.jump_out_alpha_hat(), Crossing::Up),
+            };
+            let event = level.is_finite().then_some((level, crossing));
+            let alpha_at = |tau: f64, y: &State| self.cpl.alpha_hat(y[X], self.osc.base_at(tau).0);
+            let work_start = self.law.work_hat(alpha_at(tau, &y), phase.branch);
+            let end = numeric::integrate(
+                self.law,
+                &self.osc,
+                &self.cpl,
+                phase.branch,
+                event,
+                tau,
+                y,
+                tau_end,
+                phase.h_next,
+                &self.tol,
+                &mut tracker,
+            )?;
+            e_ts += work_scale
+                * (self.law.work_hat(alpha_at(end.tau, &end.y), phase.branch) - work_start);
+            if phase.branch == Branch::Contact {
+                contact_time += end.tau - tau;
+            }
+            if end.h_last > 0.0 {
+                phase.h_next = end.h_last;
+            }
+            tau = end.tau;
+            y = end.y;
+            if end.switched {
+                phase.branch = match phase.branch {
+                    Branch::Free => {
+                        jumps_in += 1;
+                        Branch::Contact
+                    }
+                    Branch::Contact => {
+                        jumps_out += 1;
+                        Branch::Free
+                    }
+                };
+            }
+        }
+        phase.tau = tau_end;
+        phase.x = y[X];
+        phase.v = y[V];
+        Ok(CycleIntegrals {
+            period,
+            e_ts,
+            e_ts_ode: y[E_TS],
+            e_damp: y[E_DAMP],
+            e_drive: y[E_DRIVE],
+            delta_mechanical: mechanical(&y) - e0,
+            sc: y[SC],
+            ss: y[SS],
+            f_int: y[F_INT],
+            virial_int: y[VIRIAL],
+            contact_time,
+            min_alpha_hat: tracker.min_alpha,
+            max_force: tracker.max_f,
+            min_force: tracker.min_f,
+            jumps_in,
+            jumps_out,
+        })
+    }
+
+    /// Integrate cycles until the amplitude, phase and contact dissipation change by less
+    /// than `opts.tolerance` (relative; the energy relative to the drive input) over
+    /// `opts.streak` consecutive cycles, or until `opts.max_cycles`.
+    pub fn steady_state<O: StepObserver>(
+        &self,
+        phase: &mut Phase,
+        opts: &SteadyOptions,
+        observer: &mut O,
+    ) -> Result<SteadyState> {
+        let mut last: Option<CycleIntegrals> = None;
+        let mut streak = 0;
+        let mut cycles = 0;
+        while cycles < opts.max_cycles {
+            let c = self.cycle(phase, &mut numeric::Ignore)?;
+            cycles += 1;
+            if let Some(p) = last {
+                let da = (c.amplitude() - p.amplitude()).abs() / c.amplitude().max(1e-300);
+                let dphi = (c.phase() - p.phase()).abs();
+                let de = (c.e_ts - p.e_ts).abs() / c.e_drive.abs().max(1e-300);
+                if da < opts.tolerance && dphi < opts.tolerance && de < opts.tolerance {
+                    streak += 1;
+                } else {
+                    streak = 0;
+                }
+            }
+            last = Some(c);
+            if streak >= opts.streak && cycles >= opts.min_cycles {
+                break;
+            }
+        }
+        let converged = streak >= opts.streak;
+        // The reported cycle, with the observer watching.
+        let report = self.cycle(phase, observer)?;
+        Ok(SteadyState {
+            cycle: report,
+            cycles: cycles + 1,
+            converged,
+        })
+    }
+}
+
+/// Settings of the steady-state search.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SteadyOptions {
+    /// Convergence tolerance per cycle.
+    pub tolerance: f64,
+    /// Consecutive converged cycles required.
+    pub streak: usize,
+    /// At least this many cycles.
+    pub min_cycles: usize,
+    /// At most this many cycles.
+    pub max_cycles: usize,
+}
+
+/// The outcome of [`Simulation::steady_state`].
+#[derive(Debug, Clone, Copy)]
+pub struct SteadyState {
+    /// The reported (last) cycle.
+    pub cycle: CycleIntegrals,
+    /// Cycles integrated in all.
+    pub cycles: usize,
+    /// Whether the convergence criterion was met.
+    pub converged: bool,
+}

@@ -1,0 +1,165 @@
+//! Tip–sample force laws for the dynamics, behind one trait.
+//!
+//! Every law works in the contact's dimensionless variables: separation α̂ = α/(με) and
+//! force T̂ = T/(RΔγ) (tensile positive), so inner loops never touch SI units. A law has
+//! two branches — out of contact ([`Branch::Free`]) and in contact ([`Branch::Contact`]) —
+//! and switches from Free to Contact when α̂ falls to [`ForceLaw::jump_in_alpha_hat`], and
+//! back when α̂ rises to [`ForceLaw::jump_out_alpha_hat`]. Conservative laws switch both
+//! ways at the same separation; hysteretic laws enclose [`ForceLaw::loop_area_hat`].
+
+mod adhesive;
+mod conservative;
+mod table;
+
+pub use adhesive::{AdhesiveLaw, Approach};
+pub use conservative::{DmtLaw, HertzLaw, NoForce};
+pub use table::UniformTable;
+
+use crate::contact::hybrid::{self, JumpIn};
+use crate::error::{Error, Result};
+use crate::params::Contact;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// The state of the contact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Branch {
+    /// Out of contact (approach branch).
+    Free,
+    /// In contact.
+    Contact,
+}
+
+/// A two-branch tip–sample force law in dimensionless variables.
+pub trait ForceLaw: Send + Sync {
+    /// Force T̂ (tensile positive) at separation α̂ on `branch`. Finite for every finite
+    /// α̂, including past a branch's own end (integrator trial stages overshoot).
+    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64;
+    /// Work function of a branch: an antiderivative Φ with dΦ/dα̂ = T̂(α̂, branch), so the
+    /// work done along a branch between two separations is a difference of Φ (each branch
+    /// is conservative; the loss comes from switching).
+    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64;
+    /// Separation at which the Free branch gives way to Contact on the way down.
+    fn jump_in_alpha_hat(&self) -> f64;
+    /// Separation at which the Contact branch gives way to Free on the way up.
+    fn jump_out_alpha_hat(&self) -> f64;
+    /// Whether T̂ is identically zero on the Free branch above the jump-in separation
+    /// (motion there is then a linear oscillator with a closed-form solution).
+    fn free_branch_is_force_free(&self) -> bool;
+    /// Area of the force loop, ∮ T̂ dα̂ over one full traversal (Ŵ; 0 if conservative).
+    fn loop_area_hat(&self) -> f64;
+}
+
+/// The laws on offer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum LawKind {
+    /// The paper's hybrid law: force-free approach, jump-in at α̂_A from (17), JKR contact
+    /// branch (5), jump-out at α̂_C (8). Loop area Ŵ_hybrid (18).
+    #[default]
+    Hybrid,
+    /// The hybrid law with Greenwood's semi-rigid attraction (12), (14) on the approach
+    /// branch, jumping in at that curve's own fold (15).
+    HybridAttractive,
+    /// Classic JKR: no force before contact, jump-in at α̂ = 0, jump-out at α̂_C.
+    Jkr,
+    /// DMT as VEDA and dForce define it: −HR/(6d²) outside, Hertz plus constant adhesion
+    /// inside, d = α + a₀, a₀ = ε. Conservative.
+    Dmt,
+    /// Hertz: repulsion (4/3)E*√R δ^{3/2} for indentation δ = −α > 0. Conservative.
+    Hertz,
+    /// No tip–sample force (free cantilever).
+    None,
+}
+
+impl fmt::Display for LawKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            LawKind::Hybrid => "hybrid",
+            LawKind::HybridAttractive => "hybrid-attractive",
+            LawKind::Jkr => "jkr",
+            LawKind::Dmt => "dmt",
+            LawKind::Hertz => "hertz",
+            LawKind::None => "none",
+        })
+    }
+}
+
+/// One of the laws, chosen at run time.
+#[derive(Debug, Clone)]
+pub enum AnyLaw {
+    /// hybrid, hybrid-attractive or jkr.
+    Adhesive(AdhesiveLaw),
+    /// dmt.
+    Dmt(DmtLaw),
+    /// hertz.
+    Hertz(HertzLaw),
+    /// none.
+    None(NoForce),
+}
+
+impl AnyLaw {
+    /// Build law `kind` for `contact`; `hamaker_j` overrides the DMT Hamaker constant
+    /// H = 12πε²Δγ. Refuses, naming a law that applies, where `kind` does not apply.
+    pub fn new(kind: LawKind, contact: &Contact, hamaker_j: Option<f64>) -> Result<Self> {
+        let mu = contact.tabor_mu();
+        let refuse = |why: String| {
+            Error::NotApplicable(format!(
+                "the {kind} law does not apply at Tabor parameter mu = {mu:.4}: {why}; \
+                 use --law dmt (small mu) or --law jkr"
+            ))
+        };
+        Ok(match kind {
+            LawKind::Hybrid => AnyLaw::Adhesive(
+                AdhesiveLaw::hybrid(mu, JumpIn::Fit).map_err(|e| refuse(e.to_string()))?,
+            ),
+            LawKind::HybridAttractive => AnyLaw::Adhesive(
+                AdhesiveLaw::hybrid_attractive(mu).map_err(|e| refuse(e.to_string()))?,
+            ),
+            LawKind::Jkr => AnyLaw::Adhesive(AdhesiveLaw::jkr()),
+            LawKind::Dmt => AnyLaw::Dmt(DmtLaw::new(contact, hamaker_j)?),
+            LawKind::Hertz => AnyLaw::Hertz(HertzLaw),
+            LawKind::None => AnyLaw::None(NoForce),
+        })
+    }
+
+    /// The smallest μ at which the hybrid law applies (for messages).
+    pub fn hybrid_min_mu() -> f64 {
+        hybrid::min_hysteretic_mu(JumpIn::Fit).unwrap_or(f64::NAN)
+    }
+}
+
+/// Forward a method to the law inside [`AnyLaw`].
+macro_rules! dispatch {
+    ($self:ident, $l:ident => $e:expr) => {
+        match $self {
+            AnyLaw::Adhesive($l) => $e,
+            AnyLaw::Dmt($l) => $e,
+            AnyLaw::Hertz($l) => $e,
+            AnyLaw::None($l) => $e,
+        }
+    };
+}
+
+impl ForceLaw for AnyLaw {
+    #[inline]
+    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        dispatch!(self, l => l.t_hat(alpha_hat, branch))
+    }
+    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        dispatch!(self, l => l.work_hat(alpha_hat, branch))
+    }
+    fn jump_in_alpha_hat(&self) -> f64 {
+        dispatch!(self, l => l.jump_in_alpha_hat())
+    }
+    fn jump_out_alpha_hat(&self) -> f64 {
+        dispatch!(self, l => l.jump_out_alpha_hat())
+    }
+    fn free_branch_is_force_free(&self) -> bool {
+        dispatch!(self, l => l.free_branch_is_force_free())
+    }
+    fn loop_area_hat(&self) -> f64 {
+        dispatch!(self, l => l.loop_area_hat())
+    }
+}
