@@ -24,7 +24,7 @@ fn main() -> tapsim::Result<()> {
             ..default_setup()
         };
         let start = std::time::Instant::now();
-        let o = tap(&setup, &Numerics::default(), false)?.observables;
+        let o = tap(&setup, &Numerics::default(), 0)?.observables;
         println!(
             "{:>18} {:>8.5} {:>9.4} {:>9.4} {:>10.4} {:>10.4} {:>8.1e} {:>7} {:?}",
             o.law,

@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod cli;
+pub mod config;
 pub mod contact;
 pub mod dynamics;
 pub mod error;

@@ -1,6 +1,6 @@
 //! `tapsim figure`: regenerate the paper's figures as CSV, PNG and SVG.
 
-use super::args::number;
+use crate::config::number;
 use crate::contact::hybrid::JumpIn;
 use crate::error::{Error, Result};
 use crate::figures::{self, FigureOptions};

@@ -1,6 +1,6 @@
 //! `tapsim hysteresis`: the paper's closed-form results for one contact.
 
-use super::args::{ContactArgs, number, stiffness};
+use crate::config::{ContactInputs, number, stiffness};
 use crate::contact::hybrid::JumpIn;
 use crate::error::Result;
 use crate::report::hysteresis::{HysteresisReport, Input, Support};
@@ -28,7 +28,7 @@ pub struct HysteresisArgs {
           ["radius", "modulus", "tip_modulus", "sample_modulus", "work_of_adhesion", "range"])]
     mu: Option<f64>,
     #[command(flatten)]
-    contact: ContactArgs,
+    contact: ContactInputs,
     /// Dimensionless support stiffness k̂ = μεk/(RΔγ), eq. (22) [> 0].
     #[arg(long, allow_hyphen_values = true, value_parser = number, conflicts_with = "stiffness")]
     k_hat: Option<f64>,

@@ -1,9 +1,9 @@
 //! The `tapsim` command line: parse, call the library, print. Each subcommand lives in
 //! its own module.
 
-mod args;
 mod figure;
 mod hysteresis;
+mod tap;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -24,6 +24,7 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    Tap(tap::TapArgs),
     Hysteresis(hysteresis::HysteresisArgs),
     Figure(figure::FigureArgs),
 }
@@ -32,6 +33,7 @@ enum Command {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
+        Command::Tap(args) => tap::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),
         Command::Figure(args) => figure::run(args),
     };

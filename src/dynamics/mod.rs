@@ -2,6 +2,7 @@
 //! law, with located branch switches, steady-state detection and the observables of one
 //! steady cycle (DESIGN.md §2).
 
+pub mod base_drive;
 pub mod free;
 pub mod model;
 pub mod numeric;

@@ -1,8 +1,8 @@
 //! Observables of one steady-state cycle in SI units, and the whole tapping run.
 
 use super::free::FreeFlight;
-use super::model::F_INT;
-use super::numeric::{StepEnd, StepObserver};
+use super::model::{Coupling, Oscillator, V, X};
+use super::numeric::{StepEnd, StepObserver, hermite};
 use super::setup::{Numerics, Prepared, TapSetup};
 use super::steady::{CycleIntegrals, SteadyState};
 use crate::error::Result;
@@ -136,42 +136,59 @@ pub struct TrajectorySample {
     pub branch: Branch,
 }
 
-/// Records the trajectory of the reported cycle (dimensionless samples, converted later).
-#[derive(Debug, Default)]
-pub struct Recorder {
+/// Records the trajectory (dimensionless samples, converted by [`Recorder::to_si`]):
+/// step ends plus points on each step's Hermite interpolant, and closed-form free flight
+/// sampled evenly.
+pub struct Recorder<'a, L: ForceLaw> {
     /// (τ, x, x', α̂, f_ts, branch).
     pub samples: Vec<(f64, f64, f64, f64, f64, Branch)>,
-    /// Samples per period in free flight.
-    pub free_samples_per_period: usize,
-    /// Coupling offsets (a₀, a₁) for α̂.
-    pub a: (f64, f64),
-    /// Period in τ.
-    pub period: f64,
+    law: &'a L,
+    cpl: Coupling,
+    osc: Oscillator,
 }
 
-impl StepObserver for Recorder {
+/// Interpolated points per integrator step, and samples per period in free flight.
+const POINTS_PER_STEP: usize = 6;
+const FREE_SAMPLES_PER_PERIOD: f64 = 400.0;
+
+impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
     fn step(&mut self, from: &StepEnd, to: &StepEnd, branch: Branch) {
-        if self.samples.is_empty() {
-            self.push(from.tau, from.y[0], from.y[1], from.dy[F_INT], branch);
+        let start = if self.samples.is_empty() { 0 } else { 1 };
+        for i in start..=POINTS_PER_STEP {
+            let tau = from.tau + (to.tau - from.tau) * i as f64 / POINTS_PER_STEP as f64;
+            let x = hermite(from, to, X, tau);
+            let v = hermite(from, to, V, tau);
+            self.push(tau, x, v, branch);
         }
-        self.push(to.tau, to.y[0], to.y[1], to.dy[F_INT], branch);
     }
 
     fn free_flight(&mut self, flight: &FreeFlight, from: f64, to: f64) {
-        let n = ((to - from) / self.period * self.free_samples_per_period as f64)
+        let n = ((to - from) / self.osc.period() * FREE_SAMPLES_PER_PERIOD)
             .ceil()
             .max(1.0) as usize;
         for i in 0..=n {
             let tau = from + (to - from) * i as f64 / n as f64;
             let (x, v) = flight.at(tau);
-            self.push(tau, x, v, 0.0, Branch::Free);
+            self.push(tau, x, v, Branch::Free);
         }
     }
 }
 
-impl Recorder {
-    fn push(&mut self, tau: f64, x: f64, v: f64, f: f64, branch: Branch) {
-        let alpha = self.a.0 + self.a.1 * x;
+impl<'a, L: ForceLaw> Recorder<'a, L> {
+    /// An empty recorder for the law and model of a simulation.
+    pub fn new(law: &'a L, cpl: Coupling, osc: Oscillator) -> Self {
+        Self {
+            samples: Vec::new(),
+            law,
+            cpl,
+            osc,
+        }
+    }
+
+    fn push(&mut self, tau: f64, x: f64, v: f64, branch: Branch) {
+        let alpha = self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
+        // (+ 0.0 turns the −0 of a force-free branch into 0.)
+        let f = -self.cpl.f_scale * self.law.t_hat(alpha, branch) + 0.0;
         self.samples.push((tau, x, v, alpha, f, branch));
     }
 
@@ -197,7 +214,7 @@ impl Recorder {
 }
 
 /// A complete tapping run: observables and, if asked for, the trajectory of the last
-/// `record_cycles` cycles.
+/// recorded cycles.
 #[derive(Debug, Clone, Serialize)]
 pub struct TapRun {
     /// Observables of the reported cycle.
@@ -205,27 +222,30 @@ pub struct TapRun {
     /// Trajectory samples (empty unless recorded).
     #[serde(skip)]
     pub trajectory: Vec<TrajectorySample>,
+    /// The law's jump-in and jump-out separations in m (for marking plots).
+    #[serde(skip)]
+    pub switch_separations_m: (f64, f64),
 }
 
-/// Simulate `setup` to its steady state; record the trajectory of the reported cycle and
-/// `extra_cycles` more when `record` is set.
-pub fn tap(setup: &TapSetup, numerics: &Numerics, record: bool) -> Result<TapRun> {
+/// Simulate `setup` to its steady state, then integrate `record_cycles` more cycles
+/// recording the trajectory; the observables are those of the last cycle integrated.
+pub fn tap(setup: &TapSetup, numerics: &Numerics, record_cycles: usize) -> Result<TapRun> {
     let p = Prepared::new(setup, numerics)?;
     let sim = p.simulation();
     let mut phase = sim.free_steady_start();
-    let mut recorder = Recorder {
-        samples: Vec::new(),
-        free_samples_per_period: if record { 400 } else { 0 },
-        a: (p.cpl.a0, p.cpl.a1),
-        period: p.osc.period(),
-    };
-    let state = if record {
-        sim.steady_state(&mut phase, &p.steady, &mut recorder)?
-    } else {
-        sim.steady_state(&mut phase, &p.steady, &mut super::numeric::Ignore)?
-    };
+    let mut state = sim.steady_state(&mut phase, &p.steady)?;
+    let mut recorder = Recorder::new(&p.law, p.cpl, p.osc);
+    for _ in 0..record_cycles {
+        state.cycle = sim.cycle(&mut phase, &mut recorder)?;
+        state.cycles += 1;
+    }
+    let scale = setup.contact.separation_scale_m();
     Ok(TapRun {
         observables: TapObservables::new(&p, &state),
         trajectory: recorder.to_si(&p),
+        switch_separations_m: (
+            p.law.jump_in_alpha_hat() * scale,
+            p.law.jump_out_alpha_hat() * scale,
+        ),
     })
 }

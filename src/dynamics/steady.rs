@@ -277,17 +277,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
 
     /// Integrate cycles until the amplitude, phase and contact dissipation change by less
     /// than `opts.tolerance` (relative; the energy relative to the drive input) over
-    /// `opts.streak` consecutive cycles, or until `opts.max_cycles`.
-    pub fn steady_state<O: StepObserver>(
-        &self,
-        phase: &mut Phase,
-        opts: &SteadyOptions,
-        observer: &mut O,
-    ) -> Result<SteadyState> {
+    /// `opts.streak` consecutive cycles, or until `opts.max_cycles`. Reports the last cycle.
+    pub fn steady_state(&self, phase: &mut Phase, opts: &SteadyOptions) -> Result<SteadyState> {
         let mut last: Option<CycleIntegrals> = None;
         let mut streak = 0;
         let mut cycles = 0;
-        while cycles < opts.max_cycles {
+        while cycles < opts.max_cycles.max(1) {
             let c = self.cycle(phase, &mut numeric::Ignore)?;
             cycles += 1;
             if let Some(p) = last {
@@ -305,13 +300,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 break;
             }
         }
-        let converged = streak >= opts.streak;
-        // The reported cycle, with the observer watching.
-        let report = self.cycle(phase, observer)?;
         Ok(SteadyState {
-            cycle: report,
-            cycles: cycles + 1,
-            converged,
+            cycle: last.expect("at least one cycle"),
+            cycles,
+            converged: streak >= opts.streak,
         })
     }
 }

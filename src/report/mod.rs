@@ -5,3 +5,4 @@ pub mod chart;
 pub mod hysteresis;
 pub mod output;
 pub mod plot;
+pub mod tap;

@@ -39,24 +39,69 @@ fn register_font() {
 
 /// Render `chart` to a PNG file at `path` (written atomically).
 pub fn render_png(chart: &Chart, path: &Path) -> Result<()> {
-    register_font();
-    output::write_with(path, |tmp| {
-        let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
-        draw(chart, &root).map_err(|reason| fail(path, reason))?;
-        root.present().map_err(|e| fail(path, e.to_string()))
-    })
+    render_stack_png(std::slice::from_ref(chart), path)
 }
 
 /// Render `chart` to an SVG file at `path` (written atomically).
 pub fn render_svg(chart: &Chart, path: &Path) -> Result<()> {
+    render_stack_svg(std::slice::from_ref(chart), path)
+}
+
+/// Draw `charts` one above the other on `root`.
+fn draw_stack<DB: DrawingBackend>(
+    charts: &[Chart],
+    root: &DrawingArea<DB, Shift>,
+) -> std::result::Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    for (chart, area) in charts
+        .iter()
+        .zip(root.split_evenly((charts.len().max(1), 1)))
+    {
+        draw(chart, &area)?;
+    }
+    Ok(())
+}
+
+fn stack_size(n: usize) -> (u32, u32) {
+    if n <= 1 {
+        SIZE
+    } else {
+        (SIZE.0, (SIZE.1 * 2 / 3) * n as u32)
+    }
+}
+
+fn render_stack_png(charts: &[Chart], path: &Path) -> Result<()> {
+    register_font();
+    output::write_with(path, |tmp| {
+        let root = BitMapBackend::new(tmp, stack_size(charts.len())).into_drawing_area();
+        draw_stack(charts, &root).map_err(|reason| fail(path, reason))?;
+        root.present().map_err(|e| fail(path, e.to_string()))
+    })
+}
+
+fn render_stack_svg(charts: &[Chart], path: &Path) -> Result<()> {
     register_font();
     let mut text = String::new();
     {
-        let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
-        draw(chart, &root).map_err(|reason| fail(path, reason))?;
+        let root = SVGBackend::with_string(&mut text, stack_size(charts.len())).into_drawing_area();
+        draw_stack(charts, &root).map_err(|reason| fail(path, reason))?;
         root.present().map_err(|e| fail(path, e.to_string()))?;
     }
     output::write_bytes(path, text.as_bytes())
+}
+
+/// Render `charts` one above the other into `path`, PNG or SVG by its extension.
+pub fn render_stack(charts: &[Chart], path: &Path) -> Result<()> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("png") => render_stack_png(charts, path),
+        Some("svg") => render_stack_svg(charts, path),
+        _ => Err(fail(path, "the plot file must end in .png or .svg".into())),
+    }
 }
 
 fn fail(path: &Path, reason: String) -> Error {
@@ -99,7 +144,6 @@ fn draw<DB: DrawingBackend>(
     chart: &Chart,
     root: &DrawingArea<DB, Shift>,
 ) -> std::result::Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
     let xr = chart
         .x
         .range
@@ -164,10 +208,13 @@ where
         match series.style {
             Style::Markers => {
                 let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
-                ctx.draw_series(inside.map(|p| Circle::new(p, 5, style)))
-                    .map_err(|e| err(&e))?
-                    .label(series.name.as_str())
-                    .legend(move |(x, y)| Circle::new((x + 10, y), 5, style));
+                let anno = ctx
+                    .draw_series(inside.map(|p| Circle::new(p, 5, style)))
+                    .map_err(|e| err(&e))?;
+                if !series.name.is_empty() {
+                    anno.label(series.name.as_str())
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 5, style));
+                }
             }
             Style::Line | Style::Dashed | Style::Dotted => {
                 let (dash, gap) = match series.style {
@@ -181,7 +228,7 @@ where
                         ctx.draw_series(DashedLineSeries::new(run, dash, gap, style))
                     }
                     .map_err(|e| err(&e))?;
-                    if i == 0 {
+                    if i == 0 && !series.name.is_empty() {
                         let solid = series.style == Style::Line;
                         anno.label(series.name.as_str()).legend(move |(x, y)| {
                             let (d, g) = if solid { (24, 0) } else { (dash, gap) };

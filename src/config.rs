@@ -1,0 +1,420 @@
+//! User inputs — command-line flags and TOML parameter files — and their resolution into
+//! validated setups. Quantities accept unit suffixes (see [`crate::units`]); a TOML file
+//! uses the flags' names as keys, with numbers in SI base units or strings with units:
+//!
+//! ```toml
+//! law = "hybrid"
+//! radius = "20nm"
+//! sample-modulus = "0.5GPa"
+//! work-of-adhesion = 0.1
+//! stiffness = "40N/m"
+//! ```
+//!
+//! Flags override the file; the file overrides the built-in defaults.
+
+use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
+use crate::error::{Error, Result};
+use crate::law::LawKind;
+use crate::params::{self, Contact};
+use crate::units::{self, Dimension};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+macro_rules! unit_parser {
+    ($(#[$doc:meta])* $name:ident, $what:literal, $dim:expr) => {
+        $(#[$doc])*
+        pub fn $name(s: &str) -> std::result::Result<f64, String> {
+            units::parse($what, s, $dim).map_err(|e| e.to_string())
+        }
+    };
+}
+
+unit_parser!(/// A length (m).
+    length, "length", Dimension::Length);
+unit_parser!(/// A pressure or modulus (Pa).
+    pressure, "modulus", Dimension::Pressure);
+unit_parser!(/// A work of adhesion (J/m²).
+    surface_energy, "work of adhesion", Dimension::SurfaceEnergy);
+unit_parser!(/// A stiffness (N/m).
+    stiffness, "stiffness", Dimension::Stiffness);
+unit_parser!(/// A frequency (Hz).
+    frequency, "frequency", Dimension::Frequency);
+unit_parser!(/// An energy (J or eV).
+    energy, "energy", Dimension::Energy);
+unit_parser!(/// A plain number.
+    number, "value", Dimension::Dimensionless);
+
+/// Default Poisson ratio of a silicon tip.
+pub const DEFAULT_TIP_POISSON: f64 = 0.28;
+/// Default Poisson ratio of a polymer sample.
+pub const DEFAULT_SAMPLE_POISSON: f64 = 0.4;
+/// Default Young's modulus of a silicon tip, Pa.
+pub const DEFAULT_TIP_MODULUS: f64 = 169e9;
+
+/// A sphere-on-flat contact in SI units, every field optional.
+#[derive(Debug, Clone, Default, Args)]
+pub struct ContactInputs {
+    /// Tip radius R [m; e.g. 20nm].
+    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Contact (SI)")]
+    pub radius: Option<f64>,
+    /// Composite modulus E* [Pa; e.g. 1GPa]. Or give --tip-modulus/--sample-modulus.
+    #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)",
+          conflicts_with_all = ["tip_modulus", "sample_modulus"])]
+    pub modulus: Option<f64>,
+    /// Young's modulus of the tip [Pa; default 169GPa, silicon].
+    #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)")]
+    pub tip_modulus: Option<f64>,
+    /// Poisson ratio of the tip [default 0.28].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)")]
+    pub tip_poisson: Option<f64>,
+    /// Young's modulus of the sample [Pa; e.g. 2GPa].
+    #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)")]
+    pub sample_modulus: Option<f64>,
+    /// Poisson ratio of the sample [default 0.4].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)")]
+    pub sample_poisson: Option<f64>,
+    /// Work of adhesion Δγ [J/m²; e.g. 50mJ/m^2].
+    #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, help_heading = "Contact (SI)")]
+    pub work_of_adhesion: Option<f64>,
+    /// Range ε of the Lennard-Jones law (10), the equilibrium gap [m; e.g. 0.3nm].
+    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Contact (SI)")]
+    pub range: Option<f64>,
+}
+
+impl ContactInputs {
+    /// Whether any SI contact input was given.
+    pub fn any(&self) -> bool {
+        self.radius.is_some()
+            || self.modulus.is_some()
+            || self.tip_modulus.is_some()
+            || self.sample_modulus.is_some()
+            || self.work_of_adhesion.is_some()
+            || self.range.is_some()
+    }
+
+    /// Composite modulus E* from --modulus, or from tip and sample (a missing tip modulus
+    /// is silicon's, missing Poisson ratios 0.28 and 0.4); `None` if neither is given.
+    pub fn composite_modulus(&self) -> Result<Option<f64>> {
+        if let Some(e) = self.modulus {
+            return Ok(Some(e));
+        }
+        let Some(sample) = self.sample_modulus else {
+            if self.tip_modulus.is_some() {
+                return Err(Error::NotApplicable(
+                    "--tip-modulus needs --sample-modulus as well".into(),
+                ));
+            }
+            return Ok(None);
+        };
+        params::composite_modulus(
+            self.tip_modulus.unwrap_or(DEFAULT_TIP_MODULUS),
+            self.tip_poisson.unwrap_or(DEFAULT_TIP_POISSON),
+            sample,
+            self.sample_poisson.unwrap_or(DEFAULT_SAMPLE_POISSON),
+        )
+        .map(Some)
+    }
+
+    /// The contact, every input required; an error naming what is missing.
+    pub fn contact(&self) -> Result<Contact> {
+        let missing = |what: &str| {
+            Error::NotApplicable(format!(
+                "the SI contact needs {what} (give --radius, --modulus or \
+                 --sample-modulus, --work-of-adhesion and --range)"
+            ))
+        };
+        Contact::new(
+            self.radius.ok_or_else(|| missing("--radius"))?,
+            self.composite_modulus()?
+                .ok_or_else(|| missing("--modulus"))?,
+            self.work_of_adhesion
+                .ok_or_else(|| missing("--work-of-adhesion"))?,
+            self.range.ok_or_else(|| missing("--range"))?,
+        )
+    }
+
+    /// Field-wise: `self` where given, else `base`.
+    pub fn or(self, base: Self) -> Self {
+        Self {
+            radius: self.radius.or(base.radius),
+            modulus: self.modulus.or(
+                if self.tip_modulus.is_some() || self.sample_modulus.is_some() {
+                    None
+                } else {
+                    base.modulus
+                },
+            ),
+            tip_modulus: self.tip_modulus.or(base.tip_modulus),
+            tip_poisson: self.tip_poisson.or(base.tip_poisson),
+            sample_modulus: self.sample_modulus.or(if self.modulus.is_some() {
+                None
+            } else {
+                base.sample_modulus
+            }),
+            sample_poisson: self.sample_poisson.or(base.sample_poisson),
+            work_of_adhesion: self.work_of_adhesion.or(base.work_of_adhesion),
+            range: self.range.or(base.range),
+        }
+    }
+}
+
+/// Everything a tapping simulation takes, every field optional (defaults fill in).
+#[derive(Debug, Clone, Default, Args)]
+pub struct TapInputs {
+    /// Tip–sample force law.
+    #[arg(long, value_enum)]
+    pub law: Option<LawKind>,
+    /// The contact.
+    #[command(flatten)]
+    pub contact: ContactInputs,
+    /// Hamaker constant for the dmt law [J or eV; default 12πε²Δγ].
+    #[arg(long, allow_hyphen_values = true, value_parser = energy, help_heading = "Contact (SI)")]
+    pub hamaker: Option<f64>,
+    /// Cantilever spring constant k [N/m; default 40].
+    #[arg(long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Cantilever")]
+    pub stiffness: Option<f64>,
+    /// Resonance frequency f₀ [Hz; default 300kHz].
+    #[arg(long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Cantilever")]
+    pub resonance: Option<f64>,
+    /// Quality factor Q [default 400].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Cantilever")]
+    pub quality: Option<f64>,
+    /// Free amplitude A₀ [m; default 20nm].
+    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
+    pub free_amplitude: Option<f64>,
+    /// Drive frequency [Hz; default: the resonance frequency].
+    #[arg(long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Cantilever")]
+    pub drive_frequency: Option<f64>,
+    /// Rest tip–sample separation z_c, α = z_c + z [m; default 16nm].
+    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
+    pub separation: Option<f64>,
+    /// Relative tolerance of the integrator [default 1e-8].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
+    pub rtol: Option<f64>,
+    /// Most cycles to integrate looking for the steady state [default 20000].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
+    pub max_cycles: Option<f64>,
+}
+
+/// The TOML keys and the quantity each holds.
+const KEYS: &[(&str, Dimension)] = &[
+    ("radius", Dimension::Length),
+    ("modulus", Dimension::Pressure),
+    ("tip-modulus", Dimension::Pressure),
+    ("tip-poisson", Dimension::Dimensionless),
+    ("sample-modulus", Dimension::Pressure),
+    ("sample-poisson", Dimension::Dimensionless),
+    ("work-of-adhesion", Dimension::SurfaceEnergy),
+    ("range", Dimension::Length),
+    ("hamaker", Dimension::Energy),
+    ("stiffness", Dimension::Stiffness),
+    ("resonance", Dimension::Frequency),
+    ("quality", Dimension::Dimensionless),
+    ("free-amplitude", Dimension::Length),
+    ("drive-frequency", Dimension::Frequency),
+    ("separation", Dimension::Length),
+    ("rtol", Dimension::Dimensionless),
+    ("max-cycles", Dimension::Dimensionless),
+];
+
+impl TapInputs {
+    fn slot(&mut self, key: &str) -> &mut Option<f64> {
+        let c = &mut self.contact;
+        match key {
+            "radius" => &mut c.radius,
+            "modulus" => &mut c.modulus,
+            "tip-modulus" => &mut c.tip_modulus,
+            "tip-poisson" => &mut c.tip_poisson,
+            "sample-modulus" => &mut c.sample_modulus,
+            "sample-poisson" => &mut c.sample_poisson,
+            "work-of-adhesion" => &mut c.work_of_adhesion,
+            "range" => &mut c.range,
+            "hamaker" => &mut self.hamaker,
+            "stiffness" => &mut self.stiffness,
+            "resonance" => &mut self.resonance,
+            "quality" => &mut self.quality,
+            "free-amplitude" => &mut self.free_amplitude,
+            "drive-frequency" => &mut self.drive_frequency,
+            "separation" => &mut self.separation,
+            "rtol" => &mut self.rtol,
+            _ => &mut self.max_cycles,
+        }
+    }
+
+    /// Read a TOML parameter file (keys as the flags' names).
+    pub fn from_toml_file(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml(&text).map_err(|e| match e {
+            Error::Parse { name, text, reason } => Error::Parse {
+                name,
+                text,
+                reason: format!("{reason} (in {})", path.display()),
+            },
+            other => other,
+        })
+    }
+
+    /// Parse TOML text (keys as the flags' names).
+    pub fn from_toml(text: &str) -> Result<Self> {
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| Error::Parse {
+            name: "config",
+            text: String::new(),
+            reason: format!("not valid TOML: {}", e.message()),
+        })?;
+        let mut inputs = Self::default();
+        for (key, value) in &table {
+            if key == "law" {
+                let name = value.as_str().unwrap_or_default();
+                inputs.law = Some(<LawKind as clap::ValueEnum>::from_str(name, true).map_err(
+                    |_| {
+                        Error::Parse {
+                            name: "law",
+                            text: value.to_string(),
+                            reason:
+                                "expected one of hybrid, hybrid-attractive, jkr, dmt, hertz, none"
+                                    .into(),
+                        }
+                    },
+                )?);
+                continue;
+            }
+            let Some(&(name, dim)) = KEYS.iter().find(|(k, _)| k == key) else {
+                let known: Vec<&str> = KEYS.iter().map(|(k, _)| *k).collect();
+                return Err(Error::Parse {
+                    name: "config key",
+                    text: key.clone(),
+                    reason: format!("unknown key; known keys: law, {}", known.join(", ")),
+                });
+            };
+            let number = match value {
+                toml::Value::Float(f) => units::parse(name, &f.to_string(), dim)?,
+                toml::Value::Integer(i) => units::parse(name, &i.to_string(), dim)?,
+                toml::Value::String(s) => units::parse(name, s, dim)?,
+                other => {
+                    return Err(Error::Parse {
+                        name: "config value",
+                        text: other.to_string(),
+                        reason: format!("{key} must be a number or a string with a unit"),
+                    });
+                }
+            };
+            *inputs.slot(name) = Some(number);
+        }
+        Ok(inputs)
+    }
+
+    /// Field-wise: `self` where given, else `base`.
+    pub fn or(self, base: Self) -> Self {
+        Self {
+            law: self.law.or(base.law),
+            contact: self.contact.or(base.contact),
+            hamaker: self.hamaker.or(base.hamaker),
+            stiffness: self.stiffness.or(base.stiffness),
+            resonance: self.resonance.or(base.resonance),
+            quality: self.quality.or(base.quality),
+            free_amplitude: self.free_amplitude.or(base.free_amplitude),
+            drive_frequency: self.drive_frequency.or(base.drive_frequency),
+            separation: self.separation.or(base.separation),
+            rtol: self.rtol.or(base.rtol),
+            max_cycles: self.max_cycles.or(base.max_cycles),
+        }
+    }
+
+    /// Flags over an optional config file.
+    pub fn with_config(self, config: Option<&PathBuf>) -> Result<Self> {
+        Ok(match config {
+            Some(path) => self.or(Self::from_toml_file(path)?),
+            None => self,
+        })
+    }
+
+    /// The setup and numerics: these inputs over the built-in defaults
+    /// ([`default_setup`], [`Numerics::default`]).
+    pub fn resolve(&self) -> Result<(TapSetup, Numerics)> {
+        let d = default_setup();
+        let c = &self.contact;
+        let contact = Contact {
+            radius_m: c.radius.unwrap_or(d.contact.radius_m),
+            modulus_pa: c.composite_modulus()?.unwrap_or(d.contact.modulus_pa),
+            work_of_adhesion_j_m2: c
+                .work_of_adhesion
+                .unwrap_or(d.contact.work_of_adhesion_j_m2),
+            range_m: c.range.unwrap_or(d.contact.range_m),
+        };
+        let resonance = self.resonance.unwrap_or(d.cantilever.resonance_hz);
+        let mut cantilever = d.cantilever;
+        cantilever.stiffness_n_m = self.stiffness.unwrap_or(cantilever.stiffness_n_m);
+        cantilever.resonance_hz = resonance;
+        cantilever.quality = self.quality.unwrap_or(cantilever.quality);
+        cantilever.free_amplitude_m = self.free_amplitude.unwrap_or(cantilever.free_amplitude_m);
+        cantilever.drive_frequency_hz = self.drive_frequency.unwrap_or(resonance);
+        let setup = TapSetup {
+            contact,
+            cantilever,
+            separation_m: self.separation.unwrap_or(d.separation_m),
+            law: self.law.unwrap_or(d.law),
+            hamaker_j: self.hamaker.or(d.hamaker_j),
+        };
+        let mut numerics = Numerics::default();
+        if let Some(rtol) = self.rtol {
+            numerics.rtol = rtol;
+            numerics.atol = rtol * 1e-2;
+        }
+        if let Some(n) = self.max_cycles {
+            if !(n >= 1.0 && n.fract() == 0.0 && n <= 1e9) {
+                return Err(Error::InvalidParameter {
+                    name: "max cycles",
+                    value: n,
+                    reason: "must be a whole number from 1 to 1e9",
+                });
+            }
+            numerics.max_cycles = n as usize;
+        }
+        Ok((setup, numerics))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn toml_with_units_and_flags_over_it() {
+        let file = TapInputs::from_toml(
+            "law = \"dmt\"\nradius = \"10nm\"\nstiffness = 2\nsample-modulus = \"2GPa\"\n",
+        )
+        .unwrap();
+        let flags = TapInputs {
+            stiffness: Some(5.0),
+            ..Default::default()
+        };
+        let (setup, _) = flags.or(file).resolve().unwrap();
+        assert_eq!(setup.law, LawKind::Dmt);
+        assert!((setup.contact.radius_m - 10e-9).abs() < 1e-20);
+        assert_eq!(setup.cantilever.stiffness_n_m, 5.0);
+        let e = params::composite_modulus(169e9, 0.28, 2e9, 0.4).unwrap();
+        assert!((setup.contact.modulus_pa - e).abs() < 1e-3);
+    }
+
+    #[test]
+    fn toml_errors_name_the_problem() {
+        let e = TapInputs::from_toml("radis = 1").unwrap_err().to_string();
+        assert!(e.contains("unknown key") && e.contains("radius"), "{e}");
+        let e = TapInputs::from_toml("radius = \"10 furlongs\"")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown unit"), "{e}");
+        let e = TapInputs::from_toml("radius = [1]")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("number or a string"), "{e}");
+        assert!(TapInputs::from_toml("radius = ").is_err());
+        let e = TapInputs::from_toml("law = \"magic\"")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("hybrid"), "{e}");
+    }
+}

@@ -1,0 +1,246 @@
+//! Reports of a tapping run: a table for people, the trajectory as CSV, and the
+//! trajectory charts (deflection and force vs time, force vs separation).
+
+use super::chart::{Axis, Chart, Corner, Series, Style};
+use crate::dynamics::observables::{TapObservables, TapRun, TrajectorySample};
+use crate::dynamics::setup::TapSetup;
+use crate::error::{Error, Result};
+use crate::law::Branch;
+use std::fmt::Write as _;
+
+/// A table of the setup and the observables.
+pub fn to_text(setup: &TapSetup, o: &TapObservables) -> String {
+    let c = &setup.contact;
+    let k = &setup.cantilever;
+    let mut s = String::new();
+    let mut line = |label: &str, value: String| {
+        let _ = writeln!(s, "  {label:<34} {value}");
+    };
+    line("law", o.law.clone());
+    line("tip radius R", format!("{:.4} nm", c.radius_m * 1e9));
+    line(
+        "composite modulus E*",
+        format!("{:.4} GPa", c.modulus_pa * 1e-9),
+    );
+    line(
+        "work of adhesion Δγ",
+        format!("{:.4} J/m²", c.work_of_adhesion_j_m2),
+    );
+    line("LJ range ε", format!("{:.4} nm", c.range_m * 1e9));
+    line("Tabor parameter μ (2)", format!("{:.4}", o.tabor_mu));
+    line(
+        "cantilever k, f₀, Q",
+        format!(
+            "{} N/m, {:.4} kHz, {}",
+            k.stiffness_n_m,
+            k.resonance_hz * 1e-3,
+            k.quality
+        ),
+    );
+    line(
+        "free amplitude A₀, drive f/f₀",
+        format!(
+            "{:.4} nm, {:.6}",
+            k.free_amplitude_m * 1e9,
+            o.frequency_ratio
+        ),
+    );
+    line(
+        "rest separation z_c",
+        format!("{:.4} nm", setup.separation_m * 1e9),
+    );
+    let _ = writeln!(s, "Steady state");
+    let mut line = |label: &str, value: String| {
+        let _ = writeln!(s, "  {label:<34} {value}");
+    };
+    line(
+        "cycles (converged)",
+        format!("{} ({})", o.cycles, if o.converged { "yes" } else { "NO" }),
+    );
+    line(
+        "amplitude A, A/A₀",
+        format!("{:.4} nm, {:.6}", o.amplitude_m * 1e9, o.amplitude_ratio),
+    );
+    line("phase φ (lock-in)", format!("{:.4}°", o.phase_deg));
+    line(
+        "phase φ (from energy)",
+        format!("{:.4}°", o.phase_from_energy_deg),
+    );
+    line(
+        "E_ts per cycle",
+        format!("{:.4e} J = {:.4} eV", o.e_ts_j, o.e_ts_ev),
+    );
+    line("law's loop area", format!("{:.4e} J", o.loop_area_j));
+    line(
+        "E_damp, E_drive",
+        format!("{:.4e} J, {:.4e} J", o.e_damp_j, o.e_drive_j),
+    );
+    line(
+        "energy balance error",
+        format!("{:.2e}", o.energy_balance_rel),
+    );
+    line("virial ⟨F_ts z⟩", format!("{:.4e} J", o.virial_j));
+    line("mean force", format!("{:.4} nN", o.mean_force_n * 1e9));
+    line(
+        "peak repulsive / attractive force",
+        format!(
+            "{:.4} nN / {:.4} nN",
+            o.peak_force_n * 1e9,
+            o.peak_attractive_force_n * 1e9
+        ),
+    );
+    line(
+        "min separation",
+        format!("{:.4} nm", o.min_separation_m * 1e9),
+    );
+    line("contact fraction", format!("{:.4}", o.contact_fraction));
+    if !o.converged {
+        let _ = writeln!(
+            s,
+            "note: no steady state within the cycle cap (raise --max-cycles; the motion may \
+             be chaotic or period-doubled at this setpoint)"
+        );
+    }
+    s
+}
+
+/// The trajectory as CSV: t_s, z_m, v_m_s, alpha_m, force_n, branch.
+pub fn trajectory_csv(samples: &[TrajectorySample]) -> Result<Vec<u8>> {
+    let fail = |e: csv::Error| Error::Output {
+        path: "trajectory.csv".into(),
+        reason: e.to_string(),
+    };
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(["t_s", "z_m", "v_m_s", "alpha_m", "force_n", "branch"])
+        .map_err(fail)?;
+    for s in samples {
+        w.write_record([
+            s.t_s.to_string(),
+            s.z_m.to_string(),
+            s.v_m_s.to_string(),
+            s.alpha_m.to_string(),
+            s.force_n.to_string(),
+            match s.branch {
+                Branch::Free => "free".into(),
+                Branch::Contact => "contact".into(),
+            },
+        ])
+        .map_err(fail)?;
+    }
+    w.into_inner().map_err(|e| Error::Output {
+        path: "trajectory.csv".into(),
+        reason: e.to_string(),
+    })
+}
+
+/// Split samples into runs of one branch (so lines do not join across a jump).
+fn runs(
+    samples: &[TrajectorySample],
+    pick: impl Fn(&TrajectorySample) -> (f64, f64),
+) -> Vec<(Branch, Vec<(f64, f64)>)> {
+    let mut out: Vec<(Branch, Vec<(f64, f64)>)> = Vec::new();
+    for s in samples {
+        match out.last_mut() {
+            Some((b, pts)) if *b == s.branch => pts.push(pick(s)),
+            _ => out.push((s.branch, vec![pick(s)])),
+        }
+    }
+    out
+}
+
+/// Charts of the recorded trajectory: deflection vs time, force vs time, and the
+/// force–separation loop with the law's jump-in and jump-out separations marked.
+pub fn trajectory_charts(run: &TapRun, title: &str) -> Vec<Chart> {
+    let t = &run.trajectory;
+    let ns = |s: &TrajectorySample| s.t_s * 1e6;
+    let deflection = Chart {
+        name: "deflection".into(),
+        title: format!("{title}: deflection"),
+        x: Axis::linear("time t (µs)", "t_us"),
+        y: Axis::linear("deflection z (nm)", "z_nm"),
+        series: vec![Series::new(
+            "z(t)",
+            t.iter().map(|s| (ns(s), s.z_m * 1e9)).collect(),
+            Style::Line,
+            0,
+        )],
+        labels: vec![],
+        legend: Corner::UpperRight,
+    };
+    let split = |pick: &dyn Fn(&TrajectorySample) -> (f64, f64)| -> Vec<Series> {
+        let mut contact_named = false;
+        let mut free_named = false;
+        runs(t, pick)
+            .into_iter()
+            .map(|(branch, pts)| {
+                let (name, color, named) = match branch {
+                    Branch::Free => ("out of contact", 2, &mut free_named),
+                    Branch::Contact => ("in contact", 1, &mut contact_named),
+                };
+                // Only the first run of each branch carries a legend entry.
+                let label = if *named {
+                    String::new()
+                } else {
+                    name.to_string()
+                };
+                *named = true;
+                Series::new(&label, pts, Style::Line, color)
+            })
+            .collect()
+    };
+    let force = Chart {
+        name: "force".into(),
+        title: format!("{title}: tip–sample force"),
+        x: Axis::linear("time t (µs)", "t_us"),
+        y: Axis::linear("force F_ts (nN, repulsive > 0)", "force_nn"),
+        series: split(&|s| (ns(s), s.force_n * 1e9)),
+        labels: vec![],
+        legend: Corner::UpperRight,
+    };
+    let (jump_in, jump_out) = run.switch_separations_m;
+    let mut loop_series = split(&|s| (s.alpha_m * 1e9, s.force_n * 1e9));
+    let (f_lo, f_hi) = t
+        .iter()
+        .map(|s| s.force_n * 1e9)
+        .fold((0.0f64, 0.0f64), |(lo, hi), f| (lo.min(f), hi.max(f)));
+    for (alpha, name, color) in [(jump_in, "jump-in", 3), (jump_out, "jump-out", 4)] {
+        if alpha.is_finite() {
+            loop_series.push(Series::new(
+                &format!("{name} α = {:.3} nm", alpha * 1e9),
+                vec![(alpha * 1e9, f_lo), (alpha * 1e9, f_hi)],
+                Style::Dotted,
+                color,
+            ));
+        }
+    }
+    // Show the interaction region: from the deepest point to a little beyond the jumps.
+    let alpha_min = t
+        .iter()
+        .map(|s| s.alpha_m * 1e9)
+        .fold(f64::INFINITY, f64::min);
+    let alpha_max = t
+        .iter()
+        .map(|s| s.alpha_m * 1e9)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let reach = [jump_in, jump_out]
+        .iter()
+        .filter(|a| a.is_finite())
+        .fold(alpha_min.max(0.0), |m, a| m.max(a * 1e9));
+    let span = (reach - alpha_min).max(1.0);
+    let x_axis = Axis::linear("tip–sample separation α (nm)", "alpha_nm");
+    let x_axis = if alpha_min.is_finite() {
+        x_axis.with_range(alpha_min - 0.05 * span, (reach + 0.6 * span).min(alpha_max))
+    } else {
+        x_axis
+    };
+    let separation = Chart {
+        name: "force_separation".into(),
+        title: format!("{title}: force vs separation"),
+        x: x_axis,
+        y: Axis::linear("force F_ts (nN, repulsive > 0)", "force_nn"),
+        series: loop_series,
+        labels: vec![],
+        legend: Corner::UpperRight,
+    };
+    vec![deflection, force, separation]
+}
