@@ -188,7 +188,7 @@ pub struct TapInputs {
     /// Rest tip–sample separation z_c, α = z_c + z [m; default 16nm].
     #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
     pub separation: Option<f64>,
-    /// Relative tolerance of the integrator [default 1e-8].
+    /// Relative tolerance of the integrator [default 1e-9; absolute: 1e-2 of it].
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
     pub rtol: Option<f64>,
     /// Most cycles to integrate looking for the steady state [default 20000].

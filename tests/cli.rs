@@ -319,3 +319,88 @@ fn help_teaches_units_and_equations() {
         assert!(text.contains(needle), "help lacks {needle}");
     }
 }
+
+#[test]
+fn tap_json_has_the_documented_keys() {
+    let v = json(&["tap", "--json"]);
+    for key in [
+        "amplitude_m", "amplitude_ratio", "phase_deg", "phase_from_energy_deg", "e_ts_j",
+        "e_ts_ev", "e_damp_j", "e_drive_j", "energy_balance_rel", "virial_j", "mean_force_n",
+        "peak_force_n", "min_separation_m", "contact_fraction", "loop_area_j", "tabor_mu",
+    ] {
+        num(&v, key);
+    }
+    assert!(v["cycles"].as_u64().unwrap() > 10);
+    assert_eq!(v["converged"], serde_json::Value::Bool(true));
+    assert_eq!(v["law"], "hybrid");
+    // The default tap is in contact and dissipates the hybrid loop.
+    assert!((num(&v, "e_ts_j") / num(&v, "loop_area_j") - 1.0).abs() < 1e-5);
+}
+
+#[test]
+fn tap_writes_trajectory_and_plots() {
+    let dir = scratch("tap");
+    let traj = dir.join("traj.csv");
+    let png = dir.join("tap.png");
+    let svg = dir.join("tap.svg");
+    for plot in [&png, &svg] {
+        let out = tapsim(&[
+            "tap", "--law", "jkr", "--separation", "12nm", "--trajectory", traj.to_str().unwrap(),
+            "--plot", plot.to_str().unwrap(), "--record-cycles", "2",
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+    let mut r = csv::Reader::from_path(&traj).unwrap();
+    assert_eq!(
+        r.headers().unwrap().iter().collect::<Vec<_>>(),
+        ["t_s", "z_m", "v_m_s", "alpha_m", "force_n", "branch"]
+    );
+    let rows: Vec<_> = r.records().map(|r| r.unwrap()).collect();
+    let t_end: f64 = rows.last().unwrap()[0].parse().unwrap();
+    // Two periods of a 300 kHz cantilever.
+    assert!((t_end - 2.0 / 300e3).abs() < 1e-9, "{t_end}");
+    assert!(rows.iter().any(|r| &r[5] == "contact") && rows.iter().any(|r| &r[5] == "free"));
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+    assert!(String::from_utf8_lossy(&std::fs::read(&svg).unwrap()).contains("<svg"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn tap_reads_a_toml_config_and_flags_win() {
+    let dir = scratch("config");
+    std::fs::create_dir_all(&dir).unwrap();
+    let cfg = dir.join("p.toml");
+    std::fs::write(&cfg, "law = \"hertz\"\nseparation = \"14nm\"\nquality = 300\nstiffness = \"2N/m\"\n").unwrap();
+    let v = json(&["tap", "--config", cfg.to_str().unwrap(), "--stiffness", "40", "--json"]);
+    assert_eq!(v["law"], "hertz");
+    let direct = json(&["tap", "--law", "hertz", "--separation", "14e-9", "--quality", "300", "--json"]);
+    assert_eq!(num(&v, "amplitude_m"), num(&direct, "amplitude_m"));
+    std::fs::write(&cfg, "radius = \"10 parsecs\"\n").unwrap();
+    let out = tapsim(&["tap", "--config", cfg.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && stderr.contains("unknown unit") && stderr.contains("p.toml"), "{stderr}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn tap_bad_input_is_a_clear_error() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["tap", "--stiffness", "0"], "stiffness"),
+        (&["tap", "--quality", "0"], "quality"),
+        (&["tap", "--quality", "-5"], "quality"),
+        (&["tap", "--free-amplitude", "-1nm"], "free amplitude"),
+        (&["tap", "--resonance", "NaN"], "finite"),
+        (&["tap", "--separation", "inf"], "finite"),
+        (&["tap", "--config", "/nonexistent/p.toml"], "/nonexistent/p.toml"),
+        (&["tap", "--plot", "/tmp/x.gif"], ".png or .svg"),
+        (&["tap", "--work-of-adhesion", "0.01", "--modulus", "3GPa"], "use --law dmt"),
+    ];
+    for (args, needle) in cases {
+        let out = tapsim(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+    assert!(!std::path::Path::new("/tmp/x.gif").exists());
+}

@@ -103,8 +103,8 @@ pub struct Numerics {
 impl Default for Numerics {
     fn default() -> Self {
         Self {
-            rtol: 1e-8,
-            atol: 1e-10,
+            rtol: 1e-9,
+            atol: 1e-11,
             min_steps_per_period: 40.0,
             tolerance: 1e-9,
             max_cycles: 20_000,
