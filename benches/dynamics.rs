@@ -21,9 +21,14 @@ fn bench(c: &mut Criterion) {
         let p = Prepared::new(&default_setup(), &numerics).expect("defaults are valid");
         let sim = p.simulation();
         let mut phase = sim.free_steady_start();
-        let state = sim.steady_state(&mut phase, &p.steady).expect("steady state");
+        let state = sim
+            .steady_state(&mut phase, &p.steady)
+            .expect("steady state");
         let o = TapObservables::new(&p, &state);
-        assert!(o.converged && o.energy_balance_rel < 1e-6, "rtol {rtol}: {o:?}");
+        assert!(
+            o.converged && o.energy_balance_rel < 1e-6,
+            "rtol {rtol}: {o:?}"
+        );
         eprintln!(
             "rtol {rtol:e}: energy balance {:.1e}, E_ts/loop - 1 = {:.1e}",
             o.energy_balance_rel,

@@ -324,9 +324,22 @@ fn help_teaches_units_and_equations() {
 fn tap_json_has_the_documented_keys() {
     let v = json(&["tap", "--json"]);
     for key in [
-        "amplitude_m", "amplitude_ratio", "phase_deg", "phase_from_energy_deg", "e_ts_j",
-        "e_ts_ev", "e_damp_j", "e_drive_j", "energy_balance_rel", "virial_j", "mean_force_n",
-        "peak_force_n", "min_separation_m", "contact_fraction", "loop_area_j", "tabor_mu",
+        "amplitude_m",
+        "amplitude_ratio",
+        "phase_deg",
+        "phase_from_energy_deg",
+        "e_ts_j",
+        "e_ts_ev",
+        "e_damp_j",
+        "e_drive_j",
+        "energy_balance_rel",
+        "virial_j",
+        "mean_force_n",
+        "peak_force_n",
+        "min_separation_m",
+        "contact_fraction",
+        "loop_area_j",
+        "tabor_mu",
     ] {
         num(&v, key);
     }
@@ -345,10 +358,23 @@ fn tap_writes_trajectory_and_plots() {
     let svg = dir.join("tap.svg");
     for plot in [&png, &svg] {
         let out = tapsim(&[
-            "tap", "--law", "jkr", "--separation", "12nm", "--trajectory", traj.to_str().unwrap(),
-            "--plot", plot.to_str().unwrap(), "--record-cycles", "2",
+            "tap",
+            "--law",
+            "jkr",
+            "--separation",
+            "12nm",
+            "--trajectory",
+            traj.to_str().unwrap(),
+            "--plot",
+            plot.to_str().unwrap(),
+            "--record-cycles",
+            "2",
         ]);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     let mut r = csv::Reader::from_path(&traj).unwrap();
     assert_eq!(
@@ -370,15 +396,38 @@ fn tap_reads_a_toml_config_and_flags_win() {
     let dir = scratch("config");
     std::fs::create_dir_all(&dir).unwrap();
     let cfg = dir.join("p.toml");
-    std::fs::write(&cfg, "law = \"hertz\"\nseparation = \"14nm\"\nquality = 300\nstiffness = \"2N/m\"\n").unwrap();
-    let v = json(&["tap", "--config", cfg.to_str().unwrap(), "--stiffness", "40", "--json"]);
+    std::fs::write(
+        &cfg,
+        "law = \"hertz\"\nseparation = \"14nm\"\nquality = 300\nstiffness = \"2N/m\"\n",
+    )
+    .unwrap();
+    let v = json(&[
+        "tap",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--stiffness",
+        "40",
+        "--json",
+    ]);
     assert_eq!(v["law"], "hertz");
-    let direct = json(&["tap", "--law", "hertz", "--separation", "14e-9", "--quality", "300", "--json"]);
+    let direct = json(&[
+        "tap",
+        "--law",
+        "hertz",
+        "--separation",
+        "14e-9",
+        "--quality",
+        "300",
+        "--json",
+    ]);
     assert_eq!(num(&v, "amplitude_m"), num(&direct, "amplitude_m"));
     std::fs::write(&cfg, "radius = \"10 parsecs\"\n").unwrap();
     let out = tapsim(&["tap", "--config", cfg.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && stderr.contains("unknown unit") && stderr.contains("p.toml"), "{stderr}");
+    assert!(
+        !out.status.success() && stderr.contains("unknown unit") && stderr.contains("p.toml"),
+        "{stderr}"
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -391,9 +440,15 @@ fn tap_bad_input_is_a_clear_error() {
         (&["tap", "--free-amplitude", "-1nm"], "free amplitude"),
         (&["tap", "--resonance", "NaN"], "finite"),
         (&["tap", "--separation", "inf"], "finite"),
-        (&["tap", "--config", "/nonexistent/p.toml"], "/nonexistent/p.toml"),
+        (
+            &["tap", "--config", "/nonexistent/p.toml"],
+            "/nonexistent/p.toml",
+        ),
         (&["tap", "--plot", "/tmp/x.gif"], ".png or .svg"),
-        (&["tap", "--work-of-adhesion", "0.01", "--modulus", "3GPa"], "use --law dmt"),
+        (
+            &["tap", "--work-of-adhesion", "0.01", "--modulus", "3GPa"],
+            "use --law dmt",
+        ),
     ];
     for (args, needle) in cases {
         let out = tapsim(args);

@@ -73,7 +73,7 @@ fn free_response<L: ForceLaw>(law: &L, omega: f64, q: f64) -> (f64, f64) {
         x: 0.0,
         v: 0.0,
         branch: Branch::Free,
-        h_next: 0.0,
+        h_next: [0.0; 2],
     };
     let opts = SteadyOptions {
         tolerance: 1e-10,
@@ -92,11 +92,20 @@ fn without_force_the_response_is_the_analytic_driven_oscillator() {
     for &(omega, q) in &[(1.0f64, 400.0f64), (0.98, 100.0), (1.03, 50.0)] {
         let phi = (omega / q).atan2(1.0 - omega * omega).to_degrees();
         let (a, p) = free_response(&NoForce, omega, q);
-        assert!((a - 1.0).abs() < 1e-6, "closed form, omega {omega}: A = {a}");
-        assert!((p - phi).abs() < 1e-4, "closed form, omega {omega}: {p} vs {phi}");
+        assert!(
+            (a - 1.0).abs() < 1e-6,
+            "closed form, omega {omega}: A = {a}"
+        );
+        assert!(
+            (p - phi).abs() < 1e-4,
+            "closed form, omega {omega}: {p} vs {phi}"
+        );
         let (a, p) = free_response(&NumericNoForce, omega, q);
         assert!((a - 1.0).abs() < 1e-6, "Dopri5, omega {omega}: A = {a}");
-        assert!((p - phi).abs() < 1e-4, "Dopri5, omega {omega}: {p} vs {phi}");
+        assert!(
+            (p - phi).abs() < 1e-4,
+            "Dopri5, omega {omega}: {p} vs {phi}"
+        );
     }
     // Through the CLI's path too: the free cantilever at resonance.
     let o = run(LawKind::None, 16.0);
@@ -105,15 +114,39 @@ fn without_force_the_response_is_the_analytic_driven_oscillator() {
 
 #[test]
 fn conservative_laws_dissipate_nothing() {
-    for (law, z) in [(LawKind::Hertz, 14.0), (LawKind::Hertz, 18.0), (LawKind::Dmt, 14.0), (LawKind::Dmt, 18.0)] {
+    for (law, z) in [
+        (LawKind::Hertz, 14.0),
+        (LawKind::Hertz, 18.0),
+        (LawKind::Dmt, 14.0),
+        (LawKind::Dmt, 18.0),
+    ] {
         let o = run(law, z);
-        assert!(o.jumps_in >= 1 || law == LawKind::Dmt, "{law} at {z} nm never touched");
-        assert!(o.e_ts_j.abs() < 1e-6 * o.e_drive_j, "{law} {z}: E_ts {} vs E_drive {}", o.e_ts_j, o.e_drive_j);
-        assert!(o.energy_balance_rel < 1e-6, "{law} {z}: balance {}", o.energy_balance_rel);
+        assert!(
+            o.jumps_in >= 1 || law == LawKind::Dmt,
+            "{law} at {z} nm never touched"
+        );
+        assert!(
+            o.e_ts_j.abs() < 1e-6 * o.e_drive_j,
+            "{law} {z}: E_ts {} vs E_drive {}",
+            o.e_ts_j,
+            o.e_drive_j
+        );
+        assert!(
+            o.energy_balance_rel < 1e-6,
+            "{law} {z}: balance {}",
+            o.energy_balance_rel
+        );
         // At resonance, sin φ = (ω/ω₀)(A/A₀) up to higher harmonics.
         let sin_phi = o.phase_deg.to_radians().sin();
-        assert!((sin_phi - o.amplitude_ratio).abs() < 2e-3, "{law} {z}: sin φ {sin_phi} vs A/A₀ {}", o.amplitude_ratio);
-        assert!(o.amplitude_ratio < 0.99, "{law} {z}: the tip should feel the sample");
+        assert!(
+            (sin_phi - o.amplitude_ratio).abs() < 2e-3,
+            "{law} {z}: sin φ {sin_phi} vs A/A₀ {}",
+            o.amplitude_ratio
+        );
+        assert!(
+            o.amplitude_ratio < 0.99,
+            "{law} {z}: the tip should feel the sample"
+        );
     }
 }
 
@@ -128,10 +161,22 @@ fn hysteretic_laws_dissipate_their_loop_area() {
         (LawKind::Jkr, 14.0),
     ] {
         let o = run(law, z);
-        assert_eq!(o.jumps_in, 1, "{law} {z}: the loop must be traversed once a cycle");
+        assert_eq!(
+            o.jumps_in, 1,
+            "{law} {z}: the loop must be traversed once a cycle"
+        );
         let rel = (o.e_ts_j - o.loop_area_j).abs() / o.loop_area_j;
-        assert!(rel < 1e-5, "{law} {z}: E_ts {} vs loop {} ({rel:e})", o.e_ts_j, o.loop_area_j);
-        assert!(o.energy_balance_rel < 1e-6, "{law} {z}: balance {}", o.energy_balance_rel);
+        assert!(
+            rel < 1e-5,
+            "{law} {z}: E_ts {} vs loop {} ({rel:e})",
+            o.e_ts_j,
+            o.loop_area_j
+        );
+        assert!(
+            o.energy_balance_rel < 1e-6,
+            "{law} {z}: balance {}",
+            o.energy_balance_rel
+        );
         // In contact for part of the cycle, below the jump-in separation (in the
         // attractive regime the JKR contact can stay tensile: α > 0 throughout).
         let setup = default_setup();
@@ -139,7 +184,10 @@ fn hysteretic_laws_dissipate_their_loop_area() {
             LawKind::Jkr => 0.0,
             _ => 1.2 * setup.contact.separation_scale_m(),
         };
-        assert!(o.contact_fraction > 0.0 && o.min_separation_m < jump_in_m, "{law} {z}: {o:?}");
+        assert!(
+            o.contact_fraction > 0.0 && o.min_separation_m < jump_in_m,
+            "{law} {z}: {o:?}"
+        );
     }
 }
 
@@ -149,17 +197,32 @@ fn jkr_overstates_the_loss_of_the_hybrid_law() {
     // Same contact and setpoint: the classic JKR loop is Ŵ_JKR/Ŵ_hybrid(μ) times larger.
     let ratio = j.e_ts_j / h.e_ts_j;
     let expect = tapsim::contact::jkr::w_hat_jkr() / tapsim::contact::hybrid::w_hat_fit(h.tabor_mu);
-    assert!((ratio - expect).abs() < 1e-4 * expect, "{ratio} vs {expect}");
-    assert!(j.phase_deg > h.phase_deg + 5.0, "JKR's extra loss shows in the phase");
+    assert!(
+        (ratio - expect).abs() < 1e-4 * expect,
+        "{ratio} vs {expect}"
+    );
+    assert!(
+        j.phase_deg > h.phase_deg + 5.0,
+        "JKR's extra loss shows in the phase"
+    );
 }
 
 #[test]
 fn lock_in_and_energy_phase_agree_for_the_hybrid_law() {
     let o = run(LawKind::Hybrid, 15.0);
-    assert!((o.amplitude_ratio - 0.9).abs() < 0.03, "A/A₀ = {}", o.amplitude_ratio);
+    assert!(
+        (o.amplitude_ratio - 0.9).abs() < 0.03,
+        "A/A₀ = {}",
+        o.amplitude_ratio
+    );
     assert!(o.e_ts_j > 0.0);
     let diff = (o.phase_deg - o.phase_from_energy_deg).abs();
-    assert!(diff < 0.05, "lock-in {} vs energy {}", o.phase_deg, o.phase_from_energy_deg);
+    assert!(
+        diff < 0.05,
+        "lock-in {} vs energy {}",
+        o.phase_deg,
+        o.phase_from_energy_deg
+    );
     // Attractive regime: both above 90°, and still consistent.
     let o = run(LawKind::Hybrid, 18.0);
     assert!(o.phase_deg > 90.0 && o.phase_from_energy_deg > 90.0);
@@ -169,9 +232,15 @@ fn lock_in_and_energy_phase_agree_for_the_hybrid_law() {
 #[test]
 fn slow_base_drive_loses_the_finite_stiffness_hysteresis_26() {
     for (mu, k_hat) in [(5.0, 2.0), (10.0, 0.5)] {
-        let r = base_drive::hybrid_cycle(mu, k_hat, JumpIn::Fit, &BaseDriveOptions::default()).unwrap();
+        let r =
+            base_drive::hybrid_cycle(mu, k_hat, JumpIn::Fit, &BaseDriveOptions::default()).unwrap();
         let rel = (r.w_hat_dynamic - r.w_hat_closed_form).abs() / r.w_hat_closed_form;
-        assert!(rel < 0.01, "mu {mu}, k {k_hat}: {} vs (26) {} ({rel:.2e})", r.w_hat_dynamic, r.w_hat_closed_form);
+        assert!(
+            rel < 0.01,
+            "mu {mu}, k {k_hat}: {} vs (26) {} ({rel:.2e})",
+            r.w_hat_dynamic,
+            r.w_hat_closed_form
+        );
         assert_eq!(r.jumps_in, 1);
         // The contact itself loses the rigid hybrid loop; the spring's share rings out.
         let rigid = tapsim::contact::hybrid::w_hat_fit(mu);
@@ -186,7 +255,11 @@ fn amplitude_phase_and_energy_are_self_consistent() {
     let a0 = default_setup().cantilever.free_amplitude_m;
     // Damping loss of a harmonic motion, πkA²/Q at resonance, within the harmonics' share.
     let e_damp = PI * k * o.amplitude_m.powi(2) / 400.0;
-    assert!((o.e_damp_j - e_damp).abs() < 1e-3 * e_damp, "{} vs {e_damp}", o.e_damp_j);
+    assert!(
+        (o.e_damp_j - e_damp).abs() < 1e-3 * e_damp,
+        "{} vs {e_damp}",
+        o.e_damp_j
+    );
     assert!((o.amplitude_m / a0 - o.amplitude_ratio).abs() < 1e-15);
     assert!((o.e_ts_ev * 1.602_176_634e-19 - o.e_ts_j).abs() < 1e-30);
 }
@@ -198,8 +271,13 @@ fn laws_refuse_where_they_do_not_apply() {
     setup.contact.work_of_adhesion_j_m2 = 0.02;
     setup.contact.modulus_pa = 2e9;
     assert!(setup.contact.tabor_mu() < 1.0);
-    let err = tap(&setup, &Numerics::default(), 0).unwrap_err().to_string();
-    assert!(err.contains("does not apply") && err.contains("dmt"), "{err}");
+    let err = tap(&setup, &Numerics::default(), 0)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("does not apply") && err.contains("dmt"),
+        "{err}"
+    );
     setup.law = LawKind::Dmt;
     assert!(tap(&setup, &Numerics::default(), 0).is_ok());
 }

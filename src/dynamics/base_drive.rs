@@ -106,7 +106,7 @@ pub fn hybrid_cycle(
         x: 0.0,
         v: 0.0,
         branch: Branch::Free,
-        h_next: 0.0,
+        h_next: [0.0; 2],
     };
     for _ in 0..opts.warm_up_cycles {
         sim.cycle(&mut phase, &mut Ignore)?;

@@ -76,7 +76,7 @@ struct Progress {
     last: StepEnd,
     /// The step in which the switch happened (its start) and the located time.
     hit: Option<(StepEnd, f64)>,
-    /// Length of the last accepted step.
+    /// Length of the first accepted step (0 until there is one).
     h: f64,
 }
 
@@ -162,7 +162,9 @@ impl<L: ForceLaw, O: StepObserver> System<f64, State> for Segment<'_, L, O> {
             }
         }
         self.observer.step(&start, &end, self.branch);
-        self.progress.h = end.tau - start.tau;
+        if self.progress.h == 0.0 {
+            self.progress.h = end.tau - start.tau;
+        }
         self.progress.last = end;
         false
     }
@@ -177,8 +179,9 @@ pub struct SegmentEnd {
     pub y: State,
     /// Whether it ended at a branch switch (else at `tau_end`).
     pub switched: bool,
-    /// Length of the last step (a good first step for the next segment).
-    pub h_last: f64,
+    /// Length of the first accepted step (a good first step for the next segment on
+    /// the same branch, which starts in the same state of the motion).
+    pub h_first: f64,
 }
 
 fn dopri<S: System<f64, State>>(
@@ -254,7 +257,7 @@ pub fn integrate<L: ForceLaw, O: StepObserver>(
             dy: dy0,
         },
         hit: None,
-        h: h0,
+        h: 0.0,
     };
     let segment = Segment {
         law,
@@ -272,7 +275,7 @@ pub fn integrate<L: ForceLaw, O: StepObserver>(
             tau: last.tau,
             y: last.y,
             switched: false,
-            h_last: progress.h,
+            h_first: progress.h,
         });
     };
     // Integrate the part of the step up to the switch again, from the step's start, and
@@ -314,7 +317,8 @@ pub fn integrate<L: ForceLaw, O: StepObserver>(
         let (g, rate) = distance(t, &y);
         let next = t - g / rate;
         if attempt == 3
-            || g.abs() <= 1e-13 * (1.0 + level.abs())
+            // 1e-11 in α̂ moves the loop area by ~1e-11 relative.
+            || g.abs() <= 1e-11 * (1.0 + level.abs())
             || !(next > start.tau && next.is_finite())
         {
             break;
@@ -328,6 +332,6 @@ pub fn integrate<L: ForceLaw, O: StepObserver>(
         tau: t,
         y,
         switched: true,
-        h_last: progress.h,
+        h_first: progress.h,
     })
 }

@@ -25,8 +25,9 @@ pub struct Phase {
     pub v: f64,
     /// Contact branch.
     pub branch: Branch,
-    /// First trial step for the next numerical segment (0: solver's choice).
-    pub h_next: f64,
+    /// First trial step for the next numerical segment on each branch (free, contact;
+    /// 0: the solver's choice).
+    pub h_next: [f64; 2],
 }
 
 /// The integrals and extremes of one drive period (dimensionless).
@@ -94,22 +95,12 @@ impl<O: StepObserver> StepObserver for Tracker<'_, O> {
     fn step(&mut self, a: &StepEnd, b: &StepEnd, branch: Branch) {
         let alpha = |tau: f64, x: f64| self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
         let mut lowest = alpha(b.tau, b.y[X]);
-        // A turning point inside the step: the Hermite cubic's minimum (its derivative is
-        // a quadratic in the step fraction).
+        // A turning point inside the step: the minimum of the Hermite cubic, where its
+        // derivative (a quadratic in the step fraction) vanishes.
         if a.y[V] < 0.0 && b.y[V] > 0.0 {
-            let mut lo = a.tau;
-            let mut hi = b.tau;
-            for _ in 0..40 {
-                let mid = 0.5 * (lo + hi);
-                let eps = 1e-7 * (b.tau - a.tau);
-                if hermite(a, b, X, mid + eps) < hermite(a, b, X, mid - eps) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            let t = 0.5 * (lo + hi);
-            lowest = lowest.min(alpha(t, hermite(a, b, X, t)));
+            let t = hermite_minimum(a, b);
+            let tau = a.tau + t * (b.tau - a.tau);
+            lowest = lowest.min(alpha(tau, hermite(a, b, X, tau)));
         }
         self.min_alpha = self.min_alpha.min(lowest);
         self.max_f = self.max_f.max(b.dy[F_INT]);
@@ -121,6 +112,30 @@ impl<O: StepObserver> StepObserver for Tracker<'_, O> {
         self.max_f = self.max_f.max(0.0);
         self.min_f = self.min_f.min(0.0);
         self.inner.free_flight(flight, from, to);
+    }
+}
+
+/// Step fraction in [0, 1] of the minimum of the deflection's Hermite cubic on a step
+/// where the velocity goes from negative to positive.
+fn hermite_minimum(a: &StepEnd, b: &StepEnd) -> f64 {
+    let h = b.tau - a.tau;
+    let (p0, p1, m0, m1) = (a.y[X], b.y[X], h * a.y[V], h * b.y[V]);
+    // The cubic is p0 + m0 t + c2 t² + c3 t³; its derivative 3c3 t² + 2c2 t + m0.
+    let c3 = 2.0 * p0 + m0 - 2.0 * p1 + m1;
+    let c2 = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1;
+    let (qa, qb, qc) = (3.0 * c3, 2.0 * c2, m0);
+    let t = if qa.abs() <= 1e-14 * (qb.abs() + qc.abs()) {
+        -qc / qb
+    } else {
+        let disc = (qb * qb - 4.0 * qa * qc).max(0.0).sqrt();
+        let (r1, r2) = ((-qb - disc) / (2.0 * qa), (-qb + disc) / (2.0 * qa));
+        // The root where the derivative rises through zero.
+        if 2.0 * qa * r1 + qb > 0.0 { r1 } else { r2 }
+    };
+    if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.5
     }
 }
 
@@ -159,7 +174,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             x,
             v,
             branch: self.branch_at(0.0, x),
-            h_next: 0.0,
+            h_next: [0.0; 2],
         }
     }
 
@@ -225,7 +240,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 tau,
                 y,
                 tau_end,
-                phase.h_next,
+                phase.h_next[phase.branch as usize],
                 &self.tol,
                 &mut tracker,
             )?;
@@ -234,8 +249,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
             if phase.branch == Branch::Contact {
                 contact_time += end.tau - tau;
             }
-            if end.h_last > 0.0 {
-                phase.h_next = end.h_last;
+            if end.h_first > 0.0 {
+                phase.h_next[phase.branch as usize] = end.h_first;
             }
             tau = end.tau;
             y = end.y;
@@ -330,4 +345,26 @@ pub struct SteadyState {
     pub cycles: usize,
     /// Whether the convergence criterion was met.
     pub converged: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hermite_minimum_finds_the_turning_point_of_a_parabola() {
+        // x = (τ − 0.3)², sampled at τ = 0 and 1 with exact slopes: the cubic is exact.
+        let end = |tau: f64| {
+            let mut y = State::zeros();
+            y[X] = (tau - 0.3) * (tau - 0.3);
+            y[V] = 2.0 * (tau - 0.3);
+            StepEnd {
+                tau,
+                y,
+                dy: State::zeros(),
+            }
+        };
+        let t = hermite_minimum(&end(0.0), &end(1.0));
+        assert!((t - 0.3).abs() < 1e-12, "{t}");
+    }
 }
