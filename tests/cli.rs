@@ -459,3 +459,11 @@ fn tap_bad_input_is_a_clear_error() {
     }
     assert!(!std::path::Path::new("/tmp/x.gif").exists());
 }
+
+#[test]
+fn shipped_example_config_runs() {
+    let cfg = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/polymer.toml");
+    let v = json(&["tap", "--config", cfg, "--json"]);
+    assert_eq!(v["converged"], serde_json::Value::Bool(true));
+    assert!((num(&v, "amplitude_ratio") - 0.9).abs() < 0.02);
+}
