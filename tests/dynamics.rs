@@ -68,13 +68,7 @@ fn free_response<L: ForceLaw>(law: &L, omega: f64, q: f64) -> (f64, f64) {
         },
     };
     // From rest: the transient must die out.
-    let mut phase = Phase {
-        tau: 0.0,
-        x: 0.0,
-        v: 0.0,
-        branch: Branch::Free,
-        h_next: [0.0; 2],
-    };
+    let mut phase = Phase::at_rest();
     let opts = SteadyOptions {
         tolerance: 1e-10,
         streak: 3,

@@ -8,7 +8,7 @@ use super::steady::{Phase, Simulation};
 use crate::contact::hybrid::JumpIn;
 use crate::contact::spring;
 use crate::error::{Error, Result, positive};
-use crate::law::{AdhesiveLaw, Branch, ForceLaw};
+use crate::law::{AdhesiveLaw, ForceLaw};
 use serde::Serialize;
 
 /// Settings of a slow base-driven cycle.
@@ -101,13 +101,7 @@ pub fn hybrid_cycle(
             h_max: osc.period() / 2000.0,
         },
     };
-    let mut phase = Phase {
-        tau: 0.0,
-        x: 0.0,
-        v: 0.0,
-        branch: Branch::Free,
-        h_next: [0.0; 2],
-    };
+    let mut phase = Phase::at_rest();
     for _ in 0..opts.warm_up_cycles {
         sim.cycle(&mut phase, &mut Ignore)?;
     }

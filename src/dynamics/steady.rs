@@ -30,6 +30,19 @@ pub struct Phase {
     pub h_next: [f64; 2],
 }
 
+impl Phase {
+    /// At rest at τ = 0 out of contact.
+    pub fn at_rest() -> Self {
+        Self {
+            tau: 0.0,
+            x: 0.0,
+            v: 0.0,
+            branch: Branch::Free,
+            h_next: [0.0; 2],
+        }
+    }
+}
+
 /// The integrals and extremes of one drive period (dimensionless).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CycleIntegrals {
