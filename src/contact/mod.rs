@@ -4,10 +4,12 @@
 //! - [`semi_rigid`]: Greenwood's semi-rigid jump-in, eqs. (11)–(17);
 //! - [`hybrid`]: the hybrid hysteresis loss, eq. (18);
 //! - [`spring`]: a support of finite stiffness, eqs. (22)–(27);
-//! - [`length_scale`]: the adhesive length scale, eqs. (19)–(21).
+//! - [`length_scale`]: the adhesive length scale, eqs. (19)–(21);
+//! - [`lj`]: the full Lennard-Jones numerical solution (§3.1).
 
 pub mod hybrid;
 pub mod jkr;
 pub mod length_scale;
+pub mod lj;
 pub mod semi_rigid;
 pub mod spring;

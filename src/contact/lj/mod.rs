@@ -1,0 +1,5 @@
+//! The full Lennard-Jones numerical solution of the adhesive sphere (the paper's §3.1,
+//! DESIGN.md §1): the ground truth the hybrid theory is judged against.
+
+pub mod kernel;
+pub mod mesh;
