@@ -5,6 +5,26 @@
 
 use crate::error::{Error, Result};
 
+/// Gauss–Legendre nodes and weights on [−1, 1], 4 points (exact to degree 7).
+pub const GAUSS_LEGENDRE_4: [(f64, f64); 4] = [
+    (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+    (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+    (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+    (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+];
+
+/// Gauss–Legendre nodes and weights on [−1, 1], 8 points (exact to degree 15).
+pub const GAUSS_LEGENDRE_8: [(f64, f64); 8] = [
+    (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+    (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+    (-0.525_532_409_916_329, 0.313_706_645_877_887_3),
+    (-0.183_434_642_495_649_8, 0.362_683_783_378_362),
+    (0.183_434_642_495_649_8, 0.362_683_783_378_362),
+    (0.525_532_409_916_329, 0.313_706_645_877_887_3),
+    (0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+    (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+];
+
 /// Root of `f` in the bracket `[lo, hi]` (signs of `f(lo)` and `f(hi)` must differ),
 /// by the Illinois variant of regula falsi: bracketing like bisection, superlinear
 /// like the secant method. Stops when the bracket is below `x_tol` (absolute) or
@@ -73,6 +93,29 @@ mod tests {
     fn finds_cube_root_of_two() {
         let r = bracketed_root("t", |x| x * x * x - 2.0, 0.0, 2.0, 1e-15).unwrap();
         assert!((r - 2f64.cbrt()).abs() < 1e-14);
+    }
+
+    #[test]
+    fn gauss_legendre_rules_integrate_polynomials_exactly() {
+        let int =
+            |rule: &[(f64, f64)], p: i32| rule.iter().map(|(x, w)| w * x.powi(p)).sum::<f64>();
+        for p in 0..16 {
+            let exact = if p % 2 == 1 {
+                0.0
+            } else {
+                2.0 / (p as f64 + 1.0)
+            };
+            assert!(
+                (int(&GAUSS_LEGENDRE_8, p) - exact).abs() < 1e-14,
+                "GL8 x^{p}"
+            );
+            if p < 8 {
+                assert!(
+                    (int(&GAUSS_LEGENDRE_4, p) - exact).abs() < 1e-14,
+                    "GL4 x^{p}"
+                );
+            }
+        }
     }
 
     #[test]

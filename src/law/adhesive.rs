@@ -8,7 +8,7 @@ use crate::contact::hybrid::JumpIn;
 use crate::contact::jkr;
 use crate::contact::semi_rigid::{self, EighthPower};
 use crate::error::{Error, Result, positive};
-use crate::numeric::bracketed_root;
+use crate::numeric::{GAUSS_LEGENDRE_4, bracketed_root};
 
 /// Nodes of the semi-rigid approach table (uniform in √(α̂ − α̂_A)).
 const APPROACH_NODES: usize = 4097;
@@ -55,14 +55,8 @@ fn contact_table() -> UniformTable {
 /// ∫ T̂ dα̂ = ∫ T̂(s) 2s ds over [s_a, s_b] inside one table interval, exact for the
 /// cubic interpolant (4-point Gauss–Legendre).
 fn work_along(table: &UniformTable, s_a: f64, s_b: f64) -> f64 {
-    const NODES: [(f64, f64); 4] = [
-        (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-        (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-        (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-        (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-    ];
     let (mid, half) = (0.5 * (s_a + s_b), 0.5 * (s_b - s_a));
-    NODES
+    GAUSS_LEGENDRE_4
         .iter()
         .map(|&(x, w)| {
             let s = mid + half * x;

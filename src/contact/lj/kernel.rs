@@ -8,21 +8,10 @@
 //! G = R − w ln|x − y| with w = y/(x+y): the regular part R is integrated by
 //! Gauss–Legendre, the logarithmic part exactly against a quadratic interpolant of w·φ.
 
+use crate::numeric::GAUSS_LEGENDRE_8;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use std::f64::consts::PI;
-
-/// Gauss–Legendre nodes and weights on [−1, 1], 8 points.
-const GL8: [(f64, f64); 8] = [
-    (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
-    (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
-    (-0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
-    (-0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
-    (0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
-    (0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
-    (0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
-    (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
-];
 
 /// K(k) from the complementary modulus k' = √(1 − k²) (Bulirsch's cel1, the AGM).
 #[inline]
@@ -109,7 +98,7 @@ pub fn element_integrals(x: f64, a: f64, b: f64) -> (f64, f64) {
     let (mid, half) = (0.5 * (a + b), 0.5 * h);
     if distance > 2.0 * h {
         let (mut left, mut right) = (0.0, 0.0);
-        for (node, weight) in GL8 {
+        for (node, weight) in GAUSS_LEGENDRE_8 {
             let y = mid + half * node;
             let g = weight * half * kernel(x, y);
             left += g * (b - y) / h;
@@ -128,7 +117,7 @@ pub fn element_integrals(x: f64, a: f64, b: f64) -> (f64, f64) {
     };
     for &(p, q) in &pieces[..count] {
         let (m, hh) = (0.5 * (p + q), 0.5 * (q - p));
-        for (node, weight) in GL8 {
+        for (node, weight) in GAUSS_LEGENDRE_8 {
             let y = m + hh * node;
             let g = weight * hh * regular(x, y);
             left += g * (b - y) / h;
