@@ -3,6 +3,7 @@
 
 mod figure;
 mod hysteresis;
+mod lj;
 mod tap;
 
 use clap::{Parser, Subcommand};
@@ -26,6 +27,7 @@ pub struct Cli {
 enum Command {
     Tap(tap::TapArgs),
     Hysteresis(hysteresis::HysteresisArgs),
+    Lj(lj::LjArgs),
     Figure(figure::FigureArgs),
 }
 
@@ -35,6 +37,7 @@ pub fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Tap(args) => tap::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),
+        Command::Lj(args) => lj::run(args),
         Command::Figure(args) => figure::run(args),
     };
     match outcome {

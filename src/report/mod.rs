@@ -3,6 +3,7 @@
 
 pub mod chart;
 pub mod hysteresis;
+pub mod lj;
 pub mod output;
 pub mod plot;
 pub mod tap;

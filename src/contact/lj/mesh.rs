@@ -17,6 +17,9 @@ pub struct MeshSpec {
     /// Largest spacing between the axis and the band (the tractions of a nearly rigid
     /// contact vary on a scale of ~0.3 there).
     pub coarse: f64,
+    /// Largest spacing out to x = 10 beyond the band (where a distant, nearly rigid tip
+    /// still feels the force, h̄₀ ≲ 5).
+    pub middle: f64,
     /// The fine band [lo, hi].
     pub band: (f64, f64),
     /// Growth ratio of neighbouring elements outside the band.
@@ -42,16 +45,19 @@ impl MeshSpec {
         Self {
             fine,
             coarse: 0.01,
+            middle: 0.08,
             band: (lo, hi),
             growth: 1.04,
         }
     }
 
-    /// The same mesh with every spacing halved (for Richardson estimates).
-    pub fn refined(&self) -> Self {
+    /// The same mesh with every spacing multiplied by `factor` (2 for the coarse mesh of
+    /// a Richardson estimate).
+    pub fn scaled(&self, factor: f64) -> Self {
         Self {
-            fine: self.fine / 2.0,
-            coarse: self.coarse / 2.0,
+            fine: self.fine * factor,
+            coarse: self.coarse * factor,
+            middle: self.middle * factor,
             ..*self
         }
     }
@@ -75,8 +81,7 @@ impl MeshSpec {
             if x < lo {
                 s.min(self.coarse)
             } else if x < 10.0 {
-                // Where a distant, nearly rigid tip still feels the force (h̄₀ ≲ 5).
-                s.min(0.08)
+                s.min(self.middle)
             } else {
                 s.min(2.0)
             }

@@ -1,5 +1,10 @@
 //! The full Lennard-Jones numerical solution of the adhesive sphere (the paper's §3.1,
 //! DESIGN.md §1): the ground truth the hybrid theory is judged against.
 
+pub mod curve;
 pub mod kernel;
 pub mod mesh;
+pub mod result;
+pub mod solver;
+
+pub use result::{Estimate, LjSolution, solve};

@@ -1,0 +1,133 @@
+//! The Lennard-Jones results for one μ with their discretisation errors, cached on disk.
+
+use super::curve::{self, CurvePoint, TraceOptions};
+use super::mesh::MeshSpec;
+use super::solver::Problem;
+use crate::error::{Error, Result, positive};
+use crate::report::output;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// Version of the cached data: bump when the numerics change.
+const CACHE_VERSION: u32 = 1;
+
+/// Elements across the tensile annulus in the production mesh.
+pub const ELEMENTS_PER_ANNULUS: f64 = 3.0;
+
+/// Spacing ratio of the coarse mesh of the error estimate to the production mesh.
+pub const COARSE_RATIO: f64 = 1.5;
+
+/// A value with its estimated discretisation error (Richardson, from the production
+/// mesh and one with every spacing 1.5 times larger; second-order scheme).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Estimate {
+    /// The production-mesh value.
+    pub value: f64,
+    /// |value − coarse| / (1.5² − 1).
+    pub error: f64,
+}
+
+impl Estimate {
+    fn richardson(fine: f64, coarse: f64) -> Self {
+        Self {
+            value: fine,
+            error: (fine - coarse).abs() / (COARSE_RATIO * COARSE_RATIO - 1.0),
+        }
+    }
+}
+
+/// The numerical solution for one Tabor parameter.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct LjSolution {
+    /// Tabor parameter μ.
+    pub tabor_mu: f64,
+    /// Jump-in fold A: separation.
+    pub alpha_hat_a: Estimate,
+    /// Jump-in fold A: force.
+    pub t_hat_a: Estimate,
+    /// Jump-out fold C: separation.
+    pub alpha_hat_c: Estimate,
+    /// Jump-out fold C: force.
+    pub t_hat_c: Estimate,
+    /// Load-control pull-off force (largest T̂ on the contact branch).
+    pub pull_off_hat: Estimate,
+    /// Hysteresis loss Ŵ_LJ.
+    pub w_hat: Estimate,
+    /// Nodes of the production mesh.
+    pub nodes: usize,
+    /// Nodes of the coarse mesh.
+    pub nodes_coarse: usize,
+    /// Continuation steps on the production mesh.
+    pub steps: usize,
+    /// The traced curve (production mesh).
+    pub curve: Vec<CurvePoint>,
+}
+
+/// Where cached solutions live: `$TAPSIM_CACHE`, else `$XDG_CACHE_HOME/tapsim`, else
+/// `$HOME/.cache/tapsim`, else `.tapsim-cache`.
+pub fn cache_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("TAPSIM_CACHE") {
+        return PathBuf::from(dir);
+    }
+    if let Some(dir) = std::env::var_os("XDG_CACHE_HOME") {
+        return PathBuf::from(dir).join("tapsim");
+    }
+    if let Some(home) = std::env::var_os("HOME") {
+        return PathBuf::from(home).join(".cache").join("tapsim");
+    }
+    PathBuf::from(".tapsim-cache")
+}
+
+fn cache_path(tabor_mu: f64, per_annulus: f64) -> PathBuf {
+    cache_dir().join(format!(
+        "lj-v{CACHE_VERSION}-mu{:016x}-q{:016x}.json",
+        tabor_mu.to_bits(),
+        per_annulus.to_bits()
+    ))
+}
+
+/// Solve the Lennard-Jones problem for `tabor_mu` on the production mesh and a coarse
+/// one, or read the result from the cache. `use_cache = false` always computes (and
+/// still refreshes the cache).
+pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
+    positive("Tabor parameter mu", tabor_mu)?;
+    if !(0.5..=20.0).contains(&tabor_mu) {
+        return Err(Error::NotApplicable(format!(
+            "the Lennard-Jones solver covers 0.5 <= mu <= 20 (mu = {tabor_mu}); \
+             beyond, the tensile annulus is too thin for a dense mesh"
+        )));
+    }
+    let path = cache_path(tabor_mu, ELEMENTS_PER_ANNULUS);
+    if use_cache {
+        if let Ok(text) = std::fs::read_to_string(&path) {
+            if let Ok(cached) = serde_json::from_str::<LjSolution>(&text) {
+                return Ok(cached);
+            }
+        }
+    }
+    let spec = MeshSpec::for_tabor(tabor_mu, ELEMENTS_PER_ANNULUS);
+    let opts = TraceOptions::default();
+    let fine_problem = Problem::new(tabor_mu, spec.nodes());
+    let fine = curve::trace(&fine_problem, &opts)?;
+    let coarse_problem = Problem::new(tabor_mu, spec.scaled(COARSE_RATIO).nodes());
+    let coarse = curve::trace(&coarse_problem, &opts)?;
+    let r = Estimate::richardson;
+    let solution = LjSolution {
+        tabor_mu,
+        alpha_hat_a: r(fine.fold_a.alpha_hat, coarse.fold_a.alpha_hat),
+        t_hat_a: r(fine.fold_a.t_hat, coarse.fold_a.t_hat),
+        alpha_hat_c: r(fine.fold_c.alpha_hat, coarse.fold_c.alpha_hat),
+        t_hat_c: r(fine.fold_c.t_hat, coarse.fold_c.t_hat),
+        pull_off_hat: r(fine.pull_off_hat, coarse.pull_off_hat),
+        w_hat: r(fine.w_hat, coarse.w_hat),
+        nodes: fine.nodes,
+        nodes_coarse: coarse.nodes,
+        steps: fine.steps,
+        curve: fine.points,
+    };
+    // A cache that cannot be written only costs time later.
+    if let Ok(text) = serde_json::to_string(&solution) {
+        let _ = output::write_bytes(&path, text.as_bytes());
+    }
+    Ok(solution)
+}
