@@ -194,7 +194,7 @@ impl Problem {
             if norm < tol {
                 return Ok((s, it - 1));
             }
-            if lu.is_none() || (norm > 0.3 * last_norm && !fresh) {
+            if lu.is_none() || (norm > 0.8 * last_norm && !fresh) {
                 // Bordered Jacobian [[J, −1], [τ_T ∇T̂ᵀ, τ_α/μ]].
                 let mut big = DMatrix::zeros(n + 1, n + 1);
                 big.view_mut((0, 0), (n, n))
