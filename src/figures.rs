@@ -1,9 +1,11 @@
 //! The data of the paper's figures, as [`Chart`]s: Fig. 1 (JKR cycle), Fig. 3 (jump-in
 //! separation), Fig. 4 (hysteresis vs μ), Fig. 5 (cycle with a finite-stiffness
-//! support), Fig. 6 (hysteresis vs k̂). Figure 2 needs the full Lennard-Jones solution.
+//! support), Fig. 6 (hysteresis vs k̂); Figs. 2–4 include the full Lennard-Jones
+//! solution (computed once per μ and cached).
 
 use crate::contact::hybrid::{self, JumpIn};
 use crate::contact::jkr::{self, JkrPoint};
+use crate::contact::lj::{self, LjSolution};
 use crate::contact::semi_rigid::{self, EighthPower};
 use crate::contact::spring;
 use crate::error::{Error, Result};
@@ -11,7 +13,18 @@ use crate::quasistatic::{self, Segment};
 use crate::report::chart::{Axis, Chart, Corner, Label, Series, Style};
 
 /// The figure numbers this build can draw.
-pub const AVAILABLE: [u32; 5] = [1, 3, 4, 5, 6];
+pub const AVAILABLE: [u32; 6] = [1, 2, 3, 4, 5, 6];
+
+/// Tabor parameters of the numerical points of Figs. 3 and 4.
+pub const LJ_MUS: [f64; 6] = [1.0, 1.5, 2.0, 3.0, 4.0, 5.0];
+
+/// Tabor parameter of Fig. 2.
+pub const FIG2_MU: f64 = 5.0;
+
+/// The numerical solutions of Figs. 3 and 4 (from the cache when there).
+pub fn lj_solutions() -> Result<Vec<LjSolution>> {
+    LJ_MUS.iter().map(|&mu| lj::solve(mu, true)).collect()
+}
 
 /// Tabor parameters of the curves of Fig. 6.
 pub const FIG6_MUS: [f64; 4] = [2.0, 5.0, 10.0, 20.0];
@@ -64,13 +77,9 @@ impl Default for FigureOptions {
 pub fn figure(number: u32, opts: &FigureOptions) -> Result<Chart> {
     match number {
         1 => Ok(fig1()),
-        2 => Err(Error::NotApplicable(
-            "figure 2 needs the full Lennard-Jones numerical solution, which this build \
-             does not have yet; figures 1, 3, 4, 5 and 6 are available"
-                .into(),
-        )),
-        3 => fig3(),
-        4 => fig4(opts.jump_in),
+        2 => fig2(&lj::solve(FIG2_MU, true)?),
+        3 => fig3(&lj_solutions()?),
+        4 => fig4(opts.jump_in, &lj_solutions()?),
         5 => fig5(opts.fig5_mu, opts.fig5_k_hat, opts.jump_in),
         6 => fig6(opts.jump_in),
         n => Err(Error::NotApplicable(format!(
@@ -144,9 +153,102 @@ pub fn fig1() -> Chart {
     }
 }
 
-/// Fig. 3: jump-in separation α̂_A vs μ — the exact semi-rigid turning point (14)–(15),
-/// the closed form (16) and the fit (17).
-pub fn fig3() -> Result<Chart> {
+/// Fig. 2: the Lennard-Jones force–separation curve for μ = 5 (numerical), with its
+/// folds A and C, the jumps, and the JKR curve (5) for comparison.
+pub fn fig2(s: &LjSolution) -> Result<Chart> {
+    let c = jkr::point_c();
+    let jkr_curve: Vec<(f64, f64)> = grid(c.a_hat, 2.4, 300, false)
+        .map(|a| (jkr::separation_hat(a), jkr::force_hat(a)))
+        .collect();
+    let lj_curve: Vec<(f64, f64)> = s.curve.iter().map(|p| (p.alpha_hat, p.t_hat)).collect();
+    let (a, cc) = (
+        (s.alpha_hat_a.value, s.t_hat_a.value),
+        (s.alpha_hat_c.value, s.t_hat_c.value),
+    );
+    // Where the jumps land: the contact branch at α̂_A, the approach branch at α̂_C.
+    let b = (
+        a.0,
+        LjSolution::force_on(s.contact_branch(), a.0).unwrap_or(f64::NAN),
+    );
+    let d = (
+        cc.0,
+        LjSolution::force_on(s.approach_branch(), cc.0).unwrap_or(f64::NAN),
+    );
+    Ok(Chart {
+        name: "fig2_lj_mu5".into(),
+        title: format!("Fig. 2  Force–separation relation for μ = {}", s.tabor_mu),
+        x: Axis::linear("separation α/(με)", "alpha_hat"),
+        y: Axis::linear("force T/(RΔγ)  (tensile > 0)", "t_hat"),
+        series: vec![
+            Series::new("JKR (5)", jkr_curve, Style::Line, 0),
+            Series::new("Lennard-Jones (10), numerical", lj_curve, Style::Dashed, 1),
+            Series::new("jump-in A→B", vec![a, b], Style::Dotted, 2),
+            Series::new("jump-out C→D", vec![cc, d], Style::Dotted, 3),
+            Series::new("A, B, C, D", vec![a, b, cc, d], Style::Markers, 2),
+        ],
+        labels: vec![
+            label("A", a.0 + 0.04, a.1 - 0.3),
+            label("B", b.0 + 0.04, b.1 + 0.3),
+            label("C", cc.0 + 0.04, cc.1 + 0.3),
+            label("D", d.0 + 0.04, d.1 - 0.3),
+            label(
+                &format!("Ŵ = {:.4} ± {:.0e}", s.w_hat.value, s.w_hat.error),
+                -1.5,
+                0.5,
+            ),
+        ],
+        legend: Corner::UpperRight,
+    })
+}
+
+/// The numerical jump-in separations against the fit (17) and the closed form (16), as
+/// CSV (`mu, alpha_hat_a, alpha_hat_a_error, fit17, fit17_rel, closed_form16`).
+pub fn lj_fit_table(solutions: &[LjSolution]) -> Result<Vec<u8>> {
+    let fail = |e: csv::Error| Error::Output {
+        path: "fig3_lj_vs_fit.csv".into(),
+        reason: e.to_string(),
+    };
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "mu",
+        "alpha_hat_a",
+        "alpha_hat_a_error",
+        "fit17",
+        "fit17_rel",
+        "closed_form16",
+        "w_hat",
+        "w_hat_error",
+        "w_hat_hybrid",
+    ])
+    .map_err(fail)?;
+    for s in solutions {
+        let mu = s.tabor_mu;
+        let fit = semi_rigid::alpha_hat_a_fit(mu);
+        w.write_record(
+            [
+                mu,
+                s.alpha_hat_a.value,
+                s.alpha_hat_a.error,
+                fit,
+                (fit - s.alpha_hat_a.value) / s.alpha_hat_a.value,
+                semi_rigid::alpha_hat_a_closed_form(mu),
+                s.w_hat.value,
+                s.w_hat.error,
+                hybrid::w_hat_fit(mu),
+            ]
+            .map(|v| v.to_string()),
+        )
+        .map_err(fail)?;
+    }
+    w.into_inner().map_err(|e| Error::Output {
+        path: "fig3_lj_vs_fit.csv".into(),
+        reason: e.to_string(),
+    })
+}
+
+/// Fig. 3: jump-in separation α̂_A vs μ — the numerical Lennard-Jones points, the exact
+/// semi-rigid turning point (14)–(15), the closed form (16) and the fit (17).
+pub fn fig3(solutions: &[LjSolution]) -> Result<Chart> {
     let mus: Vec<f64> = grid(1.0, 10.0, 181, false).collect();
     let exact = mus
         .iter()
@@ -177,15 +279,24 @@ pub fn fig3() -> Result<Chart> {
                 2,
             ),
             Series::new("fit (17)", of(semi_rigid::alpha_hat_a_fit), Style::Line, 1),
+            Series::new(
+                "Lennard-Jones (10), numerical",
+                solutions
+                    .iter()
+                    .map(|s| (s.tabor_mu, s.alpha_hat_a.value))
+                    .collect(),
+                Style::Markers,
+                3,
+            ),
         ],
         labels: vec![],
         legend: Corner::UpperRight,
     })
 }
 
-/// Fig. 4: hysteresis Ŵ vs μ — the hybrid theory (18) and the JKR level (9), with the
-/// paper's numerical value at μ = 5 for reference.
-pub fn fig4(jump_in: JumpIn) -> Result<Chart> {
+/// Fig. 4: hysteresis Ŵ vs μ — the numerical Lennard-Jones points, the hybrid theory
+/// (18) and the JKR level (9), with the paper's numerical value at μ = 5 for reference.
+pub fn fig4(jump_in: JumpIn, solutions: &[LjSolution]) -> Result<Chart> {
     let mu_min = hybrid::min_hysteretic_mu(jump_in)?;
     let hybrid_line = std::iter::once(mu_min)
         .chain(grid(mu_min * 1.0001, 1000.0, 300, true))
@@ -209,6 +320,15 @@ pub fn fig4(jump_in: JumpIn) -> Result<Chart> {
                 vec![(1.0, w_jkr), (1000.0, w_jkr)],
                 Style::Dashed,
                 1,
+            ),
+            Series::new(
+                "Lennard-Jones (10), numerical",
+                solutions
+                    .iter()
+                    .map(|s| (s.tabor_mu, s.w_hat.value))
+                    .collect(),
+                Style::Markers,
+                3,
             ),
             Series::new(
                 "paper's numerical LJ value at μ = 5",

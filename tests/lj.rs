@@ -89,17 +89,9 @@ fn contact_branch_approaches_jkr_as_mu_grows() {
     let mut last = f64::INFINITY;
     for mu in MUS {
         let s = solution(mu);
-        // The contact branch is the part after the largest separation (fold C).
-        let c = (0..s.curve.len())
-            .max_by(|&i, &j| s.curve[i].alpha_hat.total_cmp(&s.curve[j].alpha_hat))
-            .unwrap();
         let level = s.alpha_hat_a.value;
-        let w = s.curve[c..]
-            .windows(2)
-            .find(|w| w[0].alpha_hat >= level && w[1].alpha_hat < level)
-            .expect("the contact branch is traced past the jump-in separation");
-        let f = (w[0].alpha_hat - level) / (w[0].alpha_hat - w[1].alpha_hat);
-        let t = w[0].t_hat + f * (w[1].t_hat - w[0].t_hat);
+        let t = LjSolution::force_on(s.contact_branch(), level)
+            .expect("traced past the jump-in separation");
         let t_jkr = jkr::force_hat(jkr::a_hat_from_separation(level).unwrap());
         let dev = (t - t_jkr).abs() / t_jkr;
         println!(

@@ -4,19 +4,22 @@ use crate::config::number;
 use crate::contact::hybrid::JumpIn;
 use crate::error::{Error, Result};
 use crate::figures::{self, FigureOptions};
+use crate::report::output;
 use clap::Args;
 use std::path::PathBuf;
 
 /// Regenerate a figure of the paper (CSV data + PNG + SVG plot).
 ///
-/// FIGURE is 1 (JKR cycle, eqs. 5, 8, 9), 3 (jump-in separation vs μ, eqs. 14-17),
-/// 4 (hysteresis vs μ, eq. 18), 5 (cycle with a compliant support, eqs. 22-26),
+/// FIGURE is 1 (JKR cycle, eqs. 5, 8, 9), 2 (Lennard-Jones curve for μ = 5, numerical),
+/// 3 (jump-in separation vs μ, eqs. 14-17, with numerical points), 4 (hysteresis vs μ,
+/// eq. 18, with numerical points), 5 (cycle with a compliant support, eqs. 22-26),
 /// 6 (hysteresis vs support stiffness, eqs. 26-27), or `all`.
-/// Figure 2 needs the full Lennard-Jones solution (not in this build).
+/// Figures 2-4 need the Lennard-Jones solutions for μ = 1 ... 5: about a minute the
+/// first time, then instant from the cache.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct FigureArgs {
-    /// Figure number (1, 3, 4, 5, 6) or `all`.
+    /// Figure number (1 to 6) or `all`.
     figure: String,
     /// Output directory (created if missing).
     #[arg(long, default_value = "results")]
@@ -51,6 +54,11 @@ pub fn run(args: FigureArgs) -> Result<()> {
     for n in numbers {
         let chart = figures::figure(n, &opts)?;
         for path in chart.write_all(&args.out)? {
+            println!("{}", path.display());
+        }
+        if n == 3 {
+            let path = args.out.join("fig3_lj_vs_fit.csv");
+            output::write_bytes(&path, &figures::lj_fit_table(&figures::lj_solutions()?)?)?;
             println!("{}", path.display());
         }
     }

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
 /// Version of the cached data: bump when the numerics change.
-const CACHE_VERSION: u32 = 1;
+const CACHE_VERSION: u32 = 2;
 
 /// Elements across the tensile annulus in the production mesh.
 pub const ELEMENTS_PER_ANNULUS: f64 = 3.0;
@@ -61,6 +61,41 @@ pub struct LjSolution {
     pub steps: usize,
     /// The traced curve (production mesh).
     pub curve: Vec<CurvePoint>,
+    /// Arclength of the fold A on `curve`.
+    pub s_a: f64,
+    /// Arclength of the fold C on `curve` (the contact branch follows it).
+    pub s_c: f64,
+}
+
+impl LjSolution {
+    /// The approach branch: the points before the fold A.
+    pub fn approach_branch(&self) -> &[CurvePoint] {
+        let k = self.curve.partition_point(|p| p.s < self.s_a);
+        &self.curve[..k]
+    }
+
+    /// The contact branch: the points after the fold C.
+    pub fn contact_branch(&self) -> &[CurvePoint] {
+        let k = self.curve.partition_point(|p| p.s <= self.s_c);
+        &self.curve[k..]
+    }
+
+    /// T̂ on `branch` (approach or contact, from the two methods above) at separation α̂,
+    /// by linear interpolation between traced points; `None` outside the traced range.
+    pub fn force_on(branch: &[CurvePoint], alpha_hat: f64) -> Option<f64> {
+        branch
+            .windows(2)
+            .find(|w| (w[0].alpha_hat - alpha_hat) * (w[1].alpha_hat - alpha_hat) <= 0.0)
+            .map(|w| {
+                let d = w[0].alpha_hat - w[1].alpha_hat;
+                let f = if d == 0.0 {
+                    0.0
+                } else {
+                    (w[0].alpha_hat - alpha_hat) / d
+                };
+                w[0].t_hat + f * (w[1].t_hat - w[0].t_hat)
+            })
+    }
 }
 
 /// Where cached solutions live: `$TAPSIM_CACHE`, else `$XDG_CACHE_HOME/tapsim`, else
@@ -123,6 +158,8 @@ pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
         nodes: fine.nodes,
         nodes_coarse: coarse.nodes,
         steps: fine.steps,
+        s_a: fine.fold_a.s,
+        s_c: fine.fold_c.s,
         curve: fine.points,
     };
     // A cache that cannot be written only costs time later.
