@@ -1,106 +1,78 @@
-//! Adhesive laws with a JKR contact branch: the paper's hybrid law (jump-in at α̂_A of
-//! (17)), the hybrid law with Greenwood's semi-rigid attraction on approach, and classic
-//! JKR (jump-in at α̂ = 0). All jump out at the rigid-grip point C of eq. (8).
+//! Adhesive laws with a contact branch ending at a jump-out fold: the paper's hybrid law
+//! (jump-in at α̂_A of (17)), the hybrid law with Greenwood's semi-rigid attraction on
+//! approach, classic JKR (jump-in at α̂ = 0), and the tabulated Lennard-Jones law from the
+//! numerical solution. The JKR-based laws jump out at the rigid-grip point C of eq. (8).
 
-use super::table::UniformTable;
+use super::fold_branch::{FarField, FoldBranch, Side};
 use super::{Branch, ForceLaw};
 use crate::contact::hybrid::JumpIn;
 use crate::contact::jkr;
+use crate::contact::lj::LjSolution;
+use crate::contact::lj::curve::CurvePoint;
 use crate::contact::semi_rigid::{self, EighthPower};
 use crate::error::{Error, Result, positive};
-use crate::numeric::{GAUSS_LEGENDRE_4, bracketed_root};
+use crate::numeric::bracketed_root;
 
-/// Nodes of the semi-rigid approach table (uniform in √(α̂ − α̂_A)).
+/// Nodes of the contact-branch tables (uniform in √(α̂_C − α̂)).
+const CONTACT_NODES: usize = 8193;
+/// The JKR contact table reaches down to α̂_C − this; deeper, eq. (5) in closed form.
+const CONTACT_SPAN: f64 = 60.0;
+/// Nodes of the approach tables (uniform in √(α̂ − α̂_A)).
 const APPROACH_NODES: usize = 4097;
-/// The approach table reaches α̂_A + this; beyond, T̂ falls as 1/(α̂ + 1/μ)².
+/// The semi-rigid approach table reaches α̂_A + this; beyond, T̂ falls as 1/(α̂ + 1/μ)².
 const APPROACH_SPAN: f64 = 60.0;
 
-/// The approach (out-of-contact) branch of an adhesive law.
-#[derive(Debug, Clone)]
-pub enum Approach {
-    /// No force before the jump-in.
-    ForceFree,
-    /// Greenwood's semi-rigid attraction (12) at the separation (14), tabulated against
-    /// s = √(α̂ − α̂_A), which is smooth through the fold A.
-    SemiRigid {
-        /// T̂(s).
-        table: UniformTable,
-        /// ∫ T̂ dα̂ from A to each node.
-        cumulative: Vec<f64>,
-        /// Tabor parameter μ (for the far tail).
-        tabor_mu: f64,
-    },
-}
-
-/// Nodes of the contact-branch table (uniform in √(α̂_C − α̂)).
-const CONTACT_NODES: usize = 8193;
-/// The contact table reaches down to α̂_C − this; deeper, eq. (5) is inverted in closed form.
-const CONTACT_SPAN: f64 = 60.0;
-
 /// The JKR contact branch T̂(α̂) of eq. (5) on its displacement-stable side, tabulated
-/// against s = √(α̂_C − α̂), in which it is smooth through the fold C (the closed-form
-/// inverse costs a cube root and several square roots per call; the table one).
-fn contact_table() -> UniformTable {
-    UniformTable::sample(0.0, CONTACT_SPAN.sqrt(), CONTACT_NODES, |s| {
-        if s == 0.0 {
-            // At the fold itself the inverse is ill-conditioned (â has an infinite slope):
-            // take the exact point C of eq. (8).
-            return jkr::T_HAT_C;
-        }
-        let alpha = jkr::ALPHA_HAT_C - s * s;
-        jkr::force_hat(jkr::a_hat_from_separation(alpha).unwrap_or(jkr::A_HAT_C))
-    })
+/// against √(α̂_C − α̂) (the closed-form inverse costs a cube root and several square
+/// roots per call; the table one).
+fn jkr_contact() -> FoldBranch {
+    FoldBranch::new(
+        (jkr::ALPHA_HAT_C, jkr::T_HAT_C),
+        Side::Below,
+        CONTACT_SPAN.sqrt(),
+        CONTACT_NODES,
+        FarField::JkrShift { shift: 0.0 },
+        |u| {
+            if u == 0.0 {
+                // At the fold the inverse is ill-conditioned: take C of eq. (8).
+                return jkr::T_HAT_C;
+            }
+            let alpha = jkr::ALPHA_HAT_C - u * u;
+            jkr::force_hat(jkr::a_hat_from_separation(alpha).unwrap_or(jkr::A_HAT_C))
+        },
+    )
 }
 
-/// ∫ T̂ dα̂ = ∫ T̂(s) 2s ds over [s_a, s_b] inside one table interval, exact for the
-/// cubic interpolant (4-point Gauss–Legendre).
-fn work_along(table: &UniformTable, s_a: f64, s_b: f64) -> f64 {
-    let (mid, half) = (0.5 * (s_a + s_b), 0.5 * (s_b - s_a));
-    GAUSS_LEGENDRE_4
-        .iter()
-        .map(|&(x, w)| {
-            let s = mid + half * x;
-            w * half * table.eval(s) * 2.0 * s
-        })
-        .sum()
-}
-
-/// An adhesive law: approach branch, jump-in at `jump_in`, JKR contact branch, jump-out
-/// at α̂_C.
+/// An adhesive law: approach branch (force-free or tabulated), jump-in at its fold or
+/// at a given separation, contact branch, jump-out at the contact branch's fold.
 #[derive(Debug, Clone)]
 pub struct AdhesiveLaw {
-    contact: UniformTable,
-    approach: Approach,
+    /// `None`: no force before the jump-in.
+    approach: Option<FoldBranch>,
     jump_in: f64,
-    jump_in_t_hat: f64,
-    c_alpha_hat: f64,
-    c_t_hat: f64,
+    contact: FoldBranch,
     loop_area: f64,
 }
 
 impl AdhesiveLaw {
-    fn with_approach(approach: Approach, jump_in: f64, jump_in_t_hat: f64) -> Result<Self> {
-        let c = jkr::point_c();
-        if jump_in >= c.alpha_hat {
+    fn new(approach: Option<FoldBranch>, jump_in: f64, contact: FoldBranch) -> Result<Self> {
+        let (c_alpha, _) = contact.fold();
+        if jump_in >= c_alpha {
             return Err(Error::NotApplicable(format!(
                 "its jump-in separation {jump_in:.4} is not below the jump-out separation \
-                 alpha_hat_C = {:.4}, so there is no contact branch to land on",
-                c.alpha_hat
+                 {c_alpha:.4}, so there is no contact branch to land on"
             )));
         }
         let mut law = Self {
-            contact: contact_table(),
             approach,
             jump_in,
-            jump_in_t_hat,
-            c_alpha_hat: c.alpha_hat,
-            c_t_hat: c.t_hat,
+            contact,
             loop_area: 0.0,
         };
-        let landing = jkr::a_hat_from_separation(jump_in)
-            .ok_or_else(|| Error::Numerical("landing point of the jump-in".into()))?;
-        let contact_work = jkr::work_hat(c.a_hat) - jkr::work_hat(landing);
-        law.loop_area = contact_work - law.approach_work(c.alpha_hat);
+        // ∮ T̂ dα̂ = ∫_{α̂_A}^{α̂_C} (T̂_contact − T̂_approach) dα̂.
+        law.loop_area = law.work_hat(c_alpha, Branch::Contact)
+            - law.work_hat(jump_in, Branch::Contact)
+            - (law.work_hat(c_alpha, Branch::Free) - law.work_hat(jump_in, Branch::Free));
         Ok(law)
     }
 
@@ -110,13 +82,13 @@ impl AdhesiveLaw {
         let alpha_a = jump_in.alpha_hat_a(tabor_mu)?.ok_or_else(|| {
             Error::NotApplicable("there is no jump-in instability at this mu".into())
         })?;
-        Self::with_approach(Approach::ForceFree, alpha_a, 0.0)
+        Self::new(None, alpha_a, jkr_contact())
     }
 
     /// Classic JKR: no force before contact, jump-in at α̂ = 0 (B), jump-out at C; loop
     /// area Ŵ_JKR (9).
     pub fn jkr() -> Self {
-        Self::with_approach(Approach::ForceFree, 0.0, 0.0).expect("0 < alpha_hat_C")
+        Self::new(None, 0.0, jkr_contact()).expect("0 < alpha_hat_C")
     }
 
     /// The hybrid law with the semi-rigid attraction (12), (14) on the approach branch and
@@ -128,13 +100,12 @@ impl AdhesiveLaw {
         })?;
         let alpha =
             |h: f64| semi_rigid::separation_over_range(h, tabor_mu, EighthPower::Keep) / tabor_mu;
-        let s_max = APPROACH_SPAN.sqrt();
-        // Central gap h̄₀(s) on the stable side of the fold: α̂(h̄₀) = α̂_A + s².
-        let gap_at = |s: f64| -> f64 {
-            if s <= 0.0 {
+        // Central gap h̄₀(u) on the stable side of the fold: α̂(h̄₀) = α̂_A + u².
+        let gap_at = |u: f64| -> f64 {
+            if u <= 0.0 {
                 return fold.h0_bar;
             }
-            let target = fold.alpha_hat + s * s;
+            let target = fold.alpha_hat + u * u;
             let mut hi = fold.h0_bar + 1.0;
             while alpha(hi) < target {
                 hi = fold.h0_bar + 2.0 * (hi - fold.h0_bar);
@@ -148,134 +119,123 @@ impl AdhesiveLaw {
             )
             .unwrap_or(fold.h0_bar)
         };
-        let table = UniformTable::sample(0.0, s_max, APPROACH_NODES, |s| {
-            semi_rigid::force_hat(gap_at(s))
-        });
-        let mut cumulative = Vec::with_capacity(table.len());
-        let mut sum = 0.0;
-        for i in 0..table.len() {
-            if i > 0 {
-                let h = table.step();
-                sum += work_along(&table, h * (i - 1) as f64, h * i as f64);
-            }
-            cumulative.push(sum);
-        }
-        Self::with_approach(
-            Approach::SemiRigid {
-                table,
-                cumulative,
-                tabor_mu,
+        let approach = FoldBranch::new(
+            (fold.alpha_hat, fold.t_hat),
+            Side::Above,
+            APPROACH_SPAN.sqrt(),
+            APPROACH_NODES,
+            FarField::Decay {
+                kappa: 1.0 / tabor_mu,
             },
-            fold.alpha_hat,
-            fold.t_hat,
-        )
+            |u| semi_rigid::force_hat(gap_at(u)),
+        );
+        Self::new(Some(approach), fold.alpha_hat, jkr_contact())
     }
 
-    /// Work function of the approach branch, zero at the jump-in point; past the jump-in
-    /// (α̂ < α̂_A) that of the point reflection through A.
-    fn approach_work(&self, alpha_hat: f64) -> f64 {
-        let Approach::SemiRigid {
-            table,
-            cumulative,
-            tabor_mu,
-        } = &self.approach
-        else {
-            return 0.0;
-        };
-        let d = alpha_hat - self.jump_in;
-        if d < 0.0 {
-            // Φ(α) = 2T_A(α − α_A) + Φ(2α_A − α) for the reflected force.
-            return 2.0 * self.jump_in_t_hat * d + self.approach_work(self.jump_in - d);
-        }
-        let s = d.sqrt();
-        let h = table.step();
-        if s <= table.end() {
-            let i = ((s / h) as usize).min(table.len() - 2);
-            return cumulative[i] + work_along(table, h * i as f64, s);
-        }
-        // Tail T̂ = T̂_end ((α̂_end + 1/μ)/(α̂ + 1/μ))².
-        let kappa = 1.0 / tabor_mu;
-        let far = self.jump_in + table.end() * table.end() + kappa;
-        let t_end = table.eval(table.end());
-        cumulative[table.len() - 1] + t_end * far * far * (1.0 / far - 1.0 / (alpha_hat + kappa))
-    }
-
-    /// The approach branch above the jump-in (and its point reflection through A below).
-    #[inline]
-    fn approach_t_hat(&self, alpha_hat: f64) -> f64 {
-        match &self.approach {
-            Approach::ForceFree => 0.0,
-            Approach::SemiRigid {
-                table, tabor_mu, ..
-            } => {
-                let d = alpha_hat - self.jump_in;
-                if d < 0.0 {
-                    return 2.0 * self.jump_in_t_hat - table.eval((-d).sqrt());
-                }
-                let s = d.sqrt();
-                if s <= table.end() {
-                    table.eval(s)
-                } else {
-                    let far = self.jump_in + table.end() * table.end();
-                    let k = (far + 1.0 / tabor_mu) / (alpha_hat + 1.0 / tabor_mu);
-                    table.eval(table.end()) * k * k
-                }
+    /// The tabulated Lennard-Jones law of a numerical solution: its approach branch up to
+    /// the fold A, its contact branch from the fold C into contact; beyond the traced range
+    /// the approach decays as 1/(α̂ + 1/μ)² and the contact branch follows JKR (5) shifted
+    /// to join it.
+    pub fn lennard_jones(solution: &LjSolution) -> Result<Self> {
+        let a = (solution.alpha_hat_a.value, solution.t_hat_a.value);
+        let c = (solution.alpha_hat_c.value, solution.t_hat_c.value);
+        let resample = |points: &[CurvePoint],
+                        fold: (f64, f64),
+                        side: Side|
+         -> Result<(Vec<(f64, f64)>, f64)> {
+            // (u, T̂) of the traced points, u = √|α̂ − α̂₀| increasing away from the fold.
+            let mut pts: Vec<(f64, f64)> = points
+                .iter()
+                .map(|p| {
+                    (
+                        (match side {
+                            Side::Above => p.alpha_hat - fold.0,
+                            Side::Below => fold.0 - p.alpha_hat,
+                        })
+                        .max(0.0)
+                        .sqrt(),
+                        p.t_hat,
+                    )
+                })
+                .collect();
+            pts.push((0.0, fold.1));
+            pts.sort_by(|x, y| x.0.total_cmp(&y.0));
+            pts.dedup_by(|x, y| (x.0 - y.0).abs() < 1e-12);
+            let u_max = pts.last().map_or(0.0, |p| p.0);
+            if pts.len() < 8 || u_max <= 0.0 {
+                return Err(Error::Numerical(
+                    "too few traced points for the LJ law".into(),
+                ));
             }
-        }
-    }
-
-    /// The JKR contact branch (5) on the displacement-stable side (â ≥ â_C), continued past
-    /// C by point reflection through C so that overshooting trial stages see a continuous
-    /// force.
-    #[inline]
-    fn contact_t_hat(&self, alpha_hat: f64) -> f64 {
-        let d = self.c_alpha_hat - alpha_hat;
-        if d < 0.0 {
-            return 2.0 * self.c_t_hat - self.contact.eval((-d).sqrt());
-        }
-        let s = d.sqrt();
-        if s <= self.contact.end() {
-            self.contact.eval(s)
-        } else {
-            jkr::force_hat(jkr::a_hat_from_separation(alpha_hat).unwrap_or(jkr::A_HAT_C))
-        }
+            Ok((pts, u_max))
+        };
+        let (app, u_app) = resample(solution.approach_branch(), a, Side::Above)?;
+        let (con, u_con) = resample(solution.contact_branch(), c, Side::Below)?;
+        let approach = FoldBranch::new(
+            a,
+            Side::Above,
+            u_app,
+            APPROACH_NODES,
+            FarField::Decay {
+                kappa: 1.0 / solution.tabor_mu,
+            },
+            |u| local_cubic(&app, u),
+        );
+        let deepest = c.0 - u_con * u_con;
+        let shift = local_cubic(&con, u_con)
+            - jkr::force_hat(jkr::a_hat_from_separation(deepest).unwrap_or(jkr::A_HAT_C));
+        let contact = FoldBranch::new(
+            c,
+            Side::Below,
+            u_con,
+            CONTACT_NODES,
+            FarField::JkrShift { shift },
+            |u| local_cubic(&con, u),
+        );
+        Self::new(Some(approach), a.0, contact)
     }
 }
 
-impl AdhesiveLaw {
-    /// Work function of the contact branch: Ŵ(â(α̂)) of eq. (6); past C that of the point
-    /// reflection through C.
-    fn contact_work(&self, alpha_hat: f64) -> f64 {
-        let d = alpha_hat - self.c_alpha_hat;
-        if d > 0.0 {
-            return 2.0 * self.c_t_hat * d + self.contact_work(self.c_alpha_hat - d);
-        }
-        jkr::work_hat(jkr::a_hat_from_separation(alpha_hat).unwrap_or(jkr::A_HAT_C))
-    }
+/// Cubic through the four sample points nearest to `u` (sorted by u).
+fn local_cubic(points: &[(f64, f64)], u: f64) -> f64 {
+    let k = points.partition_point(|p| p.0 < u);
+    let start = k.saturating_sub(2).min(points.len() - 4);
+    let p = &points[start..start + 4];
+    (0..4)
+        .map(|i| {
+            let li: f64 = (0..4)
+                .filter(|&j| j != i)
+                .map(|j| (u - p[j].0) / (p[i].0 - p[j].0))
+                .product();
+            li * p[i].1
+        })
+        .sum()
 }
 
 impl ForceLaw for AdhesiveLaw {
     #[inline]
     fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        match branch {
-            Branch::Free => self.approach_t_hat(alpha_hat),
-            Branch::Contact => self.contact_t_hat(alpha_hat),
+        match (branch, &self.approach) {
+            (Branch::Free, None) => 0.0,
+            (Branch::Free, Some(a)) => a.t_hat(alpha_hat),
+            (Branch::Contact, _) => self.contact.t_hat(alpha_hat),
         }
     }
     fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        match branch {
-            Branch::Free => self.approach_work(alpha_hat),
-            Branch::Contact => self.contact_work(alpha_hat),
+        match (branch, &self.approach) {
+            (Branch::Free, None) => 0.0,
+            (Branch::Free, Some(a)) => a.work_hat(alpha_hat),
+            (Branch::Contact, _) => self.contact.work_hat(alpha_hat),
         }
     }
     fn jump_in_alpha_hat(&self) -> f64 {
         self.jump_in
     }
     fn jump_out_alpha_hat(&self) -> f64 {
-        self.c_alpha_hat
+        self.contact.fold().0
     }
     fn free_branch_is_force_free(&self) -> bool {
-        matches!(self.approach, Approach::ForceFree)
+        self.approach.is_none()
     }
     fn loop_area_hat(&self) -> f64 {
         self.loop_area
@@ -290,8 +250,8 @@ mod tests {
     #[test]
     fn loop_areas_match_the_closed_forms() {
         let h = AdhesiveLaw::hybrid(5.0, JumpIn::Fit).unwrap();
-        assert!((h.loop_area_hat() - hybrid::w_hat_fit(5.0)).abs() < 1e-12);
-        assert!((AdhesiveLaw::jkr().loop_area_hat() - jkr::w_hat_jkr()).abs() < 1e-12);
+        assert!((h.loop_area_hat() - hybrid::w_hat_fit(5.0)).abs() < 1e-10);
+        assert!((AdhesiveLaw::jkr().loop_area_hat() - jkr::w_hat_jkr()).abs() < 1e-10);
     }
 
     #[test]
@@ -316,7 +276,7 @@ mod tests {
         ];
         for l in &laws {
             for branch in [Branch::Free, Branch::Contact] {
-                for &alpha in &[-3.0, -0.5, 0.3, 0.9, 1.2, 1.6, 1.7, 2.5, 40.0, 80.0] {
+                for &alpha in &[-70.0, -3.0, -0.5, 0.3, 0.9, 1.2, 1.6, 1.7, 2.5, 40.0, 80.0] {
                     let h = 1e-5;
                     let dw =
                         (l.work_hat(alpha + h, branch) - l.work_hat(alpha - h, branch)) / (2.0 * h);
@@ -357,7 +317,6 @@ mod tests {
             let expect = semi_rigid::force_hat(h);
             assert!((t - expect).abs() < 1e-6 * expect, "h {h}: {t} vs {expect}");
         }
-        // Less loss than the force-free hybrid with the same jump-in would give.
         assert!(l.loop_area_hat() > 0.0);
     }
 }

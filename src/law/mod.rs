@@ -9,10 +9,12 @@
 
 mod adhesive;
 mod conservative;
+mod fold_branch;
 mod table;
 
-pub use adhesive::{AdhesiveLaw, Approach};
+pub use adhesive::AdhesiveLaw;
 pub use conservative::{DmtLaw, HertzLaw, NoForce};
+pub use fold_branch::{FarField, FoldBranch, Side};
 pub use table::UniformTable;
 
 use crate::contact::hybrid::{self, JumpIn};
@@ -69,6 +71,9 @@ pub enum LawKind {
     Dmt,
     /// Hertz: repulsion (4/3)E*√R δ^{3/2} for indentation δ = −α > 0. Conservative.
     Hertz,
+    /// The Lennard-Jones law (10), tabulated from the full numerical solution (both
+    /// branches, jumps at its folds A and C; first use per μ solves it, then cached).
+    Lj,
     /// No tip–sample force (free cantilever).
     None,
 }
@@ -81,6 +86,7 @@ impl fmt::Display for LawKind {
             LawKind::Jkr => "jkr",
             LawKind::Dmt => "dmt",
             LawKind::Hertz => "hertz",
+            LawKind::Lj => "lj",
             LawKind::None => "none",
         })
     }
@@ -120,6 +126,10 @@ impl AnyLaw {
             LawKind::Jkr => AnyLaw::Adhesive(AdhesiveLaw::jkr()),
             LawKind::Dmt => AnyLaw::Dmt(DmtLaw::new(contact, hamaker_j)?),
             LawKind::Hertz => AnyLaw::Hertz(HertzLaw),
+            LawKind::Lj => AnyLaw::Adhesive(
+                AdhesiveLaw::lennard_jones(&crate::contact::lj::solve(mu, true)?)
+                    .map_err(|e| refuse(e.to_string()))?,
+            ),
             LawKind::None => AnyLaw::None(NoForce),
         })
     }
