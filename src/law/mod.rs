@@ -94,6 +94,11 @@ impl fmt::Display for LawKind {
 
 /// One of the laws, chosen at run time.
 #[derive(Debug, Clone)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "built once per simulation and read on every right-hand-side evaluation: \
+              a box would add a pointer chase to the hot path for no saving"
+)]
 pub enum AnyLaw {
     /// hybrid, hybrid-attractive or jkr.
     Adhesive(AdhesiveLaw),
