@@ -103,3 +103,30 @@ fn contact_branch_approaches_jkr_as_mu_grows() {
     }
     assert!(last < 0.03, "{last}");
 }
+
+#[test]
+fn a_compliant_support_adds_spring_losses_to_the_lj_loop() {
+    use tapsim::contact::lj::curve::Hysteresis;
+    use tapsim::contact::spring;
+    let s = solution(5.0);
+    let rigid = Hysteresis::of(&s.curve).unwrap().w_hat;
+    assert!((rigid - s.w_hat.value).abs() < 1e-12);
+    let mut last = rigid;
+    for k_hat in [1e4, 1e3, 100.0, 30.0, 10.0] {
+        let w = Hysteresis::with_spring(&s.curve, k_hat).unwrap().w_hat;
+        let hybrid = spring::hysteresis(5.0, k_hat, JumpIn::Fit).unwrap().w_hat;
+        println!(
+            "k_hat {k_hat}: W_LJ {w:.4}, hybrid (26) {hybrid:.4} ({:+.2} %)",
+            100.0 * (hybrid - w) / w
+        );
+        assert!(
+            w > last,
+            "k_hat {k_hat}: the loss grows as the support softens"
+        );
+        assert!((hybrid - w).abs() < 0.05 * w, "k_hat {k_hat}");
+        last = w;
+    }
+    // Stiff limit: the rigid-grip loop.
+    let stiff = Hysteresis::with_spring(&s.curve, 1e7).unwrap().w_hat;
+    assert!((stiff - rigid).abs() < 1e-5 * rigid, "{stiff} vs {rigid}");
+}

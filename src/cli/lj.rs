@@ -18,13 +18,18 @@ use std::path::PathBuf;
 ///
 /// JSON keys (--json): tabor_mu, alpha_hat_a, t_hat_a, alpha_hat_c, t_hat_c,
 /// pull_off_hat, w_hat, w_hat_error (and an _error for each), nodes, w_hat_hybrid,
-/// hybrid_rel_error, alpha_hat_a_fit, fit_rel_error.
+/// hybrid_rel_error, alpha_hat_a_fit, fit_rel_error; with --k-hat also k_hat,
+/// w_hat_spring, w_hat_spring_hybrid.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct LjArgs {
     /// Tabor parameter μ, eq. (2) [0.5 to 20; the solver is slow above ~6].
     #[arg(long, allow_hyphen_values = true, value_parser = number)]
     mu: f64,
+    /// Support stiffness k̂ = μεk/(RΔγ), eq. (22): adds the loss with the support in
+    /// series (JSON key w_hat_spring) beside the hybrid (26).
+    #[arg(long, allow_hyphen_values = true, value_parser = number)]
+    k_hat: Option<f64>,
     /// Write the traced curve as CSV (s, alpha_hat, t_hat, central_gap).
     #[arg(long)]
     curve: Option<PathBuf>,
@@ -42,7 +47,10 @@ pub fn run(args: LjArgs) -> Result<()> {
     if let Some(path) = &args.curve {
         output::write_bytes(path, &report::curve_csv(&solution)?)?;
     }
-    let r = report::LjReport::new(&solution);
+    let mut r = report::LjReport::new(&solution);
+    if let Some(k) = args.k_hat {
+        r = r.with_spring(&solution, k)?;
+    }
     if args.json {
         println!(
             "{}",

@@ -58,6 +58,15 @@ pub struct LjReport {
     pub nodes_coarse: usize,
     /// Continuation steps.
     pub steps: usize,
+    /// Support stiffness k̂ (22), when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub k_hat: Option<f64>,
+    /// Ŵ_LJ with the support in series, when k̂ is given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub w_hat_spring: Option<f64>,
+    /// The hybrid theory's (26) at the same k̂.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub w_hat_spring_hybrid: Option<f64>,
 }
 
 impl LjReport {
@@ -92,7 +101,23 @@ impl LjReport {
             nodes: s.nodes,
             nodes_coarse: s.nodes_coarse,
             steps: s.steps,
+            k_hat: None,
+            w_hat_spring: None,
+            w_hat_spring_hybrid: None,
         }
+    }
+
+    /// Add the loss with a support of stiffness k̂ in series.
+    pub fn with_spring(mut self, s: &LjSolution, k_hat: f64) -> Result<Self> {
+        crate::params::k_hat(k_hat)?;
+        let loop_ = crate::contact::lj::curve::Hysteresis::with_spring(&s.curve, k_hat)?;
+        self.k_hat = Some(k_hat);
+        self.w_hat_spring = Some(loop_.w_hat);
+        self.w_hat_spring_hybrid =
+            crate::contact::spring::hysteresis(s.tabor_mu, k_hat, JumpIn::Fit)
+                .ok()
+                .map(|h| h.w_hat);
+        Ok(self)
     }
 
     /// A table for people.
@@ -156,6 +181,17 @@ impl LjReport {
             "  pull-off / (3π/2)            {:>10.5}",
             self.pull_off_over_jkr
         );
+        if let (Some(k), Some(w)) = (self.k_hat, self.w_hat_spring) {
+            let _ = writeln!(s, "With a support of stiffness k̂ = {k} in series, eq. (22)");
+            let _ = writeln!(s, "  Ŵ_LJ with the spring         {w:>10.5}");
+            if let Some(h) = self.w_hat_spring_hybrid {
+                let _ = writeln!(
+                    s,
+                    "  Ŵ hybrid (26)                {h:>10.5}  ({:+.2} %)",
+                    100.0 * (h - w) / w
+                );
+            }
+        }
         s
     }
 }

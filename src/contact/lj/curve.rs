@@ -152,6 +152,68 @@ fn crossing(points: &[CurvePoint], from: usize, to: usize, level: f64) -> Result
     )))
 }
 
+/// The hysteresis loop of a traced S-curve: its folds and enclosed area.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hysteresis {
+    /// Jump-in fold (first local minimum of α̂).
+    pub fold_a: Fold,
+    /// Jump-out fold (the largest α̂ after A).
+    pub fold_c: Fold,
+    /// ∫_{α̂_A}^{α̂_C} (T̂_contact − T̂_approach) dα̂.
+    pub w_hat: f64,
+}
+
+impl Hysteresis {
+    /// The loop of `points` (in curve order).
+    pub fn of(points: &[CurvePoint]) -> Result<Self> {
+        let n = points.len();
+        let k_a = (1..n - 1)
+            .find(|&k| {
+                points[k].alpha_hat < points[k - 1].alpha_hat
+                    && points[k].alpha_hat <= points[k + 1].alpha_hat
+            })
+            .ok_or_else(|| Error::Numerical("no jump-in fold found".into()))?;
+        // C: the largest separation after A (small wiggles of the unstable branch, where
+        // the contact edge crosses the coarser mesh near the axis, are not folds of
+        // interest).
+        let k_c = (k_a + 1..n - 1)
+            .max_by(|&i, &j| points[i].alpha_hat.total_cmp(&points[j].alpha_hat))
+            .filter(|&k| k + 1 < n - 1)
+            .ok_or_else(|| Error::Numerical("no jump-out fold found".into()))?;
+        let fold_a = locate_fold(points, k_a)?;
+        let fold_c = locate_fold(points, k_c)?;
+        let s_land = crossing(points, k_c, n - 1, fold_a.alpha_hat)?;
+        let s_app = crossing(points, 0, k_a, fold_c.alpha_hat)?;
+        // Along s both pieces run from α̂_C to α̂_A.
+        let w_hat = work_between(points, s_app, fold_a.s) - work_between(points, fold_c.s, s_land);
+        Ok(Self {
+            fold_a,
+            fold_c,
+            w_hat,
+        })
+    }
+
+    /// The loop seen through a support of stiffness k̂ in series: the same curve in the
+    /// support separation α̂_S = α̂ + T̂/k̂ of eq. (22), whose folds are the spring's jump
+    /// points (23) and whose area is the loss with spring losses included (the LJ
+    /// counterpart of eq. (26)).
+    pub fn with_spring(points: &[CurvePoint], k_hat: f64) -> Result<Self> {
+        let support: Vec<CurvePoint> = points
+            .iter()
+            .map(|p| CurvePoint {
+                alpha_hat: p.alpha_hat + p.t_hat / k_hat,
+                ..*p
+            })
+            .collect();
+        Self::of(&support).map_err(|e| {
+            Error::NotApplicable(format!(
+                "with k_hat = {k_hat} the traced curve does not contain the whole loop ({e}); \
+                 a softer support lands deeper in contact than the solver traces"
+            ))
+        })
+    }
+}
+
 /// Settings of the continuation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TraceOptions {
@@ -286,26 +348,9 @@ pub fn trace(problem: &Problem, opts: &TraceOptions) -> Result<Curve> {
             }
         }
     }
-    // Folds: A is the first local minimum of α̂, C the next local maximum.
-    let n = points.len();
-    let k_a = (1..n - 1)
-        .find(|&k| {
-            points[k].alpha_hat < points[k - 1].alpha_hat
-                && points[k].alpha_hat <= points[k + 1].alpha_hat
-        })
-        .ok_or_else(|| Error::Numerical("no jump-in fold found".into()))?;
-    // C: the largest separation after A (small wiggles of the unstable branch, where the
-    // contact edge crosses the coarser mesh near the axis, are not folds of interest).
-    let k_c = (k_a + 1..n - 1)
-        .max_by(|&i, &j| points[i].alpha_hat.total_cmp(&points[j].alpha_hat))
-        .filter(|&k| k + 1 < n - 1)
-        .ok_or_else(|| Error::Numerical("no jump-out fold found".into()))?;
-    let fold_a = locate_fold(&points, k_a)?;
-    let fold_c = locate_fold(&points, k_c)?;
-    let s_land = crossing(&points, k_c, n - 1, fold_a.alpha_hat)?;
-    let s_app = crossing(&points, 0, k_a, fold_c.alpha_hat)?;
-    // Ŵ = ∫ (T_c − T_a) dα over [α_A, α_C]; along s both pieces run from α_C to α_A.
-    let w_hat = work_between(&points, s_app, fold_a.s) - work_between(&points, fold_c.s, s_land);
+    let hysteresis = Hysteresis::of(&points)?;
+    let (fold_a, fold_c, w_hat) = (hysteresis.fold_a, hysteresis.fold_c, hysteresis.w_hat);
+    let k_c = interval(&points, fold_c.s);
     let pull_off_hat = points[k_c..]
         .iter()
         .map(|p| p.t_hat)
