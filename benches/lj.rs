@@ -7,12 +7,17 @@ use tapsim::contact::lj::{curve, mesh::MeshSpec, result::ELEMENTS_PER_ANNULUS, s
 
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("w_hat_lj");
-    group.sample_size(10).measurement_time(Duration::from_secs(20));
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(20));
     for mu in [2.0, 5.0] {
         group.bench_function(format!("mu={mu}"), |b| {
             b.iter(|| {
-                let problem = Problem::new(mu, MeshSpec::for_tabor(mu, ELEMENTS_PER_ANNULUS).nodes());
-                curve::trace(&problem, &curve::TraceOptions::default()).expect("traced").w_hat
+                let problem =
+                    Problem::new(mu, MeshSpec::for_tabor(mu, ELEMENTS_PER_ANNULUS).nodes());
+                curve::trace(&problem, &curve::TraceOptions::default())
+                    .expect("traced")
+                    .w_hat
             })
         });
     }

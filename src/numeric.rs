@@ -85,6 +85,46 @@ pub fn bracketed_root(
     Err(Error::Numerical(format!("{what}: no convergence")))
 }
 
+/// Root of `f` in `[lo, hi]` (signs of f at the ends must differ) by Newton's method
+/// safeguarded with bisection; `f` returns the value and its derivative. Quadratic once
+/// close, never leaves the bracket. Ends at a step below `x_tol` (absolute) or after 100
+/// iterations, returning the best estimate.
+pub fn newton_bracketed(
+    f: impl Fn(f64) -> (f64, f64),
+    mut lo: f64,
+    mut hi: f64,
+    x_tol: f64,
+) -> f64 {
+    let (f_lo, _) = f(lo);
+    if f_lo == 0.0 {
+        return lo;
+    }
+    let lo_negative = f_lo < 0.0;
+    let mut x = 0.5 * (lo + hi);
+    for _ in 0..100 {
+        let (fx, dfx) = f(x);
+        if fx == 0.0 {
+            return x;
+        }
+        if (fx < 0.0) == lo_negative {
+            lo = x;
+        } else {
+            hi = x;
+        }
+        let newton = x - fx / dfx;
+        let next = if newton > lo.min(hi) && newton < lo.max(hi) && newton.is_finite() {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        if (next - x).abs() <= x_tol {
+            return next;
+        }
+        x = next;
+    }
+    x
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -116,6 +156,15 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn newton_bracketed_finds_roots_fast_and_safely() {
+        let r = newton_bracketed(|x| (x * x * x - 2.0, 3.0 * x * x), 0.0, 2.0, 1e-15);
+        assert!((r - 2f64.cbrt()).abs() < 1e-14);
+        // A derivative that would throw Newton out of the bracket.
+        let r = newton_bracketed(|x| (x.atan(), 1.0 / (1.0 + x * x)), -10.0, 3.0, 1e-15);
+        assert!(r.abs() < 1e-14);
     }
 
     #[test]

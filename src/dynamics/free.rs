@@ -3,7 +3,7 @@
 //! and so are the carried integrals.
 
 use super::model::{Drive, E_DAMP, E_DRIVE, Oscillator, SC, SS, State, V, X};
-use crate::numeric::bracketed_root;
+use crate::numeric::newton_bracketed;
 use nalgebra::Complex;
 
 /// The free motion from a given state.
@@ -88,6 +88,16 @@ impl FreeFlight {
         (x_p + x_h, v_p + v_h)
     }
 
+    /// Velocity and acceleration at τ (the acceleration from the equation of motion).
+    #[inline]
+    fn velocity_and_acceleration(&self, tau: f64) -> (f64, f64) {
+        let (x, v) = self.at(tau);
+        (
+            v,
+            self.f0 * (self.omega * tau).cos() - 2.0 * self.gamma * v - x,
+        )
+    }
+
     /// Advance `y` (deflection, velocity and the carried integrals) from `tau_a` to
     /// `tau_b`, all in closed form: the Fourier projections are integrals of exponentials,
     /// the drive's work follows from them by parts, ∫ f₀ cos Ωτ x' dτ =
@@ -149,10 +159,8 @@ impl FreeFlight {
             let (x1, v1) = self.at(t1);
             // The lowest point inside, where x' changes from negative to positive.
             let (t_low, x_low) = if v0 < 0.0 && v1 > 0.0 {
-                match bracketed_root("free-flight minimum", |t| self.at(t).1, t0, t1, 1e-14) {
-                    Ok(t) => (t, self.at(t).0),
-                    Err(_) => (t1, x1),
-                }
+                let t = newton_bracketed(|t| self.velocity_and_acceleration(t), t0, t1, 1e-14);
+                (t, self.at(t).0)
             } else if x1 < x0 {
                 (t1, x1)
             } else {
@@ -160,14 +168,15 @@ impl FreeFlight {
             };
             min_x = min_x.min(x_low);
             if x_low <= level && x0 > level {
-                let hit = bracketed_root(
-                    "free-flight jump-in",
-                    |t| self.at(t).0 - level,
+                let hit = newton_bracketed(
+                    |t| {
+                        let (x, v) = self.at(t);
+                        (x - level, v)
+                    },
                     t0,
                     t_low,
                     1e-14,
-                )
-                .unwrap_or(t_low);
+                );
                 return (Some(hit), min_x.min(level));
             }
             (t0, x0, v0) = (t1, x1, v1);

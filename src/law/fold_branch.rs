@@ -36,11 +36,14 @@ pub enum FarField {
 #[derive(Debug, Clone)]
 pub struct FoldBranch {
     table: UniformTable,
+    /// +1 above the fold, −1 below.
+    sign: f64,
+    /// Last abscissa of the table.
+    u_max: f64,
     /// ∫ T̂ dα̂ from the fold to each node.
     cumulative: Vec<f64>,
     fold_alpha_hat: f64,
     fold_t_hat: f64,
-    side: Side,
     far: FarField,
 }
 
@@ -58,10 +61,14 @@ impl FoldBranch {
         let table = UniformTable::sample(0.0, u_max, nodes, t_of_u);
         let mut branch = Self {
             cumulative: Vec::with_capacity(table.len()),
+            sign: match side {
+                Side::Above => 1.0,
+                Side::Below => -1.0,
+            },
+            u_max: table.end(),
             table,
             fold_alpha_hat: fold.0,
             fold_t_hat: fold.1,
-            side,
             far,
         };
         let h = branch.table.step();
@@ -81,10 +88,7 @@ impl FoldBranch {
     }
 
     fn sign(&self) -> f64 {
-        match self.side {
-            Side::Above => 1.0,
-            Side::Below => -1.0,
-        }
+        self.sign
     }
 
     fn alpha_at(&self, u: f64) -> f64 {
@@ -107,16 +111,23 @@ impl FoldBranch {
     /// T̂ at α̂.
     #[inline]
     pub fn t_hat(&self, alpha_hat: f64) -> f64 {
-        let d = self.sign() * (alpha_hat - self.fold_alpha_hat);
+        let d = self.sign * (alpha_hat - self.fold_alpha_hat);
+        if d >= 0.0 {
+            let u = d.sqrt();
+            if u <= self.u_max {
+                return self.table.eval(u);
+            }
+        }
+        self.t_hat_outside(alpha_hat, d)
+    }
+
+    /// T̂ past the fold (point reflection through it) or beyond the table (far field).
+    #[cold]
+    fn t_hat_outside(&self, alpha_hat: f64, d: f64) -> f64 {
         if d < 0.0 {
-            // Past the fold: point reflection through it.
             return 2.0 * self.fold_t_hat - self.t_hat(2.0 * self.fold_alpha_hat - alpha_hat);
         }
-        let u = d.sqrt();
-        if u <= self.table.end() {
-            return self.table.eval(u);
-        }
-        let end = self.table.end();
+        let end = self.u_max;
         let (alpha_end, t_end) = (self.alpha_at(end), self.table.eval(end));
         match self.far {
             FarField::Decay { kappa } => {
