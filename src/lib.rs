@@ -3,7 +3,7 @@
 //! The physics follows Ciavarella, Greenwood & Barber, "Effect of Tabor parameter on
 //! hysteresis losses during adhesive contact"; equation numbers in the documentation
 //! are that paper's. Data flows one way: [`params`] → [`contact`] (force laws) →
-//! [`quasistatic`] → [`figures`] → [`report`].
+//! [`law`] → [`dynamics`] / [`quasistatic`] → [`sweep`] → [`figures`] → [`report`].
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -19,6 +19,7 @@ pub mod numeric;
 pub mod params;
 pub mod quasistatic;
 pub mod report;
+pub mod sweep;
 pub mod units;
 
 pub use error::{Error, Result};

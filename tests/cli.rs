@@ -480,3 +480,31 @@ fn shipped_example_config_runs() {
     assert_eq!(v["converged"], serde_json::Value::Bool(true));
     assert!((num(&v, "amplitude_ratio") - 0.9).abs() < 0.02);
 }
+
+#[test]
+fn approach_json_is_one_object_of_equal_length_arrays() {
+    let v = json(&[
+        "approach", "--points", "6", "--from", "22nm", "--to", "12nm", "--json", "--quiet",
+    ]);
+    let obj = v.as_object().unwrap();
+    for key in [
+        "separation_m",
+        "direction",
+        "amplitude_m",
+        "amplitude_ratio",
+        "phase_deg",
+        "e_ts_j",
+        "virial_j",
+        "mean_force_n",
+        "peak_force_n",
+        "converged",
+    ] {
+        assert_eq!(
+            obj[key].as_array().unwrap_or_else(|| panic!("{key}")).len(),
+            12,
+            "{key}"
+        );
+    }
+    assert_eq!(obj["direction"][0], "approach");
+    assert_eq!(obj["direction"][11], "retract");
+}

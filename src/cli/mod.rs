@@ -1,6 +1,7 @@
 //! The `tapsim` command line: parse, call the library, print. Each subcommand lives in
 //! its own module.
 
+mod approach;
 mod figure;
 mod hysteresis;
 mod lj;
@@ -26,6 +27,7 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     Tap(tap::TapArgs),
+    Approach(approach::ApproachArgs),
     Hysteresis(hysteresis::HysteresisArgs),
     Lj(lj::LjArgs),
     Figure(figure::FigureArgs),
@@ -36,6 +38,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
         Command::Tap(args) => tap::run(args),
+        Command::Approach(args) => approach::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),
         Command::Lj(args) => lj::run(args),
         Command::Figure(args) => figure::run(args),

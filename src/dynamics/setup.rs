@@ -207,4 +207,12 @@ impl Prepared {
             tol: self.tol,
         }
     }
+
+    /// The simulation with the rest separation moved to `separation_m` (a sweep step).
+    pub fn simulation_at(&self, separation_m: f64) -> Result<Simulation<'_, AnyLaw>> {
+        finite("separation", separation_m)?;
+        let mut sim = self.simulation();
+        sim.cpl.a0 = separation_m / self.setup.contact.separation_scale_m();
+        Ok(sim)
+    }
 }

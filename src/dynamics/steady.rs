@@ -199,6 +199,14 @@ impl<L: ForceLaw> Simulation<'_, L> {
     ) -> Result<CycleIntegrals> {
         let period = self.osc.period();
         let tau_end = phase.tau + period;
+        // A state carried over from another setpoint may sit on the wrong side of a
+        // switch (the tip cannot be out of contact below the jump-in separation).
+        let alpha = self.cpl.alpha_hat(phase.x, self.osc.base_at(phase.tau).0);
+        phase.branch = match phase.branch {
+            Branch::Free if alpha <= self.law.jump_in_alpha_hat() => Branch::Contact,
+            Branch::Contact if alpha >= self.law.jump_out_alpha_hat() => Branch::Free,
+            b => b,
+        };
         let mut y = State::zeros();
         y[X] = phase.x;
         y[V] = phase.v;

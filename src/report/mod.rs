@@ -6,4 +6,5 @@ pub mod hysteresis;
 pub mod lj;
 pub mod output;
 pub mod plot;
+pub mod sweep;
 pub mod tap;

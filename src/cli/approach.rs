@@ -1,0 +1,114 @@
+//! `tapsim approach`: an approach–retract curve.
+
+use crate::config::{TapInputs, length};
+use crate::error::Result;
+use crate::report::{output, plot, sweep as report};
+use crate::sweep::{self, Direction};
+use clap::Args;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+/// Sweep the rest separation z_c down (approach) and back up (retract), carrying the
+/// oscillator from point to point as a slow piezo ramp does, so the attractive/repulsive
+/// bistability and its hysteresis appear. Every `tapsim tap` option applies.
+///
+/// Per point: the steady-state observables of `tapsim tap`. Output: a table on stdout,
+/// or --json (one object of equal-length arrays: separation_m, direction, amplitude_m,
+/// amplitude_ratio, phase_deg, e_ts_j, virial_j, mean_force_n, peak_force_n, converged,
+/// ...), --csv FILE, and --plot FILE.png|svg (A/A₀, φ, E_ts, virial, peak force vs z_c;
+/// φ vs A/A₀; approach and retract distinct).
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct ApproachArgs {
+    #[command(flatten)]
+    inputs: TapInputs,
+    /// TOML parameter file (keys: the flags' names).
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Farthest rest separation [m; default 1.2 A₀].
+    #[arg(long, allow_hyphen_values = true, value_parser = length)]
+    from: Option<f64>,
+    /// Nearest rest separation [m; default 0.4 A₀].
+    #[arg(long, allow_hyphen_values = true, value_parser = length)]
+    to: Option<f64>,
+    /// Points on the approach (the retract has as many).
+    #[arg(long, default_value_t = 60)]
+    points: usize,
+    /// Approach only.
+    #[arg(long)]
+    no_retract: bool,
+    /// Write every point as CSV.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Plot the curves (.png or .svg).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Print one JSON object of arrays on stdout instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// Run the subcommand.
+pub fn run(args: ApproachArgs) -> Result<()> {
+    let (setup, numerics) = args.inputs.with_config(args.config.as_ref())?.resolve()?;
+    let a0 = setup.cantilever.free_amplitude_m;
+    let ramp = sweep::ramp(
+        args.from.unwrap_or(1.2 * a0),
+        args.to.unwrap_or(0.4 * a0),
+        args.points,
+        !args.no_retract,
+    )?;
+    let bar = if args.quiet || !std::io::stderr().is_terminal() {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(ramp.len() as u64)
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} setpoints, {eta} left")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let points = sweep::approach_curve(&setup, &numerics, &ramp, |done, _| {
+        bar.set_position(done as u64)
+    })?;
+    bar.finish_and_clear();
+    if let Some(path) = &args.csv {
+        output::write_bytes(path, &report::records_csv(&points)?)?;
+    }
+    if let Some(path) = &args.plot {
+        plot::render_stack(
+            &report::approach_charts(&points, &format!("{} law", setup.law)),
+            path,
+        )?;
+    }
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report::columns_json(&points)?).expect("serialises")
+        );
+    } else {
+        println!(
+            "{:>9} {:>9} {:>9} {:>10} {:>11} {:>10} {:>5}",
+            "z_c (nm)", "dir", "A/A0", "phi (deg)", "E_ts (eV)", "F_pk (nN)", "conv"
+        );
+        for p in &points {
+            let o = &p.observables;
+            println!(
+                "{:>9.3} {:>9} {:>9.5} {:>10.4} {:>11.4} {:>10.4} {:>5}",
+                p.separation_m * 1e9,
+                match p.direction {
+                    Direction::Approach => "approach",
+                    Direction::Retract => "retract",
+                },
+                o.amplitude_ratio,
+                o.phase_deg,
+                o.e_ts_ev,
+                o.peak_force_n * 1e9,
+                if o.converged { "yes" } else { "NO" }
+            );
+        }
+    }
+    Ok(())
+}

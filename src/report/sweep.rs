@@ -1,0 +1,164 @@
+//! Reports of sweeps: records as CSV, as one JSON object of equal-length arrays, and
+//! the approach-curve charts.
+
+use super::chart::{Axis, Chart, Corner, Series, Style};
+use crate::error::{Error, Result};
+use crate::sweep::{Direction, SweepPoint};
+use serde::Serialize;
+use serde_json::{Map, Value};
+
+/// Serialise records to JSON objects (one per record).
+fn objects<T: Serialize>(records: &[T]) -> Result<Vec<Map<String, Value>>> {
+    records
+        .iter()
+        .map(|r| match serde_json::to_value(r) {
+            Ok(Value::Object(m)) => Ok(m),
+            Ok(_) => Err(Error::Output {
+                path: "records".into(),
+                reason: "a record is not an object".into(),
+            }),
+            Err(e) => Err(Error::Output {
+                path: "records".into(),
+                reason: e.to_string(),
+            }),
+        })
+        .collect()
+}
+
+/// One JSON object whose fields are arrays (one entry per record), in record-field order.
+pub fn columns_json<T: Serialize>(records: &[T]) -> Result<Value> {
+    let rows = objects(records)?;
+    let mut out = Map::new();
+    if let Some(first) = rows.first() {
+        for key in first.keys() {
+            out.insert(
+                key.clone(),
+                Value::Array(
+                    rows.iter()
+                        .map(|r| r.get(key).cloned().unwrap_or(Value::Null))
+                        .collect(),
+                ),
+            );
+        }
+    }
+    Ok(Value::Object(out))
+}
+
+/// The records as CSV, one row each, the fields as columns.
+pub fn records_csv<T: Serialize>(records: &[T]) -> Result<Vec<u8>> {
+    let rows = objects(records)?;
+    let fail = |e: csv::Error| Error::Output {
+        path: "records.csv".into(),
+        reason: e.to_string(),
+    };
+    let mut w = csv::Writer::from_writer(Vec::new());
+    if let Some(first) = rows.first() {
+        w.write_record(first.keys()).map_err(fail)?;
+        for r in &rows {
+            w.write_record(first.keys().map(|k| match r.get(k) {
+                Some(Value::String(s)) => s.clone(),
+                Some(Value::Null) | None => String::new(),
+                Some(v) => v.to_string(),
+            }))
+            .map_err(fail)?;
+        }
+    }
+    w.into_inner().map_err(|e| Error::Output {
+        path: "records.csv".into(),
+        reason: e.to_string(),
+    })
+}
+
+/// Approach-curve charts: A/A₀, φ, E_ts, virial and peak force against z_c, and φ and
+/// E_ts against A/A₀; approach and retract as separate series.
+pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
+    type Pick = fn(&SweepPoint) -> f64;
+    let nm = |p: &SweepPoint| p.separation_m * 1e9;
+    let series = |x: &dyn Fn(&SweepPoint) -> f64, y: Pick| -> Vec<Series> {
+        [
+            (Direction::Approach, "approach", 1),
+            (Direction::Retract, "retract", 2),
+        ]
+        .into_iter()
+        .filter_map(|(dir, name, color)| {
+            let pts: Vec<(f64, f64)> = points
+                .iter()
+                .filter(|p| p.direction == dir)
+                .map(|p| (x(p), y(p)))
+                .collect();
+            (!pts.is_empty()).then(|| {
+                let style = if dir == Direction::Approach {
+                    Style::Line
+                } else {
+                    Style::Dashed
+                };
+                Series::new(name, pts, style, color)
+            })
+        })
+        .collect()
+    };
+    let chart =
+        |name: &str, what: &str, x: Axis, xs: &dyn Fn(&SweepPoint) -> f64, y: Axis, ys: Pick| {
+            Chart {
+                name: name.into(),
+                title: format!("{title}: {what}"),
+                x,
+                y,
+                series: series(xs, ys),
+                labels: vec![],
+                legend: Corner::LowerRight,
+            }
+        };
+    let zc = || Axis::linear("rest separation z_c (nm)", "separation_nm");
+    let ratio = |p: &SweepPoint| p.observables.amplitude_ratio;
+    vec![
+        chart(
+            "amplitude",
+            "amplitude",
+            zc(),
+            &nm,
+            Axis::linear("A/A₀", "amplitude_ratio"),
+            |p| p.observables.amplitude_ratio,
+        ),
+        chart(
+            "phase",
+            "phase",
+            zc(),
+            &nm,
+            Axis::linear("phase lag φ (deg)", "phase_deg"),
+            |p| p.observables.phase_deg,
+        ),
+        chart(
+            "e_ts",
+            "dissipation",
+            zc(),
+            &nm,
+            Axis::linear("E_ts per cycle (eV)", "e_ts_ev"),
+            |p| p.observables.e_ts_ev,
+        ),
+        chart(
+            "virial",
+            "virial",
+            zc(),
+            &nm,
+            Axis::linear("virial ⟨F_ts z⟩ (eV)", "virial_ev"),
+            |p| p.observables.virial_j / crate::params::ELECTRONVOLT_J,
+        ),
+        chart(
+            "peak_force",
+            "peak force",
+            zc(),
+            &nm,
+            Axis::linear("peak repulsive force (nN)", "peak_force_nn"),
+            |p| p.observables.peak_force_n * 1e9,
+        ),
+        chart(
+            "phase_vs_amplitude",
+            "phase vs amplitude",
+            Axis::linear("A/A₀", "amplitude_ratio"),
+            &ratio,
+            Axis::linear("phase lag φ (deg)", "phase_deg"),
+            |p| p.observables.phase_deg,
+        ),
+    ]
+}
