@@ -19,6 +19,7 @@ pub mod numeric;
 pub mod params;
 pub mod quasistatic;
 pub mod report;
+pub mod reproduce;
 pub mod sweep;
 pub mod units;
 

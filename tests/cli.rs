@@ -508,3 +508,52 @@ fn approach_json_is_one_object_of_equal_length_arrays() {
     assert_eq!(obj["direction"][0], "approach");
     assert_eq!(obj["direction"][11], "retract");
 }
+
+#[test]
+fn reproduce_regenerates_every_file_its_readme_lists() {
+    let dir = scratch("reproduce");
+    let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .args(["reproduce", "--quiet", "--out", dir.to_str().unwrap()])
+        .env(
+            "TAPSIM_CACHE",
+            std::env::temp_dir().join(format!("tapsim-test-cache-{}", std::process::id())),
+        )
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
+    let listed: Vec<&str> = readme
+        .lines()
+        .filter_map(|l| l.strip_prefix("| `").and_then(|r| r.split('`').next()))
+        .collect();
+    assert!(listed.len() >= 25, "{listed:?}");
+    for name in &listed {
+        let path = dir.join(name);
+        let bytes = std::fs::read(&path).unwrap_or_else(|_| panic!("{name} listed but missing"));
+        assert!(!bytes.is_empty(), "{name} is empty");
+        if name.ends_with(".csv") {
+            let mut r = csv::Reader::from_reader(bytes.as_slice());
+            let width = r.headers().unwrap().len();
+            let rows: Vec<_> = r.records().map(|r| r.unwrap()).collect();
+            assert!(
+                !rows.is_empty() && rows.iter().all(|row| row.len() == width),
+                "{name}"
+            );
+        }
+    }
+    // Every file written is listed.
+    let on_disk = std::fs::read_dir(&dir).unwrap().count();
+    assert_eq!(
+        on_disk,
+        listed.len() + 1,
+        "README.md lists every other file"
+    );
+    for needle in ["Ŵ_JKR", "Ŵ_LJ(μ = 5)", "fit (17)", "default tap"] {
+        assert!(readme.contains(needle), "{needle}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -41,3 +41,32 @@ fn bad_ramps_are_refused() {
     assert!(sweep::ramp(20e-9, 10e-9, 1, true).is_err());
     assert!(sweep::ramp(f64::NAN, 10e-9, 10, true).is_err());
 }
+
+#[test]
+fn dmt_approach_jumps_from_the_attractive_to_the_repulsive_regime() {
+    // Weak attraction on a stiffer sample: the phase falls through 90° on approach.
+    let mut setup = default_setup();
+    setup.law = tapsim::law::LawKind::Dmt;
+    setup.hamaker_j = Some(5e-20);
+    setup.contact.modulus_pa = tapsim::params::composite_modulus(169e9, 0.28, 2e9, 0.4).unwrap();
+    let ramp = sweep::ramp(24e-9, 8e-9, 16, true).unwrap();
+    // This ramp once ended in a Dopri5 step-size underflow (a switch located at the very
+    // start of a step, late in the run): it must complete.
+    let points = sweep::approach_curve(&setup, &Numerics::default(), &ramp, |_, _| {}).unwrap();
+    let approach: Vec<f64> = points
+        .iter()
+        .filter(|p| p.direction == Direction::Approach)
+        .map(|p| p.observables.phase_deg)
+        .collect();
+    assert!(approach.iter().any(|&p| p > 90.5), "{approach:?}");
+    assert!(approach.last().copied().unwrap() < 40.0, "{approach:?}");
+    // The largest drop between neighbouring setpoints crosses 90°.
+    let (i, _) = approach
+        .windows(2)
+        .enumerate()
+        .map(|(i, w)| (i, w[0] - w[1]))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap();
+    assert!(approach[i] > 90.0 && approach[i + 1] < 90.0, "{approach:?}");
+    assert!(points.iter().all(|p| p.observables.converged));
+}

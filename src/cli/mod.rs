@@ -5,6 +5,7 @@ mod approach;
 mod figure;
 mod hysteresis;
 mod lj;
+mod reproduce;
 mod tap;
 
 use clap::{Parser, Subcommand};
@@ -31,6 +32,7 @@ enum Command {
     Hysteresis(hysteresis::HysteresisArgs),
     Lj(lj::LjArgs),
     Figure(figure::FigureArgs),
+    Reproduce(reproduce::ReproduceArgs),
 }
 
 /// Run the command line with the process arguments; the exit code to return.
@@ -42,6 +44,7 @@ pub fn main() -> ExitCode {
         Command::Hysteresis(args) => hysteresis::run(args),
         Command::Lj(args) => lj::run(args),
         Command::Figure(args) => figure::run(args),
+        Command::Reproduce(args) => reproduce::run(args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,

@@ -74,8 +74,8 @@ pub fn hermite(a: &StepEnd, b: &StepEnd, i: usize, tau: f64) -> f64 {
 struct Progress {
     /// The last accepted step end.
     last: StepEnd,
-    /// The step in which the switch happened (its start) and the located time.
-    hit: Option<(StepEnd, f64)>,
+    /// The step in which the switch happened (its start and end) and the located time.
+    hit: Option<(StepEnd, StepEnd, f64)>,
     /// Length of the first accepted step (0 until there is one).
     h: f64,
 }
@@ -157,7 +157,7 @@ impl<L: ForceLaw, O: StepObserver> System<f64, State> for Segment<'_, L, O> {
         let start = self.progress.last;
         if let Some((level, crossing)) = self.event {
             if let Some(t) = self.locate(&start, &end, level, crossing) {
-                self.progress.hit = Some((start, t));
+                self.progress.hit = Some((start, end, t));
                 return true;
             }
         }
@@ -214,6 +214,21 @@ fn dopri<S: System<f64, State>>(
     )
 }
 
+/// Whether [from, to] is too short for Dopri5 to step at this τ (its step-size underflow
+/// test is 0.1·h ≤ ε·|τ|); such spans are bridged by the Hermite interpolant instead.
+fn too_short(from: f64, to: f64) -> bool {
+    to - from <= 100.0 * f64::EPSILON * from.abs().max(1.0)
+}
+
+/// The state on the step [a, b] at τ from its cubic Hermite interpolant.
+fn interpolate(a: &StepEnd, b: &StepEnd, tau: f64) -> State {
+    let mut y = State::zeros();
+    for i in 0..y.len() {
+        y[i] = hermite(a, b, i, tau);
+    }
+    y
+}
+
 fn run<S: System<f64, State>>(
     system: S,
     from: f64,
@@ -250,6 +265,15 @@ pub fn integrate<L: ForceLaw, O: StepObserver>(
     set_phasor(osc, tau0, &mut y0);
     let mut dy0 = State::zeros();
     rhs(law, osc, cpl, branch, tau0, &y0, &mut dy0);
+    if too_short(tau0, tau_end) {
+        // Nothing Dopri5 could step over: advance by one Euler step (error ~ (Δτ)²).
+        return Ok(SegmentEnd {
+            tau: tau_end,
+            y: y0 + dy0 * (tau_end - tau0),
+            switched: false,
+            h_first: 0.0,
+        });
+    }
     let mut progress = Progress {
         last: StepEnd {
             tau: tau0,
@@ -269,7 +293,7 @@ pub fn integrate<L: ForceLaw, O: StepObserver>(
         observer: &mut *observer,
     };
     run(segment, tau0, tau_end, y0, h0, tol, branch)?;
-    let Some((start, t_hit)) = progress.hit else {
+    let Some((start, hit_end, t_hit)) = progress.hit else {
         let last = progress.last;
         return Ok(SegmentEnd {
             tau: last.tau,
@@ -300,7 +324,10 @@ pub fn integrate<L: ForceLaw, O: StepObserver>(
             hit: None,
             h: 0.0,
         };
-        if t > start.tau {
+        if too_short(start.tau, t) {
+            // The switch sits at the very start of the step: interpolate.
+            refine.last.y = interpolate(&start, &hit_end, t);
+        } else if t > start.tau {
             let mut quiet = Ignore;
             let again = Segment {
                 law,

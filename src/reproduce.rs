@@ -1,0 +1,329 @@
+//! `tapsim reproduce`: regenerate the paper's figures and a set of tapping-mode figures,
+//! with a generated `README.md` that lists every file and the headline numbers.
+
+use crate::contact::hybrid;
+use crate::contact::jkr;
+use crate::contact::lj;
+use crate::contact::semi_rigid;
+use crate::dynamics::observables::tap;
+use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
+use crate::error::Result;
+use crate::figures::{self, FigureOptions};
+use crate::law::LawKind;
+use crate::params::{Contact, ELECTRONVOLT_J, composite_modulus};
+use crate::report::chart::{Axis, Chart, Corner, Series, Style};
+use crate::report::{output, plot, sweep as sweep_report, tap as tap_report};
+use crate::sweep::{self, Direction, SweepPoint};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The laws compared in the tapping figures.
+const LAWS: [LawKind; 3] = [LawKind::Jkr, LawKind::Hybrid, LawKind::Lj];
+
+/// A second, stiffer and less adhesive polymer for the phase-contrast figure
+/// (E = 1 GPa, ν = 0.4, Δγ = 0.08 J/m²: μ ≈ 1.5).
+pub fn second_material() -> Contact {
+    let e = composite_modulus(169e9, 0.28, 1e9, 0.4).expect("valid");
+    Contact::new(20e-9, e, 0.08, 0.3e-9).expect("valid")
+}
+
+/// One generated file and what it shows.
+struct Entry {
+    file: String,
+    what: String,
+}
+
+fn approach(setup: &TapSetup, law: LawKind, points: usize) -> Result<Vec<SweepPoint>> {
+    let setup = TapSetup {
+        law,
+        ..setup.clone()
+    };
+    let a0 = setup.cantilever.free_amplitude_m;
+    let ramp = sweep::ramp(1.2 * a0, 0.4 * a0, points, true)?;
+    sweep::approach_curve(&setup, &Numerics::default(), &ramp, |_, _| {})
+}
+
+/// Regenerate everything into `out`; `progress` is told what is being made. Returns the
+/// files written (README.md last).
+pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathBuf>> {
+    output::ensure_dir(out)?;
+    let mut entries: Vec<Entry> = Vec::new();
+    let mut written: Vec<PathBuf> = Vec::new();
+    let mut add = |paths: Vec<PathBuf>, what: &str, entries: &mut Vec<Entry>| {
+        for p in paths {
+            entries.push(Entry {
+                file: p
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+                what: what.into(),
+            });
+            written.push(p);
+        }
+    };
+    // The paper's figures.
+    let opts = FigureOptions::default();
+    let captions = [
+        "Fig. 1: JKR loading and unloading under rigid grips, eqs. (5), (8), (9)",
+        "Fig. 2: Lennard-Jones force-separation curve for mu = 5 (numerical) beside JKR",
+        "Fig. 3: jump-in separation vs mu: numerical LJ, semi-rigid (14)-(15), (16), fit (17)",
+        "Fig. 4: hysteresis loss vs mu: numerical LJ, hybrid (18), JKR (9)",
+        "Fig. 5: loading-unloading cycle with a compliant support (mu = 5, k_hat = 2), eq. (26)",
+        "Fig. 6: hysteresis loss vs support stiffness for mu = 2, 5, 10, 20, eqs. (26), (27)",
+    ];
+    for (n, caption) in (1..=6).zip(captions) {
+        progress(&format!("figure {n}"));
+        let chart = figures::figure(n, &opts)?;
+        add(chart.write_all(out)?, caption, &mut entries);
+    }
+    let solutions = figures::lj_solutions()?;
+    let table = out.join("fig3_lj_vs_fit.csv");
+    output::write_bytes(&table, &figures::lj_fit_table(&solutions)?)?;
+    add(
+        vec![table],
+        "numerical alpha_A and W_LJ for mu = 1 ... 5 against the fit (17) and the hybrid (18)",
+        &mut entries,
+    );
+
+    // Tapping: one trajectory on the defaults.
+    progress("default tap");
+    let setup = default_setup();
+    let run = tap(&setup, &Numerics::default(), 3)?;
+    let charts = tap_report::trajectory_charts(&run, "hybrid law, defaults");
+    for ext in ["png", "svg"] {
+        let path = out.join(format!("tap_trajectory.{ext}"));
+        plot::render_stack(&charts, &path)?;
+        add(
+            vec![path],
+            "default tap (hybrid law): deflection, force, force-separation loop",
+            &mut entries,
+        );
+    }
+    let path = out.join("tap_trajectory.csv");
+    output::write_bytes(&path, &tap_report::trajectory_csv(&run.trajectory)?)?;
+    add(vec![path], "default tap: trajectory samples", &mut entries);
+
+    // Approach curves and phase contrast for JKR, hybrid and LJ, two materials.
+    let materials = [
+        ("polymer A", setup.contact),
+        ("polymer B", second_material()),
+    ];
+    let mut curves: Vec<(String, LawKind, Vec<SweepPoint>)> = Vec::new();
+    for (name, contact) in &materials {
+        for law in LAWS {
+            progress(&format!("approach curve, {name}, {law}"));
+            let s = TapSetup {
+                contact: *contact,
+                ..setup.clone()
+            };
+            curves.push((name.to_string(), law, approach(&s, law, 40)?));
+        }
+    }
+    let series_for =
+        |material: &str, y: fn(&SweepPoint) -> f64, x: fn(&SweepPoint) -> f64| -> Vec<Series> {
+            curves
+                .iter()
+                .filter(|(m, _, _)| m == material)
+                .enumerate()
+                .flat_map(|(i, (_, law, pts))| {
+                    [
+                        (Direction::Approach, Style::Line),
+                        (Direction::Retract, Style::Dashed),
+                    ]
+                    .map(|(dir, style)| {
+                        Series::new(
+                            &format!(
+                                "{law} {}",
+                                if dir == Direction::Approach {
+                                    "approach"
+                                } else {
+                                    "retract"
+                                }
+                            ),
+                            pts.iter()
+                                .filter(|p| p.direction == dir)
+                                .map(|p| (x(p), y(p)))
+                                .collect(),
+                            style,
+                            i + 1,
+                        )
+                    })
+                })
+                .collect()
+        };
+    let zc = |p: &SweepPoint| p.separation_m * 1e9;
+    let approach_charts = vec![
+        Chart {
+            name: "tap_approach_amplitude".into(),
+            title: "Approach curves, polymer A: amplitude".into(),
+            x: Axis::linear("rest separation z_c (nm)", "separation_nm"),
+            y: Axis::linear("A/A₀", "amplitude_ratio"),
+            series: series_for("polymer A", |p| p.observables.amplitude_ratio, zc),
+            labels: vec![],
+            legend: Corner::LowerRight,
+        },
+        Chart {
+            name: "tap_approach_phase".into(),
+            title: "Approach curves, polymer A: phase".into(),
+            x: Axis::linear("rest separation z_c (nm)", "separation_nm"),
+            y: Axis::linear("phase lag φ (deg)", "phase_deg"),
+            series: series_for("polymer A", |p| p.observables.phase_deg, zc),
+            labels: vec![],
+            legend: Corner::LowerLeft,
+        },
+        Chart {
+            name: "tap_approach_dissipation".into(),
+            title: "Approach curves, polymer A: dissipation".into(),
+            x: Axis::linear("rest separation z_c (nm)", "separation_nm"),
+            y: Axis::linear("E_ts per cycle (eV)", "e_ts_ev"),
+            series: series_for("polymer A", |p| p.observables.e_ts_ev, zc),
+            labels: vec![],
+            legend: Corner::UpperRight,
+        },
+    ];
+    for ext in ["png", "svg"] {
+        let path = out.join(format!("tap_approach_laws.{ext}"));
+        plot::render_stack(&approach_charts, &path)?;
+        add(
+            vec![path],
+            "approach-retract curves for the jkr, hybrid and lj laws (polymer A)",
+            &mut entries,
+        );
+    }
+    let mut records = Vec::new();
+    for (material, law, pts) in &curves {
+        for p in pts {
+            records.push(serde_json::json!({
+                "material": material,
+                "law": law.to_string(),
+                "separation_m": p.separation_m,
+                "direction": p.direction,
+                "amplitude_ratio": p.observables.amplitude_ratio,
+                "phase_deg": p.observables.phase_deg,
+                "e_ts_j": p.observables.e_ts_j,
+                "converged": p.observables.converged,
+            }));
+        }
+    }
+    let path = out.join("tap_approach_laws.csv");
+    output::write_bytes(&path, &sweep_report::records_csv(&records)?)?;
+    add(
+        vec![path],
+        "approach-retract curves, both polymers, all three laws",
+        &mut entries,
+    );
+    // Phase contrast: phase vs A/A₀ on approach for both materials, per law.
+    let contrast: Vec<Chart> = LAWS
+        .iter()
+        .map(|law| Chart {
+            name: format!("contrast_{law}"),
+            title: format!("Phase contrast, {law} law"),
+            x: Axis::linear("A/A₀", "amplitude_ratio"),
+            y: Axis::linear("phase lag φ (deg)", "phase_deg"),
+            series: curves
+                .iter()
+                .filter(|(_, l, _)| l == law)
+                .enumerate()
+                .map(|(i, (m, _, pts))| {
+                    Series::new(
+                        m,
+                        pts.iter()
+                            .filter(|p| {
+                                p.direction == Direction::Approach
+                                    && p.observables.amplitude_ratio < 0.999
+                            })
+                            .map(|p| (p.observables.amplitude_ratio, p.observables.phase_deg))
+                            .collect(),
+                        Style::Line,
+                        i + 1,
+                    )
+                })
+                .collect(),
+            labels: vec![],
+            legend: Corner::UpperRight,
+        })
+        .collect();
+    for ext in ["png", "svg"] {
+        let path = out.join(format!("tap_phase_contrast.{ext}"));
+        plot::render_stack(&contrast, &path)?;
+        add(
+            vec![path],
+            "phase vs A/A0 for polymers A and B under the jkr, hybrid and lj laws",
+            &mut entries,
+        );
+    }
+
+    // Headline numbers and the README.
+    progress("README.md");
+    let lj5 = lj::solve(5.0, true)?;
+    let w_jkr = jkr::w_hat_jkr();
+    let w_h5 = hybrid::w_hat_fit(5.0);
+    let o = &run.observables;
+    let mut md = String::new();
+    let _ = writeln!(md, "# tapsim results\n");
+    let _ = writeln!(
+        md,
+        "Generated by `tapsim reproduce`; do not edit by hand.\n"
+    );
+    let _ = writeln!(md, "## Headline numbers\n");
+    let _ = writeln!(md, "| quantity | value |\n| --- | --- |");
+    let _ = writeln!(md, "| Ŵ_JKR, eq. (9) | {w_jkr:.4} |");
+    let _ = writeln!(
+        md,
+        "| Ŵ_LJ(μ = 5), numerical | {:.5} ± {:.1e} (paper: 3.2482) |",
+        lj5.w_hat.value, lj5.w_hat.error
+    );
+    let _ = writeln!(
+        md,
+        "| Ŵ_hybrid(μ = 5), eq. (18) | {w_h5:.5} ({:+.2} % against Ŵ_LJ) |",
+        100.0 * (w_h5 - lj5.w_hat.value) / lj5.w_hat.value
+    );
+    let _ = writeln!(
+        md,
+        "| pull-off at μ = 5 / (3π/2) | {:.4} |",
+        lj5.pull_off_hat.value / jkr::PULL_OFF_T_HAT
+    );
+    for s in solutions.iter().filter(|s| s.tabor_mu >= 2.0) {
+        let fit = semi_rigid::alpha_hat_a_fit(s.tabor_mu);
+        let _ = writeln!(
+            md,
+            "| fit (17) vs numerical α̂_A, μ = {} | {fit:.5} vs {:.5} ({:+.2} %) |",
+            s.tabor_mu,
+            s.alpha_hat_a.value,
+            100.0 * (fit - s.alpha_hat_a.value) / s.alpha_hat_a.value
+        );
+    }
+    let _ = writeln!(
+        md,
+        "| default tap (hybrid, μ = {:.2}): A/A₀ | {:.5} |",
+        o.tabor_mu, o.amplitude_ratio
+    );
+    let _ = writeln!(
+        md,
+        "| default tap: φ (lock-in / from energy) | {:.4}° / {:.4}° |",
+        o.phase_deg, o.phase_from_energy_deg
+    );
+    let _ = writeln!(
+        md,
+        "| default tap: E_ts per cycle | {:.4e} J = {:.3} eV |",
+        o.e_ts_j,
+        o.e_ts_j / ELECTRONVOLT_J
+    );
+    let _ = writeln!(md, "\n## Files\n");
+    let _ = writeln!(md, "| file | shows |\n| --- | --- |");
+    for e in &entries {
+        let _ = writeln!(md, "| `{}` | {} |", e.file, e.what);
+    }
+    let _ = writeln!(
+        md,
+        "\nMaterials of the tapping figures: polymer A is the `tapsim tap` default (E = 0.5 GPa, \
+         Δγ = 0.1 J/m², μ = {:.2}); polymer B has E = 1 GPa, Δγ = 0.08 J/m² (μ = {:.2}). \
+         Cantilever: k = 40 N/m, f₀ = 300 kHz, Q = 400, A₀ = 20 nm; tip radius 20 nm, ε = 0.3 nm.",
+        setup.contact.tabor_mu(),
+        second_material().tabor_mu()
+    );
+    let readme = out.join("README.md");
+    output::write_bytes(&readme, md.as_bytes())?;
+    written.push(readme);
+    Ok(written)
+}
