@@ -194,6 +194,10 @@ pub struct TapInputs {
     /// Most cycles to integrate looking for the steady state [default 20000].
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
     pub max_cycles: Option<f64>,
+    /// Steady state: largest change of A, φ and E_ts per cycle [default 1e-9 for tap,
+    /// 1e-7 per setpoint for approach].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
+    pub tolerance: Option<f64>,
 }
 
 /// The TOML keys and the quantity each holds.
@@ -215,6 +219,7 @@ const KEYS: &[(&str, Dimension)] = &[
     ("separation", Dimension::Length),
     ("rtol", Dimension::Dimensionless),
     ("max-cycles", Dimension::Dimensionless),
+    ("tolerance", Dimension::Dimensionless),
 ];
 
 impl TapInputs {
@@ -237,6 +242,7 @@ impl TapInputs {
             "drive-frequency" => &mut self.drive_frequency,
             "separation" => &mut self.separation,
             "rtol" => &mut self.rtol,
+            "tolerance" => &mut self.tolerance,
             _ => &mut self.max_cycles,
         }
     }
@@ -320,6 +326,7 @@ impl TapInputs {
             separation: self.separation.or(base.separation),
             rtol: self.rtol.or(base.rtol),
             max_cycles: self.max_cycles.or(base.max_cycles),
+            tolerance: self.tolerance.or(base.tolerance),
         }
     }
 
@@ -362,6 +369,9 @@ impl TapInputs {
         if let Some(rtol) = self.rtol {
             numerics.rtol = rtol;
             numerics.atol = rtol * 1e-2;
+        }
+        if let Some(t) = self.tolerance {
+            numerics.tolerance = t;
         }
         if let Some(n) = self.max_cycles {
             if !(n >= 1.0 && n.fract() == 0.0 && n <= 1e9) {

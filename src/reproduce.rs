@@ -40,7 +40,11 @@ fn approach(setup: &TapSetup, law: LawKind, points: usize) -> Result<Vec<SweepPo
     };
     let a0 = setup.cantilever.free_amplitude_m;
     let ramp = sweep::ramp(1.2 * a0, 0.4 * a0, points, true)?;
-    sweep::approach_curve(&setup, &Numerics::default(), &ramp, |_, _| {})
+    let numerics = Numerics {
+        tolerance: sweep::SETPOINT_TOLERANCE,
+        ..Numerics::default()
+    };
+    sweep::approach_curve(&setup, &numerics, &ramp, |_, _| {})
 }
 
 /// Regenerate everything into `out`; `progress` is told what is being made. Returns the

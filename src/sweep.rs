@@ -7,6 +7,10 @@ use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result, finite};
 use serde::Serialize;
 
+/// Default steady-state tolerance per setpoint of a sweep: A, φ and E_ts settled to
+/// ~1e-5 (the transient left after a change < 1e-7 per cycle is < 1e-7·Q/π).
+pub const SETPOINT_TOLERANCE: f64 = 1e-7;
+
 /// Which way the ramp is moving.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]

@@ -53,7 +53,11 @@ pub struct ApproachArgs {
 
 /// Run the subcommand.
 pub fn run(args: ApproachArgs) -> Result<()> {
-    let (setup, numerics) = args.inputs.with_config(args.config.as_ref())?.resolve()?;
+    let inputs = args.inputs.with_config(args.config.as_ref())?;
+    let (setup, mut numerics) = inputs.resolve()?;
+    if inputs.tolerance.is_none() {
+        numerics.tolerance = sweep::SETPOINT_TOLERANCE;
+    }
     let a0 = setup.cantilever.free_amplitude_m;
     let ramp = sweep::ramp(
         args.from.unwrap_or(1.2 * a0),
