@@ -130,3 +130,26 @@ fn a_compliant_support_adds_spring_losses_to_the_lj_loop() {
     let stiff = Hysteresis::with_spring(&s.curve, 1e7).unwrap().w_hat;
     assert!((stiff - rigid).abs() < 1e-5 * rigid, "{stiff} vs {rigid}");
 }
+
+#[test]
+fn mesh_refinement_stays_within_the_error_estimate() {
+    use tapsim::contact::lj::{
+        curve, mesh::MeshSpec, result::ELEMENTS_PER_ANNULUS, solver::Problem,
+    };
+    let s = solution(5.0);
+    // Every spacing 0.8 times the production mesh's.
+    let spec = MeshSpec::for_tabor(5.0, ELEMENTS_PER_ANNULUS).scaled(0.8);
+    let problem = Problem::new(5.0, spec.nodes());
+    assert!(problem.len() > s.nodes);
+    let finer = curve::trace(&problem, &curve::TraceOptions::default()).unwrap();
+    let change = (finer.w_hat - s.w_hat.value).abs();
+    println!(
+        "W_LJ(5): {} nodes {:.6}, {} nodes {:.6}: change {change:.1e}, estimate {:.1e}",
+        s.nodes,
+        s.w_hat.value,
+        problem.len(),
+        finer.w_hat,
+        s.w_hat.error
+    );
+    assert!(change < s.w_hat.error, "{change:e} vs {:e}", s.w_hat.error);
+}
