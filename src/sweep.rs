@@ -83,3 +83,87 @@ pub fn approach_curve(
     }
     Ok(out)
 }
+
+/// One cell of a parameter map.
+#[derive(Debug, Clone, Serialize)]
+pub struct MapCell {
+    /// Work of adhesion Δγ in J/m².
+    pub work_of_adhesion_j_m2: f64,
+    /// Composite modulus E* in Pa.
+    pub modulus_pa: f64,
+    /// Tabor parameter μ of the cell.
+    pub tabor_mu: f64,
+    /// Steady-state observables; `None` where the law does not apply.
+    #[serde(flatten)]
+    pub observables: Option<TapObservables>,
+    /// Why the cell is empty, when it is.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// `n` values from `lo` to `hi`, evenly spaced on a log scale.
+pub fn log_grid(name: &'static str, lo: f64, hi: f64, n: usize) -> Result<Vec<f64>> {
+    crate::error::positive(name, lo)?;
+    crate::error::positive(name, hi)?;
+    if n < 2 || hi <= lo {
+        return Err(Error::NotApplicable(format!(
+            "{name}: need at least 2 points and an upper end above the lower one"
+        )));
+    }
+    Ok((0..n)
+        .map(|i| lo * (hi / lo).powf(i as f64 / (n - 1) as f64))
+        .collect())
+}
+
+/// E_ts and φ over a grid of (Δγ, E*) at the setup's setpoint, one independent steady
+/// state per cell (each from the free steady state), computed in parallel on `threads`
+/// threads (0: all cores). Cells are independent, so the result does not depend on the
+/// thread count. `progress` is called (from any thread) after each cell.
+pub fn adhesion_modulus_map(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    works_j_m2: &[f64],
+    moduli_pa: &[f64],
+    threads: usize,
+    progress: impl Fn() + Sync,
+) -> Result<Vec<MapCell>> {
+    use rayon::prelude::*;
+    let cells: Vec<(f64, f64)> = moduli_pa
+        .iter()
+        .flat_map(|&e| works_j_m2.iter().map(move |&w| (w, e)))
+        .collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::NotApplicable(format!("cannot start {threads} threads: {e}")))?;
+    pool.install(|| {
+        cells
+            .par_iter()
+            .map(|&(w, e)| {
+                let mut s = setup.clone();
+                s.contact.work_of_adhesion_j_m2 = w;
+                s.contact.modulus_pa = e;
+                let tabor_mu = s.contact.tabor_mu();
+                let cell = match crate::dynamics::observables::tap(&s, numerics, 0) {
+                    Ok(run) => MapCell {
+                        work_of_adhesion_j_m2: w,
+                        modulus_pa: e,
+                        tabor_mu,
+                        observables: Some(run.observables),
+                        note: None,
+                    },
+                    Err(Error::NotApplicable(why)) => MapCell {
+                        work_of_adhesion_j_m2: w,
+                        modulus_pa: e,
+                        tabor_mu,
+                        observables: None,
+                        note: Some(why),
+                    },
+                    Err(other) => return Err(other),
+                };
+                progress();
+                Ok(cell)
+            })
+            .collect()
+    })
+}

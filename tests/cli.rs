@@ -557,3 +557,35 @@ fn reproduce_regenerates_every_file_its_readme_lists() {
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn map_is_bit_identical_whatever_the_thread_count() {
+    let dir = scratch("map");
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |threads: &str| {
+        let path = dir.join(format!("map{threads}.csv"));
+        let out = tapsim(&[
+            "map",
+            "--steps",
+            "3",
+            "--threads",
+            threads,
+            "--quiet",
+            "--csv",
+            path.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read(path).unwrap()
+    };
+    let (one, two) = (run("1"), run("2"));
+    assert_eq!(one, two);
+    let text = String::from_utf8(one).unwrap();
+    assert_eq!(text.lines().count(), 10, "header and 9 cells");
+    // Cells where the hybrid law does not apply are kept, empty, with the reason.
+    assert!(text.contains("does not apply"));
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -5,6 +5,7 @@ mod approach;
 mod figure;
 mod hysteresis;
 mod lj;
+mod map;
 mod reproduce;
 mod tap;
 
@@ -29,6 +30,7 @@ pub struct Cli {
 enum Command {
     Tap(tap::TapArgs),
     Approach(approach::ApproachArgs),
+    Map(map::MapArgs),
     Hysteresis(hysteresis::HysteresisArgs),
     Lj(lj::LjArgs),
     Figure(figure::FigureArgs),
@@ -41,6 +43,7 @@ pub fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Tap(args) => tap::run(args),
         Command::Approach(args) => approach::run(args),
+        Command::Map(args) => map::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),
         Command::Lj(args) => lj::run(args),
         Command::Figure(args) => figure::run(args),

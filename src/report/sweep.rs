@@ -25,21 +25,30 @@ fn objects<T: Serialize>(records: &[T]) -> Result<Vec<Map<String, Value>>> {
         .collect()
 }
 
-/// One JSON object whose fields are arrays (one entry per record), in record-field order.
+/// Every field name of the records, in first-seen order (records may lack some).
+fn field_names(rows: &[Map<String, Value>]) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for r in rows {
+        for k in r.keys() {
+            if !names.contains(k) {
+                names.push(k.clone());
+            }
+        }
+    }
+    names
+}
+
+/// One JSON object whose fields are arrays (one entry per record, null where a record
+/// lacks the field), in record-field order.
 pub fn columns_json<T: Serialize>(records: &[T]) -> Result<Value> {
     let rows = objects(records)?;
     let mut out = Map::new();
-    if let Some(first) = rows.first() {
-        for key in first.keys() {
-            out.insert(
-                key.clone(),
-                Value::Array(
-                    rows.iter()
-                        .map(|r| r.get(key).cloned().unwrap_or(Value::Null))
-                        .collect(),
-                ),
-            );
-        }
+    for key in field_names(&rows) {
+        let column = rows
+            .iter()
+            .map(|r| r.get(&key).cloned().unwrap_or(Value::Null))
+            .collect();
+        out.insert(key, Value::Array(column));
     }
     Ok(Value::Object(out))
 }
@@ -52,10 +61,11 @@ pub fn records_csv<T: Serialize>(records: &[T]) -> Result<Vec<u8>> {
         reason: e.to_string(),
     };
     let mut w = csv::Writer::from_writer(Vec::new());
-    if let Some(first) = rows.first() {
-        w.write_record(first.keys()).map_err(fail)?;
+    let keys = field_names(&rows);
+    if !keys.is_empty() {
+        w.write_record(&keys).map_err(fail)?;
         for r in &rows {
-            w.write_record(first.keys().map(|k| match r.get(k) {
+            w.write_record(keys.iter().map(|k| match r.get(k) {
                 Some(Value::String(s)) => s.clone(),
                 Some(Value::Null) | None => String::new(),
                 Some(v) => v.to_string(),
