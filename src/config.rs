@@ -247,6 +247,21 @@ impl TapInputs {
         }
     }
 
+    /// Set the quantity named `key` (a flag's name) from `text` (a number with an
+    /// optional unit).
+    pub fn set(&mut self, key: &str, text: &str) -> Result<()> {
+        let Some(&(name, dim)) = KEYS.iter().find(|(k, _)| *k == key) else {
+            let known: Vec<&str> = KEYS.iter().map(|(k, _)| *k).collect();
+            return Err(Error::Parse {
+                name: "key",
+                text: key.to_string(),
+                reason: format!("unknown key; known keys: law, {}", known.join(", ")),
+            });
+        };
+        *self.slot(name) = Some(units::parse(name, text, dim)?);
+        Ok(())
+    }
+
     /// Read a TOML parameter file (keys as the flags' names).
     pub fn from_toml_file(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
@@ -287,18 +302,10 @@ impl TapInputs {
                 )?);
                 continue;
             }
-            let Some(&(name, dim)) = KEYS.iter().find(|(k, _)| k == key) else {
-                let known: Vec<&str> = KEYS.iter().map(|(k, _)| *k).collect();
-                return Err(Error::Parse {
-                    name: "config key",
-                    text: key.clone(),
-                    reason: format!("unknown key; known keys: law, {}", known.join(", ")),
-                });
-            };
-            let number = match value {
-                toml::Value::Float(f) => units::parse(name, &f.to_string(), dim)?,
-                toml::Value::Integer(i) => units::parse(name, &i.to_string(), dim)?,
-                toml::Value::String(s) => units::parse(name, s, dim)?,
+            let text = match value {
+                toml::Value::Float(f) => f.to_string(),
+                toml::Value::Integer(i) => i.to_string(),
+                toml::Value::String(s) => s.clone(),
                 other => {
                     return Err(Error::Parse {
                         name: "config value",
@@ -307,7 +314,7 @@ impl TapInputs {
                     });
                 }
             };
-            *inputs.slot(name) = Some(number);
+            inputs.set(key, &text)?;
         }
         Ok(inputs)
     }

@@ -11,6 +11,7 @@
 pub mod cli;
 pub mod config;
 pub mod contact;
+pub mod contrast;
 pub mod dynamics;
 pub mod error;
 pub mod figures;

@@ -589,3 +589,45 @@ fn map_is_bit_identical_whatever_the_thread_count() {
     assert!(text.contains("does not apply"));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn contrast_reports_a_row_per_law_and_setpoint() {
+    let v = json(&[
+        "contrast",
+        "--laws",
+        "jkr,hybrid",
+        "--setpoints",
+        "0.9,0.7",
+        "--points",
+        "12",
+        "--quiet",
+        "--json",
+        "--material",
+        "soft:sample-modulus=0.5GPa,work-of-adhesion=0.1",
+        "--material",
+        "stiff:sample-modulus=1GPa,work-of-adhesion=80mJ/m^2",
+    ]);
+    let rows = v.as_array().unwrap();
+    assert_eq!(rows.len(), 4);
+    for r in rows {
+        let phases = r["phase_deg"].as_array().unwrap();
+        assert_eq!(phases.len(), 2);
+        let (a, b) = (phases[0].as_f64().unwrap(), phases[1].as_f64().unwrap());
+        assert!((r["delta_phase_deg"].as_f64().unwrap() - (b - a)).abs() < 1e-9);
+    }
+    for bad in ["nocolon", "x:modulus", "x:radius=ten", ":modulus=1GPa"] {
+        let out = tapsim(&[
+            "contrast",
+            "--material",
+            bad,
+            "--material",
+            "y:modulus=1GPa",
+        ]);
+        assert!(!out.status.success(), "{bad}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("material")
+                || String::from_utf8_lossy(&out.stderr).contains("radius"),
+            "{bad}"
+        );
+    }
+}

@@ -2,6 +2,7 @@
 //! its own module.
 
 mod approach;
+mod contrast;
 mod figure;
 mod hysteresis;
 mod lj;
@@ -30,6 +31,7 @@ pub struct Cli {
 enum Command {
     Tap(tap::TapArgs),
     Approach(approach::ApproachArgs),
+    Contrast(contrast::ContrastArgs),
     Map(map::MapArgs),
     Hysteresis(hysteresis::HysteresisArgs),
     Lj(lj::LjArgs),
@@ -43,6 +45,7 @@ pub fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Tap(args) => tap::run(args),
         Command::Approach(args) => approach::run(args),
+        Command::Contrast(args) => contrast::run(args),
         Command::Map(args) => map::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),
         Command::Lj(args) => lj::run(args),
