@@ -61,6 +61,17 @@ pub struct ContrastRow {
     pub delta_phase_deg: f64,
 }
 
+/// The approach curve of one material under one law.
+#[derive(Debug, Clone)]
+pub struct LawCurve {
+    /// Material name.
+    pub material: String,
+    /// Force law.
+    pub law: LawKind,
+    /// The approach points.
+    pub points: Vec<SweepPoint>,
+}
+
 /// φ at amplitude ratio `r` on the approach branch of `curve`, by linear interpolation
 /// between the first pair of setpoints that brackets it.
 fn phase_at(curve: &[SweepPoint], r: f64) -> f64 {
@@ -98,7 +109,7 @@ pub fn contrast(
     ratios: &[f64],
     points: usize,
     mut progress: impl FnMut(&str),
-) -> Result<(Vec<ContrastRow>, Vec<(String, LawKind, Vec<SweepPoint>)>)> {
+) -> Result<(Vec<ContrastRow>, Vec<LawCurve>)> {
     if materials.len() < 2 {
         return Err(Error::NotApplicable(
             "phase contrast needs at least two materials".into(),
@@ -119,11 +130,11 @@ pub fn contrast(
                 law,
                 ..setup.clone()
             };
-            curves.push((
-                m.name.clone(),
+            curves.push(LawCurve {
+                material: m.name.clone(),
                 law,
-                sweep::approach_curve(&s, &numerics, &ramp, |_, _| {})?,
-            ));
+                points: sweep::approach_curve(&s, &numerics, &ramp, |_, _| {})?,
+            });
         }
     }
     let mut rows = Vec::new();
@@ -134,8 +145,8 @@ pub fn contrast(
                 .map(|m| {
                     curves
                         .iter()
-                        .find(|(n, l, _)| n == &m.name && *l == law)
-                        .map_or(f64::NAN, |(_, _, c)| phase_at(c, r))
+                        .find(|c| c.material == m.name && c.law == law)
+                        .map_or(f64::NAN, |c| phase_at(&c.points, r))
                 })
                 .collect();
             rows.push(ContrastRow {

@@ -111,10 +111,11 @@ pub fn run(args: ContrastArgs) -> Result<()> {
                 y: Axis::linear("phase lag φ (deg)", "phase_deg"),
                 series: curves
                     .iter()
-                    .filter(|(_, l, _)| l == law)
+                    .filter(|c| c.law == *law)
                     .enumerate()
-                    .map(|(i, (m, _, c))| {
+                    .map(|(i, c)| {
                         let pts = c
+                            .points
                             .iter()
                             .filter(|p| {
                                 p.direction == Direction::Approach
@@ -122,7 +123,7 @@ pub fn run(args: ContrastArgs) -> Result<()> {
                             })
                             .map(|p| (p.observables.amplitude_ratio, p.observables.phase_deg))
                             .collect();
-                        Series::new(m, pts, Style::Line, i + 1)
+                        Series::new(&c.material, pts, Style::Line, i + 1)
                     })
                     .collect(),
                 labels: vec![],
