@@ -219,32 +219,17 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
     // Phase contrast: phase vs A/A₀ on approach for both materials, per law.
     let contrast: Vec<Chart> = LAWS
         .iter()
-        .map(|law| Chart {
-            name: format!("contrast_{law}"),
-            title: format!("Phase contrast, {law} law"),
-            x: Axis::linear("A/A₀", "amplitude_ratio"),
-            y: Axis::linear("phase lag φ (deg)", "phase_deg"),
-            series: curves
+        .map(|law| {
+            let per_material: Vec<(&str, &[SweepPoint])> = curves
                 .iter()
                 .filter(|(_, l, _)| l == law)
-                .enumerate()
-                .map(|(i, (m, _, pts))| {
-                    Series::new(
-                        m,
-                        pts.iter()
-                            .filter(|p| {
-                                p.direction == Direction::Approach
-                                    && p.observables.amplitude_ratio < 0.999
-                            })
-                            .map(|p| (p.observables.amplitude_ratio, p.observables.phase_deg))
-                            .collect(),
-                        Style::Line,
-                        i + 1,
-                    )
-                })
-                .collect(),
-            labels: vec![],
-            legend: Corner::UpperRight,
+                .map(|(m, _, pts)| (m.as_str(), pts.as_slice()))
+                .collect();
+            sweep_report::phase_vs_amplitude(
+                &format!("contrast_{law}"),
+                &format!("Phase contrast, {law} law"),
+                &per_material,
+            )
         })
         .collect();
     for ext in ["png", "svg"] {

@@ -5,7 +5,6 @@ use crate::error::Result;
 use crate::report::{output, plot, sweep as report};
 use crate::sweep::{self, Direction};
 use clap::Args;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// Sweep the rest separation z_c down (approach) and back up (retract), carrying the
@@ -22,6 +21,8 @@ use std::path::PathBuf;
 pub struct ApproachArgs {
     #[command(flatten)]
     inputs: TapInputs,
+    #[command(flatten)]
+    out: super::SweepOutput,
     /// TOML parameter file (keys: the flags' names).
     #[arg(long)]
     config: Option<PathBuf>,
@@ -37,18 +38,6 @@ pub struct ApproachArgs {
     /// Approach only.
     #[arg(long)]
     no_retract: bool,
-    /// Write every point as CSV.
-    #[arg(long)]
-    csv: Option<PathBuf>,
-    /// Plot the curves (.png or .svg).
-    #[arg(long)]
-    plot: Option<PathBuf>,
-    /// Print one JSON object of arrays on stdout instead of the table.
-    #[arg(long)]
-    json: bool,
-    /// No progress bar.
-    #[arg(long)]
-    quiet: bool,
 }
 
 /// Run the subcommand.
@@ -65,29 +54,21 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         args.points,
         !args.no_retract,
     )?;
-    let bar = if args.quiet || !std::io::stderr().is_terminal() {
-        indicatif::ProgressBar::hidden()
-    } else {
-        indicatif::ProgressBar::new(ramp.len() as u64)
-    };
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} setpoints, {eta} left")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
+    let bar = args.out.progress_bar(ramp.len());
     let points = sweep::approach_curve(&setup, &numerics, &ramp, |done, _| {
         bar.set_position(done as u64)
     })?;
     bar.finish_and_clear();
-    if let Some(path) = &args.csv {
+    if let Some(path) = &args.out.csv {
         output::write_bytes(path, &report::records_csv(&points)?)?;
     }
-    if let Some(path) = &args.plot {
+    if let Some(path) = &args.out.plot {
         plot::render_stack(
             &report::approach_charts(&points, &format!("{} law", setup.law)),
             path,
         )?;
     }
-    if args.json {
+    if args.out.json {
         println!(
             "{}",
             serde_json::to_string_pretty(&report::columns_json(&points)?).expect("serialises")

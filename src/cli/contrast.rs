@@ -5,8 +5,7 @@ use crate::contrast::{self, Material};
 use crate::error::Result;
 use crate::law::LawKind;
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
-use crate::report::{output, plot};
-use crate::sweep::Direction;
+use crate::report::{output, plot, sweep as report};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -25,6 +24,8 @@ use std::path::PathBuf;
 pub struct ContrastArgs {
     #[command(flatten)]
     inputs: TapInputs,
+    #[command(flatten)]
+    out: super::SweepOutput,
     /// TOML parameter file for the common settings.
     #[arg(long)]
     config: Option<PathBuf>,
@@ -40,18 +41,6 @@ pub struct ContrastArgs {
     /// Setpoints on each approach curve.
     #[arg(long, default_value_t = 50)]
     points: usize,
-    /// Write the contrast table as CSV.
-    #[arg(long)]
-    csv: Option<PathBuf>,
-    /// Plot φ vs A/A₀ per law and the contrast (.png or .svg).
-    #[arg(long)]
-    plot: Option<PathBuf>,
-    /// Print one JSON array of rows on stdout.
-    #[arg(long)]
-    json: bool,
-    /// No progress messages.
-    #[arg(long)]
-    quiet: bool,
 }
 
 /// Run the subcommand.
@@ -65,7 +54,7 @@ pub fn run(args: ContrastArgs) -> Result<()> {
     } else {
         args.materials.clone()
     };
-    let quiet = args.quiet;
+    let quiet = args.out.quiet;
     let (rows, curves) = contrast::contrast(
         &base,
         &materials,
@@ -78,7 +67,7 @@ pub fn run(args: ContrastArgs) -> Result<()> {
             }
         },
     )?;
-    if let Some(path) = &args.csv {
+    if let Some(path) = &args.out.csv {
         let mut w = csv::Writer::from_writer(Vec::new());
         let mut header = vec!["law".to_string(), "amplitude_ratio".into()];
         header.extend(materials.iter().map(|m| format!("phase_deg_{}", m.name)));
@@ -100,34 +89,21 @@ pub fn run(args: ContrastArgs) -> Result<()> {
         })?;
         output::write_bytes(path, &bytes)?;
     }
-    if let Some(path) = &args.plot {
+    if let Some(path) = &args.out.plot {
         let mut charts: Vec<Chart> = args
             .laws
             .iter()
-            .map(|law| Chart {
-                name: format!("phase_{law}"),
-                title: format!("{law} law: phase vs amplitude"),
-                x: Axis::linear("A/A₀", "amplitude_ratio"),
-                y: Axis::linear("phase lag φ (deg)", "phase_deg"),
-                series: curves
+            .map(|law| {
+                let per_material: Vec<(&str, &[crate::sweep::SweepPoint])> = curves
                     .iter()
                     .filter(|c| c.law == *law)
-                    .enumerate()
-                    .map(|(i, c)| {
-                        let pts = c
-                            .points
-                            .iter()
-                            .filter(|p| {
-                                p.direction == Direction::Approach
-                                    && p.observables.amplitude_ratio < 0.999
-                            })
-                            .map(|p| (p.observables.amplitude_ratio, p.observables.phase_deg))
-                            .collect();
-                        Series::new(&c.material, pts, Style::Line, i + 1)
-                    })
-                    .collect(),
-                labels: vec![],
-                legend: Corner::UpperRight,
+                    .map(|c| (c.material.as_str(), c.points.as_slice()))
+                    .collect();
+                report::phase_vs_amplitude(
+                    &format!("phase_{law}"),
+                    &format!("{law} law: phase vs amplitude"),
+                    &per_material,
+                )
             })
             .collect();
         charts.push(Chart {
@@ -157,7 +133,7 @@ pub fn run(args: ContrastArgs) -> Result<()> {
         });
         plot::render_stack(&charts, path)?;
     }
-    if args.json {
+    if args.out.json {
         println!(
             "{}",
             serde_json::to_string_pretty(&rows).expect("serialises")

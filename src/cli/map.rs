@@ -6,7 +6,6 @@ use crate::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::report::{output, plot, sweep as report};
 use crate::sweep;
 use clap::Args;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// E_ts and phase over a grid of work of adhesion Δγ and composite modulus E* (log
@@ -23,6 +22,8 @@ use std::path::PathBuf;
 pub struct MapArgs {
     #[command(flatten)]
     inputs: TapInputs,
+    #[command(flatten)]
+    out: super::SweepOutput,
     /// TOML parameter file (keys: the flags' names).
     #[arg(long)]
     config: Option<PathBuf>,
@@ -44,18 +45,6 @@ pub struct MapArgs {
     /// Worker threads (0: all cores).
     #[arg(long, default_value_t = 0)]
     threads: usize,
-    /// Write the cells as CSV.
-    #[arg(long)]
-    csv: Option<PathBuf>,
-    /// Plot E_ts and φ against Δγ (.png or .svg).
-    #[arg(long)]
-    plot: Option<PathBuf>,
-    /// Print one JSON object of arrays on stdout.
-    #[arg(long)]
-    json: bool,
-    /// No progress bar.
-    #[arg(long)]
-    quiet: bool,
 }
 
 /// Run the subcommand.
@@ -68,21 +57,16 @@ pub fn run(args: MapArgs) -> Result<()> {
         args.steps,
     )?;
     let moduli = sweep::log_grid("modulus", args.modulus_from, args.modulus_to, args.steps)?;
-    let total = (works.len() * moduli.len()) as u64;
-    let bar = if args.quiet || !std::io::stderr().is_terminal() {
-        indicatif::ProgressBar::hidden()
-    } else {
-        indicatif::ProgressBar::new(total)
-    };
+    let bar = args.out.progress_bar(works.len() * moduli.len());
     let cells =
         sweep::adhesion_modulus_map(&setup, &numerics, &works, &moduli, args.threads, || {
             bar.inc(1)
         })?;
     bar.finish_and_clear();
-    if let Some(path) = &args.csv {
+    if let Some(path) = &args.out.csv {
         output::write_bytes(path, &report::records_csv(&cells)?)?;
     }
-    if let Some(path) = &args.plot {
+    if let Some(path) = &args.out.plot {
         let lines = |y: fn(&sweep::MapCell) -> Option<f64>| -> Vec<Series> {
             moduli
                 .iter()
@@ -123,12 +107,12 @@ pub fn run(args: MapArgs) -> Result<()> {
         ];
         plot::render_stack(&charts, path)?;
     }
-    if args.json {
+    if args.out.json {
         println!(
             "{}",
             serde_json::to_string_pretty(&report::columns_json(&cells)?).expect("serialises")
         );
-    } else if args.csv.is_none() && args.plot.is_none() {
+    } else if args.out.csv.is_none() && args.out.plot.is_none() {
         print!("{}", String::from_utf8_lossy(&report::records_csv(&cells)?));
     }
     Ok(())

@@ -39,6 +39,40 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
 }
 
+/// Output flags shared by the sweep commands (approach, contrast, map).
+#[derive(Debug, clap::Args)]
+pub struct SweepOutput {
+    /// Write the results as CSV.
+    #[arg(long)]
+    pub csv: Option<std::path::PathBuf>,
+    /// Plot the results (.png or .svg).
+    #[arg(long)]
+    pub plot: Option<std::path::PathBuf>,
+    /// Print JSON on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress report on stderr.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+impl SweepOutput {
+    /// A progress bar over `len` items on stderr, hidden with --quiet or when stderr is
+    /// not a terminal.
+    pub fn progress_bar(&self, len: usize) -> indicatif::ProgressBar {
+        use std::io::IsTerminal;
+        if self.quiet || !std::io::stderr().is_terminal() {
+            return indicatif::ProgressBar::hidden();
+        }
+        let bar = indicatif::ProgressBar::new(len as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len}, {eta} left")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    }
+}
+
 /// Run the command line with the process arguments; the exit code to return.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();

@@ -172,3 +172,30 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
         ),
     ]
 }
+
+/// φ against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999 left out), one series
+/// per labelled curve: the phase-contrast view.
+pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint])]) -> Chart {
+    Chart {
+        name: name.into(),
+        title: title.into(),
+        x: Axis::linear("A/A₀", "amplitude_ratio"),
+        y: Axis::linear("phase lag φ (deg)", "phase_deg"),
+        series: curves
+            .iter()
+            .enumerate()
+            .map(|(i, (label, points))| {
+                let pts = points
+                    .iter()
+                    .filter(|p| {
+                        p.direction == Direction::Approach && p.observables.amplitude_ratio < 0.999
+                    })
+                    .map(|p| (p.observables.amplitude_ratio, p.observables.phase_deg))
+                    .collect();
+                Series::new(label, pts, Style::Line, i + 1)
+            })
+            .collect(),
+        labels: vec![],
+        legend: Corner::UpperRight,
+    }
+}
