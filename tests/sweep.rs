@@ -70,3 +70,59 @@ fn dmt_approach_jumps_from_the_attractive_to_the_repulsive_regime() {
     assert!(approach[i] > 90.0 && approach[i + 1] < 90.0, "{approach:?}");
     assert!(points.iter().all(|p| p.observables.converged));
 }
+
+#[test]
+fn dmt_bistability_has_a_hysteresis_window_on_retract() {
+    let mut setup = default_setup();
+    setup.law = tapsim::law::LawKind::Dmt;
+    setup.hamaker_j = Some(1.5e-19);
+    setup.contact.modulus_pa = tapsim::params::composite_modulus(169e9, 0.28, 2e9, 0.4).unwrap();
+    let ramp = sweep::ramp(22e-9, 14e-9, 17, true).unwrap();
+    let numerics = Numerics {
+        tolerance: sweep::SETPOINT_TOLERANCE,
+        ..Numerics::default()
+    };
+    let points = sweep::approach_curve(&setup, &numerics, &ramp, |_, _| {}).unwrap();
+    let phase = |dir: Direction| -> Vec<(f64, f64)> {
+        let mut v: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| p.direction == dir)
+            .map(|p| (p.separation_m, p.observables.phase_deg))
+            .collect();
+        v.sort_by(|a, b| b.0.total_cmp(&a.0)); // far to near
+        v
+    };
+    let (approach, retract) = (phase(Direction::Approach), phase(Direction::Retract));
+    // Approach: attractive (> 90°) far out, a single jump to repulsive (< 90°).
+    let jump_in = approach
+        .windows(2)
+        .position(|w| w[0].1 > 90.0 && w[1].1 < 90.0)
+        .expect("a jump on approach");
+    assert!(approach[..=jump_in].iter().skip(3).all(|p| p.1 > 90.0));
+    assert!(approach[jump_in + 1..].iter().all(|p| p.1 < 90.0));
+    // Retract: still repulsive at the last attractive setpoint of the approach — the
+    // hysteresis window — and back to attractive further out.
+    let window = approach[jump_in].0;
+    let back = retract.iter().find(|p| p.0 == window).unwrap();
+    assert!(
+        back.1 < 90.0,
+        "no window: retract at {window:e} m has {} deg",
+        back.1
+    );
+    let jump_out = retract
+        .windows(2)
+        .position(|w| w[0].1 > 90.0 && w[1].1 < 90.0)
+        .expect("a jump on retract");
+    assert!(
+        retract[jump_out].0 > window,
+        "the retract jump lies farther out than the approach jump"
+    );
+    println!(
+        "approach jumps between {:.1} and {:.1} nm; retract stays repulsive at {:.1} nm (φ {:.1}° vs {:.1}°)",
+        approach[jump_in].0 * 1e9,
+        approach[jump_in + 1].0 * 1e9,
+        window * 1e9,
+        back.1,
+        approach[jump_in].1
+    );
+}
