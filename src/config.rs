@@ -161,6 +161,10 @@ impl ContactInputs {
 /// Everything a tapping simulation takes, every field optional (defaults fill in).
 #[derive(Debug, Clone, Default, Args)]
 pub struct TapInputs {
+    /// TOML parameter file (keys: the flags' names; values in SI or strings with units).
+    /// Flags override it.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
     /// Tip–sample force law.
     #[arg(long, value_enum)]
     pub law: Option<LawKind>,
@@ -322,6 +326,7 @@ impl TapInputs {
     /// Field-wise: `self` where given, else `base`.
     pub fn or(self, base: Self) -> Self {
         Self {
+            config: self.config.or(base.config),
             law: self.law.or(base.law),
             contact: self.contact.or(base.contact),
             hamaker: self.hamaker.or(base.hamaker),
@@ -337,10 +342,10 @@ impl TapInputs {
         }
     }
 
-    /// Flags over an optional config file.
-    pub fn with_config(self, config: Option<&PathBuf>) -> Result<Self> {
-        Ok(match config {
-            Some(path) => self.or(Self::from_toml_file(path)?),
+    /// Flags over the `--config` file, if one was given.
+    pub fn with_config(self) -> Result<Self> {
+        Ok(match self.config.clone() {
+            Some(path) => self.or(Self::from_toml_file(&path)?),
             None => self,
         })
     }

@@ -5,7 +5,6 @@ use crate::error::Result;
 use crate::report::{output, plot, sweep as report};
 use crate::sweep::{self, Direction};
 use clap::Args;
-use std::path::PathBuf;
 
 /// Sweep the rest separation z_c down (approach) and back up (retract), carrying the
 /// oscillator from point to point as a slow piezo ramp does, so the attractive/repulsive
@@ -23,9 +22,6 @@ pub struct ApproachArgs {
     inputs: TapInputs,
     #[command(flatten)]
     out: super::SweepOutput,
-    /// TOML parameter file (keys: the flags' names).
-    #[arg(long)]
-    config: Option<PathBuf>,
     /// Farthest rest separation [m; default 1.2 A₀].
     #[arg(long, allow_hyphen_values = true, value_parser = length)]
     from: Option<f64>,
@@ -42,7 +38,7 @@ pub struct ApproachArgs {
 
 /// Run the subcommand.
 pub fn run(args: ApproachArgs) -> Result<()> {
-    let inputs = args.inputs.with_config(args.config.as_ref())?;
+    let inputs = args.inputs.with_config()?;
     let (setup, mut numerics) = inputs.resolve()?;
     if inputs.tolerance.is_none() {
         numerics.tolerance = sweep::SETPOINT_TOLERANCE;

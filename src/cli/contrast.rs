@@ -7,7 +7,6 @@ use crate::law::LawKind;
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::report::{output, plot, sweep as report};
 use clap::Args;
-use std::path::PathBuf;
 
 /// Phase contrast between two or more materials at the same cantilever and amplitude
 /// setpoints, for several force laws side by side: how much phase contrast the classic
@@ -26,9 +25,6 @@ pub struct ContrastArgs {
     inputs: TapInputs,
     #[command(flatten)]
     out: super::SweepOutput,
-    /// TOML parameter file for the common settings.
-    #[arg(long)]
-    config: Option<PathBuf>,
     /// A material, name:key=value,... (repeat; at least two).
     #[arg(long = "material", value_parser = Material::parse)]
     materials: Vec<Material>,
@@ -45,7 +41,7 @@ pub struct ContrastArgs {
 
 /// Run the subcommand.
 pub fn run(args: ContrastArgs) -> Result<()> {
-    let base = args.inputs.with_config(args.config.as_ref())?;
+    let base = args.inputs.with_config()?;
     let materials = if args.materials.is_empty() {
         vec![
             Material::parse("A:sample-modulus=0.5GPa,work-of-adhesion=0.1")?,

@@ -6,7 +6,6 @@ use crate::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::report::{output, plot, sweep as report};
 use crate::sweep;
 use clap::Args;
-use std::path::PathBuf;
 
 /// E_ts and phase over a grid of work of adhesion Δγ and composite modulus E* (log
 /// spaced), at one setpoint: every cell an independent `tapsim tap`, computed in
@@ -24,9 +23,6 @@ pub struct MapArgs {
     inputs: TapInputs,
     #[command(flatten)]
     out: super::SweepOutput,
-    /// TOML parameter file (keys: the flags' names).
-    #[arg(long)]
-    config: Option<PathBuf>,
     /// Smallest work of adhesion [J/m²].
     #[arg(long, value_parser = surface_energy, default_value = "0.02")]
     adhesion_from: f64,
@@ -49,7 +45,7 @@ pub struct MapArgs {
 
 /// Run the subcommand.
 pub fn run(args: MapArgs) -> Result<()> {
-    let (setup, numerics) = args.inputs.with_config(args.config.as_ref())?.resolve()?;
+    let (setup, numerics) = args.inputs.with_config()?.resolve()?;
     let works = sweep::log_grid(
         "work of adhesion",
         args.adhesion_from,

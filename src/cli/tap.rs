@@ -29,9 +29,6 @@ use std::path::PathBuf;
 pub struct TapArgs {
     #[command(flatten)]
     inputs: TapInputs,
-    /// TOML parameter file (keys: the flags' names; values in SI or strings with units).
-    #[arg(long)]
-    config: Option<PathBuf>,
     /// Write the trajectory of the last cycles as CSV (t_s, z_m, v_m_s, alpha_m,
     /// force_n, branch).
     #[arg(long)]
@@ -49,7 +46,7 @@ pub struct TapArgs {
 
 /// Run the subcommand.
 pub fn run(args: TapArgs) -> Result<()> {
-    let (setup, numerics) = args.inputs.with_config(args.config.as_ref())?.resolve()?;
+    let (setup, numerics) = args.inputs.with_config()?.resolve()?;
     let wants_trajectory = args.trajectory.is_some() || args.plot.is_some();
     let record = if wants_trajectory {
         args.record_cycles.max(1)
