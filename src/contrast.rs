@@ -117,11 +117,9 @@ pub fn contrast(
     }
     let mut curves = Vec::new();
     for m in materials {
-        let (setup, mut numerics): (TapSetup, Numerics) =
-            m.inputs.clone().or(base.clone()).resolve()?;
-        if base.tolerance.is_none() {
-            numerics.tolerance = sweep::SETPOINT_TOLERANCE;
-        }
+        let inputs = m.inputs.clone().or(base.clone());
+        let (setup, numerics): (TapSetup, Numerics) = inputs.resolve()?;
+        let numerics = sweep::sweep_numerics(&inputs, numerics);
         let a0 = setup.cantilever.free_amplitude_m;
         let ramp = sweep::ramp(1.2 * a0, 0.3 * a0, points, false)?;
         for &law in laws {

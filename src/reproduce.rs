@@ -40,10 +40,7 @@ fn approach(setup: &TapSetup, law: LawKind, points: usize) -> Result<Vec<SweepPo
     };
     let a0 = setup.cantilever.free_amplitude_m;
     let ramp = sweep::ramp(1.2 * a0, 0.4 * a0, points, true)?;
-    let numerics = Numerics {
-        tolerance: sweep::SETPOINT_TOLERANCE,
-        ..Numerics::default()
-    };
+    let numerics = sweep::sweep_numerics(&Default::default(), Numerics::default());
     sweep::approach_curve(&setup, &numerics, &ramp, |_, _| {})
 }
 

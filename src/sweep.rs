@@ -11,6 +11,23 @@ use serde::Serialize;
 /// ~1e-5 (the transient left after a change < 1e-7 per cycle is < 1e-7·Q/π).
 pub const SETPOINT_TOLERANCE: f64 = 1e-7;
 
+/// Default cap on the periods integrated per setpoint of a sweep (near the onset of
+/// contact the motion can be period-doubled or chaotic and never settle; such points are
+/// reported with `converged: false`).
+pub const SETPOINT_MAX_CYCLES: usize = 4000;
+
+/// The numerics of a sweep: `numerics` with the sweep defaults for whatever `inputs` left
+/// unset (tolerance and cycle cap per setpoint).
+pub fn sweep_numerics(inputs: &crate::config::TapInputs, mut numerics: Numerics) -> Numerics {
+    if inputs.tolerance.is_none() {
+        numerics.tolerance = SETPOINT_TOLERANCE;
+    }
+    if inputs.max_cycles.is_none() {
+        numerics.max_cycles = SETPOINT_MAX_CYCLES;
+    }
+    numerics
+}
+
 /// Which way the ramp is moving.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]

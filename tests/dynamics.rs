@@ -74,6 +74,7 @@ fn free_response<L: ForceLaw>(law: &L, omega: f64, q: f64) -> (f64, f64) {
         streak: 3,
         min_cycles: 3,
         max_cycles: 100_000,
+        shooting: false,
     };
     let state = sim.steady_state(&mut phase, &opts).unwrap();
     assert!(state.converged);
@@ -297,4 +298,51 @@ fn tabulated_lj_law_dissipates_the_numerical_loop() {
     // At μ = 2.76 the hybrid theory underestimates the loss the LJ law gives.
     let hybrid = run(LawKind::Hybrid, 14.0);
     assert!(o.e_ts_j > hybrid.e_ts_j);
+}
+
+#[test]
+fn shooting_finds_the_same_steady_state_as_the_transient() {
+    for (law, z) in [
+        (LawKind::Hybrid, 16.0),
+        (LawKind::Hybrid, 18.0),
+        (LawKind::Dmt, 14.0),
+        (LawKind::Hertz, 14.0),
+    ] {
+        let setup = TapSetup {
+            law,
+            separation_m: z * 1e-9,
+            ..default_setup()
+        };
+        let fast = tap(&setup, &Numerics::default(), 0).unwrap().observables;
+        let slow = tap(
+            &setup,
+            &Numerics {
+                shooting: false,
+                ..Numerics::default()
+            },
+            0,
+        )
+        .unwrap()
+        .observables;
+        assert!(fast.converged && slow.converged);
+        assert!(
+            (fast.amplitude_ratio - slow.amplitude_ratio).abs() < 1e-7,
+            "{law} {z}"
+        );
+        assert!((fast.phase_deg - slow.phase_deg).abs() < 1e-5, "{law} {z}");
+        assert!(
+            (fast.e_ts_j - slow.e_ts_j).abs() <= 1e-7 * slow.e_drive_j,
+            "{law} {z}"
+        );
+        println!(
+            "{law} {z} nm: {} cycles with shooting, {} without",
+            fast.cycles, slow.cycles
+        );
+        assert!(
+            fast.cycles * 4 < slow.cycles,
+            "{law} {z}: {} vs {} cycles",
+            fast.cycles,
+            slow.cycles
+        );
+    }
 }

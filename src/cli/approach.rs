@@ -39,10 +39,8 @@ pub struct ApproachArgs {
 /// Run the subcommand.
 pub fn run(args: ApproachArgs) -> Result<()> {
     let inputs = args.inputs.with_config()?;
-    let (setup, mut numerics) = inputs.resolve()?;
-    if inputs.tolerance.is_none() {
-        numerics.tolerance = sweep::SETPOINT_TOLERANCE;
-    }
+    let (setup, numerics) = inputs.resolve()?;
+    let numerics = sweep::sweep_numerics(&inputs, numerics);
     let a0 = setup.cantilever.free_amplitude_m;
     let ramp = sweep::ramp(
         args.from.unwrap_or(1.2 * a0),

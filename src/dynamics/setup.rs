@@ -98,6 +98,8 @@ pub struct Numerics {
     pub tolerance: f64,
     /// Cycles at most.
     pub max_cycles: usize,
+    /// Find the periodic orbit by shooting before integrating the last cycles.
+    pub shooting: bool,
 }
 
 impl Default for Numerics {
@@ -108,6 +110,7 @@ impl Default for Numerics {
             min_steps_per_period: 40.0,
             tolerance: 1e-9,
             max_cycles: 20_000,
+            shooting: true,
         }
     }
 }
@@ -183,6 +186,7 @@ impl Prepared {
             streak: 3,
             min_cycles: 3,
             max_cycles: numerics.max_cycles,
+            shooting: numerics.shooting,
         };
         Ok(Self {
             setup: TapSetup {

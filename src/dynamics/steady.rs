@@ -311,13 +311,94 @@ impl<L: ForceLaw> Simulation<'_, L> {
         })
     }
 
+    /// Look for the period-one orbit by shooting: Newton's method on the one-period map
+    /// P(x, x') − (x, x') = 0, its Jacobian by finite differences (two more periods per
+    /// iteration). On success `phase` is moved onto the orbit; the periods spent are
+    /// returned either way (0 work is wasted beyond them: a failure leaves `phase` as it
+    /// was). Fails — and the caller integrates the transient — where the map changes its
+    /// switching pattern under the perturbation, or the orbit is not period-one.
+    fn shoot(&self, phase: &mut Phase) -> Result<(bool, usize)> {
+        let start = *phase;
+        let mut periods = 0;
+        let mut z = (phase.x, phase.v);
+        let map = |z: (f64, f64), periods: &mut usize| -> Result<Option<(f64, f64)>> {
+            let mut p = Phase {
+                x: z.0,
+                v: z.1,
+                ..start
+            };
+            self.cycle(&mut p, &mut numeric::Ignore)?;
+            *periods += 1;
+            // The orbit must return on the branch it left.
+            Ok((p.branch == start.branch).then_some((p.x - z.0, p.v - z.1)))
+        };
+        for _ in 0..12 {
+            let Some(f) = map(z, &mut periods)? else {
+                return Ok((false, periods));
+            };
+            let size = f.0.abs().max(f.1.abs());
+            if size < 1e-11 {
+                *phase = Phase {
+                    x: z.0,
+                    v: z.1,
+                    ..start
+                };
+                return Ok((true, periods));
+            }
+            let h = 1e-7;
+            let (Some(fx), Some(fv)) = (
+                map((z.0 + h, z.1), &mut periods)?,
+                map((z.0, z.1 + h), &mut periods)?,
+            ) else {
+                return Ok((false, periods));
+            };
+            // J = [[∂f0/∂x, ∂f0/∂v], [∂f1/∂x, ∂f1/∂v]].
+            let (a, b, c, d) = (
+                (fx.0 - f.0) / h,
+                (fv.0 - f.0) / h,
+                (fx.1 - f.1) / h,
+                (fv.1 - f.1) / h,
+            );
+            let det = a * d - b * c;
+            if !det.is_finite() || det.abs() < 1e-300 {
+                return Ok((false, periods));
+            }
+            let step = ((d * f.0 - b * f.1) / det, (a * f.1 - c * f.0) / det);
+            // Far from the orbit full Newton steps overshoot (the map is only weakly
+            // contracting): limit them; the caller integrates closer if this fails.
+            let scale = (0.2 / step.0.abs().max(step.1.abs())).min(1.0);
+            z = (z.0 - scale * step.0, z.1 - scale * step.1);
+        }
+        Ok((false, periods))
+    }
+
     /// Integrate cycles until the amplitude, phase and contact dissipation change by less
     /// than `opts.tolerance` (relative; the energy relative to the drive input) over
     /// `opts.streak` consecutive cycles, or until `opts.max_cycles`. Reports the last cycle.
+    /// When `opts.shooting` is set, the periodic orbit is first looked for by shooting
+    /// (a few dozen periods instead of ~Q ln(1/tolerance)/π); the cycles integrated
+    /// afterwards still have to pass the convergence test.
     pub fn steady_state(&self, phase: &mut Phase, opts: &SteadyOptions) -> Result<SteadyState> {
         let mut last: Option<CycleIntegrals> = None;
         let mut streak = 0;
         let mut cycles = 0;
+        if opts.shooting {
+            // A first period puts the state on a consistent branch; where shooting fails,
+            // a stretch of transient brings the state closer before the next attempt.
+            self.cycle(phase, &mut numeric::Ignore)?;
+            cycles += 1;
+            for _ in 0..4 {
+                let (found, spent) = self.shoot(phase)?;
+                cycles += spent;
+                if found || cycles >= opts.max_cycles {
+                    break;
+                }
+                for _ in 0..SHOOTING_RETRY_PERIODS {
+                    self.cycle(phase, &mut numeric::Ignore)?;
+                }
+                cycles += SHOOTING_RETRY_PERIODS;
+            }
+        }
         while cycles < opts.max_cycles.max(1) {
             let c = self.cycle(phase, &mut numeric::Ignore)?;
             cycles += 1;
@@ -344,6 +425,9 @@ impl<L: ForceLaw> Simulation<'_, L> {
     }
 }
 
+/// Transient periods integrated between shooting attempts.
+const SHOOTING_RETRY_PERIODS: usize = 100;
+
 /// Settings of the steady-state search.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SteadyOptions {
@@ -355,6 +439,8 @@ pub struct SteadyOptions {
     pub min_cycles: usize,
     /// At most this many cycles.
     pub max_cycles: usize,
+    /// Look for the periodic orbit by shooting first.
+    pub shooting: bool,
 }
 
 /// The outcome of [`Simulation::steady_state`].
