@@ -13,8 +13,8 @@ use clap::Args;
 /// Per point: the steady-state observables of `tapsim tap`. Output: a table on stdout,
 /// or --json (one object of equal-length arrays: separation_m, direction, amplitude_m,
 /// amplitude_ratio, phase_deg, e_ts_j, virial_j, mean_force_n, peak_force_n, converged,
-/// ...), --csv FILE, and --plot FILE.png|svg (A/A₀, φ, E_ts, virial, peak force vs z_c;
-/// φ vs A/A₀; approach and retract distinct).
+/// ...), --csv FILE, and --plot FILE.png|svg (A/A₀, φ, E_ts, virial, peak force vs z_c,
+/// and φ, E_ts, virial, peak force vs A/A₀; approach and retract distinct).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct ApproachArgs {

@@ -33,7 +33,8 @@ pub struct TapArgs {
     /// force_n, branch).
     #[arg(long)]
     trajectory: Option<PathBuf>,
-    /// Plot deflection and force vs time and the force–separation loop (.png or .svg).
+    /// Plot deflection and force vs time, the force–separation loop and the phase
+    /// portrait (.png or .svg).
     #[arg(long)]
     plot: Option<PathBuf>,
     /// Cycles recorded for --trajectory and --plot.

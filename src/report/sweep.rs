@@ -79,8 +79,8 @@ pub fn records_csv<T: Serialize>(records: &[T]) -> Result<Vec<u8>> {
     })
 }
 
-/// Approach-curve charts: A/A₀, φ, E_ts, virial and peak force against z_c, and φ and
-/// E_ts against A/A₀; approach and retract as separate series.
+/// Approach-curve charts: A/A₀, φ, E_ts, virial and peak force against z_c, and the
+/// last four against A/A₀; approach and retract as separate series.
 pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
     type Pick = fn(&SweepPoint) -> f64;
     let nm = |p: &SweepPoint| p.separation_m * 1e9;
@@ -121,56 +121,53 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
         };
     let zc = || Axis::linear("rest separation z_c (nm)", "separation_nm");
     let ratio = |p: &SweepPoint| p.observables.amplitude_ratio;
-    vec![
-        chart(
-            "amplitude",
-            "amplitude",
-            zc(),
-            &nm,
-            Axis::linear("A/A₀", "amplitude_ratio"),
-            |p| p.observables.amplitude_ratio,
-        ),
-        chart(
-            "phase",
-            "phase",
-            zc(),
-            &nm,
-            Axis::linear("phase lag φ (deg)", "phase_deg"),
-            |p| p.observables.phase_deg,
-        ),
-        chart(
+    // (file stem, caption, axis label, column, value); the first is A/A₀ itself.
+    let quantities: [(&str, &str, &str, &str, Pick); 5] = [
+        ("amplitude", "amplitude", "A/A₀", "amplitude_ratio", |p| {
+            p.observables.amplitude_ratio
+        }),
+        ("phase", "phase", "phase lag φ (deg)", "phase_deg", |p| {
+            p.observables.phase_deg
+        }),
+        (
             "e_ts",
             "dissipation",
-            zc(),
-            &nm,
-            Axis::linear("E_ts per cycle (eV)", "e_ts_ev"),
+            "E_ts per cycle (eV)",
+            "e_ts_ev",
             |p| p.observables.e_ts_ev,
         ),
-        chart(
+        (
             "virial",
             "virial",
-            zc(),
-            &nm,
-            Axis::linear("virial ⟨F_ts z⟩ (eV)", "virial_ev"),
+            "virial ⟨F_ts z⟩ (eV)",
+            "virial_ev",
             |p| p.observables.virial_j / crate::params::ELECTRONVOLT_J,
         ),
-        chart(
+        (
             "peak_force",
             "peak force",
-            zc(),
-            &nm,
-            Axis::linear("peak repulsive force (nN)", "peak_force_nn"),
+            "peak repulsive force (nN)",
+            "peak_force_nn",
             |p| p.observables.peak_force_n * 1e9,
         ),
-        chart(
-            "phase_vs_amplitude",
-            "phase vs amplitude",
-            Axis::linear("A/A₀", "amplitude_ratio"),
-            &ratio,
-            Axis::linear("phase lag φ (deg)", "phase_deg"),
-            |p| p.observables.phase_deg,
-        ),
-    ]
+    ];
+    let against_separation = quantities.iter().map(|&(name, what, label, column, pick)| {
+        chart(name, what, zc(), &nm, Axis::linear(label, column), pick)
+    });
+    let against_amplitude = quantities
+        .iter()
+        .skip(1)
+        .map(|&(name, what, label, column, pick)| {
+            chart(
+                &format!("{name}_vs_amplitude"),
+                &format!("{what} vs amplitude"),
+                Axis::linear("A/A₀", "amplitude_ratio"),
+                &ratio,
+                Axis::linear(label, column),
+                pick,
+            )
+        });
+    against_separation.chain(against_amplitude).collect()
 }
 
 /// φ against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999 left out), one series

@@ -148,8 +148,9 @@ fn runs(
     out
 }
 
-/// Charts of the recorded trajectory: deflection vs time, force vs time, and the
-/// force–separation loop with the law's jump-in and jump-out separations marked.
+/// Charts of the recorded trajectory: deflection vs time, force vs time, the
+/// force–separation loop with the law's jump-in and jump-out separations marked, and the
+/// phase portrait (velocity vs deflection, in and out of contact).
 pub fn trajectory_charts(run: &TapRun, title: &str) -> Vec<Chart> {
     let t = &run.trajectory;
     let ns = |s: &TrajectorySample| s.t_s * 1e6;
@@ -242,5 +243,14 @@ pub fn trajectory_charts(run: &TapRun, title: &str) -> Vec<Chart> {
         labels: vec![],
         legend: Corner::UpperRight,
     };
-    vec![deflection, force, separation]
+    let portrait = Chart {
+        name: "phase_portrait".into(),
+        title: format!("{title}: phase portrait"),
+        x: Axis::linear("deflection z (nm)", "z_nm"),
+        y: Axis::linear("velocity dz/dt (m/s)", "v_m_s"),
+        series: split(&|s| (s.z_m * 1e9, s.v_m_s)),
+        labels: vec![],
+        legend: Corner::UpperRight,
+    };
+    vec![deflection, force, separation, portrait]
 }
