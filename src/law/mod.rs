@@ -17,7 +17,7 @@ pub use conservative::{DmtLaw, HertzLaw, NoForce};
 pub use fold_branch::{FarField, FoldBranch, Side};
 pub use table::UniformTable;
 
-use crate::contact::hybrid::{self, JumpIn};
+use crate::contact::hybrid::JumpIn;
 use crate::error::{Error, Result};
 use crate::params::Contact;
 use serde::{Deserialize, Serialize};
@@ -137,11 +137,6 @@ impl AnyLaw {
             ),
             LawKind::None => AnyLaw::None(NoForce),
         })
-    }
-
-    /// The smallest μ at which the hybrid law applies (for messages).
-    pub fn hybrid_min_mu() -> f64 {
-        hybrid::min_hysteretic_mu(JumpIn::Fit).unwrap_or(f64::NAN)
     }
 }
 
