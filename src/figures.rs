@@ -204,46 +204,25 @@ pub fn fig2(s: &LjSolution) -> Result<Chart> {
 /// The numerical jump-in separations against the fit (17) and the closed form (16), as
 /// CSV (`mu, alpha_hat_a, alpha_hat_a_error, fit17, fit17_rel, closed_form16`).
 pub fn lj_fit_table(solutions: &[LjSolution]) -> Result<Vec<u8>> {
-    let fail = |e: csv::Error| Error::Output {
-        path: "fig3_lj_vs_fit.csv".into(),
-        reason: e.to_string(),
-    };
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record([
-        "mu",
-        "alpha_hat_a",
-        "alpha_hat_a_error",
-        "fit17",
-        "fit17_rel",
-        "closed_form16",
-        "w_hat",
-        "w_hat_error",
-        "w_hat_hybrid",
-    ])
-    .map_err(fail)?;
-    for s in solutions {
-        let mu = s.tabor_mu;
-        let fit = semi_rigid::alpha_hat_a_fit(mu);
-        w.write_record(
-            [
-                mu,
-                s.alpha_hat_a.value,
-                s.alpha_hat_a.error,
-                fit,
-                (fit - s.alpha_hat_a.value) / s.alpha_hat_a.value,
-                semi_rigid::alpha_hat_a_closed_form(mu),
-                s.w_hat.value,
-                s.w_hat.error,
-                hybrid::w_hat_fit(mu),
-            ]
-            .map(|v| v.to_string()),
-        )
-        .map_err(fail)?;
-    }
-    w.into_inner().map_err(|e| Error::Output {
-        path: "fig3_lj_vs_fit.csv".into(),
-        reason: e.to_string(),
-    })
+    let rows: Vec<serde_json::Value> = solutions
+        .iter()
+        .map(|s| {
+            let mu = s.tabor_mu;
+            let fit = semi_rigid::alpha_hat_a_fit(mu);
+            serde_json::json!({
+                "mu": mu,
+                "alpha_hat_a": s.alpha_hat_a.value,
+                "alpha_hat_a_error": s.alpha_hat_a.error,
+                "fit17": fit,
+                "fit17_rel": (fit - s.alpha_hat_a.value) / s.alpha_hat_a.value,
+                "closed_form16": semi_rigid::alpha_hat_a_closed_form(mu),
+                "w_hat": s.w_hat.value,
+                "w_hat_error": s.w_hat.error,
+                "w_hat_hybrid": hybrid::w_hat_fit(mu),
+            })
+        })
+        .collect();
+    crate::report::records::records_csv(&rows)
 }
 
 /// Fig. 3: jump-in separation α̂_A vs μ — the numerical Lennard-Jones points, the exact

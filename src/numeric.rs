@@ -25,6 +25,12 @@ pub const GAUSS_LEGENDRE_8: [(f64, f64); 8] = [
     (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
 ];
 
+/// Distance from `x` to the interval [lo, hi] (0 inside it).
+#[inline]
+pub fn distance_to_interval(x: f64, lo: f64, hi: f64) -> f64 {
+    (lo - x).max(x - hi).max(0.0)
+}
+
 /// Root of `f` in the bracket `[lo, hi]` (signs of `f(lo)` and `f(hi)` must differ),
 /// by the Illinois variant of regula falsi: bracketing like bisection, superlinear
 /// like the secant method. Stops when the bracket is below `x_tol` (absolute) or

@@ -12,7 +12,7 @@ use crate::figures::{self, FigureOptions};
 use crate::law::LawKind;
 use crate::params::{Contact, ELECTRONVOLT_J, composite_modulus};
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
-use crate::report::{output, plot, sweep as sweep_report, tap as tap_report};
+use crate::report::{output, plot, records, sweep as sweep_report, tap as tap_report};
 use crate::sweep::{self, Direction, SweepPoint};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -207,7 +207,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
         }
     }
     let path = out.join("tap_approach_laws.csv");
-    output::write_bytes(&path, &sweep_report::records_csv(&records)?)?;
+    output::write_bytes(&path, &records::records_csv(&records)?)?;
     add(
         vec![path],
         "approach-retract curves, both polymers, all three laws",

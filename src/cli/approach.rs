@@ -2,7 +2,7 @@
 
 use crate::config::{TapInputs, length};
 use crate::error::Result;
-use crate::report::{output, plot, sweep as report};
+use crate::report::{output, plot, records, sweep as report};
 use crate::sweep::{self, Direction};
 use clap::Args;
 
@@ -54,7 +54,7 @@ pub fn run(args: ApproachArgs) -> Result<()> {
     })?;
     bar.finish_and_clear();
     if let Some(path) = &args.out.csv {
-        output::write_bytes(path, &report::records_csv(&points)?)?;
+        output::write_bytes(path, &records::records_csv(&points)?)?;
     }
     if let Some(path) = &args.out.plot {
         plot::render_stack(
@@ -65,7 +65,7 @@ pub fn run(args: ApproachArgs) -> Result<()> {
     if args.out.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&report::columns_json(&points)?).expect("serialises")
+            serde_json::to_string_pretty(&records::columns_json(&points)?).expect("serialises")
         );
     } else {
         println!(

@@ -3,7 +3,7 @@
 use crate::config::{TapInputs, pressure, surface_energy};
 use crate::error::Result;
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
-use crate::report::{output, plot, sweep as report};
+use crate::report::{output, plot, records};
 use crate::sweep;
 use clap::Args;
 
@@ -60,7 +60,7 @@ pub fn run(args: MapArgs) -> Result<()> {
         })?;
     bar.finish_and_clear();
     if let Some(path) = &args.out.csv {
-        output::write_bytes(path, &report::records_csv(&cells)?)?;
+        output::write_bytes(path, &records::records_csv(&cells)?)?;
     }
     if let Some(path) = &args.out.plot {
         let lines = |y: fn(&sweep::MapCell) -> Option<f64>| -> Vec<Series> {
@@ -106,10 +106,13 @@ pub fn run(args: MapArgs) -> Result<()> {
     if args.out.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&report::columns_json(&cells)?).expect("serialises")
+            serde_json::to_string_pretty(&records::columns_json(&cells)?).expect("serialises")
         );
     } else if args.out.csv.is_none() && args.out.plot.is_none() {
-        print!("{}", String::from_utf8_lossy(&report::records_csv(&cells)?));
+        print!(
+            "{}",
+            String::from_utf8_lossy(&records::records_csv(&cells)?)
+        );
     }
     Ok(())
 }

@@ -5,7 +5,7 @@ use crate::contact::hybrid::{self, JumpIn};
 use crate::contact::jkr;
 use crate::contact::lj::LjSolution;
 use crate::contact::semi_rigid;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -198,19 +198,5 @@ impl LjReport {
 
 /// The traced curve as CSV: s, alpha_hat, t_hat, central_gap.
 pub fn curve_csv(s: &LjSolution) -> Result<Vec<u8>> {
-    let fail = |e: csv::Error| Error::Output {
-        path: "curve.csv".into(),
-        reason: e.to_string(),
-    };
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(["s", "alpha_hat", "t_hat", "central_gap"])
-        .map_err(fail)?;
-    for p in &s.curve {
-        w.write_record([p.s, p.alpha_hat, p.t_hat, p.central_gap].map(|v| v.to_string()))
-            .map_err(fail)?;
-    }
-    w.into_inner().map_err(|e| Error::Output {
-        path: "curve.csv".into(),
-        reason: e.to_string(),
-    })
+    super::records::records_csv(&s.curve)
 }

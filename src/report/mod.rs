@@ -6,5 +6,6 @@ pub mod hysteresis;
 pub mod lj;
 pub mod output;
 pub mod plot;
+pub mod records;
 pub mod sweep;
 pub mod tap;

@@ -4,7 +4,7 @@
 use super::chart::{Axis, Chart, Corner, Series, Style};
 use crate::dynamics::observables::{TapObservables, TapRun, TrajectorySample};
 use crate::dynamics::setup::TapSetup;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::law::Branch;
 use std::fmt::Write as _;
 
@@ -106,31 +106,7 @@ pub fn to_text(setup: &TapSetup, o: &TapObservables) -> String {
 
 /// The trajectory as CSV: t_s, z_m, v_m_s, alpha_m, force_n, branch.
 pub fn trajectory_csv(samples: &[TrajectorySample]) -> Result<Vec<u8>> {
-    let fail = |e: csv::Error| Error::Output {
-        path: "trajectory.csv".into(),
-        reason: e.to_string(),
-    };
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(["t_s", "z_m", "v_m_s", "alpha_m", "force_n", "branch"])
-        .map_err(fail)?;
-    for s in samples {
-        w.write_record([
-            s.t_s.to_string(),
-            s.z_m.to_string(),
-            s.v_m_s.to_string(),
-            s.alpha_m.to_string(),
-            s.force_n.to_string(),
-            match s.branch {
-                Branch::Free => "free".into(),
-                Branch::Contact => "contact".into(),
-            },
-        ])
-        .map_err(fail)?;
-    }
-    w.into_inner().map_err(|e| Error::Output {
-        path: "trajectory.csv".into(),
-        reason: e.to_string(),
-    })
+    super::records::records_csv(samples)
 }
 
 /// Split samples into runs of one branch (so lines do not join across a jump).

@@ -8,7 +8,7 @@
 //! G = R − w ln|x − y| with w = y/(x+y): the regular part R is integrated by
 //! Gauss–Legendre, the logarithmic part exactly against a quadratic interpolant of w·φ.
 
-use crate::numeric::GAUSS_LEGENDRE_8;
+use crate::numeric::{GAUSS_LEGENDRE_8, distance_to_interval};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -88,13 +88,7 @@ pub fn element_integrals(x: f64, a: f64, b: f64) -> (f64, f64) {
     if x == 0.0 {
         return (PI / 2.0 * h / 2.0, PI / 2.0 * h / 2.0);
     }
-    let distance = if x < a {
-        a - x
-    } else if x > b {
-        x - b
-    } else {
-        0.0
-    };
+    let distance = distance_to_interval(x, a, b);
     let (mid, half) = (0.5 * (a + b), 0.5 * h);
     if distance > 2.0 * h {
         let (mut left, mut right) = (0.0, 0.0);

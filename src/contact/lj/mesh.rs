@@ -4,6 +4,7 @@
 
 use crate::contact::hybrid::JumpIn;
 use crate::contact::jkr;
+use crate::numeric::distance_to_interval;
 use serde::{Deserialize, Serialize};
 
 /// Outer radius of every mesh: f(h̄) there is ~(2/x²)³ ≈ 1e-10.
@@ -68,13 +69,7 @@ impl MeshSpec {
         // Spacing wanted at x: fine in the band, growing geometrically away from it,
         // capped at `coarse` towards the axis.
         let spacing = |x: f64| -> f64 {
-            let d = if x < lo {
-                lo - x
-            } else if x > hi {
-                x - hi
-            } else {
-                0.0
-            };
+            let d = distance_to_interval(x, lo, hi);
             // Geometric growth with ratio g per element ≈ spacing grows linearly with
             // distance: s(d) = fine + (g − 1) d.
             let s = self.fine + (self.growth - 1.0) * d;
