@@ -118,12 +118,20 @@ pub fn newton_bracketed(
             hi = x;
         }
         let newton = x - fx / dfx;
-        let next = if newton > lo.min(hi) && newton < lo.max(hi) && newton.is_finite() {
+        // Below a few ulps of x the iteration can only cycle between neighbours.
+        let tol = x_tol.max(4.0 * f64::EPSILON * x.abs());
+        let (a, b) = (lo.min(hi), lo.max(hi));
+        if (newton - x).abs() <= tol {
+            // Converged (a last step that lands on the bracket's end is not a reason to
+            // fall back to bisection).
+            return newton.clamp(a, b);
+        }
+        let next = if newton > a && newton < b && newton.is_finite() {
             newton
         } else {
             0.5 * (lo + hi)
         };
-        if (next - x).abs() <= x_tol {
+        if (next - x).abs() <= tol {
             return next;
         }
         x = next;
@@ -162,6 +170,26 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn newton_bracketed_stops_at_the_ulp_level_far_from_zero() {
+        // At x ≈ 11 the spacing of doubles (1.8e-15) exceeds the requested tolerance; a
+        // converged Newton step that lands on the bracket's end must stop, not bisect.
+        let root = 10.982_493_883_375_94;
+        let calls = std::cell::Cell::new(0);
+        let r = newton_bracketed(
+            |x| {
+                calls.set(calls.get() + 1);
+                // The exact root lies between two doubles: no double makes f vanish.
+                (x - root + 4.7e-16, 1.0)
+            },
+            10.2,
+            11.0,
+            1e-15,
+        );
+        assert!((r - root).abs() < 4e-15, "{r}");
+        assert!(calls.get() <= 8, "{} evaluations", calls.get());
     }
 
     #[test]
