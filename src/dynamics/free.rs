@@ -73,14 +73,22 @@ impl FreeFlight {
     /// Deflection and velocity at τ.
     #[inline]
     pub fn at(&self, tau: f64) -> (f64, f64) {
-        let (s, c) = (self.omega * tau).sin_cos();
+        let t = tau - self.tau0;
+        self.combine(
+            (self.omega * tau).sin_cos(),
+            (self.omega_d * t).sin_cos(),
+            (-self.gamma * t).exp(),
+        )
+    }
+
+    /// (x, x') from the drive phasor (sin Ωτ, cos Ωτ), the transient's phasor
+    /// (sin ω_d s, cos ω_d s) and its decay e^{−γs}.
+    #[inline]
+    fn combine(&self, (s, c): (f64, f64), (sd, cd): (f64, f64), e: f64) -> (f64, f64) {
         let (x_p, v_p) = (
             self.a * c + self.b * s,
             self.omega * (-self.a * s + self.b * c),
         );
-        let t = tau - self.tau0;
-        let e = (-self.gamma * t).exp();
-        let (sd, cd) = (self.omega_d * t).sin_cos();
         let x_h = e * (self.c1 * cd + self.c2 * sd);
         let v_h = e
             * ((-self.gamma * self.c1 + self.omega_d * self.c2) * cd
@@ -99,16 +107,11 @@ impl FreeFlight {
         let (rsd, rcd) = (self.omega_d * h).sin_cos();
         let decay = (-self.gamma * h).exp();
         std::iter::from_fn(move || {
-            let x_p = self.a * c + self.b * s;
-            let v_p = self.omega * (-self.a * s + self.b * c);
-            let x_h = e * (self.c1 * cd + self.c2 * sd);
-            let v_h = e
-                * ((-self.gamma * self.c1 + self.omega_d * self.c2) * cd
-                    + (-self.gamma * self.c2 - self.omega_d * self.c1) * sd);
+            let sample = self.combine((s, c), (sd, cd), e);
             (s, c) = (s * rc + c * rs, c * rc - s * rs);
             (sd, cd) = (sd * rcd + cd * rsd, cd * rcd - sd * rsd);
             e *= decay;
-            Some((x_p + x_h, v_p + v_h))
+            Some(sample)
         })
     }
 
