@@ -181,8 +181,7 @@ impl FreeFlight {
         let h = (tau_b - tau_a) / n as f64;
         let mut min_x = f64::INFINITY;
         let mut samples = self.samples(tau_a, h);
-        let (mut t0, (mut x0, mut v0)) = (tau_a, self.at(tau_a));
-        samples.next();
+        let (mut t0, (mut x0, mut v0)) = (tau_a, samples.next().expect("endless"));
         for i in 1..=n {
             let t1 = if i == n { tau_b } else { tau_a + h * i as f64 };
             let (x1, v1) = samples.next().expect("endless");
