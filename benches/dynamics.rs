@@ -1,6 +1,7 @@
 //! Simulated steady-state tapping cycles per second with the hybrid law (default setup),
 //! at integrator tolerances whose energy-balance error is below 1e-6 (checked before
-//! measuring).
+//! measuring, at the default setpoint and at five others from 0.6 to 1.2 times its rest
+//! separation, so a lucky cancellation at one setpoint cannot pass).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use tapsim::dynamics::numeric::Ignore;
@@ -15,12 +16,29 @@ fn bench(c: &mut Criterion) {
     // (rtol, atol): the defaults, then looser settings that still keep the energy
     // balance below 1e-6 (checked below; the balance is not monotonic in the tolerances,
     // so each pair is checked rather than assumed).
-    for (rtol, atol) in [(1e-9, 1e-11), (1e-8, 1e-10), (2e-7, 2e-9), (3e-7, 1e-8)] {
+    for (rtol, atol) in [(1e-9, 1e-11), (1e-8, 1e-10), (1e-7, 1e-9), (2e-7, 2e-9)] {
         let numerics = Numerics {
             rtol,
             atol,
             ..Numerics::default()
         };
+        let mut worst: f64 = 0.0;
+        for factor in [0.6, 0.8, 0.9, 1.1, 1.2, 1.0] {
+            let mut setup = default_setup();
+            setup.separation_m *= factor;
+            let p = Prepared::new(&setup, &numerics).expect("defaults are valid");
+            let sim = p.simulation();
+            let mut phase = sim.free_steady_start();
+            let state = sim
+                .steady_state(&mut phase, &p.steady)
+                .expect("steady state");
+            let o = TapObservables::new(&p, &state);
+            assert!(
+                o.converged && o.energy_balance_rel < 1e-6,
+                "rtol {rtol}, separation x{factor}: {o:?}"
+            );
+            worst = worst.max(o.energy_balance_rel);
+        }
         let p = Prepared::new(&default_setup(), &numerics).expect("defaults are valid");
         let sim = p.simulation();
         let mut phase = sim.free_steady_start();
@@ -28,12 +46,9 @@ fn bench(c: &mut Criterion) {
             .steady_state(&mut phase, &p.steady)
             .expect("steady state");
         let o = TapObservables::new(&p, &state);
-        assert!(
-            o.converged && o.energy_balance_rel < 1e-6,
-            "rtol {rtol}: {o:?}"
-        );
         eprintln!(
-            "rtol {rtol:e}, atol {atol:e}: energy balance {:.1e}, E_ts/loop - 1 = {:.1e}",
+            "rtol {rtol:e}, atol {atol:e}: energy balance {:.1e} (worst of six setpoints \
+             {worst:.1e}), E_ts/loop - 1 = {:.1e}",
             o.energy_balance_rel,
             o.e_ts_j / o.loop_area_j - 1.0
         );

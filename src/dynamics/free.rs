@@ -2,7 +2,7 @@
 //! force: x'' + 2γx' + x = f₀ cos Ωτ. Exact, so free flight costs no integration steps,
 //! and so are the carried integrals.
 
-use super::model::{Drive, E_DAMP, E_DRIVE, Oscillator, SC, SS, State, V, X};
+use super::model::{Drive, E_DAMP, Oscillator, SC, SS, State, V, X};
 use crate::numeric::newton_bracketed;
 use nalgebra::Complex;
 
@@ -141,7 +141,6 @@ impl FreeFlight {
         y[X] = x_b;
         y[V] = v_b;
         y[E_DAMP] += drive - mechanical;
-        y[E_DRIVE] += drive;
         y[SC] += sc;
         y[SS] += ss;
     }

@@ -14,30 +14,30 @@ use nalgebra::SVector;
 /// ODE state: deflection, velocity, the per-cycle integrals carried along, and the drive
 /// phasor (cos Ωτ, sin Ωτ), integrated as a rotation so the right-hand side needs no
 /// trigonometric calls (it is reset to the exact values at every segment start).
-pub type State = SVector<f64, 11>;
+///
+/// Two energies are not carried: the contact's E_ts is exact from the law's branch work
+/// functions at the segment ends, and the drive's work follows from the Fourier
+/// projections by parts ([`Oscillator::drive_work`]).
+pub type State = SVector<f64, 9>;
 
 /// Index of the deflection x in [`State`].
 pub const X: usize = 0;
 /// Velocity x'.
 pub const V: usize = 1;
-/// Energy dissipated in the contact, ∫ −f_ts dα (in units of kL²).
-pub const E_TS: usize = 2;
 /// Energy dissipated by damping, ∫ 2γ x'² dτ.
-pub const E_DAMP: usize = 3;
-/// Energy put in by the drive.
-pub const E_DRIVE: usize = 4;
+pub const E_DAMP: usize = 2;
 /// Fourier projection ∫ x cos Ωτ dτ.
-pub const SC: usize = 5;
+pub const SC: usize = 3;
 /// Fourier projection ∫ x sin Ωτ dτ.
-pub const SS: usize = 6;
+pub const SS: usize = 4;
 /// ∫ f_ts dτ (mean force).
-pub const F_INT: usize = 7;
+pub const F_INT: usize = 5;
 /// ∫ f_ts x dτ (virial).
-pub const VIRIAL: usize = 8;
+pub const VIRIAL: usize = 6;
 /// cos Ωτ.
-pub const COS: usize = 9;
+pub const COS: usize = 7;
 /// sin Ωτ.
-pub const SIN: usize = 10;
+pub const SIN: usize = 8;
 
 /// Set the drive phasor of `y` to its exact value at τ.
 #[inline]
@@ -90,20 +90,56 @@ impl Oscillator {
     pub fn base_at(&self, tau: f64) -> (f64, f64) {
         match self.drive {
             Drive::Force { .. } => (0.0, 0.0),
+            Drive::Base { .. } => self.base_from((self.omega * tau).sin_cos()),
+        }
+    }
+
+    /// Work done by the drive between `start` and `end` (each (τ, x, x')), from the
+    /// Fourier projections `sc` = ∫ x cos Ωτ dτ and `ss` = ∫ x sin Ωτ dτ over the span.
+    ///
+    /// Force drive, by parts: ∫ f₀ cos Ωτ x' dτ = f₀([x cos Ωτ] + Ω·ss), exact for any
+    /// path. Base drive: the work −∫ f_ts x_b' dτ = bΩ ∫ f_ts sin Ωτ dτ, with f_ts =
+    /// x'' + 2γx' + x from the equation of motion and the same integration by parts:
+    /// ∫ f_ts sin Ωτ dτ = [x' sin Ωτ] − Ω[x cos Ωτ] + 2γ[x sin Ωτ] + (1 − Ω²)·ss − 2γΩ·sc.
+    pub fn drive_work(
+        &self,
+        start: (f64, f64, f64),
+        end: (f64, f64, f64),
+        sc: f64,
+        ss: f64,
+    ) -> f64 {
+        let w = self.omega;
+        let span = |g: &dyn Fn(f64, f64, f64) -> f64| {
+            g(end.0, end.1, end.2) - g(start.0, start.1, start.2)
+        };
+        match self.drive {
+            Drive::Force { amplitude } => amplitude * (span(&|t, x, _| x * (w * t).cos()) + w * ss),
             Drive::Base { amplitude } => {
-                let (s, c) = (self.omega * tau).sin_cos();
-                (amplitude * c, -amplitude * self.omega * s)
+                let force_sin = span(&|t, x, v| {
+                    let (s, c) = (w * t).sin_cos();
+                    v * s - w * x * c + 2.0 * self.gamma * x * s
+                }) + (1.0 - w * w) * ss
+                    - 2.0 * self.gamma * w * sc;
+                amplitude * w * force_sin
             }
         }
     }
 
-    /// Drive force f_drive and support displacement and velocity (x_b, x_b') from
-    /// (sin Ωτ, cos Ωτ).
+    /// Support displacement and velocity (x_b, x_b') from the phasor (sin Ωτ, cos Ωτ).
     #[inline]
-    pub fn drive_from(&self, (s, c): (f64, f64)) -> (f64, f64, f64) {
+    pub fn base_from(&self, (s, c): (f64, f64)) -> (f64, f64) {
         match self.drive {
-            Drive::Force { amplitude } => (amplitude * c, 0.0, 0.0),
-            Drive::Base { amplitude } => (0.0, amplitude * c, -amplitude * self.omega * s),
+            Drive::Force { .. } => (0.0, 0.0),
+            Drive::Base { amplitude } => (amplitude * c, -amplitude * self.omega * s),
+        }
+    }
+
+    /// Drive force f_drive and support displacement x_b from cos Ωτ.
+    #[inline]
+    pub fn drive_from(&self, c: f64) -> (f64, f64) {
+        match self.drive {
+            Drive::Force { amplitude } => (amplitude * c, 0.0),
+            Drive::Base { amplitude } => (0.0, amplitude * c),
         }
     }
 }
@@ -147,17 +183,67 @@ pub fn rhs<L: ForceLaw>(
     let _ = tau;
     let (x, v) = (y[X], y[V]);
     let (s, c) = (y[SIN], y[COS]);
-    let (drive, x_b, v_b) = osc.drive_from((s, c));
+    let (drive, x_b) = osc.drive_from(c);
     let f = -cpl.f_scale * law.t_hat(cpl.alpha_hat(x, x_b), branch);
     dy[X] = v;
     dy[V] = -2.0 * osc.gamma * v - x + f + drive;
-    dy[E_TS] = -f * (v + v_b);
     dy[E_DAMP] = 2.0 * osc.gamma * v * v;
-    dy[E_DRIVE] = drive * v - f * v_b;
     dy[SC] = x * c;
     dy[SS] = x * s;
     dy[F_INT] = f;
     dy[VIRIAL] = f * x;
     dy[COS] = -osc.omega * s;
     dy[SIN] = osc.omega * c;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Simpson's rule with `n` (even) intervals.
+    fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+        let h = (b - a) / n as f64;
+        let inner: f64 = (1..n)
+            .map(|i| f(a + h * i as f64) * if i % 2 == 1 { 4.0 } else { 2.0 })
+            .sum();
+        h / 3.0 * (f(a) + inner + f(b))
+    }
+
+    #[test]
+    fn drive_work_matches_its_defining_integrals() {
+        // Any smooth path will do: the force drive's formula is pure integration by
+        // parts, the base drive's uses f_ts = x'' + 2γx' + x along the path.
+        let x = |t: f64| 0.3 * (1.7 * t).sin() + 0.1 * t * t;
+        let v = |t: f64| 0.51 * (1.7 * t).cos() + 0.2 * t;
+        let a = |t: f64| -0.867 * (1.7 * t).sin() + 0.2;
+        let (t0, t1, n) = (0.2, 2.5, 20_000);
+        for drive in [
+            Drive::Force { amplitude: 0.7 },
+            Drive::Base { amplitude: 0.4 },
+        ] {
+            let osc = Oscillator {
+                gamma: 0.05,
+                omega: 1.3,
+                drive,
+            };
+            let w = osc.omega;
+            let sc = simpson(|t| x(t) * (w * t).cos(), t0, t1, n);
+            let ss = simpson(|t| x(t) * (w * t).sin(), t0, t1, n);
+            let direct = match drive {
+                Drive::Force { amplitude } => {
+                    simpson(|t| amplitude * (w * t).cos() * v(t), t0, t1, n)
+                }
+                Drive::Base { amplitude } => {
+                    // −∫ f_ts x_b' dτ with x_b = b cos Ωτ.
+                    let f_ts = |t: f64| a(t) + 2.0 * osc.gamma * v(t) + x(t);
+                    simpson(|t| f_ts(t) * amplitude * w * (w * t).sin(), t0, t1, n)
+                }
+            };
+            let work = osc.drive_work((t0, x(t0), v(t0)), (t1, x(t1), v(t1)), sc, ss);
+            assert!(
+                (work - direct).abs() < 1e-12,
+                "{drive:?}: {work} vs {direct}"
+            );
+        }
+    }
 }

@@ -4,13 +4,21 @@
 //! (from the states and derivatives at both ends), the crossing is located on it, and
 //! the state at the crossing is obtained by integrating again from the start of that
 //! step — never by extrapolating dense output.
+//!
+//! Usually a crossing is not located at all but landed on: when an accepted step ends
+//! within reach of the switch, the rest of the way is integrated with Hénon's trick,
+//! taking u = √|level − α̂| as the independent variable (dτ/du follows from the velocity)
+//! and stopping exactly at u = 0. The contact branches end at folds where T̂ has a
+//! square-root singularity in α̂ but is smooth in u, so this last stretch takes one or
+//! two smooth steps instead of a cascade of shrinking ones onto the cusp.
 
-use super::model::{Coupling, Oscillator, State, V, X, rhs, set_phasor};
+use super::model::{COS, Coupling, Oscillator, SIN, State, V, X, rhs, set_phasor};
 use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw};
 use crate::numeric::bracketed_root;
 use ode_solvers::dop_shared::{OutputType, System};
 use ode_solvers::dopri5::Dopri5;
+use std::cell::Cell;
 
 /// Tolerances and step limits of the integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,6 +86,9 @@ struct Progress {
     hit: Option<(StepEnd, StepEnd, f64)>,
     /// Length of the first accepted step (0 until there is one).
     h: f64,
+    /// The step end from which the switch is close enough to land on (Hénon), and the
+    /// length of the step that ended there.
+    approach: Option<(StepEnd, f64)>,
 }
 
 struct Segment<'a, L: ForceLaw, O: StepObserver> {
@@ -87,6 +98,10 @@ struct Segment<'a, L: ForceLaw, O: StepObserver> {
     branch: Branch,
     /// Switching level and direction; `None` to run to the end.
     event: Option<(f64, Crossing)>,
+    /// Whether to stop short of the switch to land on it ([`approach`]).
+    land: bool,
+    /// End of the span.
+    tau_end: f64,
     progress: &'a mut Progress,
     observer: &'a mut O,
 }
@@ -142,6 +157,51 @@ impl<L: ForceLaw, O: StepObserver> Segment<'_, L, O> {
     }
 }
 
+impl<L: ForceLaw, O: StepObserver> Segment<'_, L, O> {
+    /// Whether the switch lies within about one more step of `end` (the step that ended
+    /// there was `h` long), the motion heads for it fast enough not to stall on the way
+    /// (even decelerating at the present rate it keeps half its speed), and it is reached
+    /// well before the span ends.
+    fn within_reach(&self, end: &StepEnd, h: f64, level: f64, crossing: Crossing) -> bool {
+        let (gap, rate) = approach_rate(self.osc, self.cpl, level, crossing, end.tau, &end.y);
+        if !(gap > 0.0 && rate > 0.0) {
+            return false;
+        }
+        let time = gap / rate;
+        let (x_b, _) = self.osc.base_at(end.tau);
+        let accel =
+            sigma(crossing) * self.cpl.a1 * (end.dy[V] - self.osc.omega * self.osc.omega * x_b);
+        time <= 1.5 * h
+            && (-accel).max(0.0) * time <= 0.5 * rate
+            && end.tau + 2.0 * time < self.tau_end
+    }
+}
+
+/// +1 when α̂ rises to the level, −1 when it falls to it.
+fn sigma(crossing: Crossing) -> f64 {
+    match crossing {
+        Crossing::Up => 1.0,
+        Crossing::Down => -1.0,
+    }
+}
+
+/// (gap, rate): the distance σ(level − α̂) still to go and the speed σ dα̂/dτ towards it.
+fn approach_rate(
+    osc: &Oscillator,
+    cpl: &Coupling,
+    level: f64,
+    crossing: Crossing,
+    tau: f64,
+    y: &State,
+) -> (f64, f64) {
+    let (x_b, v_b) = osc.base_at(tau);
+    let s = sigma(crossing);
+    (
+        s * (level - cpl.alpha_hat(y[X], x_b)),
+        s * cpl.a1 * (y[V] + v_b),
+    )
+}
+
 impl<L: ForceLaw, O: StepObserver> System<f64, State> for Segment<'_, L, O> {
     #[inline]
     fn system(&self, tau: f64, y: &State, dy: &mut State) {
@@ -166,7 +226,139 @@ impl<L: ForceLaw, O: StepObserver> System<f64, State> for Segment<'_, L, O> {
             self.progress.h = end.tau - start.tau;
         }
         self.progress.last = end;
+        if let (true, Some((level, crossing))) = (self.land, self.event) {
+            let h = end.tau - start.tau;
+            if self.within_reach(&end, h, level, crossing) {
+                self.progress.approach = Some((end, h));
+                return true;
+            }
+        }
         false
+    }
+}
+
+/// The last stretch to a switch in Hénon's variable w = u₀ − u, u = √(σ(level − α̂)),
+/// from w = 0 to w = u₀ (the switch). The state keeps its layout with τ in place of x
+/// (x follows from u): d/dw = (dτ/dw)·d/dτ, dτ/dw = 2u/(σ dα̂/dτ).
+struct Approach<'a, L: ForceLaw> {
+    law: &'a L,
+    osc: &'a Oscillator,
+    cpl: &'a Coupling,
+    branch: Branch,
+    level: f64,
+    sigma: f64,
+    u0: f64,
+    /// Smallest speed towards the switch accepted (below it the motion may stall).
+    min_rate: f64,
+    landing: &'a mut Landing,
+}
+
+/// The accepted steps of a landing, kept until it is known to have succeeded.
+struct Landing {
+    steps: [StepEnd; Landing::MAX_STEPS],
+    len: usize,
+    /// Set when the speed towards the switch fell below the accepted minimum, or the
+    /// steps did not fit.
+    failed: Cell<bool>,
+}
+
+impl Landing {
+    /// Steps a landing may take (it normally takes one or two).
+    const MAX_STEPS: usize = 16;
+}
+
+impl<L: ForceLaw> Approach<'_, L> {
+    /// The τ-form state (x in place of τ) at Hénon variable `w`, and τ.
+    #[inline]
+    fn tau_form(&self, w: f64, y: &State) -> (f64, State) {
+        let u = self.u0 - w;
+        let alpha = self.level - self.sigma * u * u;
+        let (x_b, _) = self.osc.base_from((y[SIN], y[COS]));
+        let mut z = *y;
+        z[X] = self.cpl.x_at(alpha) - x_b;
+        (y[X], z)
+    }
+}
+
+impl<L: ForceLaw> System<f64, State> for Approach<'_, L> {
+    #[inline]
+    fn system(&self, w: f64, y: &State, dy: &mut State) {
+        let (tau, z) = self.tau_form(w, y);
+        rhs(self.law, self.osc, self.cpl, self.branch, tau, &z, dy);
+        let (_, v_b) = self.osc.base_from((z[SIN], z[COS]));
+        let mut rate = self.sigma * self.cpl.a1 * (z[V] + v_b);
+        if rate.is_nan() || rate < self.min_rate {
+            self.landing.failed.set(true);
+            rate = self.min_rate;
+        }
+        let dtau_dw = 2.0 * (self.u0 - w) / rate;
+        *dy *= dtau_dw;
+        dy[X] = dtau_dw;
+    }
+
+    fn solout(&mut self, w: f64, y: &State, _dy: &State) -> bool {
+        let (tau, z) = self.tau_form(w, y);
+        let mut dz = State::zeros();
+        rhs(self.law, self.osc, self.cpl, self.branch, tau, &z, &mut dz);
+        let landing = &mut *self.landing;
+        if landing.len == Landing::MAX_STEPS {
+            landing.failed.set(true);
+            return true;
+        }
+        landing.steps[landing.len] = StepEnd { tau, y: z, dy: dz };
+        landing.len += 1;
+        landing.failed.get()
+    }
+}
+
+/// Land on the switch (`level`, `crossing`) from `entry` ([`Approach`]) and pass the steps
+/// to `observer`. `None` (and nothing observed) if the motion slowed too much on the way
+/// (it might not get there) or the switch lies beyond `tau_end`.
+#[allow(clippy::too_many_arguments)]
+fn land<L: ForceLaw, O: StepObserver>(
+    law: &L,
+    osc: &Oscillator,
+    cpl: &Coupling,
+    branch: Branch,
+    (level, crossing): (f64, Crossing),
+    entry: StepEnd,
+    tau_end: f64,
+    tol: &Tolerances,
+    observer: &mut O,
+) -> Result<Option<StepEnd>> {
+    let (gap, rate) = approach_rate(osc, cpl, level, crossing, entry.tau, &entry.y);
+    let u0 = gap.sqrt();
+    let mut y = entry.y;
+    y[X] = entry.tau;
+    let mut landing = Landing {
+        steps: [entry; Landing::MAX_STEPS],
+        len: 0,
+        failed: Cell::new(false),
+    };
+    let system = Approach {
+        law,
+        osc,
+        cpl,
+        branch,
+        level,
+        sigma: sigma(crossing),
+        u0,
+        min_rate: 0.25 * rate,
+        landing: &mut landing,
+    };
+    let tol = Tolerances { h_max: u0, ..*tol };
+    run(system, 0.0, u0, y, u0, &tol, branch)?;
+    let steps = &landing.steps[..landing.len];
+    match steps.last() {
+        Some(last) if !landing.failed.get() && last.tau <= tau_end => {
+            let mut from = &entry;
+            for step in steps {
+                observer.step(from, step, branch);
+                from = step;
+            }
+            Ok(Some(*last))
+        }
+        _ => Ok(None),
     }
 }
 
@@ -261,105 +453,282 @@ pub fn integrate<L: ForceLaw, O: StepObserver>(
     tol: &Tolerances,
     observer: &mut O,
 ) -> Result<SegmentEnd> {
-    let mut y0 = y0;
-    set_phasor(osc, tau0, &mut y0);
-    let mut dy0 = State::zeros();
-    rhs(law, osc, cpl, branch, tau0, &y0, &mut dy0);
-    if too_short(tau0, tau_end) {
-        // Nothing Dopri5 could step over: advance by one Euler step (error ~ (Δτ)²).
-        return Ok(SegmentEnd {
-            tau: tau_end,
-            y: y0 + dy0 * (tau_end - tau0),
-            switched: false,
-            h_first: 0.0,
-        });
-    }
-    let mut progress = Progress {
-        last: StepEnd {
-            tau: tau0,
-            y: y0,
-            dy: dy0,
-        },
-        hit: None,
-        h: 0.0,
-    };
-    let segment = Segment {
+    let span = Span {
         law,
         osc,
         cpl,
         branch,
         event,
-        progress: &mut progress,
-        observer: &mut *observer,
+        tau_end,
+        tol,
     };
-    run(segment, tau0, tau_end, y0, h0, tol, branch)?;
-    let Some((start, hit_end, t_hit)) = progress.hit else {
-        let last = progress.last;
-        return Ok(SegmentEnd {
-            tau: last.tau,
-            y: last.y,
-            switched: false,
-            h_first: progress.h,
-        });
-    };
-    // Integrate the part of the step up to the switch again, from the step's start, and
-    // polish the switching time by Newton steps on the re-integrated state (the Hermite
-    // interpolant is only fourth-order accurate, and the force may be singular at the
-    // switch, as at the JKR fold C).
-    let (level, crossing) = event.expect("a hit implies an event");
-    let distance = |tau: f64, y: &State| {
-        let (x_b, v_b) = osc.base_at(tau);
-        let d = cpl.alpha_hat(y[X], x_b) - level;
-        let rate = cpl.a1 * (y[V] + v_b);
-        match crossing {
-            Crossing::Down => (d, rate),
-            Crossing::Up => (-d, -rate),
+    span.integrate(tau0, y0, h0, true, observer)
+}
+
+/// What [`integrate`] works on.
+struct Span<'a, L: ForceLaw> {
+    law: &'a L,
+    osc: &'a Oscillator,
+    cpl: &'a Coupling,
+    branch: Branch,
+    event: Option<(f64, Crossing)>,
+    tau_end: f64,
+    tol: &'a Tolerances,
+}
+
+impl<L: ForceLaw> Span<'_, L> {
+    /// Integrate from (`tau0`, `y0`); `land`: whether to land on the switch ([`land`])
+    /// once it is within reach, else locate its crossing.
+    fn integrate<O: StepObserver>(
+        &self,
+        tau0: f64,
+        y0: State,
+        h0: f64,
+        land_on_switch: bool,
+        observer: &mut O,
+    ) -> Result<SegmentEnd> {
+        let Self {
+            law,
+            osc,
+            cpl,
+            branch,
+            event,
+            tau_end,
+            tol,
+        } = *self;
+        let mut y0 = y0;
+        set_phasor(osc, tau0, &mut y0);
+        let mut dy0 = State::zeros();
+        rhs(law, osc, cpl, branch, tau0, &y0, &mut dy0);
+        if too_short(tau0, tau_end) {
+            // Nothing Dopri5 could step over: advance by one Euler step (error ~ (Δτ)²).
+            return Ok(SegmentEnd {
+                tau: tau_end,
+                y: y0 + dy0 * (tau_end - tau0),
+                switched: false,
+                h_first: 0.0,
+            });
         }
-    };
-    let mut t = t_hit;
-    let mut y = start.y;
-    for attempt in 0..4 {
-        let mut refine = Progress {
-            last: start,
+        let mut progress = Progress {
+            last: StepEnd {
+                tau: tau0,
+                y: y0,
+                dy: dy0,
+            },
             hit: None,
             h: 0.0,
+            approach: None,
         };
-        if too_short(start.tau, t) {
-            // The switch sits at the very start of the step: interpolate.
-            refine.last.y = interpolate(&start, &hit_end, t);
-        } else if t > start.tau {
-            let mut quiet = Ignore;
-            let again = Segment {
-                law,
-                osc,
-                cpl,
-                branch,
-                event: None,
-                progress: &mut refine,
-                observer: &mut quiet,
+        let segment = Segment {
+            law,
+            osc,
+            cpl,
+            branch,
+            event,
+            land: land_on_switch,
+            tau_end,
+            progress: &mut progress,
+            observer: &mut *observer,
+        };
+        run(segment, tau0, tau_end, y0, h0, tol, branch)?;
+        if let (Some((entry, h)), Some(event)) = (progress.approach, event) {
+            let landed = land(law, osc, cpl, branch, event, entry, tau_end, tol, observer)?;
+            let end = match landed {
+                Some(end) => SegmentEnd {
+                    tau: end.tau,
+                    y: end.y,
+                    switched: true,
+                    h_first: progress.h,
+                },
+                // Carry on from where the landing started, locating the crossing.
+                None => SegmentEnd {
+                    h_first: progress.h,
+                    ..self.integrate(entry.tau, entry.y, h, false, observer)?
+                },
             };
-            run(again, start.tau, t, start.y, t - start.tau, tol, branch)?;
+            return Ok(end);
         }
-        y = refine.last.y;
-        let (g, rate) = distance(t, &y);
-        let next = t - g / rate;
-        if attempt == 3
-            // 1e-8 in α̂ moves the loop area by ~1e-8 relative (the path itself stays
-            // consistent: it switches where it is, a hair from the level).
-            || g.abs() <= 1e-8 * (1.0 + level.abs())
-            || !(next > start.tau && next.is_finite())
-        {
-            break;
-        }
-        t = next;
+        let Some((start, hit_end, t_hit)) = progress.hit else {
+            let last = progress.last;
+            return Ok(SegmentEnd {
+                tau: last.tau,
+                y: last.y,
+                switched: false,
+                h_first: progress.h,
+            });
+        };
+        let (tau, y) = self.polish(start, hit_end, t_hit)?;
+        let mut dy = State::zeros();
+        rhs(law, osc, cpl, branch, tau, &y, &mut dy);
+        observer.step(&start, &StepEnd { tau, y, dy }, branch);
+        Ok(SegmentEnd {
+            tau,
+            y,
+            switched: true,
+            h_first: progress.h,
+        })
     }
-    let mut dy = State::zeros();
-    rhs(law, osc, cpl, branch, t, &y, &mut dy);
-    observer.step(&start, &StepEnd { tau: t, y, dy }, branch);
-    Ok(SegmentEnd {
-        tau: t,
-        y,
-        switched: true,
-        h_first: progress.h,
-    })
+
+    /// The state at the switch located at `t_hit` inside the step [`start`, `hit_end`]:
+    /// the part of the step up to it is integrated again from the step's start, and the
+    /// switching time polished by Newton steps on the re-integrated state (the Hermite
+    /// interpolant is only fourth-order accurate, and the force may be singular at the
+    /// switch, as at the JKR fold C).
+    fn polish(&self, start: StepEnd, hit_end: StepEnd, t_hit: f64) -> Result<(f64, State)> {
+        let (level, crossing) = self.event.expect("a hit implies an event");
+        let mut t = t_hit;
+        let mut y = start.y;
+        for attempt in 0..4 {
+            let mut refine = Progress {
+                last: start,
+                hit: None,
+                h: 0.0,
+                approach: None,
+            };
+            if too_short(start.tau, t) {
+                // The switch sits at the very start of the step: interpolate.
+                refine.last.y = interpolate(&start, &hit_end, t);
+            } else if t > start.tau {
+                let mut quiet = Ignore;
+                let again = Segment {
+                    law: self.law,
+                    osc: self.osc,
+                    cpl: self.cpl,
+                    branch: self.branch,
+                    event: None,
+                    land: false,
+                    tau_end: t,
+                    progress: &mut refine,
+                    observer: &mut quiet,
+                };
+                run(
+                    again,
+                    start.tau,
+                    t,
+                    start.y,
+                    t - start.tau,
+                    self.tol,
+                    self.branch,
+                )?;
+            }
+            y = refine.last.y;
+            // Still to go, and its rate of decrease.
+            let (gap, rate) = approach_rate(self.osc, self.cpl, level, crossing, t, &y);
+            let next = t + gap / rate;
+            if attempt == 3
+                // 1e-8 in α̂ moves the loop area by ~1e-8 relative (the path itself stays
+                // consistent: it switches where it is, a hair from the level).
+                || gap.abs() <= 1e-8 * (1.0 + level.abs())
+                || !(next > start.tau && next.is_finite())
+            {
+                break;
+            }
+            t = next;
+        }
+        Ok((t, y))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::model::{Drive, E_DAMP, SC, SS};
+
+    /// Free branch force-free; contact branch with a square-root fold at α̂ = LEVEL,
+    /// continued past it by point reflection, like the JKR branch at C.
+    struct Cusp;
+    const LEVEL: f64 = 0.5;
+    impl ForceLaw for Cusp {
+        fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            match branch {
+                Branch::Free => 0.0,
+                Branch::Contact => {
+                    let d = LEVEL - alpha_hat;
+                    1.0 - d.signum() * d.abs().sqrt()
+                }
+            }
+        }
+        fn work_hat(&self, _: f64, _: Branch) -> f64 {
+            0.0
+        }
+        fn jump_in_alpha_hat(&self) -> f64 {
+            -1.0
+        }
+        fn jump_out_alpha_hat(&self) -> f64 {
+            LEVEL
+        }
+        fn free_branch_is_force_free(&self) -> bool {
+            true
+        }
+        fn loop_area_hat(&self) -> f64 {
+            0.0
+        }
+    }
+
+    fn setup() -> (Oscillator, Coupling, Tolerances) {
+        let osc = Oscillator {
+            gamma: 0.01,
+            omega: 1.0,
+            drive: Drive::Force { amplitude: 0.02 },
+        };
+        let cpl = Coupling {
+            a0: 0.0,
+            a1: 1.0,
+            f_scale: 0.1,
+        };
+        let tol = Tolerances {
+            rtol: 1e-10,
+            atol: 1e-12,
+            h_max: 0.2,
+        };
+        (osc, cpl, tol)
+    }
+
+    fn to_switch(v0: f64, land_on_switch: bool) -> SegmentEnd {
+        let (osc, cpl, tol) = setup();
+        let span = Span {
+            law: &Cusp,
+            osc: &osc,
+            cpl: &cpl,
+            branch: Branch::Contact,
+            event: Some((LEVEL, Crossing::Up)),
+            tau_end: 4.0,
+            tol: &tol,
+        };
+        let mut y = State::zeros();
+        y[V] = v0;
+        span.integrate(0.0, y, 0.0, land_on_switch, &mut Ignore)
+            .expect("integrates")
+    }
+
+    #[test]
+    fn landing_on_a_fold_matches_locating_its_crossing() {
+        // v₀ = 0.5435 barely makes it (0.5431 does not): the landing starts while the
+        // tip decelerates hard towards the fold.
+        for v0 in [0.5435, 0.6, 0.8] {
+            let landed = to_switch(v0, true);
+            let located = to_switch(v0, false);
+            assert!(landed.switched && located.switched);
+            // Landing ends exactly on the level; locating polishes to 1e-8 in α̂.
+            assert!((landed.y[X] - LEVEL).abs() < 1e-14, "{}", landed.y[X]);
+            assert!((located.y[X] - LEVEL).abs() < 2e-8, "{}", located.y[X]);
+            let (t1, t2) = (landed.tau, located.tau);
+            assert!((t1 - t2).abs() < 1e-7, "{v0}: {t1} {t2}");
+            for i in [V, E_DAMP, SC, SS] {
+                let (a, b) = (landed.y[i], located.y[i]);
+                assert!((a - b).abs() < 1e-7, "{v0}, {i}: {a} {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_tip_turning_short_of_the_level_does_not_switch() {
+        // Held back by f = −0.1·T̂, the tip turns a hair below the fold for v₀ = 0.542.
+        for land_on_switch in [true, false] {
+            let end = to_switch(0.542, land_on_switch);
+            assert!(!end.switched);
+            assert_eq!(end.tau, 4.0);
+            assert!(end.y[X] < LEVEL);
+        }
+    }
 }
