@@ -16,7 +16,7 @@ use crate::report::chart::{Axis, Chart, Corner, Label, Series, Style};
 pub const AVAILABLE: [u32; 6] = [1, 2, 3, 4, 5, 6];
 
 /// Tabor parameters of the numerical points of Figs. 3 and 4.
-pub const LJ_MUS: [f64; 6] = [1.0, 1.5, 2.0, 3.0, 4.0, 5.0];
+pub const LJ_MUS: [f64; 10] = [1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0];
 
 /// Tabor parameter of Fig. 2.
 pub const FIG2_MU: f64 = 5.0;

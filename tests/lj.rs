@@ -112,7 +112,7 @@ fn a_compliant_support_adds_spring_losses_to_the_lj_loop() {
     let rigid = Hysteresis::of(&s.curve).unwrap().w_hat;
     assert!((rigid - s.w_hat.value).abs() < 1e-12);
     let mut last = rigid;
-    for k_hat in [1e4, 1e3, 100.0, 30.0, 10.0] {
+    for k_hat in [1e4, 1e3, 100.0, 30.0, 10.0, 1.0, 0.5] {
         let w = Hysteresis::with_spring(&s.curve, k_hat).unwrap().w_hat;
         let hybrid = spring::hysteresis(5.0, k_hat, JumpIn::Fit).unwrap().w_hat;
         println!(
@@ -129,27 +129,36 @@ fn a_compliant_support_adds_spring_losses_to_the_lj_loop() {
     // Stiff limit: the rigid-grip loop.
     let stiff = Hysteresis::with_spring(&s.curve, 1e7).unwrap().w_hat;
     assert!((stiff - rigid).abs() < 1e-5 * rigid, "{stiff} vs {rigid}");
+    // Softer than the trace covers: refused, saying how soft it may be.
+    match Hysteresis::with_spring(&s.curve, 0.2) {
+        Err(tapsim::error::Error::NotApplicable(m)) => assert!(m.contains("k_hat >= 0.5"), "{m}"),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn below_the_hysteresis_threshold_the_solver_says_so() {
+    match lj::solve(0.6, false) {
+        Err(tapsim::error::Error::NotApplicable(m)) => {
+            assert!(m.contains("no hysteresis"), "{m}")
+        }
+        other => panic!("{other:?}"),
+    }
 }
 
 #[test]
 fn mesh_refinement_stays_within_the_error_estimate() {
-    use tapsim::contact::lj::{
-        curve, mesh::MeshSpec, result::ELEMENTS_PER_ANNULUS, solver::Problem,
-    };
+    use tapsim::contact::lj::moving::{self, MovingOptions, MovingSpec};
+    use tapsim::contact::lj::result::ELEMENTS_PER_ANNULUS;
     let s = solution(5.0);
     // Every spacing 0.8 times the production mesh's.
-    let spec = MeshSpec::for_tabor(5.0, ELEMENTS_PER_ANNULUS).scaled(0.8);
-    let problem = Problem::new(5.0, spec.nodes());
-    assert!(problem.len() > s.nodes);
-    let finer = curve::trace(&problem, &curve::TraceOptions::default()).unwrap();
+    let spec = MovingSpec::for_tabor(5.0, ELEMENTS_PER_ANNULUS).scaled(0.8);
+    let finer = moving::trace(&spec, &MovingOptions::default()).unwrap();
+    assert!(finer.nodes > s.nodes);
     let change = (finer.w_hat - s.w_hat.value).abs();
     println!(
         "W_LJ(5): {} nodes {:.6}, {} nodes {:.6}: change {change:.1e}, estimate {:.1e}",
-        s.nodes,
-        s.w_hat.value,
-        problem.len(),
-        finer.w_hat,
-        s.w_hat.error
+        s.nodes, s.w_hat.value, finer.nodes, finer.w_hat, s.w_hat.error
     );
     assert!(change < s.w_hat.error, "{change:e} vs {:e}", s.w_hat.error);
 }

@@ -3,7 +3,8 @@
 
 use std::f64::consts::PI;
 use tapsim::contact::lj::kernel::{influence_matrix, influence_row, moment_weights};
-use tapsim::contact::lj::mesh::MeshSpec;
+use tapsim::contact::lj::moving::MovingSpec;
+use tapsim::contact::lj::result::ELEMENTS_PER_ANNULUS;
 use tapsim::contact::semi_rigid::{self, EighthPower};
 
 fn lj(h: f64) -> f64 {
@@ -32,7 +33,9 @@ fn rigid_gap_errors(nodes: &[f64], h0: f64) -> (f64, f64) {
 #[test]
 fn rigid_gaps_reproduce_the_semi_rigid_closed_forms_on_the_production_mesh() {
     for mu in [2.0, 5.0, 10.0] {
-        let nodes = MeshSpec::for_tabor(mu, 3.0).nodes();
+        // The moving mesh as it stands on the approach branch (a = a₀).
+        let spec = MovingSpec::for_tabor(mu, ELEMENTS_PER_ANNULUS);
+        let nodes: Vec<f64> = spec.nodes().0.iter().map(|xi| spec.a_start * xi).collect();
         for h0 in [1.0, 2.0, 5.0] {
             let (eu, et) = rigid_gap_errors(&nodes, h0);
             println!(

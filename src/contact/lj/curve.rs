@@ -1,8 +1,6 @@
 //! Continuation of the S-shaped force–separation curve T̂(α̂) of the Lennard-Jones
 //! problem, its folds A (jump-in) and C (jump-out), and the hysteresis loss Ŵ_LJ.
 
-use super::solver::{Problem, Solution};
-use crate::contact::hybrid::JumpIn;
 use crate::error::{Error, Result};
 use crate::numeric::{GAUSS_LEGENDRE_4, bracketed_root};
 use serde::{Deserialize, Serialize};
@@ -172,7 +170,14 @@ impl Hysteresis {
                 points[k].alpha_hat < points[k - 1].alpha_hat
                     && points[k].alpha_hat <= points[k + 1].alpha_hat
             })
-            .ok_or_else(|| Error::Numerical("no jump-in fold found".into()))?;
+            .ok_or_else(|| {
+                Error::NotApplicable(
+                    "the force-separation curve has no jump-in fold: approach and \
+                     retraction follow the same curve, with no hysteresis (the \
+                     Lennard-Jones loop closes below mu ~ 0.7)"
+                        .into(),
+                )
+            })?;
         // C: the largest separation after A (small wiggles of the unstable branch, where
         // the contact edge crosses the coarser mesh near the axis, are not folds of
         // interest).
@@ -208,163 +213,9 @@ impl Hysteresis {
         Self::of(&support).map_err(|e| {
             Error::NotApplicable(format!(
                 "with k_hat = {k_hat} the traced curve does not contain the whole loop ({e}); \
-                 a softer support lands deeper in contact than the solver traces"
+                 the solver traces the contact branch deep enough for k_hat >= {}",
+                super::moving::SOFTEST_SPRING
             ))
         })
     }
-}
-
-/// Settings of the continuation.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TraceOptions {
-    /// Newton tolerance on the gap residual.
-    pub tolerance: f64,
-    /// Largest arclength step in the (α̂, T̂) plane.
-    pub max_step: f64,
-    /// Most continuation steps.
-    pub max_steps: usize,
-}
-
-impl Default for TraceOptions {
-    fn default() -> Self {
-        Self {
-            tolerance: 1e-10,
-            max_step: 0.1,
-            max_steps: 5000,
-        }
-    }
-}
-
-/// Trace the whole S-curve of `problem` by pseudo-arclength continuation: from far out on
-/// the approach branch through the fold A, the unstable branch, the fold C, and down the
-/// contact branch past the jump-in separation; then locate the folds and integrate Ŵ.
-pub fn trace(problem: &Problem, opts: &TraceOptions) -> Result<Curve> {
-    let mu = problem.tabor_mu;
-    let guess_a = JumpIn::SemiRigid.alpha_hat_a(mu)?.unwrap_or(2.0);
-    let alpha_start = (2.0 * guess_a).max(2.5);
-    let point = |s: f64, sol: &Solution| CurvePoint {
-        s,
-        alpha_hat: sol.alpha_bar / mu,
-        t_hat: problem.force(&sol.gap).0,
-        central_gap: sol.gap[0],
-    };
-    let tol = opts.tolerance;
-    let (first, _) = problem.solve_fixed_alpha(&problem.rigid(alpha_start * mu), tol)?;
-    let (second, _) = problem.solve_fixed_alpha(&problem.rigid((alpha_start - 0.01) * mu), tol)?;
-    let p1 = point(0.0, &first);
-    let d = ((p1.alpha_hat - point(0.0, &second).alpha_hat).powi(2)
-        + (p1.t_hat - point(0.0, &second).t_hat).powi(2))
-    .sqrt();
-    let mut points = vec![p1, point(d, &second)];
-    let mut history = std::collections::VecDeque::from(vec![(0.0, first), (d, second)]);
-    let mut ds = 0.01;
-    let mut lu = None;
-    let mut seen_c = false;
-    let mut iterations_total = 0;
-    let mut steps = 0;
-    while steps < opts.max_steps {
-        let (pp, p) = (points[points.len() - 2], points[points.len() - 1]);
-        let chord = ((p.alpha_hat - pp.alpha_hat).powi(2) + (p.t_hat - pp.t_hat).powi(2)).sqrt();
-        let tangent = (
-            (p.alpha_hat - pp.alpha_hat) / chord,
-            (p.t_hat - pp.t_hat) / chord,
-        );
-        // Predictor: Lagrange extrapolation in s through the last (up to) three solutions.
-        let target = p.s + ds;
-        let m = history.len();
-        let weights: Vec<f64> = (0..m)
-            .map(|i| {
-                (0..m)
-                    .filter(|&j| j != i)
-                    .map(|j| (target - history[j].0) / (history[i].0 - history[j].0))
-                    .product()
-            })
-            .collect();
-        let mut guess = Solution {
-            gap: history[0].1.gap.scale(weights[0]),
-            alpha_bar: weights[0] * history[0].1.alpha_bar,
-        };
-        for (w, (_, sol)) in weights.iter().zip(&history).skip(1) {
-            guess.gap.axpy(*w, &sol.gap, 1.0);
-            guess.alpha_bar += w * sol.alpha_bar;
-        }
-        let step = problem
-            .arclength_step(&guess, (p.alpha_hat, p.t_hat), tangent, ds, tol, &mut lu)
-            .and_then(|(sol, iterations)| {
-                // The corrector must land ahead along the curve, near the predictor: a
-                // solution that turned back or jumped branch is refused.
-                let q = point(p.s + ds, &sol);
-                let along =
-                    (q.alpha_hat - p.alpha_hat) * tangent.0 + (q.t_hat - p.t_hat) * tangent.1;
-                let across = ((q.alpha_hat - p.alpha_hat).powi(2) + (q.t_hat - p.t_hat).powi(2)
-                    - along * along)
-                    .max(0.0)
-                    .sqrt();
-                if along > 0.5 * ds && across < 0.5 * ds {
-                    Ok((sol, iterations))
-                } else {
-                    Err(Error::Numerical("continuation step left the branch".into()))
-                }
-            });
-        match step {
-            Ok((sol, iterations)) => {
-                iterations_total += iterations;
-                if iterations > 12 {
-                    // A stale Jacobian: refactorise at the next step.
-                    lu = None;
-                }
-                let q = point(p.s + ds, &sol);
-                points.push(q);
-                history.push_back((q.s, sol));
-                if history.len() > 3 {
-                    history.pop_front();
-                }
-                steps += 1;
-                // Chord iterations are cheap (one matrix–vector product and one
-                // triangular solve each): grow the step while they stay few.
-                ds = match iterations {
-                    0..=6 => (ds * 1.3).min(opts.max_step),
-                    7..=12 => ds,
-                    _ => ds * 0.7,
-                };
-                // Past C once α̂ has risen above the semi-rigid jump-in and come back
-                // down below it on the contact branch (with a margin for the landing).
-                if q.alpha_hat > guess_a + 0.3 {
-                    seen_c = true;
-                }
-                if seen_c && q.alpha_hat < guess_a - 0.5 {
-                    break;
-                }
-            }
-            Err(_) => {
-                lu = None;
-                ds *= 0.5;
-                if ds < 1e-6 {
-                    return Err(Error::Numerical(format!(
-                        "LJ continuation stalled at alpha_hat = {:.4}, T_hat = {:.4}",
-                        p.alpha_hat, p.t_hat
-                    )));
-                }
-            }
-        }
-    }
-    let hysteresis = Hysteresis::of(&points)?;
-    let (fold_a, fold_c, w_hat) = (hysteresis.fold_a, hysteresis.fold_c, hysteresis.w_hat);
-    let k_c = interval(&points, fold_c.s);
-    let pull_off_hat = points[k_c..]
-        .iter()
-        .map(|p| p.t_hat)
-        .fold(fold_c.t_hat, f64::max);
-    Ok(Curve {
-        tabor_mu: mu,
-        nodes: problem.len(),
-        points,
-        fold_a,
-        fold_c,
-        pull_off_hat,
-        w_hat,
-        steps,
-        factorisations: problem.factorisations(),
-        iterations: iterations_total,
-    })
 }

@@ -3,7 +3,7 @@
 
 pub mod curve;
 pub mod kernel;
-pub mod mesh;
+pub mod moving;
 pub mod result;
 pub mod solver;
 

@@ -97,9 +97,19 @@ impl Problem {
 
     /// Residual of the gap equation.
     pub fn residual(&self, s: &Solution) -> DVector<f64> {
+        self.residual_scaled(s, 1.0)
+    }
+
+    /// Residual on the mesh stretched by `a` (nodes a·x_i): the influence matrix of a
+    /// stretched mesh is a times the original (the kernel G(x, y) dy is homogeneous of
+    /// degree one; a reassembled matrix differs only by its element quadrature error), so
+    /// a moving mesh needs no reassembly.
+    pub fn residual_scaled(&self, s: &Solution, a: f64) -> DVector<f64> {
         let (f, _) = self.tractions(&s.gap);
         let mut r = &self.cm * f;
+        r *= a;
         for (i, &x) in self.nodes.iter().enumerate() {
+            let x = a * x;
             r[i] += s.gap[i] - s.alpha_bar - 1.0 - 0.5 * x * x;
         }
         r
@@ -107,14 +117,21 @@ impl Problem {
 
     /// Force T̂ and its gradient with respect to the nodal gaps.
     pub fn force(&self, gap: &DVector<f64>) -> (f64, DVector<f64>) {
+        self.force_scaled(gap, 1.0)
+    }
+
+    /// Force T̂ and its gradient on the mesh stretched by `a` (moments scale as a²; the
+    /// tail beyond the last node does not depend on where that node is).
+    pub fn force_scaled(&self, gap: &DVector<f64>, a: f64) -> (f64, DVector<f64>) {
         let (f, df) = self.tractions(gap);
         let k = 16.0 * PI / 3.0;
+        let a2 = a * a;
         let n = gap.len();
         let mut t = 0.0;
         let mut grad = DVector::zeros(n);
         for j in 0..n {
-            t += self.moments[j] * f[j];
-            grad[j] = k * self.moments[j] * df[j];
+            t += a2 * self.moments[j] * f[j];
+            grad[j] = k * a2 * self.moments[j] * df[j];
         }
         // Beyond the last node the gap continues as h_N + (x² − X²)/2:
         // ∫ f x dx = ∫_{h_N}^∞ f dh = h_N⁻²/2 − h_N⁻⁸/8.
@@ -124,12 +141,12 @@ impl Problem {
         (k * t, grad)
     }
 
-    /// Jacobian of the residual with respect to the gaps: I + cM diag(f').
-    fn jacobian(&self, gap: &DVector<f64>) -> DMatrix<f64> {
+    /// Jacobian on the mesh stretched by `a`: I + a·cM diag(f').
+    fn jacobian_scaled(&self, gap: &DVector<f64>, a: f64) -> DMatrix<f64> {
         let (_, df) = self.tractions(gap);
         let mut j = self.cm.clone();
         for (col, d) in df.iter().enumerate() {
-            j.column_mut(col).scale_mut(*d);
+            j.column_mut(col).scale_mut(a * d);
         }
         for i in 0..gap.len() {
             j[(i, i)] += 1.0;
@@ -137,73 +154,37 @@ impl Problem {
         j
     }
 
-    /// The rigid-body gap ᾱ + 1 + x²/2 (a starting guess far from the sample).
-    pub fn rigid(&self, alpha_bar: f64) -> Solution {
-        Solution {
-            gap: DVector::from_iterator(
-                self.len(),
-                self.nodes.iter().map(|x| alpha_bar + 1.0 + 0.5 * x * x),
-            ),
-            alpha_bar,
-        }
-    }
-
-    /// Solve at fixed ᾱ by damped Newton from `guess`.
-    pub fn solve_fixed_alpha(&self, guess: &Solution, tol: f64) -> Result<(Solution, usize)> {
-        let mut s = guess.clone();
-        for it in 1..=50 {
-            let r = self.residual(&s);
-            if Self::residual_norm(&r, &s.gap) < tol {
-                return Ok((s, it - 1));
-            }
-            let lu = self.jacobian(&s.gap).lu();
-            let dx = lu
-                .solve(&(-r))
-                .ok_or_else(|| Error::Numerical("singular Jacobian in the LJ solver".into()))?;
-            apply_damped(&mut s.gap, &dx);
-        }
-        Err(Error::Numerical(
-            "LJ Newton iteration at fixed separation did not converge".into(),
-        ))
-    }
-
-    /// One pseudo-arclength corrector: solve R = 0 together with
-    /// τ_α(α̂ − α̂₀) + τ_T(T̂ − T̂₀) = Δs from the predictor `guess`, with a chord Newton
-    /// iteration that reuses `lu` (refactorised when convergence slows).
-    #[allow(clippy::too_many_arguments)]
-    pub fn arclength_step(
+    /// Solve on the mesh stretched by `a` with the gap at node `node` pinned to
+    /// `target` and ᾱ free (bordered system [[J, −1], [e_nodeᵀ, 0]]), by Newton from
+    /// `guess`, reusing `lu` while it converges fast (refactorised otherwise). Returns
+    /// the solution and the iterations taken.
+    pub fn solve_pinned(
         &self,
         guess: &Solution,
-        anchor: (f64, f64),
-        tangent: (f64, f64),
-        ds: f64,
+        a: f64,
+        (node, target): (usize, f64),
         tol: f64,
         lu: &mut Option<nalgebra::linalg::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
     ) -> Result<(Solution, usize)> {
         let n = self.len();
-        let mu = self.tabor_mu;
         let mut s = guess.clone();
+        s.gap[node] = target;
         let mut last_norm = f64::INFINITY;
         let mut fresh = false;
-        for it in 1..=40 {
-            let r = self.residual(&s);
-            let (t, grad) = self.force(&s.gap);
-            let g = tangent.0 * (s.alpha_bar / mu - anchor.0) + tangent.1 * (t - anchor.1) - ds;
-            let norm = Self::residual_norm(&r, &s.gap).max(g.abs());
-
+        for it in 1..=30 {
+            let r = self.residual_scaled(&s, a);
+            let norm = Self::residual_norm(&r, &s.gap);
             if norm < tol {
                 return Ok((s, it - 1));
             }
-            if lu.is_none() || (norm > 0.8 * last_norm && !fresh) {
-                // Bordered Jacobian [[J, −1], [τ_T ∇T̂ᵀ, τ_α/μ]].
+            if lu.is_none() || (norm > 0.7 * last_norm && !fresh) {
                 let mut big = DMatrix::zeros(n + 1, n + 1);
                 big.view_mut((0, 0), (n, n))
-                    .copy_from(&self.jacobian(&s.gap));
+                    .copy_from(&self.jacobian_scaled(&s.gap, a));
                 for i in 0..n {
                     big[(i, n)] = -1.0;
-                    big[(n, i)] = tangent.1 * grad[i];
                 }
-                big[(n, n)] = tangent.0 / mu;
+                big[(n, node)] = 1.0;
                 *lu = Some(big.lu());
                 self.factorisations
                     .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -214,21 +195,20 @@ impl Problem {
             last_norm = norm;
             let mut rhs = DVector::zeros(n + 1);
             rhs.rows_mut(0, n).copy_from(&(-r));
-            rhs[n] = -g;
+            rhs[n] = target - s.gap[node];
             let dx = lu
                 .as_ref()
                 .expect("factorised above")
                 .solve(&rhs)
-                .ok_or_else(|| Error::Numerical("singular bordered Jacobian".into()))?;
+                .ok_or_else(|| Error::Numerical("singular pinned Jacobian".into()))?;
             let scale = apply_damped(&mut s.gap, &dx.rows(0, n).into_owned());
-
             s.alpha_bar += scale * dx[n];
             if s.gap.iter().any(|h| !h.is_finite() || *h <= 0.0) {
                 return Err(Error::Numerical("LJ gap left the physical range".into()));
             }
         }
         Err(Error::Numerical(
-            "LJ continuation step did not converge".into(),
+            "LJ pinned Newton iteration did not converge".into(),
         ))
     }
 }
@@ -243,4 +223,38 @@ fn apply_damped(gap: &mut DVector<f64>, dx: &DVector<f64>) -> f64 {
     }
     gap.axpy(scale, dx, 1.0);
     scale
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_stretched_mesh_equals_one_assembled_stretched() {
+        let xi: Vec<f64> = (0..=60)
+            .map(|i| 0.05 * i as f64 + 0.001 * (i * i) as f64)
+            .collect();
+        let a = 1.7;
+        let unit = Problem::new(5.0, xi.clone());
+        let stretched = Problem::new(5.0, xi.iter().map(|x| a * x).collect());
+        let s = Solution {
+            gap: DVector::from_iterator(xi.len(), xi.iter().map(|x| 1.1 + 0.3 * (a * x).powi(2))),
+            alpha_bar: 0.4,
+        };
+        let (r1, r2) = (unit.residual_scaled(&s, a), stretched.residual(&s));
+        // The elastic part of the residual (the rest is identical by construction).
+        let mut elastic = r2.clone();
+        for (i, x) in stretched.nodes.iter().enumerate() {
+            elastic[i] -= s.gap[i] - s.alpha_bar - 1.0 - 0.5 * x * x;
+        }
+        // Exact in exact arithmetic (G(x, y) dy is homogeneous of degree one); the two
+        // assemblies differ by the element quadrature's error only (2.3e-5 here).
+        let d = (&r1 - &r2).amax() / elastic.amax();
+        assert!(d < 1e-4, "{d:e}");
+        let (t1, g1) = unit.force_scaled(&s.gap, a);
+        let (t2, g2) = stretched.force(&s.gap);
+        // The moments ∫ φ_j x dx are polynomial: exact under stretching.
+        assert!((t1 - t2).abs() < 1e-12 * t2.abs(), "{t1} {t2}");
+        assert!((&g1 - &g2).amax() < 1e-12 * g2.amax());
+    }
 }

@@ -1,0 +1,388 @@
+//! Continuation on a mesh that moves with the contact edge.
+//!
+//! On a fixed mesh the edge of the contact — a tensile annulus ~1/(πμ^{3/2}) wide in x —
+//! sweeps across hundreds of fine elements while the curve is traced; the nodal gaps then
+//! change abruptly along the curve, predictors fail, and the steps stay tiny. Here the
+//! nodes are x = a·ξ on a fixed mesh in ξ, fine around ξ = 1, and a is the contact
+//! radius, defined by pinning the gap at ξ = 1 to [`EDGE_GAP`]. Stretching the mesh
+//! multiplies the influence matrix by a (no reassembly), the solution varies smoothly
+//! with a, and a grows monotonically from the first contact to deep contact, so plain
+//! natural-parameter continuation in a works.
+//!
+//! Before there is a contact the same mesh is frozen at a = a₀ and the curve is followed
+//! in the central gap h̄(0), which falls monotonically from far out through the jump-in
+//! fold A to the forming contact; once the gap at x = a₀ falls to [`EDGE_GAP`] the
+//! continuation switches to a.
+
+use super::curve::{Curve, CurvePoint, Hysteresis};
+use super::solver::{Problem, Solution};
+use crate::contact::hybrid::JumpIn;
+use crate::contact::jkr;
+use crate::error::{Error, Result};
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+
+/// Outer radius of the mesh (in x, at a = a₀): f(h̄) there is ~(2/x²)³ ≈ 1e-10.
+pub const OUTER_RADIUS: f64 = 50.0;
+
+/// The softest support spring k̂ whose loop the production trace contains.
+pub const SOFTEST_SPRING: f64 = 0.5;
+
+/// The gap h̄ that marks the contact edge (inside it h̄ ≈ 1, outside it grows fast).
+pub const EDGE_GAP: f64 = 1.2;
+
+/// How the moving mesh is built.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MovingSpec {
+    /// Tabor parameter μ.
+    pub tabor_mu: f64,
+    /// Spacing in ξ at the edge ξ = 1.
+    pub fine: f64,
+    /// Largest spacing in ξ inside the contact.
+    pub inner: f64,
+    /// Largest spacing in x, at a = a₀, out to x = 3 (where a distant, nearly rigid tip
+    /// feels most of its attraction).
+    pub near: f64,
+    /// Largest spacing in x, at a = a₀, out to x = 10.
+    pub middle: f64,
+    /// Growth ratio of neighbouring elements.
+    pub growth: f64,
+    /// Contact radius (in x) at which the continuation switches to a; the mesh reaches
+    /// x = [`OUTER_RADIUS`] there.
+    pub a_start: f64,
+}
+
+impl MovingSpec {
+    /// The production mesh for μ, with `per_width` elements across the tensile annulus
+    /// at the largest contact radius traced.
+    pub fn for_tabor(tabor_mu: f64, per_width: f64) -> Self {
+        let width = 1.0 / (std::f64::consts::PI * tabor_mu.powf(1.5));
+        let root = tabor_mu.sqrt();
+        let a_max = 1.6 * Self::landing_a_hat(tabor_mu) * root;
+        Self {
+            tabor_mu,
+            fine: width / a_max / per_width,
+            inner: 0.02,
+            near: 0.02,
+            middle: 0.05,
+            growth: 1.04,
+            a_start: 0.1 * root,
+        }
+    }
+
+    /// Contact radius â where the hybrid jump-in lands on the JKR branch (or the
+    /// load-control pull-off point's, if larger).
+    fn landing_a_hat(tabor_mu: f64) -> f64 {
+        JumpIn::Fit
+            .alpha_hat_a(tabor_mu)
+            .ok()
+            .flatten()
+            .and_then(jkr::a_hat_from_separation)
+            .unwrap_or(jkr::A_HAT_B)
+            .max(jkr::pull_off_point().a_hat)
+    }
+
+    /// The same mesh with every spacing multiplied by `factor`.
+    pub fn scaled(&self, factor: f64) -> Self {
+        Self {
+            fine: self.fine * factor,
+            inner: self.inner * factor,
+            near: self.near * factor,
+            middle: self.middle * factor,
+            ..*self
+        }
+    }
+
+    /// The ξ nodes, from 0 to ξ_max = [`OUTER_RADIUS`]/a₀, with one at ξ = 1; and the
+    /// index of that one.
+    pub fn nodes(&self) -> (Vec<f64>, usize) {
+        let xi_max = OUTER_RADIUS / self.a_start;
+        let xi_near = 3.0 / self.a_start;
+        let xi_middle = 10.0 / self.a_start;
+        let spacing = |xi: f64| -> f64 {
+            let s = self.fine + (self.growth - 1.0) * (xi - 1.0).abs();
+            if xi < 1.0 {
+                s.min(self.inner)
+            } else if xi < xi_near {
+                s.min(self.near / self.a_start)
+            } else if xi < xi_middle {
+                s.min(self.middle / self.a_start)
+            } else {
+                s.min(2.0 / self.a_start)
+            }
+        };
+        let mut inner = vec![1.0];
+        let mut xi: f64 = 1.0;
+        while xi > 0.0 {
+            let h = spacing(xi).min(spacing(xi - spacing(xi)));
+            xi -= h;
+            if xi < 0.5 * h {
+                xi = 0.0;
+            }
+            inner.push(xi);
+        }
+        inner.reverse();
+        let edge = inner.len() - 1;
+        let mut nodes = inner;
+        let mut xi: f64 = 1.0;
+        while xi < xi_max {
+            let h = spacing(xi).min(spacing(xi + spacing(xi)));
+            xi += h;
+            if xi_max - xi < 0.5 * h {
+                xi = xi_max;
+            }
+            nodes.push(xi);
+        }
+        (nodes, edge)
+    }
+}
+
+/// Settings of the continuation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MovingOptions {
+    /// Newton tolerance on the gap residual.
+    pub tolerance: f64,
+    /// Largest chord between successive points in the (α̂, T̂) plane.
+    pub max_chord: f64,
+    /// Most continuation steps.
+    pub max_steps: usize,
+    /// How far past the jump-in separation the contact branch is followed (in α̂), so
+    /// that a support spring down to k̂ = `softest_spring` still finds its landing.
+    pub softest_spring: f64,
+}
+
+impl Default for MovingOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-10,
+            max_chord: 0.05,
+            max_steps: 2000,
+            softest_spring: SOFTEST_SPRING,
+        }
+    }
+}
+
+/// One continuation phase: the pinned node and how its parameter moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Phase {
+    /// Frozen mesh (a = a₀), central gap pinned and decreasing.
+    CentralGap,
+    /// Edge gap pinned, a increasing.
+    Radius,
+}
+
+/// Trace the S-curve of `spec`'s μ on the moving mesh (see the module docs): approach
+/// branch, fold A, unstable branch, fold C, contact branch past the landing point of
+/// the jump-in (and of a support spring as soft as `opts.softest_spring`).
+pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
+    let mu = spec.tabor_mu;
+    let (xi, edge) = spec.nodes();
+    let problem = Problem::new(mu, xi);
+    let a0 = spec.a_start;
+    let guess_a = JumpIn::SemiRigid.alpha_hat_a(mu)?.unwrap_or(2.0);
+    // Far enough out that the softest spring's jump-out (at α̂ + T̂/k̂ of the fold C,
+    // T̂ there below ~1.2 times the JKR pull-off 3π/2) lies on the traced approach.
+    let alpha_start = (2.0 * guess_a)
+        .max(2.5)
+        .max(jkr::ALPHA_HAT_C + 1.2 * 1.5 * std::f64::consts::PI / opts.softest_spring + 1.0);
+    let tol = opts.tolerance;
+    let point = |sol: &Solution, a: f64, s: f64| CurvePoint {
+        s,
+        alpha_hat: sol.alpha_bar / mu,
+        t_hat: problem.force_scaled(&sol.gap, a).0,
+        central_gap: sol.gap[0],
+    };
+    // Far out: the rigid gap, relaxed with the central gap pinned.
+    let rigid = Solution {
+        gap: DVector::from_iterator(
+            problem.len(),
+            problem
+                .nodes
+                .iter()
+                .map(|x| alpha_start * mu + 1.0 + 0.5 * (a0 * x).powi(2)),
+        ),
+        alpha_bar: alpha_start * mu,
+    };
+    let mut lu = None;
+    let (first, mut iterations) =
+        problem.solve_pinned(&rigid, a0, (0, rigid.gap[0]), tol, &mut lu)?;
+    let mut points = vec![point(&first, a0, 0.0)];
+    // (parameter, solution) of the last few points of the current phase.
+    let mut history: VecDeque<(f64, Solution)> = VecDeque::from(vec![(first.gap[0], first)]);
+    let mut phase = Phase::CentralGap;
+    let mut step = 0.05 * history[0].0;
+    let mut seen_c = false;
+    let mut steps = 0;
+    let landing_alpha = guess_a - 0.5;
+    while steps < opts.max_steps {
+        let (p_last, last) = history.back().expect("never empty");
+        let p_next = match phase {
+            Phase::CentralGap => p_last - step,
+            Phase::Radius => p_last + step,
+        };
+        let guess = extrapolate(&history, p_next);
+        let (pin, a_next) = match phase {
+            Phase::CentralGap => ((0, p_next), a0),
+            Phase::Radius => ((edge, EDGE_GAP), p_next),
+        };
+        let prev = *points.last().expect("never empty");
+        let (sol, its) = match problem.solve_pinned(&guess, a_next, pin, tol, &mut lu) {
+            Ok(v) => v,
+            Err(_) => {
+                lu = None;
+                step *= 0.5;
+                if step < 1e-9 * p_last.abs().max(1.0) {
+                    return Err(Error::Numerical(format!(
+                        "LJ continuation stalled at alpha_hat = {:.4}, T_hat = {:.4}",
+                        prev.alpha_hat, prev.t_hat
+                    )));
+                }
+                continue;
+            }
+        };
+        let q = point(&sol, a_next, 0.0);
+        let chord = (q.alpha_hat - prev.alpha_hat).hypot(q.t_hat - prev.t_hat);
+        let max_chord = chord_cap(opts, prev.alpha_hat);
+        if chord > max_chord {
+            // Too far along the curve for its points to resolve it: shorten in proportion.
+            step *= 0.8 * max_chord / chord;
+            continue;
+        }
+        if phase == Phase::CentralGap && sol.gap[edge] <= EDGE_GAP {
+            // The contact has reached x = a₀: pin the edge there (from the two solutions
+            // around that point) and follow a from now on.
+            let before = &last.gap[edge];
+            let f = (before - EDGE_GAP) / (before - sol.gap[edge]);
+            let mut guess = last.clone();
+            guess.gap.axpy(f, &(&sol.gap - &last.gap), 1.0);
+            guess.alpha_bar += f * (sol.alpha_bar - last.alpha_bar);
+            match problem.solve_pinned(&guess, a0, (edge, EDGE_GAP), tol, &mut lu) {
+                Ok((sol, its)) => {
+                    iterations += its;
+                    steps += 1;
+                    let q = point(&sol, a0, 0.0);
+                    let chord = (q.alpha_hat - prev.alpha_hat).hypot(q.t_hat - prev.t_hat);
+                    points.push(CurvePoint {
+                        s: prev.s + chord,
+                        ..q
+                    });
+                    history.clear();
+                    history.push_back((a0, sol));
+                    phase = Phase::Radius;
+                    step = 0.02 * a0;
+                }
+                Err(_) => {
+                    lu = None;
+                    step *= 0.5;
+                }
+            }
+            continue;
+        }
+        iterations += its;
+        steps += 1;
+        points.push(CurvePoint {
+            s: prev.s + chord,
+            ..q
+        });
+        history.push_back((p_next, sol));
+        if history.len() > 3 {
+            history.pop_front();
+        }
+        // Step control from the predictor's error (third order for the quadratic
+        // extrapolation once three points are known), aiming at PREDICTOR_ERROR.
+        let predicted = predictor_error(&guess, &history.back().expect("just pushed").1);
+        let factor = if history.len() < 3 {
+            1.5
+        } else {
+            (PREDICTOR_ERROR / predicted.max(1e-12))
+                .cbrt()
+                .clamp(0.5, 2.0)
+        };
+        // …and at a chord of 0.8 of the largest.
+        step *= factor.min(0.8 * max_chord / chord.max(1e-12));
+        if q.alpha_hat > guess_a + 0.3 {
+            seen_c = true;
+        }
+        if seen_c && phase == Phase::Radius && past_landing(&points, landing_alpha, opts) {
+            break;
+        }
+    }
+    let hysteresis = Hysteresis::of(&points)?;
+    let k_c = points.partition_point(|p| p.s <= hysteresis.fold_c.s);
+    let pull_off_hat = points[k_c..]
+        .iter()
+        .map(|p| p.t_hat)
+        .fold(hysteresis.fold_c.t_hat, f64::max);
+    Ok(Curve {
+        tabor_mu: mu,
+        nodes: problem.len(),
+        points,
+        fold_a: hysteresis.fold_a,
+        fold_c: hysteresis.fold_c,
+        pull_off_hat,
+        w_hat: hysteresis.w_hat,
+        steps,
+        factorisations: problem.factorisations(),
+        iterations,
+    })
+}
+
+/// The largest chord allowed from a point at α̂: `opts.max_chord` where the folds are
+/// (α̂ ≤ 3 for every μ), growing in proportion beyond, where the approach branch is a
+/// gentle tail T̂ ~ α̂⁻².
+fn chord_cap(opts: &MovingOptions, alpha_hat: f64) -> f64 {
+    opts.max_chord * (alpha_hat - 2.0).max(1.0)
+}
+
+/// Whether the contact branch has gone below `landing_alpha` and, seen through the
+/// softest support spring, below the spring's own jump-in landing too.
+fn past_landing(points: &[CurvePoint], landing_alpha: f64, opts: &MovingOptions) -> bool {
+    let q = points.last().expect("never empty");
+    if q.alpha_hat >= landing_alpha {
+        return false;
+    }
+    let k = opts.softest_spring;
+    // The spring's jump-in: the first minimum of α̂ + T̂/k̂ (on the approach branch).
+    let support = |p: &CurvePoint| p.alpha_hat + p.t_hat / k;
+    let first_min = points
+        .windows(2)
+        .find(|w| support(&w[1]) > support(&w[0]))
+        .map(|w| support(&w[0]));
+    first_min.is_some_and(|m| support(q) < m - 0.5)
+}
+
+/// Largest relative gap error of the predictor accepted before the step shrinks.
+const PREDICTOR_ERROR: f64 = 1e-2;
+
+/// How far the predictor `guess` was from the converged `solution`: largest change of a
+/// gap relative to max(1, gap), or of ᾱ.
+fn predictor_error(guess: &Solution, solution: &Solution) -> f64 {
+    guess
+        .gap
+        .iter()
+        .zip(solution.gap.iter())
+        .map(|(g, h)| (g - h).abs() / h.abs().max(1.0))
+        .fold((guess.alpha_bar - solution.alpha_bar).abs(), f64::max)
+}
+
+/// Lagrange extrapolation of the last solutions to parameter `p`.
+fn extrapolate(history: &VecDeque<(f64, Solution)>, p: f64) -> Solution {
+    let m = history.len();
+    let weight = |i: usize| -> f64 {
+        (0..m)
+            .filter(|&j| j != i)
+            .map(|j| (p - history[j].0) / (history[i].0 - history[j].0))
+            .product()
+    };
+    let mut guess = Solution {
+        gap: history[0].1.gap.scale(weight(0)),
+        alpha_bar: weight(0) * history[0].1.alpha_bar,
+    };
+    for (i, (_, sol)) in history.iter().enumerate().skip(1) {
+        let w = weight(i);
+        guess.gap.axpy(w, &sol.gap, 1.0);
+        guess.alpha_bar += w * sol.alpha_bar;
+    }
+    guess
+}
