@@ -153,6 +153,9 @@ pub fn fig1() -> Chart {
     }
 }
 
+/// Largest separation shown in Fig. 2.
+const FIG2_ALPHA_MAX: f64 = 4.0;
+
 /// Fig. 2: the Lennard-Jones force–separation curve for μ = 5 (numerical), with its
 /// folds A and C, the jumps, and the JKR curve (5) for comparison.
 pub fn fig2(s: &LjSolution) -> Result<Chart> {
@@ -160,7 +163,13 @@ pub fn fig2(s: &LjSolution) -> Result<Chart> {
     let jkr_curve: Vec<(f64, f64)> = grid(c.a_hat, 2.4, 300, false)
         .map(|a| (jkr::separation_hat(a), jkr::force_hat(a)))
         .collect();
-    let lj_curve: Vec<(f64, f64)> = s.curve.iter().map(|p| (p.alpha_hat, p.t_hat)).collect();
+    // The trace starts far out (for soft support springs); the figure shows the loop.
+    let lj_curve: Vec<(f64, f64)> = s
+        .curve
+        .iter()
+        .filter(|p| p.alpha_hat <= FIG2_ALPHA_MAX)
+        .map(|p| (p.alpha_hat, p.t_hat))
+        .collect();
     let (a, cc) = (
         (s.alpha_hat_a.value, s.t_hat_a.value),
         (s.alpha_hat_c.value, s.t_hat_c.value),
