@@ -5,7 +5,7 @@
 
 use crate::contact::hybrid::{self, JumpIn};
 use crate::contact::jkr::{self, JkrPoint};
-use crate::contact::lj::{self, LjSolution};
+use crate::contact::lj::{self, LjSolution, curve::Hysteresis};
 use crate::contact::semi_rigid::{self, EighthPower};
 use crate::contact::spring;
 use crate::error::{Error, Result};
@@ -81,7 +81,17 @@ pub fn figure(number: u32, opts: &FigureOptions) -> Result<Chart> {
         3 => fig3(&lj_solutions()?),
         4 => fig4(opts.jump_in, &lj_solutions()?),
         5 => fig5(opts.fig5_mu, opts.fig5_k_hat, opts.jump_in),
-        6 => fig6(opts.jump_in),
+        6 => {
+            let covered = FIG6_MUS
+                .iter()
+                .filter(|&&mu| mu <= lj::result::MAX_TABOR_MU);
+            fig6(
+                opts.jump_in,
+                &covered
+                    .map(|&mu| lj::solve(mu, true))
+                    .collect::<Result<Vec<_>>>()?,
+            )
+        }
         n => Err(Error::NotApplicable(format!(
             "the paper has figures 1 to 6; there is no figure {n}"
         ))),
@@ -395,9 +405,14 @@ pub fn fig5(tabor_mu: f64, k_hat: f64, jump_in: JumpIn) -> Result<Chart> {
     })
 }
 
+/// Support stiffnesses of the numerical points of Fig. 6.
+pub const FIG6_LJ_K_HATS: [f64; 9] = [0.5, 1.0, 2.0, 5.0, 10.0, 30.0, 100.0, 300.0, 1000.0];
+
 /// Fig. 6: hysteresis Ŵ(k̂) (26) for μ = 2, 5, 10, 20, with the soft-support asymptote
-/// (27) and the rigid-grip levels (18).
-pub fn fig6(jump_in: JumpIn) -> Result<Chart> {
+/// (27), the rigid-grip levels (18), and the numerical Lennard-Jones loss through the
+/// same spring (the S-curve seen in α̂ + T̂/k̂) for each solution in `lj` (μ of
+/// [`FIG6_MUS`] the solver covers).
+pub fn fig6(jump_in: JumpIn, lj: &[LjSolution]) -> Result<Chart> {
     let (k_lo, k_hi) = (1e-2, 1e3);
     let mut series = Vec::new();
     for (i, &mu) in FIG6_MUS.iter().enumerate() {
@@ -417,6 +432,18 @@ pub fn fig6(jump_in: JumpIn) -> Result<Chart> {
             Style::Dashed,
             i + 1,
         ));
+        if let Some(solution) = lj.iter().find(|s| s.tabor_mu == mu) {
+            let points = FIG6_LJ_K_HATS
+                .iter()
+                .map(|&k| Ok((k, Hysteresis::with_spring(&solution.curve, k)?.w_hat)))
+                .collect::<Result<Vec<_>>>()?;
+            series.push(Series::new(
+                &format!("μ = {mu}, Lennard-Jones (10), numerical"),
+                points,
+                Style::Markers,
+                i + 1,
+            ));
+        }
     }
     series.push(Series::new(
         "soft-support limit (27)",
