@@ -9,8 +9,8 @@
 //! within reach of the switch, the rest of the way is integrated with Hénon's trick,
 //! taking u = √|level − α̂| as the independent variable (dτ/du follows from the velocity)
 //! and stopping exactly at u = 0. The contact branches end at folds where T̂ has a
-//! square-root singularity in α̂ but is smooth in u, so this last stretch takes one or
-//! two smooth steps instead of a cascade of shrinking ones onto the cusp.
+//! square-root singularity in α̂ but is smooth in u, so this last stretch takes two or
+//! three smooth steps instead of a cascade of shrinking ones onto the cusp.
 
 use super::model::{COS, Coupling, Oscillator, SIN, State, V, X, rhs, set_phasor};
 use crate::error::{Error, Result};
@@ -98,7 +98,7 @@ struct Segment<'a, L: ForceLaw, O: StepObserver> {
     branch: Branch,
     /// Switching level and direction; `None` to run to the end.
     event: Option<(f64, Crossing)>,
-    /// Whether to stop short of the switch to land on it ([`approach`]).
+    /// Whether to stop short of the switch to land on it ([`land`]).
     land: bool,
     /// End of the span.
     tau_end: f64,
@@ -106,33 +106,25 @@ struct Segment<'a, L: ForceLaw, O: StepObserver> {
     observer: &'a mut O,
 }
 impl<L: ForceLaw, O: StepObserver> Segment<'_, L, O> {
-    /// Signed distance to the switch, positive on the side the branch lives on.
+    /// (gap, rate) at τ for deflection `x` and velocity `v` ([`approach_rate`]).
     #[inline]
-    fn distance(&self, level: f64, crossing: Crossing, tau: f64, x: f64) -> f64 {
-        let (x_b, _) = self.osc.base_at(tau);
-        let d = self.cpl.alpha_hat(x, x_b) - level;
-        match crossing {
-            Crossing::Down => d,
-            Crossing::Up => -d,
-        }
+    fn approach(&self, level: f64, crossing: Crossing, tau: f64, x: f64, v: f64) -> (f64, f64) {
+        approach_rate(self.osc, self.cpl, (level, crossing), tau, x, v)
     }
 
-    /// The first time in the step where the distance reaches zero, from 8 sub-samples of
-    /// the Hermite interpolant and a bracketed refinement.
+    /// The first time in the step where the gap to the switch closes, from 8 sub-samples
+    /// of the Hermite interpolant and a bracketed refinement.
     fn locate(&self, a: &StepEnd, b: &StepEnd, level: f64, crossing: Crossing) -> Option<f64> {
-        let g = |tau: f64| self.distance(level, crossing, tau, hermite(a, b, X, tau));
-        let g_end = self.distance(level, crossing, b.tau, b.y[X]);
+        let g = |tau: f64| {
+            self.approach(level, crossing, tau, hermite(a, b, X, tau), 0.0)
+                .0
+        };
+        let (g_end, rate_end) = self.approach(level, crossing, b.tau, b.y[X], b.y[V]);
         if g_end > 0.0 {
             // Not crossed at the step's end; it can only have dipped through the level and
             // back if the separation turned around inside the step.
-            let rate = |e: &StepEnd| {
-                let (_, v_b) = self.osc.base_at(e.tau);
-                match crossing {
-                    Crossing::Down => e.y[V] + v_b,
-                    Crossing::Up => -(e.y[V] + v_b),
-                }
-            };
-            if !(rate(a) < 0.0 && rate(b) > 0.0) {
+            let (_, rate_start) = self.approach(level, crossing, a.tau, a.y[X], a.y[V]);
+            if !(rate_start > 0.0 && rate_end < 0.0) {
                 return None;
             }
         }
@@ -155,15 +147,13 @@ impl<L: ForceLaw, O: StepObserver> Segment<'_, L, O> {
         }
         None
     }
-}
 
-impl<L: ForceLaw, O: StepObserver> Segment<'_, L, O> {
     /// Whether the switch lies within about one more step of `end` (the step that ended
     /// there was `h` long), the motion heads for it fast enough not to stall on the way
     /// (even decelerating at the present rate it keeps half its speed), and it is reached
     /// well before the span ends.
     fn within_reach(&self, end: &StepEnd, h: f64, level: f64, crossing: Crossing) -> bool {
-        let (gap, rate) = approach_rate(self.osc, self.cpl, level, crossing, end.tau, &end.y);
+        let (gap, rate) = self.approach(level, crossing, end.tau, end.y[X], end.y[V]);
         if !(gap > 0.0 && rate > 0.0) {
             return false;
         }
@@ -185,21 +175,20 @@ fn sigma(crossing: Crossing) -> f64 {
     }
 }
 
-/// (gap, rate): the distance σ(level − α̂) still to go and the speed σ dα̂/dτ towards it.
+/// (gap, rate) at τ for deflection `x` and velocity `v`: the distance σ(level − α̂) still
+/// to go to the switch (positive on the side the branch lives on) and σ dα̂/dτ, the
+/// speed towards it.
 fn approach_rate(
     osc: &Oscillator,
     cpl: &Coupling,
-    level: f64,
-    crossing: Crossing,
+    (level, crossing): (f64, Crossing),
     tau: f64,
-    y: &State,
+    x: f64,
+    v: f64,
 ) -> (f64, f64) {
     let (x_b, v_b) = osc.base_at(tau);
     let s = sigma(crossing);
-    (
-        s * (level - cpl.alpha_hat(y[X], x_b)),
-        s * cpl.a1 * (y[V] + v_b),
-    )
+    (s * (level - cpl.alpha_hat(x, x_b)), s * cpl.a1 * (v + v_b))
 }
 
 impl<L: ForceLaw, O: StepObserver> System<f64, State> for Segment<'_, L, O> {
@@ -263,7 +252,7 @@ struct Landing {
 }
 
 impl Landing {
-    /// Steps a landing may take (it normally takes one or two).
+    /// Steps a landing may take (it normally takes two or three).
     const MAX_STEPS: usize = 16;
 }
 
@@ -326,7 +315,14 @@ fn land<L: ForceLaw, O: StepObserver>(
     tol: &Tolerances,
     observer: &mut O,
 ) -> Result<Option<StepEnd>> {
-    let (gap, rate) = approach_rate(osc, cpl, level, crossing, entry.tau, &entry.y);
+    let (gap, rate) = approach_rate(
+        osc,
+        cpl,
+        (level, crossing),
+        entry.tau,
+        entry.y[X],
+        entry.y[V],
+    );
     let u0 = gap.sqrt();
     let mut y = entry.y;
     y[X] = entry.tau;
@@ -613,7 +609,7 @@ impl<L: ForceLaw> Span<'_, L> {
             }
             y = refine.last.y;
             // Still to go, and its rate of decrease.
-            let (gap, rate) = approach_rate(self.osc, self.cpl, level, crossing, t, &y);
+            let (gap, rate) = approach_rate(self.osc, self.cpl, (level, crossing), t, y[X], y[V]);
             let next = t + gap / rate;
             if attempt == 3
                 // 1e-8 in α̂ moves the loop area by ~1e-8 relative (the path itself stays
