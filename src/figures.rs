@@ -52,27 +52,26 @@ fn label(text: &str, x: f64, y: f64) -> Label {
     }
 }
 
-/// The jumps A→B and C→D of a hysteresis loop: their dotted lines (colours `colors`,
-/// the markers in the first), the four markers, and labels `drop` below A and D and
-/// `rise` above B and C.
-fn jumps(
+/// Add the jumps A→B and C→D of a hysteresis loop to a chart's `series` and `labels`:
+/// their dotted lines (colours `colors`, the markers in the first), the four markers,
+/// and labels `drop` below A and D and `rise` above B and C.
+fn add_jumps(
+    (series, labels): (&mut Vec<Series>, &mut Vec<Label>),
     [a, b, c, d]: [(f64, f64); 4],
     colors: (usize, usize),
     (drop, rise): (f64, f64),
-) -> (Vec<Series>, Vec<Label>) {
-    (
-        vec![
-            Series::new("jump-in A→B", vec![a, b], Style::Dotted, colors.0),
-            Series::new("jump-out C→D", vec![c, d], Style::Dotted, colors.1),
-            Series::new("A, B, C, D", vec![a, b, c, d], Style::Markers, colors.0),
-        ],
-        vec![
-            label("A", a.0 + 0.04, a.1 - drop),
-            label("B", b.0 + 0.04, b.1 + rise),
-            label("C", c.0 + 0.04, c.1 + rise),
-            label("D", d.0 + 0.04, d.1 - drop),
-        ],
-    )
+) {
+    series.extend([
+        Series::new("jump-in A→B", vec![a, b], Style::Dotted, colors.0),
+        Series::new("jump-out C→D", vec![c, d], Style::Dotted, colors.1),
+        Series::new("A, B, C, D", vec![a, b, c, d], Style::Markers, colors.0),
+    ]);
+    labels.extend([
+        label("A", a.0 + 0.04, a.1 - drop),
+        label("B", b.0 + 0.04, b.1 + rise),
+        label("C", c.0 + 0.04, c.1 + rise),
+        label("D", d.0 + 0.04, d.1 - drop),
+    ]);
 }
 
 /// Options of the figures that have free parameters.
@@ -216,27 +215,29 @@ pub fn fig2(s: &LjSolution) -> Result<Chart> {
         cc.0,
         LjSolution::force_on(s.approach_branch(), cc.0).unwrap_or(f64::NAN),
     );
-    let (jump_series, jump_labels) = jumps([a, b, cc, d], (2, 3), (0.3, 0.3));
+    let mut series = vec![
+        Series::new("JKR (5)", jkr_curve, Style::Line, 0),
+        Series::new("Lennard-Jones (10), numerical", lj_curve, Style::Dashed, 1),
+    ];
+    let mut labels = Vec::new();
+    add_jumps(
+        (&mut series, &mut labels),
+        [a, b, cc, d],
+        (2, 3),
+        (0.3, 0.3),
+    );
+    labels.push(label(
+        &format!("Ŵ = {:.4} ± {:.0e}", s.w_hat.value, s.w_hat.error),
+        -1.5,
+        0.5,
+    ));
     Ok(Chart {
         name: "fig2_lj_mu5".into(),
         title: format!("Fig. 2  Force–separation relation for μ = {}", s.tabor_mu),
         x: Axis::linear("separation α/(με)", "alpha_hat"),
         y: Axis::linear("force T/(RΔγ)  (tensile > 0)", "t_hat"),
-        series: [
-            Series::new("JKR (5)", jkr_curve, Style::Line, 0),
-            Series::new("Lennard-Jones (10), numerical", lj_curve, Style::Dashed, 1),
-        ]
-        .into_iter()
-        .chain(jump_series)
-        .collect(),
-        labels: jump_labels
-            .into_iter()
-            .chain([label(
-                &format!("Ŵ = {:.4} ± {:.0e}", s.w_hat.value, s.w_hat.error),
-                -1.5,
-                0.5,
-            )])
-            .collect(),
+        series,
+        labels,
         legend: Corner::UpperRight,
     })
 }
@@ -389,7 +390,27 @@ pub fn fig5(tabor_mu: f64, k_hat: f64, jump_in: JumpIn) -> Result<Chart> {
     let mut approach = segment(Segment::Approach);
     approach.extend(segment(Segment::Retract));
     approach.sort_by(|p, q| p.0.total_cmp(&q.0));
-    let (jump_series, jump_labels) = jumps([a, b, c, d], (1, 1), (0.2, 0.35));
+    let mut series = vec![
+        Series::new(
+            "contact branch (5), (22)",
+            segment(Segment::Unloading),
+            Style::Line,
+            0,
+        ),
+        Series::new("force-free approach/retract", approach, Style::Line, 2),
+    ];
+    let mut labels = Vec::new();
+    add_jumps(
+        (&mut series, &mut labels),
+        [a, b, c, d],
+        (1, 1),
+        (0.2, 0.35),
+    );
+    labels.push(label(
+        &format!("W/(μεRΔγ) = {:.4}  (26)", h.w_hat),
+        left,
+        0.9 * jkr::PULL_OFF_T_HAT,
+    ));
     Ok(Chart {
         name: "fig5_finite_stiffness_cycle".into(),
         title: format!(
@@ -400,26 +421,8 @@ pub fn fig5(tabor_mu: f64, k_hat: f64, jump_in: JumpIn) -> Result<Chart> {
             "support_alpha_hat",
         ),
         y: Axis::linear("force T/(RΔγ)  (tensile > 0)", "t_hat"),
-        series: [
-            Series::new(
-                "contact branch (5), (22)",
-                segment(Segment::Unloading),
-                Style::Line,
-                0,
-            ),
-            Series::new("force-free approach/retract", approach, Style::Line, 2),
-        ]
-        .into_iter()
-        .chain(jump_series)
-        .collect(),
-        labels: jump_labels
-            .into_iter()
-            .chain([label(
-                &format!("W/(μεRΔγ) = {:.4}  (26)", h.w_hat),
-                left,
-                0.9 * jkr::PULL_OFF_T_HAT,
-            )])
-            .collect(),
+        series,
+        labels,
         legend: Corner::LowerRight,
     })
 }
