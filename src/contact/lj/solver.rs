@@ -95,12 +95,7 @@ impl Problem {
             .fold(0.0, f64::max)
     }
 
-    /// Residual of the gap equation.
-    pub fn residual(&self, s: &Solution) -> DVector<f64> {
-        self.residual_scaled(s, 1.0)
-    }
-
-    /// Residual on the mesh stretched by `a` (nodes a·x_i): the influence matrix of a
+    /// Residual of the gap equation on the mesh stretched by `a` (nodes a·x_i): the influence matrix of a
     /// stretched mesh is a times the original (the kernel G(x, y) dy is homogeneous of
     /// degree one; a reassembled matrix differs only by its element quadrature error), so
     /// a moving mesh needs no reassembly.
@@ -115,12 +110,7 @@ impl Problem {
         r
     }
 
-    /// Force T̂ and its gradient with respect to the nodal gaps.
-    pub fn force(&self, gap: &DVector<f64>) -> (f64, DVector<f64>) {
-        self.force_scaled(gap, 1.0)
-    }
-
-    /// Force T̂ and its gradient on the mesh stretched by `a` (moments scale as a²; the
+    /// Force T̂ and its gradient with respect to the nodal gaps, on the mesh stretched by `a` (moments scale as a²; the
     /// tail beyond the last node does not depend on where that node is).
     pub fn force_scaled(&self, gap: &DVector<f64>, a: f64) -> (f64, DVector<f64>) {
         let (f, df) = self.tractions(gap);
@@ -241,7 +231,10 @@ mod tests {
             gap: DVector::from_iterator(xi.len(), xi.iter().map(|x| 1.1 + 0.3 * (a * x).powi(2))),
             alpha_bar: 0.4,
         };
-        let (r1, r2) = (unit.residual_scaled(&s, a), stretched.residual(&s));
+        let (r1, r2) = (
+            unit.residual_scaled(&s, a),
+            stretched.residual_scaled(&s, 1.0),
+        );
         // The elastic part of the residual (the rest is identical by construction).
         let mut elastic = r2.clone();
         for (i, x) in stretched.nodes.iter().enumerate() {
@@ -252,7 +245,7 @@ mod tests {
         let d = (&r1 - &r2).amax() / elastic.amax();
         assert!(d < 1e-4, "{d:e}");
         let (t1, g1) = unit.force_scaled(&s.gap, a);
-        let (t2, g2) = stretched.force(&s.gap);
+        let (t2, g2) = stretched.force_scaled(&s.gap, 1.0);
         // The moments ∫ φ_j x dx are polynomial: exact under stretching.
         assert!((t1 - t2).abs() < 1e-12 * t2.abs(), "{t1} {t2}");
         assert!((&g1 - &g2).amax() < 1e-12 * g2.amax());
