@@ -198,10 +198,14 @@ pub struct TapInputs {
     /// Most cycles to integrate looking for the steady state [default 20000].
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
     pub max_cycles: Option<f64>,
-    /// Steady state: largest change of A, φ and E_ts per cycle [default 1e-9 for tap,
-    /// 1e-7 per setpoint for approach].
+    /// Periodic steady state: how closely the state must return after n periods, in
+    /// units of A₀ [default 1e-9 for tap, 1e-7 per setpoint for sweeps].
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
     pub tolerance: Option<f64>,
+    /// Irregular (not periodic) motion: standard error the averages must reach, A and
+    /// E_ts relative, φ in rad [default 1e-3].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
+    pub average_tolerance: Option<f64>,
 }
 
 /// The TOML keys and the quantity each holds.
@@ -224,6 +228,7 @@ const KEYS: &[(&str, Dimension)] = &[
     ("rtol", Dimension::Dimensionless),
     ("max-cycles", Dimension::Dimensionless),
     ("tolerance", Dimension::Dimensionless),
+    ("average-tolerance", Dimension::Dimensionless),
 ];
 
 impl TapInputs {
@@ -247,6 +252,7 @@ impl TapInputs {
             "separation" => &mut self.separation,
             "rtol" => &mut self.rtol,
             "tolerance" => &mut self.tolerance,
+            "average-tolerance" => &mut self.average_tolerance,
             _ => &mut self.max_cycles,
         }
     }
@@ -339,6 +345,7 @@ impl TapInputs {
             rtol: self.rtol.or(base.rtol),
             max_cycles: self.max_cycles.or(base.max_cycles),
             tolerance: self.tolerance.or(base.tolerance),
+            average_tolerance: self.average_tolerance.or(base.average_tolerance),
         }
     }
 
@@ -385,12 +392,16 @@ impl TapInputs {
         if let Some(t) = self.tolerance {
             numerics.tolerance = t;
         }
+        if let Some(t) = self.average_tolerance {
+            numerics.average_tolerance = t;
+        }
         if let Some(n) = self.max_cycles {
-            if !(n >= 1.0 && n.fract() == 0.0 && n <= 1e9) {
+            if !(n >= 32.0 && n.fract() == 0.0 && n <= 1e9) {
                 return Err(Error::InvalidParameter {
                     name: "max cycles",
                     value: n,
-                    reason: "must be a whole number from 1 to 1e9",
+                    reason: "must be a whole number from 32 to 1e9 (classifying the steady \
+                             state and averaging irregular motion need at least 32 periods)",
                 });
             }
             numerics.max_cycles = n as usize;

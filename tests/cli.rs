@@ -376,9 +376,25 @@ fn tap_json_has_the_documented_keys() {
     ] {
         num(&v, key);
     }
-    assert!(v["cycles"].as_u64().unwrap() > 10);
+    // Settled by Newton's method on the period map: at most 20 periods in all.
+    let cycles = v["cycles"].as_u64().unwrap();
+    assert!((3..=20).contains(&cycles), "{cycles} cycles");
     assert_eq!(v["converged"], serde_json::Value::Bool(true));
     assert_eq!(v["law"], "hybrid");
+    // A stable period-1 orbit, reported over its one period with no statistical error.
+    assert_eq!(v["regime"], "period-1");
+    assert_eq!(v["period"], 1);
+    assert_eq!(v["periods_averaged"], 1);
+    assert_eq!(v["stable"], serde_json::Value::Bool(true));
+    let multipliers = v["floquet_multipliers"].as_array().unwrap();
+    assert_eq!(multipliers.len(), 2);
+    for m in multipliers {
+        let (re, im) = (m[0].as_f64().unwrap(), m[1].as_f64().unwrap());
+        assert!(re.hypot(im) < 1.0, "{m}");
+    }
+    for key in ["amplitude_std_err_m", "phase_std_err_deg", "e_ts_std_err_j"] {
+        assert_eq!(num(&v, key), 0.0, "{key}");
+    }
     // The default tap is in contact and dissipates the hybrid loop.
     assert!((num(&v, "e_ts_j") / num(&v, "loop_area_j") - 1.0).abs() < 1e-5);
 }

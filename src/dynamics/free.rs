@@ -2,9 +2,9 @@
 //! force: x'' + 2γx' + x = f₀ cos Ωτ. Exact, so free flight costs no integration steps,
 //! and so are the carried integrals.
 
-use super::model::{Drive, E_DAMP, Oscillator, SC, SS, State, V, X};
+use super::model::{Drive, E_DAMP, Oscillator, SC, SS, State, TANGENT, V, X, phi, set_phi};
 use crate::numeric::newton_bracketed;
-use nalgebra::Complex;
+use nalgebra::{Complex, Matrix2};
 
 /// The free motion from a given state.
 #[derive(Debug, Clone, Copy)]
@@ -129,8 +129,9 @@ impl FreeFlight {
     /// `tau_b`, all in closed form: the Fourier projections are integrals of exponentials,
     /// the drive's work follows from them by parts, ∫ f₀ cos Ωτ x' dτ =
     /// f₀([x cos Ωτ] + Ω ∫ x sin Ωτ dτ), and damping takes the rest of the energy balance
-    /// (the tip feels no force). The tip–sample integrals do not change.
-    pub fn advance(&self, y: &mut State, tau_a: f64, tau_b: f64) {
+    /// (the tip feels no force). The tip–sample integrals do not change. The variational
+    /// matrix of a [`TANGENT`] state is carried by [`FreeFlight::transition`].
+    pub fn advance<const N: usize>(&self, y: &mut State<N>, tau_a: f64, tau_b: f64) {
         let (sc, ss) = self.fourier(tau_a, tau_b);
         let (x_a, v_a) = self.at(tau_a);
         let (x_b, v_b) = self.at(tau_b);
@@ -143,6 +144,25 @@ impl FreeFlight {
         y[E_DAMP] += drive - mechanical;
         y[SC] += sc;
         y[SS] += ss;
+        if N == TANGENT {
+            set_phi(y, &(self.transition(tau_b - tau_a) * phi(y)));
+        }
+    }
+
+    /// ∂(x, x')(τ₀ + s)/∂(x, x')(τ₀): the free oscillation's transition matrix over a
+    /// time s (the drive only shifts the particular solution),
+    /// e^{−γs}[[cos ω_d s + (γ/ω_d) sin ω_d s, sin ω_d s/ω_d],
+    ///         [−sin ω_d s/ω_d, cos ω_d s − (γ/ω_d) sin ω_d s]].
+    pub fn transition(&self, s: f64) -> Matrix2<f64> {
+        let e = (-self.gamma * s).exp();
+        let (sd, cd) = (self.omega_d * s).sin_cos();
+        let g = self.gamma / self.omega_d;
+        Matrix2::new(
+            e * (cd + g * sd),
+            e * sd / self.omega_d,
+            -e * sd / self.omega_d,
+            e * (cd - g * sd),
+        )
     }
 
     /// (∫ x cos Ωτ dτ, ∫ x sin Ωτ dτ) over [a, b], exactly: with x = Re[P e^{iΩτ}] +
@@ -215,7 +235,7 @@ impl FreeFlight {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::model::{Coupling, rhs};
+    use crate::dynamics::model::{BASE, Coupling, rhs};
     use crate::law::{Branch, NoForce};
 
     fn osc() -> Oscillator {
@@ -242,11 +262,11 @@ mod tests {
             let (xp, vp) = f.at(t + h);
             let (xm, vm) = f.at(t - h);
             let acc = (vp - vm) / (2.0 * h);
-            let mut y = State::zeros();
+            let mut y = State::<BASE>::zeros();
             y[X] = x;
             y[V] = v;
             crate::dynamics::model::set_phasor(&osc, t, &mut y);
-            let mut dy = State::zeros();
+            let mut dy = State::<BASE>::zeros();
             rhs(&NoForce, &osc, &cpl, Branch::Free, t, &y, &mut dy);
             assert!((acc - dy[V]).abs() < 1e-7, "{acc} vs {}", dy[V]);
             assert!(((xp - xm) / (2.0 * h) - v).abs() < 1e-7);
@@ -270,7 +290,7 @@ mod tests {
             ss += h * x * (osc.omega * t).sin();
             damp += h * 2.0 * osc.gamma * v * v;
         }
-        let mut y = State::zeros();
+        let mut y = State::<BASE>::zeros();
         f.advance(&mut y, a, b);
         assert!((y[SC] - sc).abs() < 1e-9, "{} {sc}", y[SC]);
         assert!((y[SS] - ss).abs() < 1e-9, "{} {ss}", y[SS]);

@@ -13,12 +13,20 @@ use nalgebra::SVector;
 
 /// ODE state: deflection, velocity, the per-cycle integrals carried along, and the drive
 /// phasor (cos Ωτ, sin Ωτ), integrated as a rotation so the right-hand side needs no
-/// trigonometric calls (it is reset to the exact values at every segment start).
+/// trigonometric calls (it is reset to the exact values at every segment start). With
+/// `N` = [`TANGENT`] it also carries the variational matrix Φ = ∂(x, x')/∂(x₀, x₀')
+/// from [`PHI`] on, for the derivative of the period map; with `N` = [`BASE`] it does
+/// not, and the hot path pays nothing for it.
 ///
 /// Two energies are not carried: the contact's E_ts is exact from the law's branch work
 /// functions at the segment ends, and the drive's work follows from the Fourier
 /// projections by parts ([`Oscillator::drive_work`]).
-pub type State = SVector<f64, 9>;
+pub type State<const N: usize = BASE> = SVector<f64, N>;
+
+/// Components of the plain state.
+pub const BASE: usize = 9;
+/// Components of the state with the variational matrix.
+pub const TANGENT: usize = 13;
 
 /// Index of the deflection x in [`State`].
 pub const X: usize = 0;
@@ -38,10 +46,27 @@ pub const VIRIAL: usize = 6;
 pub const COS: usize = 7;
 /// sin Ωτ.
 pub const SIN: usize = 8;
+/// First of the four entries of Φ, column by column: ∂x/∂x₀, ∂x'/∂x₀, ∂x/∂x₀', ∂x'/∂x₀'.
+pub const PHI: usize = 9;
+
+/// Φ of a [`TANGENT`] state as a matrix.
+#[inline]
+pub fn phi<const N: usize>(y: &State<N>) -> nalgebra::Matrix2<f64> {
+    nalgebra::Matrix2::new(y[PHI], y[PHI + 2], y[PHI + 1], y[PHI + 3])
+}
+
+/// Store `m` as Φ of a [`TANGENT`] state.
+#[inline]
+pub fn set_phi<const N: usize>(y: &mut State<N>, m: &nalgebra::Matrix2<f64>) {
+    y[PHI] = m[(0, 0)];
+    y[PHI + 1] = m[(1, 0)];
+    y[PHI + 2] = m[(0, 1)];
+    y[PHI + 3] = m[(1, 1)];
+}
 
 /// Set the drive phasor of `y` to its exact value at τ.
 #[inline]
-pub fn set_phasor(osc: &Oscillator, tau: f64, y: &mut State) {
+pub fn set_phasor<const N: usize>(osc: &Oscillator, tau: f64, y: &mut State<N>) {
     let (s, c) = (osc.omega * tau).sin_cos();
     y[COS] = c;
     y[SIN] = s;
@@ -169,22 +194,33 @@ impl Coupling {
     }
 }
 
-/// The right-hand side of the equation of motion and of the carried integrals.
+/// The right-hand side of the equation of motion and of the carried integrals; for a
+/// [`TANGENT`] state also of the variational equations δx'' + 2γδx' + δx = (∂f_ts/∂x)δx,
+/// ∂f_ts/∂x = −f_scale·a₁·dT̂/dα̂.
 #[inline]
-pub fn rhs<L: ForceLaw>(
+pub fn rhs<L: ForceLaw, const N: usize>(
     law: &L,
     osc: &Oscillator,
     cpl: &Coupling,
     branch: Branch,
     tau: f64,
-    y: &State,
-    dy: &mut State,
+    y: &State<N>,
+    dy: &mut State<N>,
 ) {
     let _ = tau;
     let (x, v) = (y[X], y[V]);
     let (s, c) = (y[SIN], y[COS]);
     let (drive, x_b) = osc.drive_from(c);
-    let f = -cpl.f_scale * law.t_hat(cpl.alpha_hat(x, x_b), branch);
+    let alpha = cpl.alpha_hat(x, x_b);
+    let f = -cpl.f_scale * law.t_hat(alpha, branch);
+    if N == TANGENT {
+        let stiffness = -cpl.f_scale * cpl.a1 * law.slope_hat(alpha, branch);
+        for col in [PHI, PHI + 2] {
+            let (dx, dv) = (y[col], y[col + 1]);
+            dy[col] = dv;
+            dy[col + 1] = -2.0 * osc.gamma * dv - dx + stiffness * dx;
+        }
+    }
     dy[X] = v;
     dy[V] = -2.0 * osc.gamma * v - x + f + drive;
     dy[E_DAMP] = 2.0 * osc.gamma * v * v;

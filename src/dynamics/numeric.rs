@@ -12,7 +12,7 @@
 //! square-root singularity in α̂ but is smooth in u, so this last stretch takes two or
 //! three smooth steps instead of a cascade of shrinking ones onto the cusp.
 
-use super::model::{COS, Coupling, Oscillator, SIN, State, V, X, rhs, set_phasor};
+use super::model::{BASE, COS, Coupling, Oscillator, SIN, State, V, X, rhs, set_phasor};
 use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw};
 use crate::numeric::bracketed_root;
@@ -42,19 +42,19 @@ pub enum Crossing {
 
 /// A sample of the trajectory at the end of an accepted step.
 #[derive(Debug, Clone, Copy)]
-pub struct StepEnd {
+pub struct StepEnd<const N: usize = BASE> {
     /// τ.
     pub tau: f64,
     /// State.
-    pub y: State,
+    pub y: State<N>,
     /// Its derivative.
-    pub dy: State,
+    pub dy: State<N>,
 }
 
 /// Per-step observer (trajectory recording and extrema).
 pub trait StepObserver {
     /// Called for each accepted step [from, to] of the branch `branch`.
-    fn step(&mut self, from: &StepEnd, to: &StepEnd, branch: Branch);
+    fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch);
     /// Called for each closed-form free flight from τ `from` to `to`.
     fn free_flight(&mut self, _flight: &super::free::FreeFlight, _from: f64, _to: f64) {}
 }
@@ -63,12 +63,12 @@ pub trait StepObserver {
 pub struct Ignore;
 
 impl StepObserver for Ignore {
-    fn step(&mut self, _: &StepEnd, _: &StepEnd, _: Branch) {}
+    fn step<const N: usize>(&mut self, _: &StepEnd<N>, _: &StepEnd<N>, _: Branch) {}
 }
 
 /// Cubic Hermite interpolation of component `i` on the step [a, b] at τ.
 #[inline]
-pub fn hermite(a: &StepEnd, b: &StepEnd, i: usize, tau: f64) -> f64 {
+pub fn hermite<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, i: usize, tau: f64) -> f64 {
     let h = b.tau - a.tau;
     let t = (tau - a.tau) / h;
     let (t2, t3) = (t * t, t * t * t);
@@ -79,19 +79,19 @@ pub fn hermite(a: &StepEnd, b: &StepEnd, i: usize, tau: f64) -> f64 {
 }
 
 /// What a segment learns while the solver owns it.
-struct Progress {
+struct Progress<const N: usize> {
     /// The last accepted step end.
-    last: StepEnd,
+    last: StepEnd<N>,
     /// The step in which the switch happened (its start and end) and the located time.
-    hit: Option<(StepEnd, StepEnd, f64)>,
+    hit: Option<(StepEnd<N>, StepEnd<N>, f64)>,
     /// Length of the first accepted step (0 until there is one).
     h: f64,
     /// The step end from which the switch is close enough to land on (Hénon), and the
     /// length of the step that ended there.
-    approach: Option<(StepEnd, f64)>,
+    approach: Option<(StepEnd<N>, f64)>,
 }
 
-struct Segment<'a, L: ForceLaw, O: StepObserver> {
+struct Segment<'a, L: ForceLaw, O: StepObserver, const N: usize> {
     law: &'a L,
     osc: &'a Oscillator,
     cpl: &'a Coupling,
@@ -102,10 +102,10 @@ struct Segment<'a, L: ForceLaw, O: StepObserver> {
     land: bool,
     /// End of the span.
     tau_end: f64,
-    progress: &'a mut Progress,
+    progress: &'a mut Progress<N>,
     observer: &'a mut O,
 }
-impl<L: ForceLaw, O: StepObserver> Segment<'_, L, O> {
+impl<L: ForceLaw, O: StepObserver, const N: usize> Segment<'_, L, O, N> {
     /// (gap, rate) at τ for deflection `x` and velocity `v` ([`approach_rate`]).
     #[inline]
     fn approach(&self, level: f64, crossing: Crossing, tau: f64, x: f64, v: f64) -> (f64, f64) {
@@ -114,7 +114,13 @@ impl<L: ForceLaw, O: StepObserver> Segment<'_, L, O> {
 
     /// The first time in the step where the gap to the switch closes, from 8 sub-samples
     /// of the Hermite interpolant and a bracketed refinement.
-    fn locate(&self, a: &StepEnd, b: &StepEnd, level: f64, crossing: Crossing) -> Option<f64> {
+    fn locate(
+        &self,
+        a: &StepEnd<N>,
+        b: &StepEnd<N>,
+        level: f64,
+        crossing: Crossing,
+    ) -> Option<f64> {
         let g = |tau: f64| {
             self.approach(level, crossing, tau, hermite(a, b, X, tau), 0.0)
                 .0
@@ -152,7 +158,7 @@ impl<L: ForceLaw, O: StepObserver> Segment<'_, L, O> {
     /// there was `h` long), the motion heads for it fast enough not to stall on the way
     /// (even decelerating at the present rate it keeps half its speed), and it is reached
     /// well before the span ends.
-    fn within_reach(&self, end: &StepEnd, h: f64, level: f64, crossing: Crossing) -> bool {
+    fn within_reach(&self, end: &StepEnd<N>, h: f64, level: f64, crossing: Crossing) -> bool {
         let (gap, rate) = self.approach(level, crossing, end.tau, end.y[X], end.y[V]);
         if !(gap > 0.0 && rate > 0.0) {
             return false;
@@ -191,13 +197,13 @@ fn approach_rate(
     (s * (level - cpl.alpha_hat(x, x_b)), s * cpl.a1 * (v + v_b))
 }
 
-impl<L: ForceLaw, O: StepObserver> System<f64, State> for Segment<'_, L, O> {
+impl<L: ForceLaw, O: StepObserver, const N: usize> System<f64, State<N>> for Segment<'_, L, O, N> {
     #[inline]
-    fn system(&self, tau: f64, y: &State, dy: &mut State) {
+    fn system(&self, tau: f64, y: &State<N>, dy: &mut State<N>) {
         rhs(self.law, self.osc, self.cpl, self.branch, tau, y, dy);
     }
 
-    fn solout(&mut self, tau: f64, y: &State, dy: &State) -> bool {
+    fn solout(&mut self, tau: f64, y: &State<N>, dy: &State<N>) -> bool {
         let end = StepEnd {
             tau,
             y: *y,
@@ -229,7 +235,7 @@ impl<L: ForceLaw, O: StepObserver> System<f64, State> for Segment<'_, L, O> {
 /// The last stretch to a switch in Hénon's variable w = u₀ − u, u = √(σ(level − α̂)),
 /// from w = 0 to w = u₀ (the switch). The state keeps its layout with τ in place of x
 /// (x follows from u): d/dw = (dτ/dw)·d/dτ, dτ/dw = 2u/(σ dα̂/dτ).
-struct Approach<'a, L: ForceLaw> {
+struct Approach<'a, L: ForceLaw, const N: usize> {
     law: &'a L,
     osc: &'a Oscillator,
     cpl: &'a Coupling,
@@ -239,27 +245,25 @@ struct Approach<'a, L: ForceLaw> {
     u0: f64,
     /// Smallest speed towards the switch accepted (below it the motion may stall).
     min_rate: f64,
-    landing: &'a mut Landing,
+    landing: &'a mut Landing<N>,
 }
 
 /// The accepted steps of a landing, kept until it is known to have succeeded.
-struct Landing {
-    steps: [StepEnd; Landing::MAX_STEPS],
+struct Landing<const N: usize> {
+    steps: [StepEnd<N>; MAX_LANDING_STEPS],
     len: usize,
     /// Set when the speed towards the switch fell below the accepted minimum, or the
     /// steps did not fit.
     failed: Cell<bool>,
 }
 
-impl Landing {
-    /// Steps a landing may take (it normally takes two or three).
-    const MAX_STEPS: usize = 16;
-}
+/// Steps a landing may take (it normally takes two or three).
+const MAX_LANDING_STEPS: usize = 16;
 
-impl<L: ForceLaw> Approach<'_, L> {
+impl<L: ForceLaw, const N: usize> Approach<'_, L, N> {
     /// The τ-form state (x in place of τ) at Hénon variable `w`, and τ.
     #[inline]
-    fn tau_form(&self, w: f64, y: &State) -> (f64, State) {
+    fn tau_form(&self, w: f64, y: &State<N>) -> (f64, State<N>) {
         let u = self.u0 - w;
         let alpha = self.level - self.sigma * u * u;
         let (x_b, _) = self.osc.base_from((y[SIN], y[COS]));
@@ -269,9 +273,9 @@ impl<L: ForceLaw> Approach<'_, L> {
     }
 }
 
-impl<L: ForceLaw> System<f64, State> for Approach<'_, L> {
+impl<L: ForceLaw, const N: usize> System<f64, State<N>> for Approach<'_, L, N> {
     #[inline]
-    fn system(&self, w: f64, y: &State, dy: &mut State) {
+    fn system(&self, w: f64, y: &State<N>, dy: &mut State<N>) {
         let (tau, z) = self.tau_form(w, y);
         rhs(self.law, self.osc, self.cpl, self.branch, tau, &z, dy);
         let (_, v_b) = self.osc.base_from((z[SIN], z[COS]));
@@ -285,12 +289,12 @@ impl<L: ForceLaw> System<f64, State> for Approach<'_, L> {
         dy[X] = dtau_dw;
     }
 
-    fn solout(&mut self, w: f64, y: &State, _dy: &State) -> bool {
+    fn solout(&mut self, w: f64, y: &State<N>, _dy: &State<N>) -> bool {
         let (tau, z) = self.tau_form(w, y);
-        let mut dz = State::zeros();
+        let mut dz = State::<N>::zeros();
         rhs(self.law, self.osc, self.cpl, self.branch, tau, &z, &mut dz);
         let landing = &mut *self.landing;
-        if landing.len == Landing::MAX_STEPS {
+        if landing.len == MAX_LANDING_STEPS {
             landing.failed.set(true);
             return true;
         }
@@ -304,17 +308,17 @@ impl<L: ForceLaw> System<f64, State> for Approach<'_, L> {
 /// to `observer`. `None` (and nothing observed) if the motion slowed too much on the way
 /// (it might not get there) or the switch lies beyond `tau_end`.
 #[allow(clippy::too_many_arguments)]
-fn land<L: ForceLaw, O: StepObserver>(
+fn land<L: ForceLaw, O: StepObserver, const N: usize>(
     law: &L,
     osc: &Oscillator,
     cpl: &Coupling,
     branch: Branch,
     (level, crossing): (f64, Crossing),
-    entry: StepEnd,
+    entry: StepEnd<N>,
     tau_end: f64,
     tol: &Tolerances,
     observer: &mut O,
-) -> Result<Option<StepEnd>> {
+) -> Result<Option<StepEnd<N>>> {
     let (gap, rate) = approach_rate(
         osc,
         cpl,
@@ -327,7 +331,7 @@ fn land<L: ForceLaw, O: StepObserver>(
     let mut y = entry.y;
     y[X] = entry.tau;
     let mut landing = Landing {
-        steps: [entry; Landing::MAX_STEPS],
+        steps: [entry; MAX_LANDING_STEPS],
         len: 0,
         failed: Cell::new(false),
     };
@@ -360,11 +364,11 @@ fn land<L: ForceLaw, O: StepObserver>(
 
 /// Where a numerical segment ended.
 #[derive(Debug, Clone, Copy)]
-pub struct SegmentEnd {
+pub struct SegmentEnd<const N: usize = BASE> {
     /// τ at the end.
     pub tau: f64,
     /// State at the end.
-    pub y: State,
+    pub y: State<N>,
     /// Whether it ended at a branch switch (else at `tau_end`).
     pub switched: bool,
     /// Length of the first accepted step (a good first step for the next segment on
@@ -372,14 +376,14 @@ pub struct SegmentEnd {
     pub h_first: f64,
 }
 
-fn dopri<S: System<f64, State>>(
+fn dopri<S: System<f64, State<N>>, const N: usize>(
     system: S,
     tau0: f64,
     tau1: f64,
-    y0: State,
+    y0: State<N>,
     h0: f64,
     tol: &Tolerances,
-) -> Dopri5<f64, State, S> {
+) -> Dopri5<f64, State<N>, S> {
     Dopri5::from_param(
         system,
         tau0,
@@ -409,19 +413,19 @@ fn too_short(from: f64, to: f64) -> bool {
 }
 
 /// The state on the step [a, b] at τ from its cubic Hermite interpolant.
-fn interpolate(a: &StepEnd, b: &StepEnd, tau: f64) -> State {
-    let mut y = State::zeros();
+fn interpolate<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, tau: f64) -> State<N> {
+    let mut y = State::<N>::zeros();
     for i in 0..y.len() {
         y[i] = hermite(a, b, i, tau);
     }
     y
 }
 
-fn run<S: System<f64, State>>(
+fn run<S: System<f64, State<N>>, const N: usize>(
     system: S,
     from: f64,
     to: f64,
-    y: State,
+    y: State<N>,
     h: f64,
     tol: &Tolerances,
     branch: Branch,
@@ -436,19 +440,19 @@ fn run<S: System<f64, State>>(
 /// crossing of `event` (level, direction) if given. `h0` is the first trial step (0 lets
 /// the solver choose).
 #[allow(clippy::too_many_arguments)]
-pub fn integrate<L: ForceLaw, O: StepObserver>(
+pub fn integrate<L: ForceLaw, O: StepObserver, const N: usize>(
     law: &L,
     osc: &Oscillator,
     cpl: &Coupling,
     branch: Branch,
     event: Option<(f64, Crossing)>,
     tau0: f64,
-    y0: State,
+    y0: State<N>,
     tau_end: f64,
     h0: f64,
     tol: &Tolerances,
     observer: &mut O,
-) -> Result<SegmentEnd> {
+) -> Result<SegmentEnd<N>> {
     let span = Span {
         law,
         osc,
@@ -475,14 +479,14 @@ struct Span<'a, L: ForceLaw> {
 impl<L: ForceLaw> Span<'_, L> {
     /// Integrate from (`tau0`, `y0`); `land`: whether to land on the switch ([`land`])
     /// once it is within reach, else locate its crossing.
-    fn integrate<O: StepObserver>(
+    fn integrate<O: StepObserver, const N: usize>(
         &self,
         tau0: f64,
-        y0: State,
+        y0: State<N>,
         h0: f64,
         land_on_switch: bool,
         observer: &mut O,
-    ) -> Result<SegmentEnd> {
+    ) -> Result<SegmentEnd<N>> {
         let Self {
             law,
             osc,
@@ -494,7 +498,7 @@ impl<L: ForceLaw> Span<'_, L> {
         } = *self;
         let mut y0 = y0;
         set_phasor(osc, tau0, &mut y0);
-        let mut dy0 = State::zeros();
+        let mut dy0 = State::<N>::zeros();
         rhs(law, osc, cpl, branch, tau0, &y0, &mut dy0);
         if too_short(tau0, tau_end) {
             // Nothing Dopri5 could step over: advance by one Euler step (error ~ (Δτ)²).
@@ -554,7 +558,7 @@ impl<L: ForceLaw> Span<'_, L> {
             });
         };
         let (tau, y) = self.polish(start, hit_end, t_hit)?;
-        let mut dy = State::zeros();
+        let mut dy = State::<N>::zeros();
         rhs(law, osc, cpl, branch, tau, &y, &mut dy);
         observer.step(&start, &StepEnd { tau, y, dy }, branch);
         Ok(SegmentEnd {
@@ -570,7 +574,12 @@ impl<L: ForceLaw> Span<'_, L> {
     /// switching time polished by Newton steps on the re-integrated state (the Hermite
     /// interpolant is only fourth-order accurate, and the force may be singular at the
     /// switch, as at the JKR fold C).
-    fn polish(&self, start: StepEnd, hit_end: StepEnd, t_hit: f64) -> Result<(f64, State)> {
+    fn polish<const N: usize>(
+        &self,
+        start: StepEnd<N>,
+        hit_end: StepEnd<N>,
+        t_hit: f64,
+    ) -> Result<(f64, State<N>)> {
         let (level, crossing) = self.event.expect("a hit implies an event");
         let mut t = t_hit;
         let mut y = start.y;
@@ -628,7 +637,7 @@ impl<L: ForceLaw> Span<'_, L> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::model::{Drive, E_DAMP, SC, SS};
+    use crate::dynamics::model::{BASE, Drive, E_DAMP, SC, SS};
 
     /// Free branch force-free; contact branch with a square-root fold at α̂ = LEVEL,
     /// continued past it by point reflection, like the JKR branch at C.
@@ -642,6 +651,12 @@ mod tests {
                     let d = LEVEL - alpha_hat;
                     1.0 - d.signum() * d.abs().sqrt()
                 }
+            }
+        }
+        fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            match branch {
+                Branch::Free => 0.0,
+                Branch::Contact => 0.5 / (LEVEL - alpha_hat).abs().sqrt().max(1e-8),
             }
         }
         fn work_hat(&self, _: f64, _: Branch) -> f64 {
@@ -691,7 +706,7 @@ mod tests {
             tau_end: 4.0,
             tol: &tol,
         };
-        let mut y = State::zeros();
+        let mut y = State::<BASE>::zeros();
         y[V] = v0;
         span.integrate(0.0, y, 0.0, land_on_switch, &mut Ignore)
             .expect("integrates")

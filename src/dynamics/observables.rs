@@ -4,14 +4,17 @@ use super::free::FreeFlight;
 use super::model::{Coupling, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver, hermite};
 use super::setup::{Numerics, Prepared, TapSetup};
-use super::steady::{CycleIntegrals, SteadyState};
+use super::steady::{CycleIntegrals, Motion, SteadyState};
 use crate::error::Result;
 use crate::law::{Branch, ForceLaw};
 use crate::params::ELECTRONVOLT_J;
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// What one steady tapping cycle shows (DESIGN.md §2).
+/// What the steady tapping motion shows, as an instrument reads it: for a period-n orbit
+/// the lock-in values (fundamental projected over the n periods) and every energy, force
+/// and time per drive period averaged over them, extremes over them; for irregular motion
+/// the same over the averaging window, with standard errors.
 #[derive(Debug, Clone, Serialize)]
 pub struct TapObservables {
     /// Tip–sample law.
@@ -26,7 +29,10 @@ pub struct TapObservables {
     /// resonance, above 90° attractive, below repulsive.
     pub phase_deg: f64,
     /// Phase from the energy relation π F₀ A sin φ = π k (ω/ω₀) A²/Q + E_ts, quadrant from
-    /// the virial, in degrees.
+    /// the virial, in degrees. Over a window of irregular motion the relation also counts
+    /// what the oscillator stored between the window's ends (its energy change and the
+    /// drive's end term); both vanish on a periodic orbit. It differs from the lock-in
+    /// phase by the damping of the higher harmonics, which the relation leaves out.
     pub phase_from_energy_deg: f64,
     /// Energy dissipated in the contact per cycle, ∮ T dα, in J.
     pub e_ts_j: f64,
@@ -53,8 +59,8 @@ pub struct TapObservables {
     pub max_indentation_m: f64,
     /// Fraction of the period spent in contact.
     pub contact_fraction: f64,
-    /// Jumps into contact during the cycle.
-    pub jumps_in: u32,
+    /// Jumps into contact per drive period (0.75: three periods in four touch).
+    pub jumps_in: f64,
     /// The law's own loop area (the loss of one full traversal) in J.
     pub loop_area_j: f64,
     /// The law's loop area, dimensionless (Ŵ).
@@ -63,14 +69,36 @@ pub struct TapObservables {
     pub frequency_ratio: f64,
     /// Cycles integrated in all.
     pub cycles: usize,
-    /// Whether the steady state was reached within the cycle cap.
+    /// Whether the reported values meet their tolerance (a periodic orbit closed to
+    /// `tolerance`, or irregular averages with standard errors below
+    /// `average_tolerance`).
     pub converged: bool,
+    /// "period-1", "period-2", … or "irregular".
+    pub regime: String,
+    /// n of a period-n orbit; null for irregular motion.
+    pub period: Option<usize>,
+    /// Drive periods the reported values are averaged over.
+    pub periods_averaged: u32,
+    /// Whether the periodic orbit is stable (every Floquet multiplier inside the unit
+    /// circle); null for irregular motion.
+    pub stable: Option<bool>,
+    /// Floquet multipliers of the periodic orbit, [re, im] each; empty for irregular
+    /// motion.
+    pub floquet_multipliers: Vec<[f64; 2]>,
+    /// Standard error of the amplitude in m (0 for a periodic orbit; null where the
+    /// window was too short to estimate it).
+    pub amplitude_std_err_m: Option<f64>,
+    /// Standard error of the lock-in phase in degrees (0 for a periodic orbit).
+    pub phase_std_err_deg: Option<f64>,
+    /// Standard error of E_ts per cycle in J (0 for a periodic orbit).
+    pub e_ts_std_err_j: Option<f64>,
 }
 
 impl TapObservables {
-    /// Observables of `state`'s reported cycle for the prepared experiment `p`.
+    /// Observables of `state` for the prepared experiment `p`.
     pub fn new(p: &Prepared, state: &SteadyState) -> Self {
-        let c: &CycleIntegrals = &state.cycle;
+        let c: &CycleIntegrals = &state.window;
+        let periods = f64::from(c.periods);
         let cant = &p.setup.cantilever;
         let contact = &p.setup.contact;
         let (k, a0) = (cant.stiffness_n_m, cant.free_amplitude_m);
@@ -81,8 +109,11 @@ impl TapObservables {
         let f0 = cant.drive_over_k_a0();
         let mean_f = c.f_int / c.period;
         let virial = c.virial_int / c.period;
-        // π F₀ A sin φ = π k Ω A²/Q + E_ts (units kA₀²).
-        let sin_phi = (omega * amp / q + c.e_ts / (PI * amp)) / f0;
+        // π F₀ A sin φ = π k Ω A²/Q + E_ts (units kA₀², per period), plus, per period of
+        // the window, the oscillator's energy change and the drive's end term
+        // E_drive − F₀Ω∫x sin Ωτ dτ (whole periods of a lock-in read the rest).
+        let stored = (c.delta_mechanical - (c.e_drive - f0 * omega * c.ss)) / periods;
+        let sin_phi = (omega * amp / q + (c.e_ts_per_period() + stored) / (PI * amp)) / f0;
         // ⟨(F_ts)(z − z̄)⟩ with k z̄ = ⟨F_ts⟩ fixes the sign of cos φ.
         let cos_phi = amp * (1.0 - omega * omega) - 2.0 * (virial - mean_f * mean_f) / amp;
         let asin = sin_phi.clamp(-1.0, 1.0).asin().to_degrees();
@@ -97,10 +128,10 @@ impl TapObservables {
             amplitude_ratio: amp,
             phase_deg: c.phase().to_degrees(),
             phase_from_energy_deg,
-            e_ts_j: c.e_ts * energy,
-            e_ts_ev: c.e_ts * energy / ELECTRONVOLT_J,
-            e_damp_j: c.e_damp * energy,
-            e_drive_j: c.e_drive * energy,
+            e_ts_j: c.e_ts_per_period() * energy,
+            e_ts_ev: c.e_ts_per_period() * energy / ELECTRONVOLT_J,
+            e_damp_j: c.e_damp / periods * energy,
+            e_drive_j: c.e_drive_per_period() * energy,
             energy_balance_rel: balance,
             virial_j: virial * energy,
             mean_force_n: mean_f * k * a0,
@@ -109,14 +140,32 @@ impl TapObservables {
             min_separation_m: min_sep,
             max_indentation_m: (-min_sep).max(0.0),
             contact_fraction: c.contact_time / c.period,
-            jumps_in: c.jumps_in,
+            jumps_in: f64::from(c.jumps_in) / periods,
             loop_area_j: p.law.loop_area_hat() * contact.energy_scale_j(),
             loop_area_hat: p.law.loop_area_hat(),
             frequency_ratio: omega,
             cycles: state.cycles,
             converged: state.converged,
+            regime: state.motion.regime(),
+            period: state.motion.period(),
+            periods_averaged: c.periods,
+            stable: state.motion.stable(),
+            floquet_multipliers: match state.motion {
+                Motion::Periodic { multipliers, .. } => {
+                    multipliers.iter().map(|m| [m.re, m.im]).collect()
+                }
+                Motion::Irregular => Vec::new(),
+            },
+            amplitude_std_err_m: known(state.std_err.amplitude * a0),
+            phase_std_err_deg: known(state.std_err.phase.to_degrees()),
+            e_ts_std_err_j: known(state.std_err.e_ts * energy),
         }
     }
+}
+
+/// `x` if it is finite (an error estimate that could be made), else `None`.
+fn known(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
 }
 
 /// One recorded point of the trajectory (SI).
@@ -152,7 +201,7 @@ const POINTS_PER_STEP: usize = 6;
 const FREE_SAMPLES_PER_PERIOD: f64 = 400.0;
 
 impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
-    fn step(&mut self, from: &StepEnd, to: &StepEnd, branch: Branch) {
+    fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch) {
         let start = if self.samples.is_empty() { 0 } else { 1 };
         for i in start..=POINTS_PER_STEP {
             let tau = from.tau + (to.tau - from.tau) * i as f64 / POINTS_PER_STEP as f64;
@@ -227,17 +276,18 @@ pub struct TapRun {
     pub switch_separations_m: (f64, f64),
 }
 
-/// Simulate `setup` to its steady state, then integrate `record_cycles` more cycles
-/// recording the trajectory; the observables are those of the last cycle integrated.
+/// Simulate `setup` from the free steady state (the cantilever oscillating freely, far
+/// from the sample, when the rest separation is set) to the steady state it settles on,
+/// then integrate `record_cycles` more cycles recording the trajectory (not counted in
+/// the observables, which are the steady state's).
 pub fn tap(setup: &TapSetup, numerics: &Numerics, record_cycles: usize) -> Result<TapRun> {
     let p = Prepared::new(setup, numerics)?;
     let sim = p.simulation();
     let mut phase = sim.free_steady_start();
-    let mut state = sim.steady_state(&mut phase, &p.steady)?;
+    let state = sim.steady_state(&mut phase, &p.steady)?;
     let mut recorder = Recorder::new(&p.law, p.cpl, p.osc);
     for _ in 0..record_cycles {
-        state.cycle = sim.cycle(&mut phase, &mut recorder)?;
-        state.cycles += 1;
+        sim.cycle(&mut phase, &mut recorder)?;
     }
     let scale = setup.contact.separation_scale_m();
     Ok(TapRun {

@@ -3,7 +3,7 @@
 
 use super::model::{Coupling, Drive, Oscillator};
 use super::numeric::Tolerances;
-use super::steady::{Simulation, SteadyOptions};
+use super::steady::{MIN_CYCLES, Simulation, SteadyOptions};
 use crate::error::{Error, Result, finite, positive};
 use crate::law::{AnyLaw, LawKind};
 use crate::params::{Contact, composite_modulus};
@@ -94,11 +94,16 @@ pub struct Numerics {
     pub atol: f64,
     /// Steps per drive period at most.
     pub min_steps_per_period: f64,
-    /// Per-cycle convergence tolerance of A, φ and E_ts.
+    /// Periodic orbits: the largest |Pⁿ(z) − z| accepted, in units of A₀ (Newton aims
+    /// 100× lower); time-marching: the return distance that counts as repeating.
     pub tolerance: f64,
+    /// Irregular motion: the standard error its averages must reach (A relative, φ in
+    /// rad, E_ts relative to E_drive).
+    pub average_tolerance: f64,
     /// Cycles at most.
     pub max_cycles: usize,
-    /// Find the periodic orbit by shooting before integrating the last cycles.
+    /// Look for periodic orbits by Newton's method on the period map (else only
+    /// integrate).
     pub shooting: bool,
 }
 
@@ -109,6 +114,7 @@ impl Default for Numerics {
             atol: 1e-11,
             min_steps_per_period: 40.0,
             tolerance: 1e-9,
+            average_tolerance: 1e-3,
             max_cycles: 20_000,
             shooting: true,
         }
@@ -122,11 +128,13 @@ impl Numerics {
         positive("atol", self.atol)?;
         positive("steps per period", self.min_steps_per_period)?;
         positive("convergence tolerance", self.tolerance)?;
-        if self.max_cycles == 0 {
+        positive("average tolerance", self.average_tolerance)?;
+        if self.max_cycles < MIN_CYCLES {
             return Err(Error::InvalidParameter {
                 name: "max cycles",
-                value: 0.0,
-                reason: "must be at least 1",
+                value: self.max_cycles as f64,
+                reason: "must be at least 32: classifying the steady state and averaging \
+                         irregular motion need that many periods",
             });
         }
         Ok(self)
@@ -183,8 +191,7 @@ impl Prepared {
         };
         let steady = SteadyOptions {
             tolerance: numerics.tolerance,
-            streak: 3,
-            min_cycles: 3,
+            average_tolerance: numerics.average_tolerance,
             max_cycles: numerics.max_cycles,
             shooting: numerics.shooting,
         };

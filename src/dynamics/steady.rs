@@ -1,16 +1,28 @@
-//! Cycle-by-cycle integration to the steady state.
+//! Cycle-by-cycle integration to the steady state, its classification and what an
+//! instrument reads from it.
 //!
 //! Each drive period is integrated as a chain of segments, one per branch: closed-form
 //! free flight where the law is force-free out of contact (and the oscillator is
 //! force-driven and underdamped), Dopri5 otherwise; every branch switch is located and the
 //! next segment restarts from the located state. The carried integrals give the energies,
 //! Fourier projections, mean force and virial of each cycle.
+//!
+//! The steady state is found on the period map P (the state at the same drive phase one
+//! period later). Its exact derivative comes from the variational equations integrated
+//! with the motion and a saltation matrix at every branch switch, so Newton's method on
+//! Pⁿ(z) − z converges quadratically to a period-n orbit, and the orbit's Floquet
+//! multipliers (the eigenvalues of the monodromy matrix) say whether it is stable. Motion
+//! that settles on no orbit of period ≤ [`MAX_PERIOD`] is `irregular` and averaged over a
+//! window that grows until its batch means agree.
 
 use super::free::FreeFlight;
-use super::model::{Coupling, E_DAMP, F_INT, Oscillator, SC, SS, State, V, VIRIAL, X};
+use super::model::{
+    BASE, Coupling, E_DAMP, F_INT, Oscillator, SC, SS, State, TANGENT, V, VIRIAL, X, phi, set_phi,
+};
 use super::numeric::{self, Crossing, StepEnd, StepObserver, Tolerances, hermite};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw};
+use nalgebra::{Complex, Matrix2, Vector2};
 
 /// Where the oscillator is: time, deflection, velocity and contact branch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,12 +51,20 @@ impl Phase {
             h_next: [0.0; 2],
         }
     }
+
+    /// (x, x') as a vector.
+    fn z(&self) -> Vector2<f64> {
+        Vector2::new(self.x, self.v)
+    }
 }
 
-/// The integrals and extremes of one drive period (dimensionless).
+/// The integrals and extremes of a whole number of drive periods (dimensionless): one
+/// period from [`Simulation::cycle`], or the window a steady state is averaged over.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CycleIntegrals {
-    /// Drive period in τ.
+    /// Drive periods covered.
+    pub periods: u32,
+    /// Length of the span in τ (`periods` drive periods).
     pub period: f64,
     /// Energy dissipated in the contact, ∮ −f_ts dα, summed from the branch work functions
     /// between the located switches (exact for the computed path).
@@ -53,15 +73,15 @@ pub struct CycleIntegrals {
     pub e_damp: f64,
     /// Energy put in by the drive ([`Oscillator::drive_work`]).
     pub e_drive: f64,
-    /// Change of the oscillator's energy ½(x² + x'²) over the period.
+    /// Change of the oscillator's energy ½(x² + x'²) over the span.
     pub delta_mechanical: f64,
-    /// ∮ x cos Ωτ dτ.
+    /// ∫ x cos Ωτ dτ.
     pub sc: f64,
-    /// ∮ x sin Ωτ dτ.
+    /// ∫ x sin Ωτ dτ.
     pub ss: f64,
-    /// ∮ f_ts dτ.
+    /// ∫ f_ts dτ.
     pub f_int: f64,
-    /// ∮ f_ts x dτ.
+    /// ∫ f_ts x dτ.
     pub virial_int: f64,
     /// Time spent on the contact branch.
     pub contact_time: f64,
@@ -78,20 +98,53 @@ pub struct CycleIntegrals {
 }
 
 impl CycleIntegrals {
-    /// Amplitude of the fundamental (units of L).
+    /// Amplitude of the fundamental over the span (units of L): what a lock-in reads.
     pub fn amplitude(&self) -> f64 {
         2.0 / self.period * self.sc.hypot(self.ss)
     }
 
-    /// Phase lag φ of the fundamental, z ≈ A cos(ωt − φ), in radians.
+    /// Phase lag φ of the fundamental over the span, z ≈ A cos(ωt − φ), in radians.
     pub fn phase(&self) -> f64 {
         self.ss.atan2(self.sc)
+    }
+
+    /// Energy dissipated in the contact per drive period.
+    pub fn e_ts_per_period(&self) -> f64 {
+        self.e_ts / f64::from(self.periods)
+    }
+
+    /// Energy put in by the drive per drive period.
+    pub fn e_drive_per_period(&self) -> f64 {
+        self.e_drive / f64::from(self.periods)
+    }
+
+    /// The integrals of this span followed by `next` (sums; extremes over both).
+    pub fn then(&self, next: &CycleIntegrals) -> CycleIntegrals {
+        CycleIntegrals {
+            periods: self.periods + next.periods,
+            period: self.period + next.period,
+            e_ts: self.e_ts + next.e_ts,
+            e_damp: self.e_damp + next.e_damp,
+            e_drive: self.e_drive + next.e_drive,
+            delta_mechanical: self.delta_mechanical + next.delta_mechanical,
+            sc: self.sc + next.sc,
+            ss: self.ss + next.ss,
+            f_int: self.f_int + next.f_int,
+            virial_int: self.virial_int + next.virial_int,
+            contact_time: self.contact_time + next.contact_time,
+            min_alpha_hat: self.min_alpha_hat.min(next.min_alpha_hat),
+            max_force: self.max_force.max(next.max_force),
+            min_force: self.min_force.min(next.min_force),
+            jumps_in: self.jumps_in + next.jumps_in,
+            jumps_out: self.jumps_out + next.jumps_out,
+        }
     }
 }
 
 /// Tracks extremes of the separation and force over accepted steps, then passes each
 /// step on.
-struct Tracker<'a, O: StepObserver> {
+struct Tracker<'a, L: ForceLaw, O: StepObserver> {
+    law: &'a L,
     osc: &'a Oscillator,
     cpl: &'a Coupling,
     inner: &'a mut O,
@@ -100,20 +153,26 @@ struct Tracker<'a, O: StepObserver> {
     min_f: f64,
 }
 
-impl<O: StepObserver> StepObserver for Tracker<'_, O> {
-    fn step(&mut self, a: &StepEnd, b: &StepEnd, branch: Branch) {
+impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
+    fn step<const N: usize>(&mut self, a: &StepEnd<N>, b: &StepEnd<N>, branch: Branch) {
         let alpha = |tau: f64, x: f64| self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
         let mut lowest = alpha(b.tau, b.y[X]);
         // A turning point inside the step: the minimum of the Hermite cubic, where its
         // derivative (a quadratic in the step fraction) vanishes.
+        // The force there is an extreme too when the law is monotonic on the branch, as
+        // every contact branch is: sampling step ends alone would miss the peak.
+        self.max_f = self.max_f.max(b.dy[F_INT]);
+        self.min_f = self.min_f.min(b.dy[F_INT]);
         if a.y[V] < 0.0 && b.y[V] > 0.0 {
             let t = hermite_minimum(a, b);
             let tau = a.tau + t * (b.tau - a.tau);
-            lowest = lowest.min(alpha(tau, hermite(a, b, X, tau)));
+            let turn = alpha(tau, hermite(a, b, X, tau));
+            lowest = lowest.min(turn);
+            let f = -self.cpl.f_scale * self.law.t_hat(turn, branch);
+            self.max_f = self.max_f.max(f);
+            self.min_f = self.min_f.min(f);
         }
         self.min_alpha = self.min_alpha.min(lowest);
-        self.max_f = self.max_f.max(b.dy[F_INT]);
-        self.min_f = self.min_f.min(b.dy[F_INT]);
         self.inner.step(a, b, branch);
     }
 
@@ -126,7 +185,7 @@ impl<O: StepObserver> StepObserver for Tracker<'_, O> {
 
 /// Step fraction in [0, 1] of the minimum of the deflection's Hermite cubic on a step
 /// where the velocity goes from negative to positive.
-fn hermite_minimum(a: &StepEnd, b: &StepEnd) -> f64 {
+fn hermite_minimum<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>) -> f64 {
     let h = b.tau - a.tau;
     let (p0, p1, m0, m1) = (a.y[X], b.y[X], h * a.y[V], h * b.y[V]);
     // The cubic is p0 + m0 t + c2 t² + c3 t³; its derivative 3c3 t² + 2c2 t + m0.
@@ -161,6 +220,72 @@ pub struct Simulation<'a, L: ForceLaw> {
     pub tol: Tolerances,
 }
 
+/// The longest period looked for; motion that repeats after no n ≤ this is `irregular`.
+pub const MAX_PERIOD: usize = 8;
+
+/// How the steady motion repeats.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Motion {
+    /// The state at the drive phase returns after `period` drive periods (and after no
+    /// fewer).
+    Periodic {
+        /// n.
+        period: usize,
+        /// Eigenvalues of the orbit's monodromy matrix (the derivative of the n-period
+        /// map).
+        multipliers: [Complex<f64>; 2],
+    },
+    /// Quasi-periodic, chaotic or intermittent motion, or a period above [`MAX_PERIOD`].
+    Irregular,
+}
+
+impl Motion {
+    /// "period-n" or "irregular".
+    pub fn regime(&self) -> String {
+        match self {
+            Motion::Periodic { period, .. } => format!("period-{period}"),
+            Motion::Irregular => "irregular".into(),
+        }
+    }
+
+    /// n for a periodic orbit.
+    pub fn period(&self) -> Option<usize> {
+        match self {
+            Motion::Periodic { period, .. } => Some(*period),
+            Motion::Irregular => None,
+        }
+    }
+
+    /// Whether a periodic orbit is stable (every multiplier inside the unit circle).
+    pub fn stable(&self) -> Option<bool> {
+        match self {
+            Motion::Periodic { multipliers, .. } => {
+                Some(multipliers.iter().all(|m| m.norm() < 1.0))
+            }
+            Motion::Irregular => None,
+        }
+    }
+}
+
+/// Standard errors of window averages (batch means); zero for a periodic orbit.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StdErr {
+    /// Of the amplitude (units of L).
+    pub amplitude: f64,
+    /// Of the phase (rad).
+    pub phase: f64,
+    /// Of E_ts per drive period (units of kL²).
+    pub e_ts: f64,
+}
+
+/// A periodic orbit found by Newton's method.
+struct Orbit {
+    /// The state on the orbit at the section.
+    phase: Phase,
+    /// |Pⁿ(z) − z|∞ there.
+    residual: f64,
+}
+
 impl<L: ForceLaw> Simulation<'_, L> {
     /// The branch a state at rest separation α̂ starts on: in contact if the tip is already
     /// below the jump-in separation.
@@ -193,6 +318,41 @@ impl<L: ForceLaw> Simulation<'_, L> {
         phase: &mut Phase,
         observer: &mut O,
     ) -> Result<CycleIntegrals> {
+        Ok(self.cycle_in::<BASE, O>(phase, observer)?.0)
+    }
+
+    /// Integrate one drive period from `phase`, updating it, with the derivative of the
+    /// period map, ∂(x, x')(τ + T)/∂(x, x')(τ): the variational equations along every
+    /// segment, the free flight's transition matrix in closed form, and at every branch
+    /// switch the saltation matrix [[1, 0], [Δf_ts/(dα̂/dτ / a₁), 1]] (the force jumps by
+    /// Δf_ts where α̂ crosses the switching level).
+    pub fn cycle_with_derivative(
+        &self,
+        phase: &mut Phase,
+    ) -> Result<(CycleIntegrals, Matrix2<f64>)> {
+        self.cycle_in::<TANGENT, _>(phase, &mut numeric::Ignore)
+    }
+
+    /// Apply the saltation matrix of a switch `from` → `to` in state `y` at τ.
+    fn saltation<const N: usize>(&self, tau: f64, y: &mut State<N>, from: Branch, to: Branch) {
+        if N != TANGENT {
+            return;
+        }
+        let (x_b, v_b) = self.osc.base_at(tau);
+        let alpha = self.cpl.alpha_hat(y[X], x_b);
+        let jump = -self.cpl.f_scale * (self.law.t_hat(alpha, to) - self.law.t_hat(alpha, from));
+        if jump == 0.0 {
+            return;
+        }
+        let s = Matrix2::new(1.0, 0.0, jump / (y[V] + v_b), 1.0);
+        set_phi(y, &(s * phi(y)));
+    }
+
+    fn cycle_in<const N: usize, O: StepObserver>(
+        &self,
+        phase: &mut Phase,
+        observer: &mut O,
+    ) -> Result<(CycleIntegrals, Matrix2<f64>)> {
         let period = self.osc.period();
         let tau_end = phase.tau + period;
         // A state carried over from another setpoint may sit on the wrong side of a
@@ -203,13 +363,17 @@ impl<L: ForceLaw> Simulation<'_, L> {
             Branch::Contact if alpha >= self.law.jump_out_alpha_hat() => Branch::Free,
             b => b,
         };
-        let mut y = State::zeros();
+        let mut y = State::<N>::zeros();
         y[X] = phase.x;
         y[V] = phase.v;
-        let mechanical = |y: &State| 0.5 * (y[X] * y[X] + y[V] * y[V]);
+        if N == TANGENT {
+            set_phi(&mut y, &Matrix2::identity());
+        }
+        let mechanical = |y: &State<N>| 0.5 * (y[X] * y[X] + y[V] * y[V]);
         let e0 = mechanical(&y);
         let start = (phase.tau, phase.x, phase.v);
         let mut tracker = Tracker {
+            law: self.law,
             osc: &self.osc,
             cpl: &self.cpl,
             inner: observer,
@@ -237,6 +401,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 tracker.min_alpha = tracker.min_alpha.min(self.cpl.alpha_hat(min_x, 0.0));
                 tau = stop;
                 if hit.is_some() {
+                    self.saltation(tau, &mut y, Branch::Free, Branch::Contact);
                     phase.branch = Branch::Contact;
                     jumps_in += 1;
                 }
@@ -247,7 +412,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 Branch::Contact => (self.law.jump_out_alpha_hat(), Crossing::Up),
             };
             let event = level.is_finite().then_some((level, crossing));
-            let alpha_at = |tau: f64, y: &State| self.cpl.alpha_hat(y[X], self.osc.base_at(tau).0);
+            let alpha_at =
+                |tau: f64, y: &State<N>| self.cpl.alpha_hat(y[X], self.osc.base_at(tau).0);
             let work_start = self.law.work_hat(alpha_at(tau, &y), phase.branch);
             let end = numeric::integrate(
                 self.law,
@@ -273,7 +439,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             tau = end.tau;
             y = end.y;
             if end.switched {
-                phase.branch = match phase.branch {
+                let next = match phase.branch {
                     Branch::Free => {
                         jumps_in += 1;
                         Branch::Contact
@@ -283,12 +449,15 @@ impl<L: ForceLaw> Simulation<'_, L> {
                         Branch::Free
                     }
                 };
+                self.saltation(tau, &mut y, phase.branch, next);
+                phase.branch = next;
             }
         }
         phase.tau = tau_end;
         phase.x = y[X];
         phase.v = y[V];
-        Ok(CycleIntegrals {
+        let integrals = CycleIntegrals {
+            periods: 1,
             period,
             e_ts,
             e_damp: y[E_DAMP],
@@ -304,150 +473,528 @@ impl<L: ForceLaw> Simulation<'_, L> {
             min_force: tracker.min_f,
             jumps_in,
             jumps_out,
-        })
-    }
-
-    /// Look for the period-one orbit by shooting: Newton's method on the one-period map
-    /// P(x, x') − (x, x') = 0, its Jacobian by finite differences (two more periods per
-    /// iteration). On success `phase` is moved onto the orbit; the periods spent are
-    /// returned either way (0 work is wasted beyond them: a failure leaves `phase` as it
-    /// was). Fails — and the caller integrates the transient — where the map changes its
-    /// switching pattern under the perturbation, or the orbit is not period-one.
-    fn shoot(&self, phase: &mut Phase) -> Result<(bool, usize)> {
-        let start = *phase;
-        let mut periods = 0;
-        let mut z = (phase.x, phase.v);
-        let map = |z: (f64, f64), periods: &mut usize| -> Result<Option<(f64, f64)>> {
-            let mut p = Phase {
-                x: z.0,
-                v: z.1,
-                ..start
-            };
-            self.cycle(&mut p, &mut numeric::Ignore)?;
-            *periods += 1;
-            // The orbit must return on the branch it left.
-            Ok((p.branch == start.branch).then_some((p.x - z.0, p.v - z.1)))
         };
-        for _ in 0..12 {
-            let Some(f) = map(z, &mut periods)? else {
-                return Ok((false, periods));
-            };
-            let size = f.0.abs().max(f.1.abs());
-            if size < 1e-11 {
-                *phase = Phase {
-                    x: z.0,
-                    v: z.1,
-                    ..start
-                };
-                return Ok((true, periods));
-            }
-            let h = 1e-7;
-            let (Some(fx), Some(fv)) = (
-                map((z.0 + h, z.1), &mut periods)?,
-                map((z.0, z.1 + h), &mut periods)?,
-            ) else {
-                return Ok((false, periods));
-            };
-            // J = [[∂f0/∂x, ∂f0/∂v], [∂f1/∂x, ∂f1/∂v]].
-            let (a, b, c, d) = (
-                (fx.0 - f.0) / h,
-                (fv.0 - f.0) / h,
-                (fx.1 - f.1) / h,
-                (fv.1 - f.1) / h,
-            );
-            let det = a * d - b * c;
-            if !det.is_finite() || det.abs() < 1e-300 {
-                return Ok((false, periods));
-            }
-            let step = ((d * f.0 - b * f.1) / det, (a * f.1 - c * f.0) / det);
-            // Far from the orbit full Newton steps overshoot (the map is only weakly
-            // contracting): limit them; the caller integrates closer if this fails.
-            let scale = (0.2 / step.0.abs().max(step.1.abs())).min(1.0);
-            z = (z.0 - scale * step.0, z.1 - scale * step.1);
-        }
-        Ok((false, periods))
+        let derivative = if N == TANGENT {
+            phi(&y)
+        } else {
+            Matrix2::identity()
+        };
+        Ok((integrals, derivative))
     }
 
-    /// Integrate cycles until the amplitude, phase and contact dissipation change by less
-    /// than `opts.tolerance` (relative; the energy relative to the drive input) over
-    /// `opts.streak` consecutive cycles, or until `opts.max_cycles`. Reports the last cycle.
-    /// When `opts.shooting` is set, the periodic orbit is first looked for by shooting
-    /// (a few dozen periods instead of ~Q ln(1/tolerance)/π); the cycles integrated
-    /// afterwards still have to pass the convergence test.
-    pub fn steady_state(&self, phase: &mut Phase, opts: &SteadyOptions) -> Result<SteadyState> {
-        let mut last: Option<CycleIntegrals> = None;
-        let mut streak = 0;
-        let mut cycles = 0;
-        if opts.shooting {
-            // A first period puts the state on a consistent branch; where shooting fails,
-            // a stretch of transient brings the state closer before the next attempt.
-            self.cycle(phase, &mut numeric::Ignore)?;
-            cycles += 1;
-            for _ in 0..4 {
-                let (found, spent) = self.shoot(phase)?;
-                cycles += spent;
-                if found || cycles >= opts.max_cycles {
-                    break;
-                }
-                for _ in 0..SHOOTING_RETRY_PERIODS {
-                    self.cycle(phase, &mut numeric::Ignore)?;
-                }
-                cycles += SHOOTING_RETRY_PERIODS;
+    /// The n-period map from `start` moved to `z`: the state n periods later and the
+    /// map's derivative there; `None` if the motion does not return on the branch it
+    /// left, or if the variational equations cannot be integrated there (a tip that
+    /// stalls at a fold of the force law, where the map is not smooth). Counts the
+    /// periods in `spent`.
+    fn period_map(
+        &self,
+        start: &Phase,
+        z: Vector2<f64>,
+        n: usize,
+        spent: &mut usize,
+    ) -> Result<Option<(Phase, Matrix2<f64>)>> {
+        let mut p = Phase {
+            x: z[0],
+            v: z[1],
+            ..*start
+        };
+        let mut m = Matrix2::identity();
+        for _ in 0..n {
+            *spent += 1;
+            match self.cycle_with_derivative(&mut p) {
+                Ok((_, d)) => m = d * m,
+                Err(Error::Numerical(_)) => return Ok(None),
+                Err(e) => return Err(e),
             }
         }
-        while cycles < opts.max_cycles.max(1) {
-            let c = self.cycle(phase, &mut numeric::Ignore)?;
-            cycles += 1;
-            if let Some(p) = last {
-                let da = (c.amplitude() - p.amplitude()).abs() / c.amplitude().max(1e-300);
-                let dphi = (c.phase() - p.phase()).abs();
-                let de = (c.e_ts - p.e_ts).abs() / c.e_drive.abs().max(1e-300);
-                if da < opts.tolerance && dphi < opts.tolerance && de < opts.tolerance {
-                    streak += 1;
-                } else {
-                    streak = 0;
-                }
-            }
-            last = Some(c);
-            if streak >= opts.streak && cycles >= opts.min_cycles {
+        Ok((p.branch == start.branch && p.x.is_finite() && p.v.is_finite()).then_some((p, m)))
+    }
+
+    /// Newton's method on Pⁿ(z) − z = 0 from `start`, with the exact derivative of the
+    /// map. Each step is limited to a trust radius (largest change of x or x', in units
+    /// of L) that grows after a step that reduces the residual as the linear model
+    /// promises (at least a tenth of the promised reduction) and shrinks fourfold after
+    /// one that does not. There is no cap on the number of steps, however many a slowly
+    /// contracting (high-Q) orbit needs; it ends when the residual is below `target`,
+    /// when a full step no longer reduces a residual already below `floor` (the
+    /// integrator's noise), after [`MAX_REJECTIONS`] rejected steps in a row or
+    /// [`STALL_STEPS`] accepted ones that do not halve the residual (the map is not
+    /// smooth there: a grazing contact), or when `budget` periods are spent.
+    fn newton(
+        &self,
+        start: &Phase,
+        n: usize,
+        (target, floor): (f64, f64),
+        budget: usize,
+        spent: &mut usize,
+    ) -> Result<Option<Orbit>> {
+        let mut z = start.z();
+        let Some((mut end, mut m)) = self.period_map(start, z, n, spent)? else {
+            return Ok(None);
+        };
+        let mut r = end.z() - z;
+        let mut norm = r.amax();
+        let mut radius: f64 = 0.2;
+        let mut rejected = 0;
+        // The residual at the last halving and the accepted steps since.
+        let (mut checkpoint, mut since) = (norm, 0);
+        loop {
+            if norm <= target {
                 break;
             }
+            if *spent + n > budget {
+                return Ok(None);
+            }
+            let Some(inverse) = (m - Matrix2::identity()).try_inverse() else {
+                return Ok(None);
+            };
+            let step = -(inverse * r);
+            let length = step.amax();
+            if !length.is_finite() {
+                return Ok(None);
+            }
+            let scale = (radius / length).min(1.0);
+            let trial = z + step * scale;
+            match self.period_map(start, trial, n, spent)? {
+                Some((e, d)) if (e.z() - trial).amax() <= (1.0 - 0.1 * scale) * norm => {
+                    z = trial;
+                    end = e;
+                    m = d;
+                    r = end.z() - z;
+                    norm = r.amax();
+                    radius = radius.max(2.0 * scale * length);
+                    rejected = 0;
+                    since += 1;
+                    if norm <= 0.5 * checkpoint {
+                        (checkpoint, since) = (norm, 0);
+                    } else if since == STALL_STEPS {
+                        return Ok(None);
+                    }
+                }
+                _ if scale == 1.0 && norm <= floor => break,
+                _ => {
+                    radius = 0.25 * scale * length;
+                    rejected += 1;
+                    if rejected == MAX_REJECTIONS {
+                        return Ok(None);
+                    }
+                }
+            }
         }
-        Ok(SteadyState {
-            cycle: last.expect("at least one cycle"),
-            cycles,
-            converged: streak >= opts.streak,
-        })
+        Ok(Some(Orbit {
+            phase: Phase {
+                x: z[0],
+                v: z[1],
+                ..end
+            },
+            residual: norm,
+        }))
+    }
+
+    /// Integrate `n` periods from a point of an orbit: the summed integrals, the
+    /// monodromy matrix, and the distance of the state after each m < n periods from the
+    /// start (for the smallest period).
+    fn orbit_pass(
+        &self,
+        phase: &mut Phase,
+        n: usize,
+    ) -> Result<(CycleIntegrals, Matrix2<f64>, [f64; MAX_PERIOD])> {
+        let z0 = phase.z();
+        let mut m = Matrix2::identity();
+        let mut returns = [f64::INFINITY; MAX_PERIOD];
+        let mut sum: Option<CycleIntegrals> = None;
+        for distance in returns.iter_mut().take(n) {
+            let (c, d) = self.cycle_with_derivative(phase)?;
+            m = d * m;
+            sum = Some(sum.map_or(c, |s| s.then(&c)));
+            *distance = (phase.z() - z0).amax();
+        }
+        Ok((sum.expect("n >= 1"), m, returns))
+    }
+
+    /// Look for a stable period-n orbit near `phase` by Newton's method. On success
+    /// `phase` is moved onto it and the steady state over one pass of the orbit returned;
+    /// otherwise `phase` is left as it was. An orbit that is unstable, or whose least
+    /// period is below n, is not taken (it is not what the motion settles on).
+    fn try_period(
+        &self,
+        phase: &mut Phase,
+        n: usize,
+        opts: &SteadyOptions,
+        budget: usize,
+        spent: &mut usize,
+    ) -> Result<Option<SteadyState>> {
+        let target = (1e-2 * opts.tolerance).max(1e-13);
+        let Some(orbit) = self.newton(phase, n, (target, opts.tolerance), budget, spent)? else {
+            return Ok(None);
+        };
+        if *spent + 2 * n > budget {
+            return Ok(None);
+        }
+        let mut on = orbit.phase;
+        let Some(state) = self.settle(&mut on, n, orbit.residual, spent)? else {
+            return Ok(None);
+        };
+        if state.motion.stable() != Some(true) {
+            return Ok(None);
+        }
+        *phase = on;
+        Ok(Some(SteadyState {
+            converged: orbit.residual <= opts.tolerance,
+            ..state
+        }))
+    }
+
+    /// The steady state on the orbit through `phase` that returns after n periods within
+    /// `residual`: one pass of it (its least period m, a divisor of n to which the state
+    /// returns within 10³ residuals), with its monodromy matrix. `None` if the
+    /// variational equations cannot be integrated along it (see `period_map`).
+    fn settle(
+        &self,
+        phase: &mut Phase,
+        n: usize,
+        residual: f64,
+        spent: &mut usize,
+    ) -> Result<Option<SteadyState>> {
+        let start = *phase;
+        let mut pass = |n: usize, spent: &mut usize| {
+            *phase = start;
+            *spent += n;
+            match self.orbit_pass(phase, n) {
+                Ok(pass) => Ok(Some(pass)),
+                Err(Error::Numerical(_)) => Ok(None),
+                Err(e) => Err(e),
+            }
+        };
+        let Some((mut window, mut monodromy, returns)) = pass(n, spent)? else {
+            return Ok(None);
+        };
+        let least = (1..=n)
+            .find(|&m| n % m == 0 && (m == n || returns[m - 1] <= 1e3 * residual.max(1e-12)))
+            .unwrap_or(n);
+        if least < n {
+            let Some((w, m, _)) = pass(least, spent)? else {
+                return Ok(None);
+            };
+            (window, monodromy) = (w, m);
+        }
+        Ok(Some(SteadyState {
+            window,
+            cycles: *spent,
+            converged: true,
+            motion: Motion::Periodic {
+                period: least,
+                multipliers: eigenvalues(&monodromy),
+            },
+            std_err: StdErr::default(),
+        }))
+    }
+
+    /// The steady state reached from `phase` (which is left on it): the attractor the
+    /// motion settles on, classified as period-n (n ≤ [`MAX_PERIOD`]) or irregular, with
+    /// what an instrument reads from it — averages over one pass of a periodic orbit, or
+    /// over a window of irregular motion that grows until its batch means agree within
+    /// `opts.average_tolerance` (standard errors reported).
+    ///
+    /// With `opts.shooting` (the default) the period-1 orbit is first looked for by
+    /// Newton's method from `phase`; if that fails, or the orbit found is unstable, the
+    /// motion is integrated in growing stretches and, after each, orbits of the periods
+    /// the last states nearly repeat with are looked for the same way. Without it, the
+    /// motion is only integrated, until the state at the drive phase repeats after n
+    /// periods closely enough three times running to lie within `opts.tolerance` of the
+    /// orbit. Either way at most
+    /// `opts.max_cycles` periods are integrated; `converged` says whether the reported
+    /// averages meet their tolerance.
+    pub fn steady_state(&self, phase: &mut Phase, opts: &SteadyOptions) -> Result<SteadyState> {
+        let budget = opts.max_cycles.max(MIN_CYCLES);
+        // The search for an orbit gets at most half the budget (seven eighths without
+        // shooting); the rest is left for averaging.
+        let search_budget = if opts.shooting {
+            (budget / 2).min(1 + SEARCH_PERIODS)
+        } else {
+            budget - budget / 8
+        };
+        // A first period puts the state on a consistent branch.
+        self.cycle(phase, &mut numeric::Ignore)?;
+        let mut spent = 1;
+        if opts.shooting {
+            if let Some(found) = self.try_period(phase, 1, opts, search_budget, &mut spent)? {
+                return Ok(found);
+            }
+        }
+        let mut ring = Recurrence::default();
+        ring.push(phase);
+        let mut stretch = FIRST_STRETCH;
+        while spent < search_budget {
+            for _ in 0..stretch.min(search_budget - spent) {
+                self.cycle(phase, &mut numeric::Ignore)?;
+                spent += 1;
+                ring.push(phase);
+                if !opts.shooting {
+                    // A state contracting onto the orbit by a factor ρ per n periods
+                    // is |Δz|·ρ/(1 − ρ) from it; ρ is at most the free oscillator's
+                    // e^{−γnT}, so this return distance puts it within `tolerance`.
+                    let within = |n: usize| {
+                        let rho = (-self.osc.gamma * self.osc.period() * n as f64).exp();
+                        opts.tolerance * (1.0 - rho) / rho
+                    };
+                    if let Some(n) = ring.repeats(within) {
+                        let gap = ring.gap(0, n).unwrap_or(0.0);
+                        let mut on = *phase;
+                        // (`None`: the orbit grazes a fold, see `period_map`: march on.)
+                        if let Some(state) = self.settle(&mut on, n, gap, &mut spent)? {
+                            *phase = on;
+                            return Ok(state);
+                        }
+                    }
+                }
+            }
+            if opts.shooting {
+                for n in ring.candidates() {
+                    if spent >= search_budget {
+                        break;
+                    }
+                    if let Some(found) =
+                        self.try_period(phase, n, opts, search_budget, &mut spent)?
+                    {
+                        return Ok(found);
+                    }
+                }
+            }
+            stretch *= 2;
+        }
+        self.average(phase, opts, budget, spent)
+    }
+
+    /// Average irregular motion over a window of 16 batches whose length doubles (by
+    /// merging pairs and integrating as many again) until the standard errors of the
+    /// batch means of A (relative), φ (rad) and E_ts (relative to E_drive) are below
+    /// `opts.average_tolerance`, or the budget is spent. Batches start as long as the
+    /// oscillator's memory (QΩ/π periods), so the window is at least 16 of those. Whenever the first and second
+    /// halves of a full window differ by more than four combined standard errors in any
+    /// of them, the motion is still drifting: the first half is dropped instead.
+    fn average(
+        &self,
+        phase: &mut Phase,
+        opts: &SteadyOptions,
+        budget: usize,
+        mut spent: usize,
+    ) -> Result<SteadyState> {
+        // Batches must outlast the oscillator's memory, the amplitude's relaxation time
+        // 2Q (in τ), to be nearly independent: QΩ/π periods. Where the budget left is
+        // too short for 16 of those, shorter batches still give a window and an error
+        // estimate, but not a converged one.
+        let memory = (self.osc.omega / (2.0 * std::f64::consts::PI * self.osc.gamma))
+            .ceil()
+            .clamp(1.0, 1e9) as usize;
+        let mut batch_len = memory.min(budget.saturating_sub(spent) / BATCHES).max(1);
+        let long_enough = batch_len == memory;
+        let mut batches: Vec<CycleIntegrals> = Vec::with_capacity(BATCHES);
+        let mut current: Option<CycleIntegrals> = None;
+        let mut current_len = 0;
+        loop {
+            let c = self.cycle(phase, &mut numeric::Ignore)?;
+            spent += 1;
+            current = Some(current.map_or(c, |s| s.then(&c)));
+            current_len += 1;
+            if current_len == batch_len {
+                batches.push(current.take().expect("a batch"));
+                current_len = 0;
+            }
+            let full = batches.len() == BATCHES;
+            let out_of_budget = spent >= budget;
+            if full || out_of_budget {
+                let (window, std_err) = batch_statistics(&batches, current.as_ref());
+                let relative = |x: f64, of: f64| if of > 0.0 { x / of } else { x };
+                let met = batches.len() >= 2
+                    && relative(std_err.amplitude, window.amplitude()) <= opts.average_tolerance
+                    && std_err.phase <= opts.average_tolerance
+                    && relative(std_err.e_ts, window.e_drive_per_period().abs())
+                        <= opts.average_tolerance;
+                if out_of_budget || (met && !drifting(&batches)) {
+                    return Ok(SteadyState {
+                        window,
+                        cycles: spent,
+                        converged: met && long_enough && !drifting(&batches),
+                        motion: Motion::Irregular,
+                        std_err,
+                    });
+                }
+                if drifting(&batches) {
+                    batches.drain(..BATCHES / 2);
+                } else {
+                    batches = batches.chunks(2).map(|p| p[0].then(&p[1])).collect();
+                    batch_len *= 2;
+                }
+            }
+        }
     }
 }
 
-/// Transient periods integrated between shooting attempts.
-const SHOOTING_RETRY_PERIODS: usize = 100;
+/// Rejected Newton steps in a row after which the search for an orbit gives up.
+const MAX_REJECTIONS: usize = 6;
+/// Accepted Newton steps that may pass without halving the residual.
+const STALL_STEPS: usize = 8;
+/// The fewest periods a steady-state search may be given: enough to classify the motion
+/// and average irregular motion over a window of its own.
+pub const MIN_CYCLES: usize = 32;
+/// Batches of an irregular window.
+const BATCHES: usize = 16;
+/// Periods integrated before the first look for orbits of higher period.
+const FIRST_STRETCH: usize = 32;
+/// Periods the search for an orbit may integrate at most (with shooting).
+const SEARCH_PERIODS: usize = 1000;
+
+/// The window (every batch and the unfinished rest) and the standard errors of the
+/// means of the whole batches.
+fn batch_statistics(
+    batches: &[CycleIntegrals],
+    rest: Option<&CycleIntegrals>,
+) -> (CycleIntegrals, StdErr) {
+    let mut window = batches[0];
+    for b in &batches[1..] {
+        window = window.then(b);
+    }
+    if let Some(r) = rest {
+        window = window.then(r);
+    }
+    let n = batches.len() as f64;
+    let phase = window.phase();
+    let std_err_of = |value: &dyn Fn(&CycleIntegrals) -> f64| {
+        let mean = batches.iter().map(value).sum::<f64>() / n;
+        let var = batches
+            .iter()
+            .map(|b| (value(b) - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        (var / n).sqrt()
+    };
+    let wrap = |d: f64| {
+        (d + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
+    };
+    let std_err = if batches.len() < 2 {
+        StdErr {
+            amplitude: f64::INFINITY,
+            phase: f64::INFINITY,
+            e_ts: f64::INFINITY,
+        }
+    } else {
+        StdErr {
+            amplitude: std_err_of(&|b| b.amplitude()),
+            phase: std_err_of(&|b| wrap(b.phase() - phase)),
+            e_ts: std_err_of(&|b| b.e_ts_per_period()),
+        }
+    };
+    (window, std_err)
+}
+
+/// Whether the first and second halves of a window of batches differ by more than four
+/// combined standard errors in A, φ or E_ts per period (a transient still in the window).
+fn drifting(batches: &[CycleIntegrals]) -> bool {
+    if batches.len() < 4 {
+        return false;
+    }
+    let (early, late) = batches.split_at(batches.len() / 2);
+    let ((a, sa), (b, sb)) = (batch_statistics(early, None), batch_statistics(late, None));
+    let apart = |x: f64, y: f64, sx: f64, sy: f64| (x - y).abs() > 4.0 * sx.hypot(sy);
+    let wrap = |d: f64| {
+        (d + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
+    };
+    apart(a.amplitude(), b.amplitude(), sa.amplitude, sb.amplitude)
+        || wrap(a.phase() - b.phase()).abs() > 4.0 * sa.phase.hypot(sb.phase)
+        || apart(a.e_ts_per_period(), b.e_ts_per_period(), sa.e_ts, sb.e_ts)
+}
+
+/// Eigenvalues of a 2×2 matrix.
+fn eigenvalues(m: &Matrix2<f64>) -> [Complex<f64>; 2] {
+    let half_trace = 0.5 * m.trace();
+    let disc = Complex::new(half_trace * half_trace - m.determinant(), 0.0).sqrt();
+    let h = Complex::new(half_trace, 0.0);
+    [h + disc, h - disc]
+}
+
+/// The last states at the drive phase, to see after how many periods they repeat.
+#[derive(Default)]
+struct Recurrence {
+    /// (x, x', branch), newest last; at most 3 + [`MAX_PERIOD`].
+    states: Vec<(Vector2<f64>, Branch)>,
+}
+
+impl Recurrence {
+    const KEEP: usize = MAX_PERIOD + 3;
+
+    fn push(&mut self, phase: &Phase) {
+        if self.states.len() == Self::KEEP {
+            self.states.remove(0);
+        }
+        self.states.push((phase.z(), phase.branch));
+    }
+
+    /// Distance between the state `back` places from the newest and the one n before it.
+    fn gap(&self, back: usize, n: usize) -> Option<f64> {
+        let len = self.states.len();
+        let (a, b) = (
+            self.states.get(len.checked_sub(1 + back)?)?,
+            self.states.get(len.checked_sub(1 + back + n)?)?,
+        );
+        (a.1 == b.1).then(|| (a.0 - b.0).amax())
+    }
+
+    /// The least n whose return distance has been within `within(n)` for the last three
+    /// periods.
+    fn repeats(&self, within: impl Fn(usize) -> f64) -> Option<usize> {
+        (1..=MAX_PERIOD)
+            .find(|&n| (0..3).all(|back| self.gap(back, n).is_some_and(|g| g <= within(n))))
+    }
+
+    /// Periods worth a Newton search: those the newest state nearly returns with (within
+    /// 0.1 in x and x'), the nearest returns first, at most three; a multiple of a
+    /// period already listed is left out (its orbit would be found as the shorter one).
+    fn candidates(&self) -> Vec<usize> {
+        let mut near: Vec<(f64, usize)> = (1..=MAX_PERIOD)
+            .filter_map(|n| self.gap(0, n).filter(|&g| g <= 0.1).map(|g| (g, n)))
+            .collect();
+        near.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut out: Vec<usize> = Vec::with_capacity(3);
+        for (_, n) in near {
+            if out.len() < 3 && !out.iter().any(|&m| n % m == 0) {
+                out.push(n);
+            }
+        }
+        out
+    }
+}
 
 /// Settings of the steady-state search.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SteadyOptions {
-    /// Convergence tolerance per cycle.
+    /// Periodic orbits: the largest |Pⁿ(z) − z| accepted (units of L); Newton aims 100×
+    /// lower. Time-marching: the return distance that counts as repeating.
     pub tolerance: f64,
-    /// Consecutive converged cycles required.
-    pub streak: usize,
-    /// At least this many cycles.
-    pub min_cycles: usize,
-    /// At most this many cycles.
+    /// Irregular motion: the standard error of the averages (A relative, φ in rad, E_ts
+    /// relative to E_drive) to reach.
+    pub average_tolerance: f64,
+    /// At most this many periods.
     pub max_cycles: usize,
-    /// Look for the periodic orbit by shooting first.
+    /// Look for periodic orbits by Newton's method on the period map.
     pub shooting: bool,
 }
 
 /// The outcome of [`Simulation::steady_state`].
 #[derive(Debug, Clone, Copy)]
 pub struct SteadyState {
-    /// The reported (last) cycle.
-    pub cycle: CycleIntegrals,
-    /// Cycles integrated in all.
+    /// The integrals over what is reported: one pass of the periodic orbit (n periods),
+    /// or the averaging window of irregular motion.
+    pub window: CycleIntegrals,
+    /// Periods integrated in all.
     pub cycles: usize,
-    /// Whether the convergence criterion was met.
+    /// Whether the reported values meet their tolerance.
     pub converged: bool,
+    /// How the motion repeats.
+    pub motion: Motion,
+    /// Standard errors of the window averages.
+    pub std_err: StdErr,
 }
 
 #[cfg(test)]
@@ -458,13 +1005,13 @@ mod tests {
     fn hermite_minimum_finds_the_turning_point_of_a_parabola() {
         // x = (τ − 0.3)², sampled at τ = 0 and 1 with exact slopes: the cubic is exact.
         let end = |tau: f64| {
-            let mut y = State::zeros();
+            let mut y = State::<BASE>::zeros();
             y[X] = (tau - 0.3) * (tau - 0.3);
             y[V] = 2.0 * (tau - 0.3);
             StepEnd {
                 tau,
                 y,
-                dy: State::zeros(),
+                dy: State::<BASE>::zeros(),
             }
         };
         let t = hermite_minimum(&end(0.0), &end(1.0));

@@ -20,6 +20,16 @@ fn hertz_t_hat(alpha_hat: f64) -> f64 {
     }
 }
 
+/// dT̂/dα̂ of the Hertz law: 2√(−α̂) for α̂ < 0.
+#[inline]
+fn hertz_slope_hat(alpha_hat: f64) -> f64 {
+    if alpha_hat < 0.0 {
+        2.0 * (-alpha_hat).sqrt()
+    } else {
+        0.0
+    }
+}
+
 /// Work function of the Hertz law: (8/15)(−α̂)^{5/2} for α̂ < 0.
 #[inline]
 fn hertz_work_hat(alpha_hat: f64) -> f64 {
@@ -35,6 +45,10 @@ impl ForceLaw for HertzLaw {
     #[inline]
     fn t_hat(&self, alpha_hat: f64, _branch: Branch) -> f64 {
         hertz_t_hat(alpha_hat)
+    }
+    #[inline]
+    fn slope_hat(&self, alpha_hat: f64, _branch: Branch) -> f64 {
+        hertz_slope_hat(alpha_hat)
     }
     fn work_hat(&self, alpha_hat: f64, _branch: Branch) -> f64 {
         hertz_work_hat(alpha_hat)
@@ -92,6 +106,15 @@ impl ForceLaw for DmtLaw {
             self.adhesion_t_hat + hertz_t_hat(alpha_hat)
         }
     }
+    #[inline]
+    fn slope_hat(&self, alpha_hat: f64, _branch: Branch) -> f64 {
+        if alpha_hat > 0.0 {
+            let d = 1.0 + self.tabor_mu * alpha_hat;
+            -2.0 * self.adhesion_t_hat * self.tabor_mu / (d * d * d)
+        } else {
+            hertz_slope_hat(alpha_hat)
+        }
+    }
     fn work_hat(&self, alpha_hat: f64, _branch: Branch) -> f64 {
         let c = self.adhesion_t_hat;
         if alpha_hat > 0.0 {
@@ -121,6 +144,9 @@ pub struct NoForce;
 impl ForceLaw for NoForce {
     #[inline]
     fn t_hat(&self, _alpha_hat: f64, _branch: Branch) -> f64 {
+        0.0
+    }
+    fn slope_hat(&self, _alpha_hat: f64, _branch: Branch) -> f64 {
         0.0
     }
     fn work_hat(&self, _alpha_hat: f64, _branch: Branch) -> f64 {

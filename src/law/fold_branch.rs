@@ -138,6 +138,39 @@ impl FoldBranch {
         }
     }
 
+    /// Slope dT̂/dα̂ at α̂: (dT̂/du)·σ/(2u). It grows as 1/√(distance) towards the fold,
+    /// where it is capped at the value a distance [`FOLD_SLOPE_FLOOR_U`]² away (an
+    /// integrable singularity: the cap changes ∫ (dT̂/dα̂) dτ by O(that distance)).
+    #[inline]
+    pub fn slope_hat(&self, alpha_hat: f64) -> f64 {
+        let d = self.sign * (alpha_hat - self.fold_alpha_hat);
+        if d >= 0.0 {
+            let u = d.sqrt();
+            if u <= self.u_max {
+                return self.table.slope(u) * self.sign / (2.0 * u.max(FOLD_SLOPE_FLOOR_U));
+            }
+        }
+        self.slope_outside(alpha_hat, d)
+    }
+
+    /// The slope past the fold (the reflected force has the mirrored slope) or beyond
+    /// the table (the far field's derivative).
+    #[cold]
+    fn slope_outside(&self, alpha_hat: f64, d: f64) -> f64 {
+        if d < 0.0 {
+            return self.slope_hat(2.0 * self.fold_alpha_hat - alpha_hat);
+        }
+        match self.far {
+            FarField::Decay { kappa } => {
+                let end = self.u_max;
+                let (alpha_end, t_end) = (self.alpha_at(end), self.table.eval(end));
+                let k = (alpha_end + kappa) / (alpha_hat + kappa);
+                -2.0 * t_end * k * k / (alpha_hat + kappa)
+            }
+            FarField::JkrShift { .. } => jkr_slope(alpha_hat),
+        }
+    }
+
     /// Work function Φ with dΦ/dα̂ = T̂, zero at the fold.
     pub fn work_hat(&self, alpha_hat: f64) -> f64 {
         let d = self.sign() * (alpha_hat - self.fold_alpha_hat);
@@ -172,6 +205,16 @@ fn jkr_force(alpha_hat: f64) -> f64 {
     jkr::force_hat(jkr::a_hat_from_separation(alpha_hat).unwrap_or(jkr::A_HAT_C))
 }
 
+/// dT̂/dα̂ of the JKR curve (5) on its stable contact branch at α̂: (dT̂/dâ)/(dα̂/dâ).
+fn jkr_slope(alpha_hat: f64) -> f64 {
+    let a = jkr::a_hat_from_separation(alpha_hat).unwrap_or(jkr::A_HAT_C);
+    jkr::d_force_d_a(a) / jkr::d_separation_d_a(a)
+}
+
+/// Distance in u = √|α̂ − α̂₀| from the fold below which [`FoldBranch::slope_hat`] is
+/// held at its value there.
+pub const FOLD_SLOPE_FLOOR_U: f64 = 1e-8;
+
 /// JKR work function (6) along the stable contact branch at α̂.
 fn jkr_work(alpha_hat: f64) -> f64 {
     jkr::work_hat(jkr::a_hat_from_separation(alpha_hat).unwrap_or(jkr::A_HAT_C))
@@ -202,5 +245,40 @@ mod tests {
             );
         }
         assert_eq!(b.work_hat(1.0), 0.0);
+    }
+
+    #[test]
+    fn slope_is_the_derivative_of_the_force_everywhere() {
+        let approach = FoldBranch::new(
+            (1.0, 2.0),
+            Side::Above,
+            3.0,
+            2001,
+            FarField::Decay { kappa: 0.2 },
+            |u| 2.0 - u + 0.1 * u * u,
+        );
+        let contact = FoldBranch::new(
+            (jkr::ALPHA_HAT_C, jkr::T_HAT_C),
+            Side::Below,
+            2.0,
+            2001,
+            FarField::JkrShift { shift: 0.0 },
+            |u| jkr_force(jkr::ALPHA_HAT_C - u * u),
+        );
+        let check = |b: &FoldBranch, alpha: f64| {
+            let h = 1e-6;
+            let fd = (b.t_hat(alpha + h) - b.t_hat(alpha - h)) / (2.0 * h);
+            let s = b.slope_hat(alpha);
+            assert!(
+                (s - fd).abs() < 1e-5 * (1.0 + fd.abs()),
+                "{alpha}: {s} vs {fd}"
+            );
+        };
+        for &alpha in &[0.2, 0.9, 1.3, 5.0, 9.9, 10.5, 40.0] {
+            check(&approach, alpha);
+        }
+        for &alpha in &[-20.0, -3.9, -2.0, 0.0, 1.0, 1.5, 1.7, 3.0] {
+            check(&contact, alpha);
+        }
     }
 }

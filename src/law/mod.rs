@@ -38,6 +38,9 @@ pub trait ForceLaw: Send + Sync {
     /// Force T̂ (tensile positive) at separation α̂ on `branch`. Finite for every finite
     /// α̂, including past a branch's own end (integrator trial stages overshoot).
     fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64;
+    /// Slope dT̂/dα̂ on `branch`, for the variational equations of the one-period map.
+    /// Finite everywhere (where T̂ has a square-root fold, capped very near it).
+    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64;
     /// Work function of a branch: an antiderivative Φ with dΦ/dα̂ = T̂(α̂, branch), so the
     /// work done along a branch between two separations is a difference of Φ (each branch
     /// is conservative; the loss comes from switching).
@@ -156,6 +159,10 @@ impl ForceLaw for AnyLaw {
     #[inline]
     fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         dispatch!(self, l => l.t_hat(alpha_hat, branch))
+    }
+    #[inline]
+    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        dispatch!(self, l => l.slope_hat(alpha_hat, branch))
     }
     fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         dispatch!(self, l => l.work_hat(alpha_hat, branch))

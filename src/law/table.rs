@@ -81,6 +81,19 @@ impl UniformTable {
         let d = y1 - y0;
         y0 + t * (m0 + t * (3.0 * d - 2.0 * m0 - m1 + t * (m0 + m1 - 2.0 * d)))
     }
+
+    /// Slope of the interpolant at `x` (the derivative of [`UniformTable::eval`]).
+    #[inline]
+    pub fn slope(&self, x: f64) -> f64 {
+        let u = (x - self.x0) * self.inv_dx;
+        let last = self.nodes.len() - 2;
+        let i = (u as usize).min(last);
+        let t = u - i as f64;
+        let [y0, m0] = self.nodes[i];
+        let [y1, m1] = self.nodes[i + 1];
+        let d = y1 - y0;
+        (m0 + t * (2.0 * (3.0 * d - 2.0 * m0 - m1) + 3.0 * t * (m0 + m1 - 2.0 * d))) * self.inv_dx
+    }
 }
 
 #[cfg(test)]
@@ -100,5 +113,17 @@ mod tests {
         };
         let (e1, e2) = (err(50), err(100));
         assert!(e1 < 1e-5 && e2 < e1 / 12.0, "{e1} {e2}");
+    }
+
+    #[test]
+    fn slope_is_the_derivative_of_the_interpolant() {
+        let t = UniformTable::sample(0.0, 3.0, 60, f64::sin);
+        for i in 0..300 {
+            let x = 0.001 + 2.99 * i as f64 / 299.0;
+            let h = 1e-6;
+            let fd = (t.eval(x + h) - t.eval(x - h)) / (2.0 * h);
+            assert!((t.slope(x) - fd).abs() < 1e-8, "{x}");
+            assert!((t.slope(x) - x.cos()).abs() < 1e-4, "{x}");
+        }
     }
 }

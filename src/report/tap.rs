@@ -53,22 +53,41 @@ pub fn to_text(setup: &TapSetup, o: &TapObservables) -> String {
     let mut line = |label: &str, value: String| {
         let _ = writeln!(s, "  {label:<34} {value}");
     };
+    line("motion", motion_text(o));
     line(
         "cycles (converged)",
         format!("{} ({})", o.cycles, if o.converged { "yes" } else { "NO" }),
     );
+    let err = |e: Option<f64>, scale: f64, digits: usize| match (o.period, e) {
+        (Some(_), _) => String::new(),
+        (None, Some(e)) => format!(" ± {:.*e}", digits, e * scale),
+        (None, None) => " ± ?".into(),
+    };
     line(
         "amplitude A, A/A₀",
-        format!("{:.4} nm, {:.6}", o.amplitude_m * 1e9, o.amplitude_ratio),
+        format!(
+            "{:.4} nm{}, {:.6}",
+            o.amplitude_m * 1e9,
+            err(o.amplitude_std_err_m, 1e9, 1),
+            o.amplitude_ratio
+        ),
     );
-    line("phase φ (lock-in)", format!("{:.4}°", o.phase_deg));
+    line(
+        "phase φ (lock-in)",
+        format!("{:.4}°{}", o.phase_deg, err(o.phase_std_err_deg, 1.0, 1)),
+    );
     line(
         "phase φ (from energy)",
         format!("{:.4}°", o.phase_from_energy_deg),
     );
     line(
         "E_ts per cycle",
-        format!("{:.4e} J = {:.4} eV", o.e_ts_j, o.e_ts_ev),
+        format!(
+            "{:.4e} J{} = {:.4} eV",
+            o.e_ts_j,
+            err(o.e_ts_std_err_j, 1.0, 1),
+            o.e_ts_ev
+        ),
     );
     line("law's loop area", format!("{:.4e} J", o.loop_area_j));
     line(
@@ -94,14 +113,38 @@ pub fn to_text(setup: &TapSetup, o: &TapObservables) -> String {
         format!("{:.4} nm", o.min_separation_m * 1e9),
     );
     line("contact fraction", format!("{:.4}", o.contact_fraction));
+    line("jumps into contact per cycle", format!("{:.4}", o.jumps_in));
     if !o.converged {
         let _ = writeln!(
             s,
-            "note: no steady state within the cycle cap (raise --max-cycles; the motion may \
-             be chaotic or period-doubled at this setpoint)"
+            "note: {}",
+            if o.period.is_some() {
+                "the periodic orbit did not close to --tolerance within the cycle cap"
+            } else {
+                "the averages did not reach --average-tolerance within the cycle cap (raise \
+                 --max-cycles)"
+            }
         );
     }
     s
+}
+
+/// The kind of motion, the periods the values are averaged over, and the stability of a
+/// periodic orbit with its largest Floquet multiplier.
+fn motion_text(o: &TapObservables) -> String {
+    let largest = o
+        .floquet_multipliers
+        .iter()
+        .map(|m| m[0].hypot(m[1]))
+        .fold(0.0, f64::max);
+    match o.stable {
+        Some(stable) => format!(
+            "{} ({}, largest |Floquet multiplier| {largest:.4})",
+            o.regime,
+            if stable { "stable" } else { "unstable" }
+        ),
+        None => format!("{}: averages over {} periods", o.regime, o.periods_averaged),
+    }
 }
 
 /// The trajectory as CSV: t_s, z_m, v_m_s, alpha_m, force_n, branch.
