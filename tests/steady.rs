@@ -1,0 +1,223 @@
+//! Steady states that are not period-1: Newton's method on the period map with its exact
+//! derivative, the classification of the motion, and what is reported for it.
+
+use tapsim::dynamics::observables::{TapObservables, tap};
+use tapsim::dynamics::setup::{Cantilever, Numerics, TapSetup, default_setup};
+use tapsim::law::LawKind;
+use tapsim::params::{Contact, composite_modulus};
+
+/// The dForce 2.0 Hertz example: k = 0.9 N/m, f₀ = 100 kHz, A₀ = 15 nm, R = 5 nm,
+/// E_s = 100 MPa, rest gap 9 nm, driven at resonance.
+fn dforce_hertz(quality: f64) -> TapSetup {
+    TapSetup {
+        contact: Contact::new(
+            5e-9,
+            composite_modulus(169e9, 0.28, 100e6, 0.3).unwrap(),
+            0.1,
+            0.3e-9,
+        )
+        .unwrap(),
+        cantilever: Cantilever {
+            stiffness_n_m: 0.9,
+            resonance_hz: 100e3,
+            quality,
+            free_amplitude_m: 15e-9,
+            drive_frequency_hz: 100e3,
+        },
+        separation_m: 9e-9,
+        law: LawKind::Hertz,
+        hamaker_j: None,
+    }
+}
+
+#[test]
+fn high_q_orbits_settle_in_a_few_dozen_periods_and_match_the_time_marched_ones() {
+    for quality in [1e3, 1e4, 1e5] {
+        let setup = dforce_hertz(quality);
+        let shot = tap(&setup, &Numerics::default(), 0).unwrap().observables;
+        // Brute force: integrate until the state at the drive phase lies within 1e-8 of
+        // the orbit (~Q ln(1e8)/π periods).
+        let marched = tap(
+            &setup,
+            &Numerics {
+                shooting: false,
+                tolerance: 1e-8,
+                max_cycles: 2_000_000,
+                ..Numerics::default()
+            },
+            0,
+        )
+        .unwrap()
+        .observables;
+        println!(
+            "Q {quality:e}: {} periods shooting, {} marching; A/A0 {:.10} vs {:.10}, \
+             phase {:.7} vs {:.7}",
+            shot.cycles,
+            marched.cycles,
+            shot.amplitude_ratio,
+            marched.amplitude_ratio,
+            shot.phase_deg,
+            marched.phase_deg
+        );
+        assert!(shot.converged && marched.converged);
+        assert_eq!(shot.regime, "period-1");
+        assert_eq!(marched.regime, "period-1");
+        assert!(shot.cycles <= 60, "Q {quality:e}: {} periods", shot.cycles);
+        assert!(
+            marched.cycles as f64 > quality,
+            "the reference must really march"
+        );
+        let rel = (shot.amplitude_ratio / marched.amplitude_ratio - 1.0).abs();
+        assert!(rel < 1e-6, "Q {quality:e}: amplitude off by {rel:e}");
+        let dphi = (shot.phase_deg - marched.phase_deg).abs();
+        assert!(dphi < 1e-4, "Q {quality:e}: phase off by {dphi:e} deg");
+        // A stable orbit whose multipliers approach the unit circle as Q grows
+        // (the free oscillator's are e^{-π/Q} in modulus).
+        assert_eq!(shot.stable, Some(true));
+        let largest = shot
+            .floquet_multipliers
+            .iter()
+            .map(|m| m[0].hypot(m[1]))
+            .fold(0.0, f64::max);
+        assert!(largest < 1.0 && largest > (-10.0 * std::f64::consts::PI / quality).exp());
+    }
+}
+
+fn jkr_defaults(average_tolerance: f64) -> TapObservables {
+    let setup = TapSetup {
+        law: LawKind::Jkr,
+        ..default_setup()
+    };
+    let numerics = Numerics {
+        average_tolerance,
+        ..Numerics::default()
+    };
+    tap(&setup, &numerics, 0).unwrap().observables
+}
+
+#[test]
+fn jkr_on_the_defaults_is_named_and_averaged_over_a_window() {
+    let o = jkr_defaults(1e-3);
+    println!(
+        "{}: {} periods averaged, A/A0 {:.6} ± {:?} m, phase {:.4} ± {:?} deg, \
+         from energy {:.4}, E_ts {:.3} eV ({} touches per period), balance {:.1e}",
+        o.regime,
+        o.periods_averaged,
+        o.amplitude_ratio,
+        o.amplitude_std_err_m,
+        o.phase_deg,
+        o.phase_std_err_deg,
+        o.phase_from_energy_deg,
+        o.e_ts_ev,
+        o.jumps_in,
+        o.energy_balance_rel
+    );
+    assert!(o.converged);
+    // Three periods in four touch, with slips: the motion repeats after no n <= 8.
+    assert_eq!(o.regime, "irregular");
+    assert_eq!(o.period, None);
+    assert_eq!(o.stable, None);
+    assert!(o.floquet_multipliers.is_empty());
+    assert!(o.jumps_in > 0.0 && o.jumps_in < 1.0);
+    // Averaged over at least 16 batches of the oscillator's memory, QΩ/π periods.
+    assert!(o.periods_averaged as f64 >= 16.0 * 400.0 / std::f64::consts::PI);
+    // Not every period touches, so less than the full loop per period.
+    assert!(o.e_ts_j > 0.0 && o.e_ts_j < o.loop_area_j);
+    // Each touch dissipates the whole JKR loop.
+    assert!((o.e_ts_j / (o.jumps_in * o.loop_area_j) - 1.0).abs() < 1e-6);
+    assert!(o.energy_balance_rel < 1e-6);
+    let se = o.phase_std_err_deg.unwrap();
+    assert!(se > 0.0 && se < 0.057, "{se}");
+    // The energy relation over the same window leaves out only the damping of the higher
+    // harmonics; with it put back, it is the lock-in phase within the statistical error.
+    let cant = &default_setup().cantilever;
+    let (k, q) = (cant.stiffness_n_m, cant.quality);
+    let a = o.amplitude_m;
+    let f0 = k * cant.free_amplitude_m / q;
+    let damping_model = std::f64::consts::PI * k * a * a / q;
+    let harmonics = o.e_damp_j - damping_model;
+    let sin_energy =
+        o.phase_from_energy_deg.to_radians().sin() + harmonics / (std::f64::consts::PI * f0 * a);
+    let with_harmonics = 180.0 - sin_energy.asin().to_degrees();
+    assert!(
+        o.phase_deg > 90.0,
+        "attractive: the quadrant from the virial"
+    );
+    assert!(
+        (with_harmonics - o.phase_deg).abs() < 3.0 * se,
+        "{with_harmonics} vs {} ± {se}",
+        o.phase_deg
+    );
+    assert!((o.phase_from_energy_deg - o.phase_deg).abs() < 0.05);
+}
+
+#[test]
+fn two_windows_of_irregular_motion_agree_within_their_errors() {
+    let (a, b) = (jkr_defaults(1e-3), jkr_defaults(1e-5));
+    assert!(a.converged && a.regime == "irregular" && b.regime == "irregular");
+    assert!(
+        b.periods_averaged > a.periods_averaged,
+        "{} vs {}",
+        a.periods_averaged,
+        b.periods_averaged
+    );
+    let agree = |x: f64, y: f64, sx: Option<f64>, sy: Option<f64>, what: &str| {
+        let combined = sx.unwrap().hypot(sy.unwrap());
+        println!("{what}: {x} vs {y}, combined error {combined:e}");
+        assert!(
+            (x - y).abs() <= 3.0 * combined,
+            "{what}: {x} vs {y} ± {combined}"
+        );
+    };
+    agree(
+        a.amplitude_m,
+        b.amplitude_m,
+        a.amplitude_std_err_m,
+        b.amplitude_std_err_m,
+        "A",
+    );
+    agree(
+        a.phase_deg,
+        b.phase_deg,
+        a.phase_std_err_deg,
+        b.phase_std_err_deg,
+        "phase",
+    );
+    agree(
+        a.e_ts_j,
+        b.e_ts_j,
+        a.e_ts_std_err_j,
+        b.e_ts_std_err_j,
+        "E_ts",
+    );
+}
+
+#[test]
+fn no_value_is_one_period_of_motion_that_is_not_period_one() {
+    // A soft cantilever near contact: period-n orbits and irregular motion side by side.
+    let mut seen = std::collections::BTreeSet::new();
+    for (law, z_nm) in [
+        (LawKind::Jkr, 19.1),
+        (LawKind::Jkr, 18.4),
+        (LawKind::Dmt, 17.7),
+        (LawKind::Hybrid, 14.0),
+    ] {
+        let mut setup = default_setup();
+        setup.law = law;
+        setup.separation_m = z_nm * 1e-9;
+        setup.cantilever.stiffness_n_m = 1.0;
+        setup.cantilever.quality = 5.0;
+        let o = tap(&setup, &Numerics::default(), 0).unwrap().observables;
+        println!("{law} {z_nm} nm: {} over {}", o.regime, o.periods_averaged);
+        match o.period {
+            Some(n) => {
+                assert_eq!(o.regime, format!("period-{n}"));
+                assert_eq!(o.periods_averaged as usize, n, "one pass of the orbit");
+                assert!(o.stable == Some(true) && o.floquet_multipliers.len() == 2);
+            }
+            None => assert!(o.periods_averaged >= 16),
+        }
+        seen.insert(o.regime.clone());
+    }
+    assert!(seen.len() >= 3, "{seen:?}");
+}
