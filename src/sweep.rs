@@ -11,10 +11,10 @@ use serde::Serialize;
 /// ~1e-5 (the transient left after a change < 1e-7 per cycle is < 1e-7·Q/π).
 pub const SETPOINT_TOLERANCE: f64 = 1e-7;
 
-/// Default cap on the periods integrated per setpoint of a sweep (near the onset of
-/// contact the motion can be period-doubled or chaotic and never settle; such points are
-/// reported with `converged: false`).
-pub const SETPOINT_MAX_CYCLES: usize = 4000;
+/// Default cap on the periods integrated per setpoint of a sweep. A periodic orbit takes
+/// a few dozen; irregular motion (near the onset of contact) is averaged over windows of
+/// thousands, and a ramp that has just left a fold may take thousands to settle.
+pub const SETPOINT_MAX_CYCLES: usize = 20_000;
 
 /// The numerics of a sweep: `numerics` with the sweep defaults for whatever `inputs` left
 /// unset (tolerance and cycle cap per setpoint).
@@ -183,4 +183,166 @@ pub fn adhesion_modulus_map(
             })
             .collect()
     })
+}
+
+/// What a point of an orbit branch is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BranchPointKind {
+    /// A point of the branch.
+    Regular,
+    /// A fold: a Floquet multiplier at +1, where the branch turns back.
+    Fold,
+    /// A period doubling: a Floquet multiplier at −1.
+    PeriodDoubling,
+}
+
+/// One orbit of the period-1 family.
+#[derive(Debug, Clone, Serialize)]
+pub struct BranchRecord {
+    /// Rest separation z_c in m.
+    pub separation_m: f64,
+    /// The continuous piece of the branch the orbit lies on (0, 1, …; the period map
+    /// jumps between pieces where an orbit starts to touch the sample).
+    pub segment: usize,
+    /// What the point is.
+    pub point: BranchPointKind,
+    /// The orbit's observables (`stable` and `floquet_multipliers` among them).
+    #[serde(flatten)]
+    pub observables: TapObservables,
+}
+
+/// The period-1 orbit family followed from one rest separation to another.
+#[derive(Debug, Clone)]
+pub struct OrbitBranch {
+    /// The orbits in order along the branch (folds and period doublings where they lie).
+    pub points: Vec<BranchRecord>,
+    /// How the branch went: where pieces ended and the next began, and why it ends.
+    pub notes: Vec<String>,
+}
+
+/// Follow the period-1 orbit family through the rest separation from `from_m` to `to_m`
+/// by pseudo-arclength continuation ([`crate::dynamics::continuation`]), stable and
+/// unstable orbits alike, with folds and period doublings located. It starts on the orbit
+/// the free steady state settles on at `from_m`, which must be period-1. `max_step_m`
+/// bounds the step along the branch (in m of the (z, ż/ω₀, z_c) arclength).
+///
+/// Where a piece of the family ends at a grazing orbit (for a hysteretic law the period
+/// map jumps there: touching the sample dissipates a whole loop), the rest separation is
+/// moved on by `max_step_m` at a time, carrying the oscillator, until the motion settles
+/// on a stable period-1 orbit again, and the next piece is followed from there.
+pub fn orbit_branch(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    (from_m, to_m): (f64, f64),
+    max_step_m: f64,
+) -> Result<OrbitBranch> {
+    use crate::dynamics::continuation::{ContinuationOptions, PointKind, Stop, follow_period_one};
+    use crate::dynamics::steady::{Motion, StdErr, SteadyState};
+    finite("--from", from_m)?;
+    finite("--to", to_m)?;
+    crate::error::positive("--max-step", max_step_m)?;
+    if max_step_m > (from_m - to_m).abs() {
+        return Err(Error::NotApplicable(format!(
+            "--max-step ({:.4} nm) exceeds the range from --from to --to",
+            max_step_m * 1e9
+        )));
+    }
+    let p = Prepared::new(setup, numerics)?;
+    let a0 = p.setup.cantilever.free_amplitude_m;
+    let nm = |m: f64| m * 1e9;
+    let toward = (to_m - from_m).signum();
+    let mut phase = p.simulation().free_steady_start();
+    let mut points: Vec<BranchRecord> = Vec::new();
+    let mut notes = Vec::new();
+    let mut at = from_m;
+    let mut segment = 0;
+    loop {
+        // Settle at `at`; a piece of the family starts on a stable period-1 orbit.
+        let sim = p.simulation_at(at)?;
+        let settled = sim.steady_state(&mut phase, &p.steady)?;
+        if settled.motion.period() != Some(1) || !settled.converged {
+            if segment == 0 && points.is_empty() && at == from_m {
+                notes.push(format!(
+                    "at --from ({:.4} nm) the motion settles as {}, not on a period-1 orbit",
+                    nm(at),
+                    settled.motion.regime()
+                ));
+            }
+            at += toward * max_step_m;
+            if (at - to_m) * toward > 0.0 {
+                notes.push(format!(
+                    "no stable period-1 orbit from there to --to ({:.4} nm)",
+                    nm(to_m)
+                ));
+                break;
+            }
+            continue;
+        }
+        if !points.is_empty() {
+            notes.push(format!(
+                "piece {segment} starts at {:.4} nm, where the motion settles on a stable \
+                 period-1 orbit again",
+                nm(at)
+            ));
+        }
+        let opts = ContinuationOptions {
+            q_end: to_m / a0,
+            max_step: max_step_m / a0,
+            tolerance: (1e-2 * numerics.tolerance).max(1e-12),
+            ..ContinuationOptions::default()
+        };
+        let branch = follow_period_one(&sim, &phase, &opts)?;
+        points.extend(branch.points.iter().map(|b| {
+            let state = SteadyState {
+                window: b.integrals,
+                cycles: 1,
+                converged: true,
+                motion: Motion::Periodic {
+                    period: 1,
+                    multipliers: b.multipliers,
+                },
+                std_err: StdErr::default(),
+            };
+            BranchRecord {
+                separation_m: b.q * a0,
+                segment,
+                point: match b.kind {
+                    PointKind::Regular => BranchPointKind::Regular,
+                    PointKind::Fold => BranchPointKind::Fold,
+                    PointKind::PeriodDoubling => BranchPointKind::PeriodDoubling,
+                },
+                observables: TapObservables::new(&p, &state),
+            }
+        }));
+        match branch.stop {
+            Stop::Reached => {
+                notes.push(format!("reached --to ({:.4} nm)", nm(to_m)));
+                break;
+            }
+            Stop::TurnedBack => {
+                notes.push("turned back past --from".into());
+                break;
+            }
+            Stop::PointCap => {
+                notes.push("stopped at the point cap (raise --max-step)".into());
+                break;
+            }
+            Stop::NotSmooth(q) => {
+                notes.push(format!(
+                    "piece {segment} ends at {:.4} nm, where the period map is not smooth \
+                     (an orbit grazing a switch of the force law)",
+                    nm(q * a0)
+                ));
+                let last = branch.points.last().expect("a piece has points");
+                phase = last.phase;
+                at = q * a0 + toward * max_step_m;
+                segment += 1;
+                if (at - to_m) * toward > 0.0 {
+                    break;
+                }
+            }
+        }
+    }
+    Ok(OrbitBranch { points, notes })
 }

@@ -221,3 +221,64 @@ fn no_value_is_one_period_of_motion_that_is_not_period_one() {
     }
     assert!(seen.len() >= 3, "{seen:?}");
 }
+
+#[test]
+fn the_period_map_derivative_matches_finite_differences_across_switches() {
+    use tapsim::dynamics::numeric::Ignore;
+    use tapsim::dynamics::setup::Prepared;
+    use tapsim::dynamics::steady::Phase;
+    // In contact for part of the period, with the force jumping at both switches
+    // (hybrid, jkr), continuous (dmt, hertz), or tabulated with an attractive approach.
+    for (law, z_nm) in [
+        (LawKind::Hybrid, 16.0),
+        (LawKind::Jkr, 12.0),
+        (LawKind::HybridAttractive, 15.0),
+        (LawKind::Dmt, 14.0),
+        (LawKind::Hertz, 14.0),
+    ] {
+        let setup = TapSetup {
+            law,
+            separation_m: z_nm * 1e-9,
+            ..default_setup()
+        };
+        let numerics = Numerics {
+            rtol: 1e-12,
+            ..Numerics::default()
+        };
+        let p = Prepared::new(&setup, &numerics).unwrap();
+        let sim = p.simulation();
+        // A state on the settled motion, so the period touches the sample.
+        let mut start = sim.free_steady_start();
+        sim.steady_state(&mut start, &p.steady).unwrap();
+        let (c, d) = sim.cycle_with_derivative(&mut start.clone()).unwrap();
+        assert!(c.jumps_in >= 1, "{law}: the period must touch");
+        let map = |dx: f64, dv: f64, dq: f64| {
+            let mut s = sim;
+            s.cpl.a0 += dq * s.cpl.a1;
+            let mut ph = Phase {
+                x: start.x + dx,
+                v: start.v + dv,
+                ..start
+            };
+            s.cycle(&mut ph, &mut Ignore).unwrap();
+            (ph.x, ph.v)
+        };
+        let h = 1e-6;
+        for (col, (dx, dv, dq)) in [(h, 0.0, 0.0), (0.0, h, 0.0), (0.0, 0.0, h)]
+            .into_iter()
+            .enumerate()
+        {
+            let (xp, vp) = map(dx, dv, dq);
+            let (xm, vm) = map(-dx, -dv, -dq);
+            let fd = [(xp - xm) / (2.0 * h), (vp - vm) / (2.0 * h)];
+            for row in 0..2 {
+                let exact = d[(row, col)];
+                assert!(
+                    (exact - fd[row]).abs() < 1e-5 * (1.0 + fd[row].abs()),
+                    "{law}: d[{row}, {col}] = {exact} vs finite differences {}",
+                    fd[row]
+                );
+            }
+        }
+    }
+}

@@ -2,6 +2,7 @@
 //! its own module.
 
 mod approach;
+mod branches;
 mod contrast;
 mod figure;
 mod hysteresis;
@@ -31,6 +32,7 @@ pub struct Cli {
 enum Command {
     Tap(tap::TapArgs),
     Approach(approach::ApproachArgs),
+    Branches(branches::BranchesArgs),
     Contrast(contrast::ContrastArgs),
     Map(map::MapArgs),
     Hysteresis(hysteresis::HysteresisArgs),
@@ -79,6 +81,7 @@ pub fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Tap(args) => tap::run(args),
         Command::Approach(args) => approach::run(args),
+        Command::Branches(args) => branches::run(args),
         Command::Contrast(args) => contrast::run(args),
         Command::Map(args) => map::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),

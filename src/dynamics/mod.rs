@@ -3,6 +3,7 @@
 //! steady cycle (DESIGN.md §2).
 
 pub mod base_drive;
+pub mod continuation;
 pub mod free;
 pub mod model;
 pub mod numeric;

@@ -9,14 +9,15 @@
 //! where x_b is the support displacement of a base drive (zero for a force drive).
 
 use crate::law::{Branch, ForceLaw};
-use nalgebra::SVector;
+use nalgebra::{Matrix2x3, SVector};
 
 /// ODE state: deflection, velocity, the per-cycle integrals carried along, and the drive
 /// phasor (cos Ωτ, sin Ωτ), integrated as a rotation so the right-hand side needs no
 /// trigonometric calls (it is reset to the exact values at every segment start). With
-/// `N` = [`TANGENT`] it also carries the variational matrix Φ = ∂(x, x')/∂(x₀, x₀')
-/// from [`PHI`] on, for the derivative of the period map; with `N` = [`BASE`] it does
-/// not, and the hot path pays nothing for it.
+/// `N` = [`TANGENT`] it also carries the variational matrix Φ = ∂(x, x')/∂(x₀, x₀', q)
+/// from [`PHI`] on, q = z_c/L the rest separation (α̂ = a₁(q + x + x_b)), for the
+/// derivative of the period map; with `N` = [`BASE`] it does not, and the hot path pays
+/// nothing for it.
 ///
 /// Two energies are not carried: the contact's E_ts is exact from the law's branch work
 /// functions at the segment ends, and the drive's work follows from the Fourier
@@ -26,7 +27,7 @@ pub type State<const N: usize = BASE> = SVector<f64, N>;
 /// Components of the plain state.
 pub const BASE: usize = 9;
 /// Components of the state with the variational matrix.
-pub const TANGENT: usize = 13;
+pub const TANGENT: usize = 15;
 
 /// Index of the deflection x in [`State`].
 pub const X: usize = 0;
@@ -46,22 +47,34 @@ pub const VIRIAL: usize = 6;
 pub const COS: usize = 7;
 /// sin Ωτ.
 pub const SIN: usize = 8;
-/// First of the four entries of Φ, column by column: ∂x/∂x₀, ∂x'/∂x₀, ∂x/∂x₀', ∂x'/∂x₀'.
+/// First of the six entries of Φ, column by column: ∂(x, x')/∂x₀, ∂(x, x')/∂x₀',
+/// ∂(x, x')/∂q.
 pub const PHI: usize = 9;
 
 /// Φ of a [`TANGENT`] state as a matrix.
 #[inline]
-pub fn phi<const N: usize>(y: &State<N>) -> nalgebra::Matrix2<f64> {
-    nalgebra::Matrix2::new(y[PHI], y[PHI + 2], y[PHI + 1], y[PHI + 3])
+pub fn phi<const N: usize>(y: &State<N>) -> Matrix2x3<f64> {
+    Matrix2x3::from_column_slice(&y.as_slice()[PHI..PHI + 6])
 }
 
 /// Store `m` as Φ of a [`TANGENT`] state.
 #[inline]
-pub fn set_phi<const N: usize>(y: &mut State<N>, m: &nalgebra::Matrix2<f64>) {
-    y[PHI] = m[(0, 0)];
-    y[PHI + 1] = m[(1, 0)];
-    y[PHI + 2] = m[(0, 1)];
-    y[PHI + 3] = m[(1, 1)];
+pub fn set_phi<const N: usize>(y: &mut State<N>, m: &Matrix2x3<f64>) {
+    y.as_mut_slice()[PHI..PHI + 6].copy_from_slice(m.as_slice());
+}
+
+/// Φ at the start of a span: the identity in (x₀, x₀'), nothing yet from q.
+pub fn phi_start() -> Matrix2x3<f64> {
+    Matrix2x3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+}
+
+/// The derivative over two spans, `first` then `then` (each ∂(x, x')/∂(x₀, x₀', q)):
+/// the chain rule, with q entering both.
+pub fn chain(first: &Matrix2x3<f64>, then: &Matrix2x3<f64>) -> Matrix2x3<f64> {
+    let mut out = then.fixed_columns::<2>(0) * first;
+    out[(0, 2)] += then[(0, 2)];
+    out[(1, 2)] += then[(1, 2)];
+    out
 }
 
 /// Set the drive phasor of `y` to its exact value at τ.
@@ -195,8 +208,8 @@ impl Coupling {
 }
 
 /// The right-hand side of the equation of motion and of the carried integrals; for a
-/// [`TANGENT`] state also of the variational equations δx'' + 2γδx' + δx = (∂f_ts/∂x)δx,
-/// ∂f_ts/∂x = −f_scale·a₁·dT̂/dα̂.
+/// [`TANGENT`] state also of the variational equations δx'' + 2γδx' + δx = (∂f_ts/∂x)δx
+/// (+ ∂f_ts/∂q for the q column), ∂f_ts/∂x = ∂f_ts/∂q = −f_scale·a₁·dT̂/dα̂.
 #[inline]
 pub fn rhs<L: ForceLaw, const N: usize>(
     law: &L,
@@ -215,11 +228,12 @@ pub fn rhs<L: ForceLaw, const N: usize>(
     let f = -cpl.f_scale * law.t_hat(alpha, branch);
     if N == TANGENT {
         let stiffness = -cpl.f_scale * cpl.a1 * law.slope_hat(alpha, branch);
-        for col in [PHI, PHI + 2] {
+        for col in [PHI, PHI + 2, PHI + 4] {
             let (dx, dv) = (y[col], y[col + 1]);
             dy[col] = dv;
             dy[col + 1] = -2.0 * osc.gamma * dv - dx + stiffness * dx;
         }
+        dy[PHI + 5] += stiffness;
     }
     dy[X] = v;
     dy[V] = -2.0 * osc.gamma * v - x + f + drive;

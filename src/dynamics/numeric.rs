@@ -12,7 +12,7 @@
 //! square-root singularity in α̂ but is smooth in u, so this last stretch takes two or
 //! three smooth steps instead of a cascade of shrinking ones onto the cusp.
 
-use super::model::{BASE, COS, Coupling, Oscillator, SIN, State, V, X, rhs, set_phasor};
+use super::model::{BASE, COS, Coupling, Oscillator, SIN, State, TANGENT, V, X, rhs, set_phasor};
 use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw};
 use crate::numeric::bracketed_root;
@@ -398,13 +398,24 @@ fn dopri<S: System<f64, State<N>>, const N: usize>(
         10.0,
         tol.h_max,
         h0,
-        u32::MAX,
+        if N == TANGENT {
+            MAX_TANGENT_STEPS
+        } else {
+            u32::MAX
+        },
         // No stiffness test: slow base-driven cycles run Dopri5 at its stability limit
         // on purpose (the problem is only mildly stiff there).
         u32::MAX,
         OutputType::Sparse,
     )
 }
+
+/// Most steps of one segment with the variational equations. A segment normally takes
+/// a hundred or so; where the tip lingers next to a fold of the force law the variational
+/// equations grow stiff (the slope there is ∝ 1/√distance) and Dopri5 would crawl. The
+/// period map is not smooth there anyway: exceeding this is a numerical failure, which
+/// the shooting takes as "no orbit here".
+const MAX_TANGENT_STEPS: u32 = 4000;
 
 /// Whether [from, to] is too short for Dopri5 to step at this τ (its step-size underflow
 /// test is 0.1·h ≤ ε·|τ|); such spans are bridged by the Hermite interpolant instead.

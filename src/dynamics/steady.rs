@@ -17,12 +17,13 @@
 
 use super::free::FreeFlight;
 use super::model::{
-    BASE, Coupling, E_DAMP, F_INT, Oscillator, SC, SS, State, TANGENT, V, VIRIAL, X, phi, set_phi,
+    BASE, Coupling, E_DAMP, F_INT, Oscillator, SC, SS, State, TANGENT, V, VIRIAL, X, chain, phi,
+    phi_start, set_phi,
 };
 use super::numeric::{self, Crossing, StepEnd, StepObserver, Tolerances, hermite};
 use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw};
-use nalgebra::{Complex, Matrix2, Vector2};
+use nalgebra::{Complex, Matrix2, Matrix2x3, Vector2};
 
 /// Where the oscillator is: time, deflection, velocity and contact branch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -208,7 +209,7 @@ fn hermite_minimum<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>) -> f64 {
 }
 
 /// A law, an oscillator, its coupling to the contact and the integrator settings.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug)]
 pub struct Simulation<'a, L: ForceLaw> {
     /// Tip–sample force law.
     pub law: &'a L,
@@ -219,6 +220,14 @@ pub struct Simulation<'a, L: ForceLaw> {
     /// Integrator settings.
     pub tol: Tolerances,
 }
+
+// By hand: derived, they would ask the law itself to be Copy.
+impl<L: ForceLaw> Clone for Simulation<'_, L> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<L: ForceLaw> Copy for Simulation<'_, L> {}
 
 /// The longest period looked for; motion that repeats after no n ≤ this is `irregular`.
 pub const MAX_PERIOD: usize = 8;
@@ -278,6 +287,23 @@ pub struct StdErr {
     pub e_ts: f64,
 }
 
+/// The n-period map evaluated at a state.
+pub(crate) struct MapValue {
+    /// The state n periods later.
+    pub end: Phase,
+    /// ∂(x, x')(end)/∂(x, x', q)(start).
+    pub derivative: Matrix2x3<f64>,
+    /// The integrals over the n periods.
+    pub integrals: CycleIntegrals,
+}
+
+impl MapValue {
+    /// The derivative in the state alone (the monodromy matrix on an orbit).
+    pub fn monodromy(&self) -> Matrix2<f64> {
+        self.derivative.fixed_columns::<2>(0).into_owned()
+    }
+}
+
 /// A periodic orbit found by Newton's method.
 struct Orbit {
     /// The state on the orbit at the section.
@@ -322,15 +348,38 @@ impl<L: ForceLaw> Simulation<'_, L> {
     }
 
     /// Integrate one drive period from `phase`, updating it, with the derivative of the
-    /// period map, ∂(x, x')(τ + T)/∂(x, x')(τ): the variational equations along every
-    /// segment, the free flight's transition matrix in closed form, and at every branch
-    /// switch the saltation matrix [[1, 0], [Δf_ts/(dα̂/dτ / a₁), 1]] (the force jumps by
-    /// Δf_ts where α̂ crosses the switching level).
+    /// period map, ∂(x, x')(τ + T)/∂(x, x', q)(τ), q = z_c/L: the variational equations
+    /// along every segment, the free flight's transition matrix in closed form, and at
+    /// every branch switch the saltation matrix: where the force jumps by Δf_ts as α̂
+    /// crosses its level, δx' gains Δf_ts(δx + δq)/(x' + x_b').
     pub fn cycle_with_derivative(
         &self,
         phase: &mut Phase,
-    ) -> Result<(CycleIntegrals, Matrix2<f64>)> {
+    ) -> Result<(CycleIntegrals, Matrix2x3<f64>)> {
         self.cycle_in::<TANGENT, _>(phase, &mut numeric::Ignore)
+    }
+
+    /// Move `phase` back by whole drive periods to τ in [0, T): the drive is periodic,
+    /// and a τ that grows through a long run costs the integrator its precision (at
+    /// τ ≈ 10⁷ Dopri5's steps underflow).
+    fn rewind(&self, phase: &mut Phase) {
+        let period = self.osc.period();
+        if phase.tau >= period {
+            phase.tau -= (phase.tau / period).floor() * period;
+        }
+    }
+
+    /// The branch a state can be on: its own, unless it sits on the wrong side of a
+    /// switch (a state carried over from another setpoint or moved by Newton's method:
+    /// the tip cannot be out of contact below the jump-in separation, nor in contact
+    /// above the jump-out one).
+    fn consistent_branch(&self, phase: &Phase) -> Branch {
+        let alpha = self.cpl.alpha_hat(phase.x, self.osc.base_at(phase.tau).0);
+        match phase.branch {
+            Branch::Free if alpha <= self.law.jump_in_alpha_hat() => Branch::Contact,
+            Branch::Contact if alpha >= self.law.jump_out_alpha_hat() => Branch::Free,
+            b => b,
+        }
     }
 
     /// Apply the saltation matrix of a switch `from` → `to` in state `y` at τ.
@@ -344,30 +393,27 @@ impl<L: ForceLaw> Simulation<'_, L> {
         if jump == 0.0 {
             return;
         }
-        let s = Matrix2::new(1.0, 0.0, jump / (y[V] + v_b), 1.0);
-        set_phi(y, &(s * phi(y)));
+        let mut d = phi(y);
+        let k = jump / (y[V] + v_b);
+        for col in 0..3 {
+            d[(1, col)] += k * (d[(0, col)] + if col == 2 { 1.0 } else { 0.0 });
+        }
+        set_phi(y, &d);
     }
 
     fn cycle_in<const N: usize, O: StepObserver>(
         &self,
         phase: &mut Phase,
         observer: &mut O,
-    ) -> Result<(CycleIntegrals, Matrix2<f64>)> {
+    ) -> Result<(CycleIntegrals, Matrix2x3<f64>)> {
         let period = self.osc.period();
         let tau_end = phase.tau + period;
-        // A state carried over from another setpoint may sit on the wrong side of a
-        // switch (the tip cannot be out of contact below the jump-in separation).
-        let alpha = self.cpl.alpha_hat(phase.x, self.osc.base_at(phase.tau).0);
-        phase.branch = match phase.branch {
-            Branch::Free if alpha <= self.law.jump_in_alpha_hat() => Branch::Contact,
-            Branch::Contact if alpha >= self.law.jump_out_alpha_hat() => Branch::Free,
-            b => b,
-        };
+        phase.branch = self.consistent_branch(phase);
         let mut y = State::<N>::zeros();
         y[X] = phase.x;
         y[V] = phase.v;
         if N == TANGENT {
-            set_phi(&mut y, &Matrix2::identity());
+            set_phi(&mut y, &phi_start());
         }
         let mechanical = |y: &State<N>| 0.5 * (y[X] * y[X] + y[V] * y[V]);
         let e0 = mechanical(&y);
@@ -474,11 +520,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             jumps_in,
             jumps_out,
         };
-        let derivative = if N == TANGENT {
-            phi(&y)
-        } else {
-            Matrix2::identity()
-        };
+        let derivative = if N == TANGENT { phi(&y) } else { phi_start() };
         Ok((integrals, derivative))
     }
 
@@ -487,28 +529,38 @@ impl<L: ForceLaw> Simulation<'_, L> {
     /// left, or if the variational equations cannot be integrated there (a tip that
     /// stalls at a fold of the force law, where the map is not smooth). Counts the
     /// periods in `spent`.
-    fn period_map(
+    pub(crate) fn period_map(
         &self,
         start: &Phase,
         z: Vector2<f64>,
         n: usize,
         spent: &mut usize,
-    ) -> Result<Option<(Phase, Matrix2<f64>)>> {
+    ) -> Result<Option<MapValue>> {
         let mut p = Phase {
             x: z[0],
             v: z[1],
             ..*start
         };
-        let mut m = Matrix2::identity();
+        let branch = self.consistent_branch(&p);
+        let mut derivative = phi_start();
+        let mut integrals: Option<CycleIntegrals> = None;
         for _ in 0..n {
             *spent += 1;
             match self.cycle_with_derivative(&mut p) {
-                Ok((_, d)) => m = d * m,
+                Ok((c, d)) => {
+                    derivative = chain(&derivative, &d);
+                    integrals = Some(integrals.map_or(c, |s| s.then(&c)));
+                }
                 Err(Error::Numerical(_)) => return Ok(None),
                 Err(e) => return Err(e),
             }
         }
-        Ok((p.branch == start.branch && p.x.is_finite() && p.v.is_finite()).then_some((p, m)))
+        let back = p.branch == branch && p.x.is_finite() && p.v.is_finite();
+        Ok(back.then(|| MapValue {
+            end: p,
+            derivative,
+            integrals: integrals.expect("n >= 1"),
+        }))
     }
 
     /// Newton's method on Pⁿ(z) − z = 0 from `start`, with the exact derivative of the
@@ -530,9 +582,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
         spent: &mut usize,
     ) -> Result<Option<Orbit>> {
         let mut z = start.z();
-        let Some((mut end, mut m)) = self.period_map(start, z, n, spent)? else {
+        let Some(value) = self.period_map(start, z, n, spent)? else {
             return Ok(None);
         };
+        let (mut end, mut m) = (value.end, value.monodromy());
         let mut r = end.z() - z;
         let mut norm = r.amax();
         let mut radius: f64 = 0.2;
@@ -557,10 +610,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
             let scale = (radius / length).min(1.0);
             let trial = z + step * scale;
             match self.period_map(start, trial, n, spent)? {
-                Some((e, d)) if (e.z() - trial).amax() <= (1.0 - 0.1 * scale) * norm => {
+                Some(value) if (value.end.z() - trial).amax() <= (1.0 - 0.1 * scale) * norm => {
                     z = trial;
-                    end = e;
-                    m = d;
+                    m = value.monodromy();
+                    end = value.end;
                     r = end.z() - z;
                     norm = r.amax();
                     radius = radius.max(2.0 * scale * length);
@@ -606,7 +659,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let mut sum: Option<CycleIntegrals> = None;
         for distance in returns.iter_mut().take(n) {
             let (c, d) = self.cycle_with_derivative(phase)?;
-            m = d * m;
+            m = d.fixed_columns::<2>(0) * m;
             sum = Some(sum.map_or(c, |s| s.then(&c)));
             *distance = (phase.z() - z0).amax();
         }
@@ -716,6 +769,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             budget - budget / 8
         };
         // A first period puts the state on a consistent branch.
+        self.rewind(phase);
         self.cycle(phase, &mut numeric::Ignore)?;
         let mut spent = 1;
         if opts.shooting {
@@ -728,6 +782,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let mut stretch = FIRST_STRETCH;
         while spent < search_budget {
             for _ in 0..stretch.min(search_budget - spent) {
+                self.rewind(phase);
                 self.cycle(phase, &mut numeric::Ignore)?;
                 spent += 1;
                 ring.push(phase);
@@ -771,9 +826,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
     /// merging pairs and integrating as many again) until the standard errors of the
     /// batch means of A (relative), φ (rad) and E_ts (relative to E_drive) are below
     /// `opts.average_tolerance`, or the budget is spent. Batches start as long as the
-    /// oscillator's memory (QΩ/π periods), so the window is at least 16 of those. Whenever the first and second
-    /// halves of a full window differ by more than four combined standard errors in any
-    /// of them, the motion is still drifting: the first half is dropped instead.
+    /// oscillator's memory (QΩ/π periods), so the window is at least 16 of those.
+    /// Whenever a full window starts with a transient ([`transient_batches`]), the motion
+    /// is not yet stationary: orbits are looked for again (with shooting), and the
+    /// transient batches are dropped.
     fn average(
         &self,
         phase: &mut Phase,
@@ -793,9 +849,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let mut batches: Vec<CycleIntegrals> = Vec::with_capacity(BATCHES);
         let mut current: Option<CycleIntegrals> = None;
         let mut current_len = 0;
+        let mut ring = Recurrence::default();
         loop {
+            self.rewind(phase);
             let c = self.cycle(phase, &mut numeric::Ignore)?;
             spent += 1;
+            ring.push(phase);
             current = Some(current.map_or(c, |s| s.then(&c)));
             current_len += 1;
             if current_len == batch_len {
@@ -812,17 +871,29 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     && std_err.phase <= opts.average_tolerance
                     && relative(std_err.e_ts, window.e_drive_per_period().abs())
                         <= opts.average_tolerance;
-                if out_of_budget || (met && !drifting(&batches)) {
+                let transient = transient_batches(&batches);
+                if out_of_budget || (met && transient == 0) {
                     return Ok(SteadyState {
                         window,
                         cycles: spent,
-                        converged: met && long_enough && !drifting(&batches),
+                        converged: met && long_enough && transient == 0,
                         motion: Motion::Irregular,
                         std_err,
                     });
                 }
-                if drifting(&batches) {
-                    batches.drain(..BATCHES / 2);
+                if transient > 0 {
+                    // Still a transient (a slow passage, e.g. past a fold's ghost): it
+                    // may yet settle on an orbit.
+                    if opts.shooting {
+                        for n in ring.candidates() {
+                            if let Some(found) =
+                                self.try_period(phase, n, opts, budget, &mut spent)?
+                            {
+                                return Ok(found);
+                            }
+                        }
+                    }
+                    batches.drain(..transient);
                 } else {
                     batches = batches.chunks(2).map(|p| p[0].then(&p[1])).collect();
                     batch_len *= 2;
@@ -870,9 +941,6 @@ fn batch_statistics(
             / (n - 1.0);
         (var / n).sqrt()
     };
-    let wrap = |d: f64| {
-        (d + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
-    };
     let std_err = if batches.len() < 2 {
         StdErr {
             amplitude: f64::INFINITY,
@@ -882,32 +950,54 @@ fn batch_statistics(
     } else {
         StdErr {
             amplitude: std_err_of(&|b| b.amplitude()),
-            phase: std_err_of(&|b| wrap(b.phase() - phase)),
+            phase: std_err_of(&|b| wrap_angle(b.phase() - phase)),
             e_ts: std_err_of(&|b| b.e_ts_per_period()),
         }
     };
     (window, std_err)
 }
 
-/// Whether the first and second halves of a window of batches differ by more than four
-/// combined standard errors in A, φ or E_ts per period (a transient still in the window).
-fn drifting(batches: &[CycleIntegrals]) -> bool {
-    if batches.len() < 4 {
-        return false;
+/// How many leading batches of a window are transient, by the marginal standard error
+/// rule (MSER; White, Simulation 69, 323, 1997): for A, φ and E_ts per period, the cut d
+/// ≤ n/2 that minimises the variance of the remaining batch values over (n − d)², taken
+/// only where it at least halves that of the whole window (a stationary window's
+/// minimum is at d = 0 but for chance); the largest such cut of the three. A transient
+/// that creeps (past a fold's ghost, say) shows up as leading batches far from the rest.
+fn transient_batches(batches: &[CycleIntegrals]) -> usize {
+    let n = batches.len();
+    if n < 4 {
+        return 0;
     }
-    let (early, late) = batches.split_at(batches.len() / 2);
-    let ((a, sa), (b, sb)) = (batch_statistics(early, None), batch_statistics(late, None));
-    let apart = |x: f64, y: f64, sx: f64, sy: f64| (x - y).abs() > 4.0 * sx.hypot(sy);
-    let wrap = |d: f64| {
-        (d + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
+    let (window, _) = batch_statistics(batches, None);
+    let phase = window.phase();
+    let cut = |value: &dyn Fn(&CycleIntegrals) -> f64| {
+        let ys: Vec<f64> = batches.iter().map(value).collect();
+        let mser = |d: usize| {
+            let rest = &ys[d..];
+            let m = rest.len() as f64;
+            let mean = rest.iter().sum::<f64>() / m;
+            rest.iter().map(|y| (y - mean).powi(2)).sum::<f64>() / (m * m * m)
+        };
+        let whole = mser(0);
+        let (best, at) = (1..=n / 2)
+            .map(|d| (d, mser(d)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("n >= 4");
+        if at < 0.5 * whole { best } else { 0 }
     };
-    apart(a.amplitude(), b.amplitude(), sa.amplitude, sb.amplitude)
-        || wrap(a.phase() - b.phase()).abs() > 4.0 * sa.phase.hypot(sb.phase)
-        || apart(a.e_ts_per_period(), b.e_ts_per_period(), sa.e_ts, sb.e_ts)
+    cut(&|b| b.amplitude())
+        .max(cut(&|b| wrap_angle(b.phase() - phase)))
+        .max(cut(&|b| b.e_ts_per_period()))
+}
+
+/// An angle difference brought into (−π, π].
+fn wrap_angle(d: f64) -> f64 {
+    use std::f64::consts::PI;
+    PI - (PI - d).rem_euclid(2.0 * PI)
 }
 
 /// Eigenvalues of a 2×2 matrix.
-fn eigenvalues(m: &Matrix2<f64>) -> [Complex<f64>; 2] {
+pub(crate) fn eigenvalues(m: &Matrix2<f64>) -> [Complex<f64>; 2] {
     let half_trace = 0.5 * m.trace();
     let disc = Complex::new(half_trace * half_trace - m.determinant(), 0.0).sqrt();
     let h = Complex::new(half_trace, 0.0);

@@ -105,6 +105,39 @@ pub enum Corner {
     LowerRight,
 }
 
+impl Corner {
+    /// The corner whose quarter of the data's box (35 % of each axis) holds the fewest
+    /// points of `series`: where a legend hides the least.
+    pub fn quietest(series: &[Series]) -> Corner {
+        let all = || series.iter().flat_map(|s| s.points.iter().copied());
+        let finite = |v: f64| v.is_finite();
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for (x, y) in all().filter(|p| finite(p.0) && finite(p.1)) {
+            (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+        }
+        let (w, h) = ((x1 - x0).max(1e-300), (y1 - y0).max(1e-300));
+        let count = |left: bool, top: bool| {
+            all()
+                .filter(|&(x, y)| {
+                    let fx = (x - x0) / w;
+                    let fy = (y - y0) / h;
+                    (if left { fx <= 0.35 } else { fx >= 0.65 })
+                        && (if top { fy >= 0.65 } else { fy <= 0.35 })
+                })
+                .count()
+        };
+        [
+            (Corner::UpperRight, count(false, true)),
+            (Corner::UpperLeft, count(true, true)),
+            (Corner::LowerRight, count(false, false)),
+            (Corner::LowerLeft, count(true, false)),
+        ]
+        .into_iter()
+        .min_by_key(|c| c.1)
+        .map_or(Corner::UpperRight, |c| c.0)
+    }
+}
+
 /// A text label placed next to a data point (e.g. the letters of the paper's figures).
 #[derive(Debug, Clone, Serialize)]
 pub struct Label {

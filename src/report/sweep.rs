@@ -10,27 +10,23 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
     type Pick = fn(&SweepPoint) -> f64;
     let nm = |p: &SweepPoint| p.separation_m * 1e9;
     let series = |x: &dyn Fn(&SweepPoint) -> f64, y: Pick| -> Vec<Series> {
-        [
+        let mut out: Vec<Series> = [
             (Direction::Approach, "approach", 1),
             (Direction::Retract, "retract", 2),
         ]
         .into_iter()
-        .filter_map(|(dir, name, color)| {
-            let pts: Vec<(f64, f64)> = points
-                .iter()
-                .filter(|p| p.direction == dir)
-                .map(|p| (x(p), y(p)))
-                .collect();
-            (!pts.is_empty()).then(|| {
-                let style = if dir == Direction::Approach {
-                    Style::Line
-                } else {
-                    Style::Dashed
-                };
-                Series::new(name, pts, style, color)
-            })
+        .flat_map(|(dir, name, color)| {
+            let style = if dir == Direction::Approach {
+                Style::Line
+            } else {
+                Style::Dashed
+            };
+            let on: Vec<&SweepPoint> = points.iter().filter(|p| p.direction == dir).collect();
+            period_one_lines(&on, &|p| (x(p), y(p)), name, style, color)
         })
-        .collect()
+        .collect();
+        out.extend(not_period_one(points, &|p| (x(p), y(p))));
+        out
     };
     let chart =
         |name: &str, what: &str, x: Axis, xs: &dyn Fn(&SweepPoint) -> f64, y: Axis, ys: Pick| {
@@ -103,21 +99,100 @@ pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint
         title: title.into(),
         x: Axis::linear("A/A₀", "amplitude_ratio"),
         y: Axis::linear("phase lag φ (deg)", "phase_deg"),
-        series: curves
-            .iter()
-            .enumerate()
-            .map(|(i, (label, points))| {
-                let pts = points
-                    .iter()
-                    .filter(|p| {
-                        p.direction == Direction::Approach && p.observables.amplitude_ratio < 0.999
-                    })
-                    .map(|p| (p.observables.amplitude_ratio, p.observables.phase_deg))
-                    .collect();
-                Series::new(label, pts, Style::Line, i + 1)
-            })
-            .collect(),
+        series: {
+            let xy = |p: &SweepPoint| (p.observables.amplitude_ratio, p.observables.phase_deg);
+            let kept: Vec<Vec<&SweepPoint>> = curves
+                .iter()
+                .map(|(_, points)| {
+                    points
+                        .iter()
+                        .filter(|p| {
+                            p.direction == Direction::Approach
+                                && p.observables.amplitude_ratio < 0.999
+                        })
+                        .collect()
+                })
+                .collect();
+            let mut series: Vec<Series> = curves
+                .iter()
+                .zip(&kept)
+                .enumerate()
+                .flat_map(|(i, ((label, _), on))| {
+                    period_one_lines(on, &xy, label, Style::Line, i + 1)
+                })
+                .collect();
+            let others: Vec<SweepPoint> = kept.iter().flatten().map(|p| (*p).clone()).collect();
+            series.extend(not_period_one(&others, &xy));
+            series
+        },
         labels: vec![],
         legend: Corner::UpperRight,
     }
+}
+
+/// Lines through `points` (in order) that join neighbouring period-1 points only, the
+/// first named `name`: a value of motion that is not period-1 is no point of a smooth
+/// curve ([`not_period_one`] marks those).
+pub fn period_one_lines(
+    points: &[&SweepPoint],
+    xy: &dyn Fn(&SweepPoint) -> (f64, f64),
+    name: &str,
+    style: Style,
+    color: usize,
+) -> Vec<Series> {
+    let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for p in points {
+        if p.observables.period == Some(1) {
+            runs.last_mut().expect("a run").push(xy(p));
+        } else if !runs.last().expect("a run").is_empty() {
+            runs.push(Vec::new());
+        }
+    }
+    runs.into_iter()
+        .filter(|r| !r.is_empty())
+        .enumerate()
+        .map(|(i, r)| Series::new(if i == 0 { name } else { "" }, r, style, color))
+        .collect()
+}
+
+/// Points that are not period-1, as markers of their own: periodic orbits of higher
+/// period, and irregular motion (its values averages over a window).
+pub fn not_period_one(
+    points: &[SweepPoint],
+    xy: &dyn Fn(&SweepPoint) -> (f64, f64),
+) -> Vec<Series> {
+    let pick = |keep: &dyn Fn(&SweepPoint) -> bool| -> Vec<(f64, f64)> {
+        points.iter().filter(|p| keep(p)).map(xy).collect()
+    };
+    [
+        (
+            pick(&|p| p.observables.period.is_some_and(|n| n > 1)),
+            "period-n orbit (n ≥ 2)",
+            0,
+        ),
+        (
+            pick(&|p| p.observables.period.is_none()),
+            "irregular (window average)",
+            4,
+        ),
+    ]
+    .into_iter()
+    .filter(|(pts, _, _)| !pts.is_empty())
+    .map(|(pts, name, color)| Series::new(name, pts, Style::Markers, color))
+    .collect()
+}
+
+/// An approach ramp drawn over an orbit branch: its points as markers, approach and
+/// retract apart.
+pub fn ramp_markers(ramp: &[SweepPoint], xy: &dyn Fn(&SweepPoint) -> (f64, f64)) -> Vec<Series> {
+    [
+        (Direction::Approach, "approach ramp", 5),
+        (Direction::Retract, "retract ramp", 6),
+    ]
+    .into_iter()
+    .filter_map(|(dir, name, color)| {
+        let pts: Vec<(f64, f64)> = ramp.iter().filter(|p| p.direction == dir).map(xy).collect();
+        (!pts.is_empty()).then(|| Series::new(name, pts, Style::Markers, color))
+    })
+    .collect()
 }
