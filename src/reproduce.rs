@@ -120,40 +120,34 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
             curves.push((name.to_string(), law, approach(&s, law, 40)?));
         }
     }
-    let series_for =
-        |material: &str, y: fn(&SweepPoint) -> f64, x: fn(&SweepPoint) -> f64| -> Vec<Series> {
-            curves
-                .iter()
-                .filter(|(m, _, _)| m == material)
-                .enumerate()
-                .flat_map(|(i, (_, law, pts))| {
-                    [
-                        (Direction::Approach, Style::Line),
-                        (Direction::Retract, Style::Dashed),
-                    ]
-                    .map(|(dir, style)| {
-                        Series::new(
-                            &format!(
-                                "{law} {}",
-                                if dir == Direction::Approach {
-                                    "approach"
-                                } else {
-                                    "retract"
-                                }
-                            ),
-                            pts.iter()
-                                .filter(|p| p.direction == dir)
-                                .map(|p| (x(p), y(p)))
-                                .collect(),
-                            style,
-                            i + 1,
-                        )
-                    })
+    let series_for = |material: &str,
+                      y: fn(&SweepPoint) -> f64,
+                      x: fn(&SweepPoint) -> f64|
+     -> Vec<Series> {
+        let xy = |p: &SweepPoint| (x(p), y(p));
+        let mine: Vec<&(String, LawKind, Vec<SweepPoint>)> =
+            curves.iter().filter(|(m, _, _)| m == material).collect();
+        let mut series: Vec<Series> = mine
+            .iter()
+            .enumerate()
+            .flat_map(|(i, (_, law, pts))| {
+                [
+                    (Direction::Approach, Style::Line, "approach"),
+                    (Direction::Retract, Style::Dashed, "retract"),
+                ]
+                .into_iter()
+                .flat_map(move |(dir, style, what)| {
+                    let on: Vec<&SweepPoint> = pts.iter().filter(|p| p.direction == dir).collect();
+                    sweep_report::period_one_lines(&on, &xy, &format!("{law} {what}"), style, i + 1)
                 })
-                .collect()
-        };
+            })
+            .collect();
+        let all: Vec<SweepPoint> = mine.iter().flat_map(|c| c.2.iter().cloned()).collect();
+        series.extend(sweep_report::not_period_one(&all, &xy));
+        series
+    };
     let zc = |p: &SweepPoint| p.separation_m * 1e9;
-    let approach_charts = vec![
+    let mut approach_charts = vec![
         Chart {
             name: "tap_approach_amplitude".into(),
             title: "Approach curves, polymer A: amplitude".into(),
@@ -161,7 +155,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
             y: Axis::linear("A/A₀", "amplitude_ratio"),
             series: series_for("polymer A", |p| p.observables.amplitude_ratio, zc),
             labels: vec![],
-            legend: Corner::LowerRight,
+            legend: Corner::UpperRight,
         },
         Chart {
             name: "tap_approach_phase".into(),
@@ -182,6 +176,9 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
             legend: Corner::UpperRight,
         },
     ];
+    for chart in &mut approach_charts {
+        chart.legend = Corner::quietest(&chart.series);
+    }
     for ext in ["png", "svg"] {
         let path = out.join(format!("tap_approach_laws.{ext}"));
         plot::render_stack(&approach_charts, &path)?;
@@ -202,6 +199,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
                 "amplitude_ratio": p.observables.amplitude_ratio,
                 "phase_deg": p.observables.phase_deg,
                 "e_ts_j": p.observables.e_ts_j,
+                "regime": p.observables.regime,
                 "converged": p.observables.converged,
             }));
         }

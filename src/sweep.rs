@@ -346,3 +346,60 @@ pub fn orbit_branch(
     }
     Ok(OrbitBranch { points, notes })
 }
+
+/// Poincaré samples of the settled motion at one rest separation.
+#[derive(Debug, Clone, Serialize)]
+pub struct PoincareSample {
+    /// Rest separation z_c in m.
+    pub separation_m: f64,
+    /// How the settled motion repeats there ("period-2", "irregular", …).
+    pub regime: String,
+    /// Deflection z at drive phase 0 (the start of a drive period) in m.
+    pub deflection_m: f64,
+    /// Smallest tip–sample separation during that period in m.
+    pub min_separation_m: f64,
+}
+
+/// A bifurcation diagram: along an approach ramp (`separations_m`, carrying the
+/// oscillator from point to point), settle the motion at each rest separation, then
+/// record `samples` drive periods of it: the deflection at drive phase 0 and the smallest
+/// separation of each period. A period-n orbit shows n distinct values; irregular motion
+/// a cloud. `progress` is called after each separation with (done, total).
+pub fn bifurcation(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    separations_m: &[f64],
+    samples: usize,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Vec<PoincareSample>> {
+    use crate::dynamics::numeric::Ignore;
+    if samples == 0 {
+        return Err(Error::InvalidParameter {
+            name: "samples",
+            value: 0.0,
+            reason: "must be at least 1",
+        });
+    }
+    let p = Prepared::new(setup, numerics)?;
+    let scale = p.setup.contact.separation_scale_m();
+    let a0 = p.setup.cantilever.free_amplitude_m;
+    let mut phase = p.simulation().free_steady_start();
+    let mut out = Vec::with_capacity(separations_m.len() * samples);
+    for (i, &z) in separations_m.iter().enumerate() {
+        let sim = p.simulation_at(z)?;
+        let state = sim.steady_state(&mut phase, &p.steady)?;
+        let regime = state.motion.regime();
+        for _ in 0..samples {
+            let deflection_m = phase.x * a0;
+            let c = sim.cycle(&mut phase, &mut Ignore)?;
+            out.push(PoincareSample {
+                separation_m: z,
+                regime: regime.clone(),
+                deflection_m,
+                min_separation_m: c.min_alpha_hat * scale,
+            });
+        }
+        progress(i + 1, separations_m.len());
+    }
+    Ok(out)
+}

@@ -667,3 +667,100 @@ fn contrast_reports_a_row_per_law_and_setpoint() {
         );
     }
 }
+
+#[test]
+fn branches_lists_the_folds_of_a_bistable_case_and_writes_every_output() {
+    let (csv, png) = (scratch("branches.csv"), scratch("branches.png"));
+    let dmt = [
+        "--law",
+        "dmt",
+        "--hamaker",
+        "1.5e-19",
+        "--sample-modulus",
+        "2GPa",
+        "--from",
+        "22nm",
+        "--to",
+        "14nm",
+    ];
+    let mut args = vec!["branches"];
+    args.extend(dmt);
+    args.extend([
+        "--csv",
+        csv.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    let out = tapsim(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.matches("fold").count(), 2, "{text}");
+    assert!(text.contains("reached --to"), "{text}");
+    assert!(std::fs::read_to_string(&csv).unwrap().lines().count() > 20);
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    let mut args = vec!["branches", "--json"];
+    args.extend(dmt);
+    let v = json(&args);
+    let kinds = v["point"].as_array().unwrap();
+    let n = kinds.len();
+    for key in [
+        "separation_m",
+        "stable",
+        "floquet_multipliers",
+        "phase_deg",
+        "segment",
+    ] {
+        assert_eq!(v[key].as_array().unwrap().len(), n, "{key}");
+    }
+    let folds: Vec<usize> = (0..n).filter(|&i| kinds[i] == "fold").collect();
+    assert_eq!(folds.len(), 2);
+    // Unstable between the folds, stable outside them.
+    assert!(v["stable"][folds[0] + 1] == false && v["stable"][0] == true);
+    assert!(
+        v["notes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|s| s.as_str().unwrap().contains("reached"))
+    );
+    // A bad step is refused with a message.
+    let out = tapsim(&["branches", "--max-step", "-1nm"]);
+    assert!(!out.status.success());
+}
+
+#[test]
+fn bifurcation_samples_every_period_and_names_the_motion() {
+    let v = json(&[
+        "bifurcation",
+        "--law",
+        "jkr",
+        "--from",
+        "21nm",
+        "--to",
+        "14nm",
+        "--points",
+        "8",
+        "--samples",
+        "5",
+        "--json",
+        "--quiet",
+    ]);
+    let regimes = v["regime"].as_array().unwrap();
+    assert_eq!(regimes.len(), 40);
+    for key in ["separation_m", "deflection_m", "min_separation_m"] {
+        let col = v[key].as_array().unwrap();
+        assert_eq!(col.len(), 40, "{key}");
+        assert!(col.iter().all(|x| x.as_f64().unwrap().is_finite()));
+    }
+    // Far out period-1 (one value, repeated); near contact other kinds of motion.
+    assert_eq!(regimes[0], "period-1");
+    let d = v["deflection_m"].as_array().unwrap();
+    assert!((d[0].as_f64().unwrap() - d[4].as_f64().unwrap()).abs() < 1e-15);
+    assert!(regimes.iter().any(|r| r != "period-1"));
+    let out = tapsim(&["bifurcation", "--samples", "0"]);
+    assert!(!out.status.success());
+}

@@ -13,8 +13,10 @@ use clap::Args;
 /// Per point: the steady-state observables of `tapsim tap`. Output: a table on stdout,
 /// or --json (one object of equal-length arrays: separation_m, direction, amplitude_m,
 /// amplitude_ratio, phase_deg, e_ts_j, virial_j, mean_force_n, peak_force_n, converged,
-/// ...), --csv FILE, and --plot FILE.png|svg (A/A₀, φ, E_ts, virial, peak force vs z_c,
-/// and φ, E_ts, virial, peak force vs A/A₀; approach and retract distinct).
+/// regime, period, periods_averaged, stable, floquet_multipliers, *_std_err_*, ...),
+/// --csv FILE, and --plot FILE.png|svg (A/A₀, φ, E_ts, virial, peak force vs z_c, and
+/// φ, E_ts, virial, peak force vs A/A₀; approach and retract distinct; lines join
+/// period-1 points only, period-n and irregular points are marked).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct ApproachArgs {
@@ -69,18 +71,19 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         );
     } else {
         println!(
-            "{:>9} {:>9} {:>9} {:>10} {:>11} {:>10} {:>5}",
-            "z_c (nm)", "dir", "A/A0", "phi (deg)", "E_ts (eV)", "F_pk (nN)", "conv"
+            "{:>9} {:>9} {:>10} {:>9} {:>10} {:>11} {:>10} {:>5}",
+            "z_c (nm)", "dir", "motion", "A/A0", "phi (deg)", "E_ts (eV)", "F_pk (nN)", "conv"
         );
         for p in &points {
             let o = &p.observables;
             println!(
-                "{:>9.3} {:>9} {:>9.5} {:>10.4} {:>11.4} {:>10.4} {:>5}",
+                "{:>9.3} {:>9} {:>10} {:>9.5} {:>10.4} {:>11.4} {:>10.4} {:>5}",
                 p.separation_m * 1e9,
                 match p.direction {
                     Direction::Approach => "approach",
                     Direction::Retract => "retract",
                 },
+                o.regime,
                 o.amplitude_ratio,
                 o.phase_deg,
                 o.e_ts_ev,

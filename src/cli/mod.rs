@@ -2,6 +2,7 @@
 //! its own module.
 
 mod approach;
+mod bifurcation;
 mod branches;
 mod contrast;
 mod figure;
@@ -33,6 +34,7 @@ enum Command {
     Tap(tap::TapArgs),
     Approach(approach::ApproachArgs),
     Branches(branches::BranchesArgs),
+    Bifurcation(bifurcation::BifurcationArgs),
     Contrast(contrast::ContrastArgs),
     Map(map::MapArgs),
     Hysteresis(hysteresis::HysteresisArgs),
@@ -82,6 +84,7 @@ pub fn main() -> ExitCode {
         Command::Tap(args) => tap::run(args),
         Command::Approach(args) => approach::run(args),
         Command::Branches(args) => branches::run(args),
+        Command::Bifurcation(args) => bifurcation::run(args),
         Command::Contrast(args) => contrast::run(args),
         Command::Map(args) => map::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),

@@ -779,13 +779,17 @@ impl<L: ForceLaw> Simulation<'_, L> {
         }
         let mut ring = Recurrence::default();
         ring.push(phase);
+        // The periods marched while searching are the averaging window's first batches,
+        // should the motion prove irregular (a transient at their head is cut there).
+        let mut window = Window::new(self.memory_periods(), budget - spent);
         let mut stretch = FIRST_STRETCH;
         while spent < search_budget {
             for _ in 0..stretch.min(search_budget - spent) {
                 self.rewind(phase);
-                self.cycle(phase, &mut numeric::Ignore)?;
+                let c = self.cycle(phase, &mut numeric::Ignore)?;
                 spent += 1;
                 ring.push(phase);
+                window.add(&c);
                 if !opts.shooting {
                     // A state contracting onto the orbit by a factor ρ per n periods
                     // is |Δz|·ρ/(1 − ρ) from it; ρ is at most the free oscillator's
@@ -819,15 +823,22 @@ impl<L: ForceLaw> Simulation<'_, L> {
             }
             stretch *= 2;
         }
-        self.average(phase, opts, budget, spent)
+        self.average(phase, opts, budget, spent, window, ring)
     }
 
-    /// Average irregular motion over a window of 16 batches whose length doubles (by
-    /// merging pairs and integrating as many again) until the standard errors of the
-    /// batch means of A (relative), φ (rad) and E_ts (relative to E_drive) are below
-    /// `opts.average_tolerance`, or the budget is spent. Batches start as long as the
-    /// oscillator's memory (QΩ/π periods), so the window is at least 16 of those.
-    /// Whenever a full window starts with a transient ([`transient_batches`]), the motion
+    /// The oscillator's memory, the amplitude's relaxation time 2Q (in τ), in periods:
+    /// QΩ/π.
+    fn memory_periods(&self) -> usize {
+        (self.osc.omega / (2.0 * std::f64::consts::PI * self.osc.gamma))
+            .ceil()
+            .clamp(1.0, 1e9) as usize
+    }
+
+    /// Average irregular motion over a window of 16 batches (begun during the search for
+    /// an orbit, `window`) whose length doubles (by merging pairs and integrating as
+    /// many again) until the standard errors of the batch means of A (relative), φ (rad)
+    /// and E_ts (relative to E_drive) are below `opts.average_tolerance`, or the budget
+    /// is spent. Whenever a full window starts with a transient ([`transient_batches`]), the motion
     /// is not yet stationary: orbits are looked for again (with shooting), and the
     /// transient batches are dropped.
     fn average(
@@ -836,47 +847,32 @@ impl<L: ForceLaw> Simulation<'_, L> {
         opts: &SteadyOptions,
         budget: usize,
         mut spent: usize,
+        mut window: Window,
+        mut ring: Recurrence,
     ) -> Result<SteadyState> {
-        // Batches must outlast the oscillator's memory, the amplitude's relaxation time
-        // 2Q (in τ), to be nearly independent: QΩ/π periods. Where the budget left is
-        // too short for 16 of those, shorter batches still give a window and an error
-        // estimate, but not a converged one.
-        let memory = (self.osc.omega / (2.0 * std::f64::consts::PI * self.osc.gamma))
-            .ceil()
-            .clamp(1.0, 1e9) as usize;
-        let mut batch_len = memory.min(budget.saturating_sub(spent) / BATCHES).max(1);
-        let long_enough = batch_len == memory;
-        let mut batches: Vec<CycleIntegrals> = Vec::with_capacity(BATCHES);
-        let mut current: Option<CycleIntegrals> = None;
-        let mut current_len = 0;
-        let mut ring = Recurrence::default();
         loop {
             self.rewind(phase);
             let c = self.cycle(phase, &mut numeric::Ignore)?;
             spent += 1;
             ring.push(phase);
-            current = Some(current.map_or(c, |s| s.then(&c)));
-            current_len += 1;
-            if current_len == batch_len {
-                batches.push(current.take().expect("a batch"));
-                current_len = 0;
-            }
-            let full = batches.len() == BATCHES;
+            window.add(&c);
+            let full = window.batches.len() >= BATCHES;
             let out_of_budget = spent >= budget;
             if full || out_of_budget {
-                let (window, std_err) = batch_statistics(&batches, current.as_ref());
+                let (averages, std_err) =
+                    batch_statistics(&window.batches, window.current.as_ref());
                 let relative = |x: f64, of: f64| if of > 0.0 { x / of } else { x };
-                let met = batches.len() >= 2
-                    && relative(std_err.amplitude, window.amplitude()) <= opts.average_tolerance
+                let met = window.batches.len() >= 2
+                    && relative(std_err.amplitude, averages.amplitude()) <= opts.average_tolerance
                     && std_err.phase <= opts.average_tolerance
-                    && relative(std_err.e_ts, window.e_drive_per_period().abs())
+                    && relative(std_err.e_ts, averages.e_drive_per_period().abs())
                         <= opts.average_tolerance;
-                let transient = transient_batches(&batches);
+                let transient = transient_batches(&window.batches);
                 if out_of_budget || (met && transient == 0) {
                     return Ok(SteadyState {
-                        window,
+                        window: averages,
                         cycles: spent,
-                        converged: met && long_enough && transient == 0,
+                        converged: met && window.long_enough && transient == 0,
                         motion: Motion::Irregular,
                         std_err,
                     });
@@ -893,10 +889,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
                             }
                         }
                     }
-                    batches.drain(..transient);
+                    window.batches.drain(..transient);
                 } else {
-                    batches = batches.chunks(2).map(|p| p[0].then(&p[1])).collect();
-                    batch_len *= 2;
+                    window.batches = window.batches.chunks(2).map(|p| p[0].then(&p[1])).collect();
+                    window.batch_len *= 2;
                 }
             }
         }
@@ -910,6 +906,43 @@ const STALL_STEPS: usize = 8;
 /// The fewest periods a steady-state search may be given: enough to classify the motion
 /// and average irregular motion over a window of its own.
 pub const MIN_CYCLES: usize = 32;
+/// The averaging window of irregular motion: whole batches and the one being filled.
+struct Window {
+    /// Periods per batch.
+    batch_len: usize,
+    /// Whether batches are as long as the oscillator's memory (else the error estimate
+    /// is not trusted: the batch means are correlated).
+    long_enough: bool,
+    batches: Vec<CycleIntegrals>,
+    current: Option<CycleIntegrals>,
+    current_len: usize,
+}
+
+impl Window {
+    /// Batches must outlast the oscillator's `memory` (in periods) to be nearly
+    /// independent; where `budget` periods are too few for [`BATCHES`] of those, shorter
+    /// batches still give a window and an error estimate, but not a converged one.
+    fn new(memory: usize, budget: usize) -> Self {
+        let batch_len = memory.min(budget / BATCHES).max(1);
+        Self {
+            batch_len,
+            long_enough: batch_len == memory,
+            batches: Vec::with_capacity(BATCHES),
+            current: None,
+            current_len: 0,
+        }
+    }
+
+    fn add(&mut self, c: &CycleIntegrals) {
+        self.current = Some(self.current.map_or(*c, |s| s.then(c)));
+        self.current_len += 1;
+        if self.current_len == self.batch_len {
+            self.batches.push(self.current.take().expect("a batch"));
+            self.current_len = 0;
+        }
+    }
+}
+
 /// Batches of an irregular window.
 const BATCHES: usize = 16;
 /// Periods integrated before the first look for orbits of higher period.

@@ -1,6 +1,7 @@
 //! Everything that leaves tapsim: charts (PNG, SVG), CSV tables, JSON objects and the
 //! human-readable summaries. Files are written whole or not at all.
 
+pub mod bifurcation;
 pub mod branches;
 pub mod chart;
 pub mod hysteresis;

@@ -30,14 +30,15 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
     };
     let chart =
         |name: &str, what: &str, x: Axis, xs: &dyn Fn(&SweepPoint) -> f64, y: Axis, ys: Pick| {
+            let series = series(xs, ys);
             Chart {
                 name: name.into(),
                 title: format!("{title}: {what}"),
                 x,
                 y,
-                series: series(xs, ys),
+                legend: Corner::quietest(&series),
+                series,
                 labels: vec![],
-                legend: Corner::LowerRight,
             }
         };
     let zc = || Axis::linear("rest separation z_c (nm)", "separation_nm");
@@ -94,7 +95,7 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
 /// φ against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999 left out), one series
 /// per labelled curve: the phase-contrast view.
 pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint])]) -> Chart {
-    Chart {
+    let mut chart = Chart {
         name: name.into(),
         title: title.into(),
         x: Axis::linear("A/A₀", "amplitude_ratio"),
@@ -127,7 +128,9 @@ pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint
         },
         labels: vec![],
         legend: Corner::UpperRight,
-    }
+    };
+    chart.legend = Corner::quietest(&chart.series);
+    chart
 }
 
 /// Lines through `points` (in order) that join neighbouring period-1 points only, the
