@@ -61,5 +61,54 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// Whole `tap` runs from the free oscillation to the reported steady state: the defaults
+/// (period-1, found by Newton's method on the period map) and dForce's Hertz case at
+/// Q = 1e5 (time-marching needs ~580 000 periods there). The periods each takes are
+/// printed and bounded (20 and 60) before timing.
+fn settle(c: &mut Criterion) {
+    use tapsim::dynamics::observables::tap;
+    use tapsim::dynamics::setup::{Cantilever, TapSetup};
+    use tapsim::law::LawKind;
+    use tapsim::params::{Contact, composite_modulus};
+    let hertz = TapSetup {
+        contact: Contact::new(
+            5e-9,
+            composite_modulus(169e9, 0.28, 100e6, 0.3).expect("valid"),
+            0.1,
+            0.3e-9,
+        )
+        .expect("valid"),
+        cantilever: Cantilever {
+            stiffness_n_m: 0.9,
+            resonance_hz: 100e3,
+            quality: 1e5,
+            free_amplitude_m: 15e-9,
+            drive_frequency_hz: 100e3,
+        },
+        separation_m: 9e-9,
+        law: LawKind::Hertz,
+        hamaker_j: None,
+    };
+    let mut group = c.benchmark_group("settle");
+    for (name, setup, most) in [
+        ("hybrid defaults", default_setup(), 20),
+        ("dforce hertz Q=1e5", hertz, 60),
+    ] {
+        let o = tap(&setup, &Numerics::default(), 0)
+            .expect("tap")
+            .observables;
+        eprintln!("{name}: {} in {} periods", o.regime, o.cycles);
+        assert!(
+            o.converged && o.cycles <= most,
+            "{name}: {} periods",
+            o.cycles
+        );
+        group.bench_function(name, |b| {
+            b.iter(|| tap(&setup, &Numerics::default(), 0).expect("tap"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, settle);
 criterion_main!(benches);

@@ -20,10 +20,17 @@ use std::path::PathBuf;
 /// hybrid-attractive (semi-rigid attraction (12), (14) before contact), jkr (jump-in
 /// at α = 0), dmt, hertz, none.
 ///
+/// The motion starts from the free oscillation and settles on a steady state, which is
+/// named: a period-n orbit (n ≤ 8; its Floquet multipliers say whether it is stable) or
+/// irregular motion. What is reported is what a lock-in and a dissipation measurement
+/// read: averages over the n periods of the orbit, or over a window of irregular motion
+/// (with standard errors), never one period of motion that is not period-1.
+///
 /// JSON keys (--json): amplitude_m, amplitude_ratio, phase_deg, phase_from_energy_deg,
 /// e_ts_j, e_ts_ev, e_damp_j, e_drive_j, energy_balance_rel, virial_j, mean_force_n,
-/// peak_force_n, min_separation_m, contact_fraction, loop_area_j, tabor_mu, cycles,
-/// converged, and more (see README).
+/// peak_force_n, min_separation_m, contact_fraction, jumps_in, loop_area_j, tabor_mu,
+/// regime, period, periods_averaged, stable, floquet_multipliers, amplitude_std_err_m,
+/// phase_std_err_deg, e_ts_std_err_j, cycles, converged, and more (see README).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct TapArgs {
