@@ -224,7 +224,8 @@ pub struct OrbitBranch {
 /// Follow the period-1 orbit family through the rest separation from `from_m` to `to_m`
 /// by pseudo-arclength continuation ([`crate::dynamics::continuation`]), stable and
 /// unstable orbits alike, with folds and period doublings located. It starts on the orbit
-/// the free steady state settles on at `from_m`, which must be period-1. `max_step_m`
+/// the free steady state settles on at `from_m` (if that is a stable period-1 orbit;
+/// else as below, where a piece ends). `max_step_m`
 /// bounds the step along the branch (in m of the (z, ż/ω₀, z_c) arclength).
 ///
 /// Where a piece of the family ends at a grazing orbit (for a hysteretic law the period

@@ -1,6 +1,6 @@
 //! `tapsim approach`: an approach–retract curve.
 
-use crate::config::{TapInputs, length};
+use crate::config::TapInputs;
 use crate::error::Result;
 use crate::report::{output, plot, records, sweep as report};
 use crate::sweep::{self, Direction};
@@ -24,12 +24,8 @@ pub struct ApproachArgs {
     inputs: TapInputs,
     #[command(flatten)]
     out: super::SweepOutput,
-    /// Farthest rest separation [m; default 1.2 A₀].
-    #[arg(long, allow_hyphen_values = true, value_parser = length)]
-    from: Option<f64>,
-    /// Nearest rest separation [m; default 0.4 A₀].
-    #[arg(long, allow_hyphen_values = true, value_parser = length)]
-    to: Option<f64>,
+    #[command(flatten)]
+    range: super::SeparationRange,
     /// Points on the approach (the retract has as many).
     #[arg(long, default_value_t = 60)]
     points: usize,
@@ -44,12 +40,8 @@ pub fn run(args: ApproachArgs) -> Result<()> {
     let (setup, numerics) = inputs.resolve()?;
     let numerics = sweep::sweep_numerics(&inputs, numerics);
     let a0 = setup.cantilever.free_amplitude_m;
-    let ramp = sweep::ramp(
-        args.from.unwrap_or(1.2 * a0),
-        args.to.unwrap_or(0.4 * a0),
-        args.points,
-        !args.no_retract,
-    )?;
+    let (from, to) = args.range.resolve(a0);
+    let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
     let bar = args.out.progress_bar(ramp.len());
     let points = sweep::approach_curve(&setup, &numerics, &ramp, |done, _| {
         bar.set_position(done as u64)

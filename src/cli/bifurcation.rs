@@ -1,6 +1,6 @@
 //! `tapsim bifurcation`: Poincaré samples of the settled motion along an approach.
 
-use crate::config::{TapInputs, length};
+use crate::config::TapInputs;
 use crate::error::{Error, Result};
 use crate::report::{bifurcation as report, output, plot, records};
 use crate::sweep;
@@ -23,12 +23,8 @@ pub struct BifurcationArgs {
     inputs: TapInputs,
     #[command(flatten)]
     out: super::SweepOutput,
-    /// Farthest rest separation [m; default 1.05 A₀].
-    #[arg(long, allow_hyphen_values = true, value_parser = length)]
-    from: Option<f64>,
-    /// Nearest rest separation [m; default 0.4 A₀].
-    #[arg(long, allow_hyphen_values = true, value_parser = length)]
-    to: Option<f64>,
+    #[command(flatten)]
+    range: super::SeparationRange,
     /// Rest separations on the ramp.
     #[arg(long, default_value_t = 120)]
     points: usize,
@@ -43,12 +39,8 @@ pub fn run(args: BifurcationArgs) -> Result<()> {
     let (setup, numerics) = inputs.resolve()?;
     let numerics = sweep::sweep_numerics(&inputs, numerics);
     let a0 = setup.cantilever.free_amplitude_m;
-    let ramp = sweep::ramp(
-        args.from.unwrap_or(1.05 * a0),
-        args.to.unwrap_or(0.4 * a0),
-        args.points,
-        false,
-    )?;
+    let (from, to) = args.range.resolve(a0);
+    let ramp = sweep::ramp(from, to, args.points, false)?;
     if args.samples == 0 || args.samples > 10_000 {
         return Err(Error::InvalidParameter {
             name: "--samples",

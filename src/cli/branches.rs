@@ -12,7 +12,8 @@ use clap::Args;
 /// through +1: where an approach or retract ramp jumps between the attractive and the
 /// repulsive regime) and period doublings (through −1: where a period-2 orbit takes
 /// over). Every `tapsim tap` option applies. The branch starts on the orbit the free
-/// oscillation settles on at --from, which must be period-1.
+/// oscillation settles on at --from (or, if that is not a stable period-1 orbit, a
+/// --max-step further on at a time until it is).
 ///
 /// Where an orbit just grazes a switch of a hysteretic force law (it starts to touch the
 /// sample) the period map jumps: touching dissipates a whole loop. The family is then
@@ -33,12 +34,8 @@ pub struct BranchesArgs {
     inputs: TapInputs,
     #[command(flatten)]
     out: super::SweepOutput,
-    /// Where the branch starts [m; default 1.2 A₀].
-    #[arg(long, allow_hyphen_values = true, value_parser = length)]
-    from: Option<f64>,
-    /// Where it ends [m; default 0.4 A₀].
-    #[arg(long, allow_hyphen_values = true, value_parser = length)]
-    to: Option<f64>,
+    #[command(flatten)]
+    range: super::SeparationRange,
     /// Largest step along the branch [m; default 0.01 A₀].
     #[arg(long, allow_hyphen_values = true, value_parser = length)]
     max_step: Option<f64>,
@@ -53,7 +50,7 @@ pub fn run(args: BranchesArgs) -> Result<()> {
     let inputs = args.inputs.with_config()?;
     let (setup, numerics) = inputs.resolve()?;
     let a0 = setup.cantilever.free_amplitude_m;
-    let (from, to) = (args.from.unwrap_or(1.2 * a0), args.to.unwrap_or(0.4 * a0));
+    let (from, to) = args.range.resolve(a0);
     let branch = sweep::orbit_branch(
         &setup,
         &numerics,

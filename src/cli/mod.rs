@@ -43,6 +43,28 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
 }
 
+/// The range of rest separations of the commands that sweep it (approach, branches,
+/// bifurcation).
+#[derive(Debug, clap::Args)]
+pub struct SeparationRange {
+    /// Farthest rest separation [m; default 1.2 A₀].
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::config::length)]
+    pub from: Option<f64>,
+    /// Nearest rest separation [m; default 0.4 A₀].
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::config::length)]
+    pub to: Option<f64>,
+}
+
+impl SeparationRange {
+    /// (from, to) in m, the defaults for free amplitude `a0_m` where unset.
+    pub fn resolve(&self, a0_m: f64) -> (f64, f64) {
+        (
+            self.from.unwrap_or(1.2 * a0_m),
+            self.to.unwrap_or(0.4 * a0_m),
+        )
+    }
+}
+
 /// Output flags shared by the sweep commands (approach, contrast, map).
 #[derive(Debug, clap::Args)]
 pub struct SweepOutput {

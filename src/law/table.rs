@@ -67,31 +67,31 @@ impl UniformTable {
         self.nodes.is_empty()
     }
 
-    /// Interpolated value; outside the grid the end cubic is extrapolated.
+    /// The interval holding `x` (the end ones outside the grid): its fraction t, the
+    /// value y₀ and scaled slope m₀ at its start, those at its end, and y₁ − y₀.
     #[inline]
-    pub fn eval(&self, x: f64) -> f64 {
+    fn interval(&self, x: f64) -> (f64, f64, f64, f64, f64) {
         let u = (x - self.x0) * self.inv_dx;
         let last = self.nodes.len() - 2;
         // `as usize` saturates: negative u and NaN give 0.
         let i = (u as usize).min(last);
-        let t = u - i as f64;
         let [y0, m0] = self.nodes[i];
         let [y1, m1] = self.nodes[i + 1];
+        (u - i as f64, y0, m0, m1, y1 - y0)
+    }
+
+    /// Interpolated value; outside the grid the end cubic is extrapolated.
+    #[inline]
+    pub fn eval(&self, x: f64) -> f64 {
+        let (t, y0, m0, m1, d) = self.interval(x);
         // Hermite basis in Horner form.
-        let d = y1 - y0;
         y0 + t * (m0 + t * (3.0 * d - 2.0 * m0 - m1 + t * (m0 + m1 - 2.0 * d)))
     }
 
     /// Slope of the interpolant at `x` (the derivative of [`UniformTable::eval`]).
     #[inline]
     pub fn slope(&self, x: f64) -> f64 {
-        let u = (x - self.x0) * self.inv_dx;
-        let last = self.nodes.len() - 2;
-        let i = (u as usize).min(last);
-        let t = u - i as f64;
-        let [y0, m0] = self.nodes[i];
-        let [y1, m1] = self.nodes[i + 1];
-        let d = y1 - y0;
+        let (t, _, m0, m1, d) = self.interval(x);
         (m0 + t * (2.0 * (3.0 * d - 2.0 * m0 - m1) + 3.0 * t * (m0 + m1 - 2.0 * d))) * self.inv_dx
     }
 }
