@@ -243,10 +243,17 @@ pub fn orbit_branch(
     finite("--from", from_m)?;
     finite("--to", to_m)?;
     crate::error::positive("--max-step", max_step_m)?;
-    if max_step_m > (from_m - to_m).abs() {
+    let range = (from_m - to_m).abs();
+    if range == 0.0 {
+        return Err(Error::NotApplicable(
+            "--from and --to must differ: the branch is followed between them".into(),
+        ));
+    }
+    if !(max_step_m <= range && max_step_m >= 1e-4 * range) {
         return Err(Error::NotApplicable(format!(
-            "--max-step ({:.4} nm) exceeds the range from --from to --to",
-            max_step_m * 1e9
+            "--max-step ({:e} m) must lie between 1e-4 of the range from --from to --to \
+             and the whole of it ({:e} m)",
+            max_step_m, range
         )));
     }
     let p = Prepared::new(setup, numerics)?;

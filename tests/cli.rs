@@ -764,3 +764,20 @@ fn bifurcation_samples_every_period_and_names_the_motion() {
     let out = tapsim(&["bifurcation", "--samples", "0"]);
     assert!(!out.status.success());
 }
+
+#[test]
+fn branches_refuses_steps_that_would_not_finish() {
+    for args in [
+        vec!["branches", "--max-step", "1e-300"],
+        vec!["branches", "--max-step", "1m"],
+        vec!["branches", "--from", "10nm", "--to", "10nm"],
+    ] {
+        let out = tapsim(&args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--max-step") || err.contains("must differ"),
+            "{err}"
+        );
+    }
+}
