@@ -95,7 +95,7 @@ pub struct Numerics {
     /// Steps per drive period at most.
     pub min_steps_per_period: f64,
     /// Periodic orbits: the largest |Pⁿ(z) − z| accepted, in units of A₀ (Newton aims
-    /// 100× lower); time-marching: the return distance that counts as repeating.
+    /// 100× lower); time-marching: how close to the orbit the state must be.
     pub tolerance: f64,
     /// Irregular motion: the standard error its averages must reach (A relative, φ in
     /// rad, E_ts relative to E_drive).

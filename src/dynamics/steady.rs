@@ -295,6 +295,8 @@ pub(crate) struct MapValue {
     pub derivative: Matrix2x3<f64>,
     /// The integrals over the n periods.
     pub integrals: CycleIntegrals,
+    /// |state after k + 1 periods − start|∞ for k < min(n, [`MAX_PERIOD`]).
+    pub returns: [f64; MAX_PERIOD],
 }
 
 impl MapValue {
@@ -544,12 +546,16 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let branch = self.consistent_branch(&p);
         let mut derivative = phi_start();
         let mut integrals: Option<CycleIntegrals> = None;
-        for _ in 0..n {
+        let mut returns = [f64::INFINITY; MAX_PERIOD];
+        for k in 0..n {
             *spent += 1;
             match self.cycle_with_derivative(&mut p) {
                 Ok((c, d)) => {
                     derivative = chain(&derivative, &d);
                     integrals = Some(integrals.map_or(c, |s| s.then(&c)));
+                    if let Some(r) = returns.get_mut(k) {
+                        *r = (p.z() - z).amax();
+                    }
                 }
                 Err(Error::Numerical(_)) => return Ok(None),
                 Err(e) => return Err(e),
@@ -560,6 +566,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             end: p,
             derivative,
             integrals: integrals.expect("n >= 1"),
+            returns,
         }))
     }
 
@@ -645,27 +652,6 @@ impl<L: ForceLaw> Simulation<'_, L> {
         }))
     }
 
-    /// Integrate `n` periods from a point of an orbit: the summed integrals, the
-    /// monodromy matrix, and the distance of the state after each m < n periods from the
-    /// start (for the smallest period).
-    fn orbit_pass(
-        &self,
-        phase: &mut Phase,
-        n: usize,
-    ) -> Result<(CycleIntegrals, Matrix2<f64>, [f64; MAX_PERIOD])> {
-        let z0 = phase.z();
-        let mut m = Matrix2::identity();
-        let mut returns = [f64::INFINITY; MAX_PERIOD];
-        let mut sum: Option<CycleIntegrals> = None;
-        for distance in returns.iter_mut().take(n) {
-            let (c, d) = self.cycle_with_derivative(phase)?;
-            m = d.fixed_columns::<2>(0) * m;
-            sum = Some(sum.map_or(c, |s| s.then(&c)));
-            *distance = (phase.z() - z0).amax();
-        }
-        Ok((sum.expect("n >= 1"), m, returns))
-    }
-
     /// Look for a stable period-n orbit near `phase` by Newton's method. On success
     /// `phase` is moved onto it and the steady state over one pass of the orbit returned;
     /// otherwise `phase` is left as it was. An orbit that is unstable, or whose least
@@ -711,34 +697,26 @@ impl<L: ForceLaw> Simulation<'_, L> {
         spent: &mut usize,
     ) -> Result<Option<SteadyState>> {
         let start = *phase;
-        let mut pass = |n: usize, spent: &mut usize| {
-            *phase = start;
-            *spent += n;
-            match self.orbit_pass(phase, n) {
-                Ok(pass) => Ok(Some(pass)),
-                Err(Error::Numerical(_)) => Ok(None),
-                Err(e) => Err(e),
-            }
-        };
-        let Some((mut window, mut monodromy, returns)) = pass(n, spent)? else {
+        let Some(mut pass) = self.period_map(&start, start.z(), n, spent)? else {
             return Ok(None);
         };
         let least = (1..=n)
-            .find(|&m| n % m == 0 && (m == n || returns[m - 1] <= 1e3 * residual.max(1e-12)))
+            .find(|&m| n % m == 0 && (m == n || pass.returns[m - 1] <= 1e3 * residual.max(1e-12)))
             .unwrap_or(n);
         if least < n {
-            let Some((w, m, _)) = pass(least, spent)? else {
+            let Some(shorter) = self.period_map(&start, start.z(), least, spent)? else {
                 return Ok(None);
             };
-            (window, monodromy) = (w, m);
+            pass = shorter;
         }
+        *phase = pass.end;
         Ok(Some(SteadyState {
-            window,
+            window: pass.integrals,
             cycles: *spent,
             converged: true,
             motion: Motion::Periodic {
                 period: least,
-                multipliers: eigenvalues(&monodromy),
+                multipliers: eigenvalues(&pass.monodromy()),
             },
             std_err: StdErr::default(),
         }))
@@ -1093,7 +1071,8 @@ impl Recurrence {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SteadyOptions {
     /// Periodic orbits: the largest |Pⁿ(z) − z| accepted (units of L); Newton aims 100×
-    /// lower. Time-marching: the return distance that counts as repeating.
+    /// lower. Time-marching: how close to the orbit the state must be (judged from its
+    /// return distances).
     pub tolerance: f64,
     /// Irregular motion: the standard error of the averages (A relative, φ in rad, E_ts
     /// relative to E_drive) to reach.
