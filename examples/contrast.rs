@@ -18,10 +18,15 @@ fn main() -> tapsim::Result<()> {
         30,
         |what| eprintln!("approach curve: {what}"),
     )?;
+    // Materials are compared only on the same branch (attractive or repulsive).
     for r in rows {
+        let delta = r.delta_phase_deg.map_or(
+            "none: the materials sit on different branches".into(),
+            |d| format!("{d:+.2} deg"),
+        );
         println!(
-            "{:>7} A/A0 = {:.1}: delta phi = {:+.2} deg",
-            r.law, r.amplitude_ratio, r.delta_phase_deg
+            "{:>7} A/A0 = {:.1}, {:?} branch: delta phi = {delta}",
+            r.law, r.amplitude_ratio, r.branch
         );
     }
     Ok(())

@@ -47,21 +47,111 @@ impl Material {
     }
 }
 
-/// φ at one amplitude setpoint for every material, and the contrast.
+/// The regime an oscillating tip is in, told by its phase: attractive where φ lies above
+/// the free oscillator's phase (90° at resonance), repulsive below.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PhaseBranch {
+    /// Net attractive tip–sample force over the cycle: φ above the free phase.
+    Attractive,
+    /// Net repulsive: φ below the free phase.
+    Repulsive,
+}
+
+/// φ at one amplitude setpoint on one branch for every material, and the contrast.
 #[derive(Debug, Clone, Serialize)]
 pub struct ContrastRow {
     /// Force law.
     pub law: String,
     /// Amplitude setpoint A/A₀.
     pub amplitude_ratio: f64,
-    /// φ of each material (degrees), in the order given; NaN where the approach curve does
-    /// not reach this setpoint.
-    pub phase_deg: Vec<f64>,
-    /// φ(last material) − φ(first material), degrees.
-    pub delta_phase_deg: f64,
+    /// The branch the phases belong to (where a setpoint is bistable, both have a row).
+    pub branch: PhaseBranch,
+    /// φ of each material (degrees), in the order given; null where the material has no
+    /// steady state on this branch at this setpoint.
+    pub phase_deg: Vec<Option<f64>>,
+    /// The motion each φ comes from: "period-1" from the continuation of the period-1
+    /// family (stable orbits), else the regime of the approach-curve points it is
+    /// interpolated between ("irregular", "period-3", …).
+    pub regime: Vec<Option<String>>,
+    /// φ(last material) − φ(first material), degrees, where both are on this branch.
+    pub delta_phase_deg: Option<f64>,
 }
 
-/// The approach curve of one material under one law.
+/// One steady state at an amplitude setpoint.
+#[derive(Debug, Clone)]
+struct AtSetpoint {
+    branch: PhaseBranch,
+    phase_deg: f64,
+    regime: String,
+}
+
+/// Linear interpolation of (A/A₀, φ) pairs at A/A₀ = `r`, if `a` and `b` bracket it.
+fn crossing(a: (f64, f64), b: (f64, f64), r: f64) -> Option<f64> {
+    ((a.0 - r) * (b.0 - r) <= 0.0 && a.0 != b.0)
+        .then(|| a.1 + (r - a.0) / (b.0 - a.0) * (b.1 - a.1))
+}
+
+/// The steady states of one material and law at amplitude setpoint `r`: every stable
+/// period-1 orbit of the continued family there, and, on a branch with none, the approach
+/// curve's states (orbits of higher period or irregular motion) interpolated there.
+fn states_at(
+    family: &[sweep::BranchRecord],
+    ramp: &[SweepPoint],
+    r: f64,
+    free_phase_deg: f64,
+) -> Vec<AtSetpoint> {
+    let branch_of = |phase: f64| {
+        if phase > free_phase_deg {
+            PhaseBranch::Attractive
+        } else {
+            PhaseBranch::Repulsive
+        }
+    };
+    let pair = |o: &crate::dynamics::observables::TapObservables| (o.amplitude_ratio, o.phase_deg);
+    let mut out: Vec<AtSetpoint> = family
+        .windows(2)
+        .filter(|w| {
+            w[0].segment == w[1].segment
+                && w[0].observables.stable == Some(true)
+                && w[1].observables.stable == Some(true)
+        })
+        .filter_map(|w| crossing(pair(&w[0].observables), pair(&w[1].observables), r))
+        .map(|phase_deg| AtSetpoint {
+            branch: branch_of(phase_deg),
+            phase_deg,
+            regime: "period-1".into(),
+        })
+        .collect();
+    let approach: Vec<&SweepPoint> = ramp
+        .iter()
+        .filter(|p| p.direction == Direction::Approach)
+        .collect();
+    for w in approach.windows(2) {
+        let (a, b) = (&w[0].observables, &w[1].observables);
+        if a.period == Some(1) && b.period == Some(1) {
+            continue;
+        }
+        if let Some(phase_deg) = crossing(pair(a), pair(b), r) {
+            let branch = branch_of(phase_deg);
+            if !out.iter().any(|s| s.branch == branch) {
+                let nearer = if (a.amplitude_ratio - r).abs() < (b.amplitude_ratio - r).abs() {
+                    a
+                } else {
+                    b
+                };
+                out.push(AtSetpoint {
+                    branch,
+                    phase_deg,
+                    regime: nearer.regime.clone(),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The approach curve and the period-1 family of one material under one law.
 #[derive(Debug, Clone)]
 pub struct LawCurve {
     /// Material name.
@@ -70,38 +160,17 @@ pub struct LawCurve {
     pub law: LawKind,
     /// The approach points.
     pub points: Vec<SweepPoint>,
+    /// The period-1 orbit family over the same range ([`sweep::orbit_branch`]).
+    pub family: Vec<sweep::BranchRecord>,
+    /// The free oscillator's phase in degrees, atan2(Ω/Q, 1 − Ω²): the border between
+    /// the attractive and the repulsive branch.
+    pub free_phase_deg: f64,
 }
 
-/// φ at amplitude ratio `r` on the approach branch of `curve`, by linear interpolation
-/// between the first pair of setpoints that brackets it.
-fn phase_at(curve: &[SweepPoint], r: f64) -> f64 {
-    let approach: Vec<&SweepPoint> = curve
-        .iter()
-        .filter(|p| p.direction == Direction::Approach)
-        .collect();
-    approach
-        .windows(2)
-        .find(|w| {
-            let (a, b) = (
-                w[0].observables.amplitude_ratio,
-                w[1].observables.amplitude_ratio,
-            );
-            (a - r) * (b - r) <= 0.0 && a != b
-        })
-        .map(|w| {
-            let (a, b) = (
-                w[0].observables.amplitude_ratio,
-                w[1].observables.amplitude_ratio,
-            );
-            let f = (a - r) / (a - b);
-            w[0].observables.phase_deg
-                + f * (w[1].observables.phase_deg - w[0].observables.phase_deg)
-        })
-        .unwrap_or(f64::NAN)
-}
-
-/// Approach curves of every material under every law, and the contrast table at the
-/// amplitude setpoints `ratios`. `progress` is told what is being computed.
+/// Approach curves and period-1 orbit families of every material under every law, and
+/// the contrast table at the amplitude setpoints `ratios`: at each, every branch
+/// (attractive, repulsive) on which some material has a steady state, with Δφ between
+/// materials on the same branch. `progress` is told what is being computed.
 pub fn contrast(
     base: &TapInputs,
     materials: &[Material],
@@ -122,6 +191,8 @@ pub fn contrast(
         let numerics = sweep::sweep_numerics(&inputs, numerics);
         let a0 = setup.cantilever.free_amplitude_m;
         let ramp = sweep::ramp(1.2 * a0, 0.3 * a0, points, false)?;
+        let (w, q) = (setup.cantilever.omega_ratio(), setup.cantilever.quality);
+        let free_phase_deg = (w / q).atan2(1.0 - w * w).to_degrees();
         for &law in laws {
             progress(&format!("{}, {law}", m.name));
             let s = TapSetup {
@@ -132,27 +203,44 @@ pub fn contrast(
                 material: m.name.clone(),
                 law,
                 points: sweep::approach_curve(&s, &numerics, &ramp, |_, _| {})?,
+                family: sweep::orbit_branch(&s, &numerics, (1.2 * a0, 0.3 * a0), 0.01 * a0)?.points,
+                free_phase_deg,
             });
         }
     }
     let mut rows = Vec::new();
     for &law in laws {
+        let of_law: Vec<&LawCurve> = materials
+            .iter()
+            .filter_map(|m| curves.iter().find(|c| c.material == m.name && c.law == law))
+            .collect();
         for &r in ratios {
-            let phase_deg: Vec<f64> = materials
+            let states: Vec<Vec<AtSetpoint>> = of_law
                 .iter()
-                .map(|m| {
-                    curves
-                        .iter()
-                        .find(|c| c.material == m.name && c.law == law)
-                        .map_or(f64::NAN, |c| phase_at(&c.points, r))
-                })
+                .map(|c| states_at(&c.family, &c.points, r, c.free_phase_deg))
                 .collect();
-            rows.push(ContrastRow {
-                law: law.to_string(),
-                amplitude_ratio: r,
-                delta_phase_deg: phase_deg[phase_deg.len() - 1] - phase_deg[0],
-                phase_deg,
-            });
+            for branch in [PhaseBranch::Attractive, PhaseBranch::Repulsive] {
+                let on: Vec<Option<&AtSetpoint>> = states
+                    .iter()
+                    .map(|s| s.iter().find(|a| a.branch == branch))
+                    .collect();
+                if on.iter().all(Option::is_none) {
+                    continue;
+                }
+                let phase_deg: Vec<Option<f64>> =
+                    on.iter().map(|s| s.map(|a| a.phase_deg)).collect();
+                rows.push(ContrastRow {
+                    law: law.to_string(),
+                    amplitude_ratio: r,
+                    branch,
+                    delta_phase_deg: match (phase_deg[0], phase_deg[phase_deg.len() - 1]) {
+                        (Some(first), Some(last)) => Some(last - first),
+                        _ => None,
+                    },
+                    regime: on.iter().map(|s| s.map(|a| a.regime.clone())).collect(),
+                    phase_deg,
+                });
+            }
         }
     }
     Ok((rows, curves))

@@ -644,13 +644,46 @@ fn contrast_reports_a_row_per_law_and_setpoint() {
         "stiff:sample-modulus=1GPa,work-of-adhesion=80mJ/m^2",
     ]);
     let rows = v.as_array().unwrap();
-    assert_eq!(rows.len(), 4);
-    for r in rows {
-        let phases = r["phase_deg"].as_array().unwrap();
-        assert_eq!(phases.len(), 2);
-        let (a, b) = (phases[0].as_f64().unwrap(), phases[1].as_f64().unwrap());
-        assert!((r["delta_phase_deg"].as_f64().unwrap() - (b - a)).abs() < 1e-9);
+    // A row per law, setpoint and branch on which some material has a steady state.
+    assert!(rows.len() >= 4, "{rows:?}");
+    for law in ["jkr", "hybrid"] {
+        for r in [0.9, 0.7] {
+            assert!(
+                rows.iter()
+                    .any(|x| x["law"] == law && x["amplitude_ratio"] == r)
+            );
+        }
     }
+    for r in rows {
+        assert!(r["branch"] == "attractive" || r["branch"] == "repulsive");
+        let phases = r["phase_deg"].as_array().unwrap();
+        let regimes = r["regime"].as_array().unwrap();
+        assert_eq!(phases.len(), 2);
+        assert_eq!(regimes.len(), 2);
+        // Each phase lies on the row's branch (above or below 90° at resonance).
+        for (p, g) in phases.iter().zip(regimes) {
+            assert_eq!(p.is_null(), g.is_null());
+            if let Some(p) = p.as_f64() {
+                assert_eq!(p > 90.0, r["branch"] == "attractive", "{r}");
+            }
+        }
+        // Δφ only between materials on the same branch.
+        match (phases[0].as_f64(), phases[1].as_f64()) {
+            (Some(a), Some(b)) => {
+                assert!((r["delta_phase_deg"].as_f64().unwrap() - (b - a)).abs() < 1e-9)
+            }
+            _ => assert!(r["delta_phase_deg"].is_null()),
+        }
+    }
+    // Under the hybrid law both polymers stay attractive at A/A0 = 0.9, on period-1 orbits.
+    let h = rows
+        .iter()
+        .find(|x| {
+            x["law"] == "hybrid" && x["amplitude_ratio"] == 0.9 && x["branch"] == "attractive"
+        })
+        .unwrap();
+    assert_eq!(h["regime"][0], "period-1");
+    assert!(h["delta_phase_deg"].as_f64().unwrap().abs() > 0.1);
     for bad in ["nocolon", "x:modulus", "x:radius=ten", ":modulus=1GPa"] {
         let out = tapsim(&[
             "contrast",

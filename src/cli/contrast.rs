@@ -1,7 +1,7 @@
 //! `tapsim contrast`: phase contrast between materials under several laws.
 
 use crate::config::TapInputs;
-use crate::contrast::{self, Material};
+use crate::contrast::{self, Material, PhaseBranch};
 use crate::error::Result;
 use crate::law::LawKind;
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
@@ -16,8 +16,16 @@ use clap::Args;
 ///   --material a:sample-modulus=0.5GPa,work-of-adhesion=0.1
 ///   --material b:sample-modulus=1GPa,work-of-adhesion=0.08
 /// (without --material: these two). Every other `tapsim tap` option sets the common
-/// cantilever and tip. φ(A/A₀) comes from an approach curve per material and law; Δφ is
-/// φ(last material) − φ(first) at each setpoint.
+/// cantilever and tip.
+///
+/// At each amplitude setpoint every steady state of each material is found: the stable
+/// orbits of its period-1 family (continued through z_c as `tapsim branches` does), or,
+/// on a branch where there is none, the approach curve's states there (orbits of
+/// higher period, irregular motion). Each lies on the attractive (φ above the free
+/// phase, 90° at resonance) or the repulsive branch. Δφ = φ(last material) − φ(first)
+/// is taken only between materials on the same branch; where a setpoint is bistable,
+/// both branches get a row. The table names the motion behind every φ and compares
+/// JKR's contrast with the other laws', branch by branch.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct ContrastArgs {
@@ -65,8 +73,9 @@ pub fn run(args: ContrastArgs) -> Result<()> {
     )?;
     if let Some(path) = &args.out.csv {
         let mut w = csv::Writer::from_writer(Vec::new());
-        let mut header = vec!["law".to_string(), "amplitude_ratio".into()];
+        let mut header = vec!["law".to_string(), "amplitude_ratio".into(), "branch".into()];
         header.extend(materials.iter().map(|m| format!("phase_deg_{}", m.name)));
+        header.extend(materials.iter().map(|m| format!("regime_{}", m.name)));
         header.push("delta_phase_deg".into());
         let fail = |e: csv::Error| crate::Error::Output {
             path: path.clone(),
@@ -74,9 +83,15 @@ pub fn run(args: ContrastArgs) -> Result<()> {
         };
         w.write_record(&header).map_err(fail)?;
         for r in &rows {
-            let mut rec = vec![r.law.clone(), r.amplitude_ratio.to_string()];
-            rec.extend(r.phase_deg.iter().map(|p| p.to_string()));
-            rec.push(r.delta_phase_deg.to_string());
+            let cell = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
+            let mut rec = vec![
+                r.law.clone(),
+                r.amplitude_ratio.to_string(),
+                branch_name(r.branch).into(),
+            ];
+            rec.extend(r.phase_deg.iter().map(|&p| cell(p)));
+            rec.extend(r.regime.iter().map(|g| g.clone().unwrap_or_default()));
+            rec.push(cell(r.delta_phase_deg));
             w.write_record(&rec).map_err(fail)?;
         }
         let bytes = w.into_inner().map_err(|e| crate::Error::Output {
@@ -115,13 +130,22 @@ pub fn run(args: ContrastArgs) -> Result<()> {
                 .laws
                 .iter()
                 .enumerate()
-                .map(|(i, law)| {
-                    let pts = rows
-                        .iter()
-                        .filter(|r| r.law == law.to_string() && r.delta_phase_deg.is_finite())
-                        .map(|r| (r.amplitude_ratio, r.delta_phase_deg))
-                        .collect();
-                    Series::new(&law.to_string(), pts, Style::Line, i + 1)
+                .flat_map(|(i, law)| {
+                    let rows = &rows;
+                    [
+                        (PhaseBranch::Attractive, Style::Line),
+                        (PhaseBranch::Repulsive, Style::Dashed),
+                    ]
+                    .into_iter()
+                    .filter_map(move |(branch, style)| {
+                        let pts: Vec<(f64, f64)> = rows
+                            .iter()
+                            .filter(|r| r.law == law.to_string() && r.branch == branch)
+                            .filter_map(|r| r.delta_phase_deg.map(|d| (r.amplitude_ratio, d)))
+                            .collect();
+                        let name = format!("{law}, {}", branch_name(branch));
+                        (!pts.is_empty()).then(|| Series::new(&name, pts, style, i + 1))
+                    })
                 })
                 .collect(),
             labels: vec![],
@@ -135,13 +159,54 @@ pub fn run(args: ContrastArgs) -> Result<()> {
             serde_json::to_string_pretty(&rows).expect("serialises")
         );
     } else {
-        println!("{:>18} {:>8} {:>12}", "law", "A/A0", "Δφ (deg)");
+        println!(
+            "{:>18} {:>8} {:>11} {:>10}  motion",
+            "law", "A/A0", "branch", "Δφ (deg)"
+        );
         for r in &rows {
+            let regimes: Vec<&str> = r
+                .regime
+                .iter()
+                .map(|g| g.as_deref().unwrap_or("none"))
+                .collect();
             println!(
-                "{:>18} {:>8.3} {:>12.3}",
-                r.law, r.amplitude_ratio, r.delta_phase_deg
+                "{:>18} {:>8.3} {:>11} {:>10}  {}",
+                r.law,
+                r.amplitude_ratio,
+                branch_name(r.branch),
+                r.delta_phase_deg.map_or("—".into(), |d| format!("{d:.3}")),
+                regimes.join(", ")
             );
+        }
+        // How much more (or less) contrast JKR shows than each other law, branch by
+        // branch: only materials on the same branch are compared.
+        for other in args.laws.iter().filter(|l| **l != LawKind::Jkr) {
+            for r in rows.iter().filter(|r| r.law == "jkr") {
+                let same = rows.iter().find(|o| {
+                    o.law == other.to_string()
+                        && o.branch == r.branch
+                        && o.amplitude_ratio == r.amplitude_ratio
+                });
+                if let (Some(j), Some(o)) =
+                    (r.delta_phase_deg, same.and_then(|o| o.delta_phase_deg))
+                {
+                    println!(
+                        "A/A0 = {:.3}, {} branch: Δφ = {j:.3}° under jkr, {o:.3}° under {other} \
+                         (jkr {:+.3}°)",
+                        r.amplitude_ratio,
+                        branch_name(r.branch),
+                        j.abs() - o.abs(),
+                    );
+                }
+            }
         }
     }
     Ok(())
+}
+
+fn branch_name(b: PhaseBranch) -> &'static str {
+    match b {
+        PhaseBranch::Attractive => "attractive",
+        PhaseBranch::Repulsive => "repulsive",
+    }
 }
