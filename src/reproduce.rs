@@ -120,32 +120,37 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
             curves.push((name.to_string(), law, approach(&s, law, 40)?));
         }
     }
-    let series_for = |material: &str,
-                      y: fn(&SweepPoint) -> f64,
-                      x: fn(&SweepPoint) -> f64|
-     -> Vec<Series> {
-        let xy = |p: &SweepPoint| (x(p), y(p));
-        let mine: Vec<&(String, LawKind, Vec<SweepPoint>)> =
-            curves.iter().filter(|(m, _, _)| m == material).collect();
-        let mut series: Vec<Series> = mine
-            .iter()
-            .enumerate()
-            .flat_map(|(i, (_, law, pts))| {
-                [
-                    (Direction::Approach, Style::Line, "approach"),
-                    (Direction::Retract, Style::Dashed, "retract"),
-                ]
-                .into_iter()
-                .flat_map(move |(dir, style, what)| {
-                    let on: Vec<&SweepPoint> = pts.iter().filter(|p| p.direction == dir).collect();
-                    sweep_report::period_one_lines(&on, &xy, &format!("{law} {what}"), style, i + 1)
+    let series_for =
+        |material: &str, y: fn(&SweepPoint) -> f64, x: fn(&SweepPoint) -> f64| -> Vec<Series> {
+            let xy = |p: &SweepPoint| (x(p), y(p));
+            let mine: Vec<&(String, LawKind, Vec<SweepPoint>)> =
+                curves.iter().filter(|(m, _, _)| m == material).collect();
+            let mut series: Vec<Series> = mine
+                .iter()
+                .enumerate()
+                .flat_map(|(i, (_, law, pts))| {
+                    [
+                        (Direction::Approach, Style::Line, "approach"),
+                        (Direction::Retract, Style::Dashed, "retract"),
+                    ]
+                    .into_iter()
+                    .flat_map(move |(dir, style, what)| {
+                        let on: Vec<sweep_report::Located> = pts
+                            .iter()
+                            .filter(|p| p.direction == dir)
+                            .map(|p| sweep_report::locate(p, &xy))
+                            .collect();
+                        sweep_report::period_one_lines(&on, &format!("{law} {what}"), style, i + 1)
+                    })
                 })
-            })
-            .collect();
-        let all: Vec<SweepPoint> = mine.iter().flat_map(|c| c.2.iter().cloned()).collect();
-        series.extend(sweep_report::not_period_one(&all, &xy));
-        series
-    };
+                .collect();
+            let all: Vec<sweep_report::Located> = mine
+                .iter()
+                .flat_map(|c| c.2.iter().map(|p| sweep_report::locate(p, &xy)))
+                .collect();
+            series.extend(sweep_report::not_period_one(&all));
+            series
+        };
     let zc = |p: &SweepPoint| p.separation_m * 1e9;
     let mut approach_charts = vec![
         Chart {

@@ -1,9 +1,10 @@
 //! `tapsim map`: dissipation and phase over a grid of work of adhesion and modulus.
 
 use crate::config::{TapInputs, pressure, surface_energy};
+use crate::dynamics::observables::TapObservables;
 use crate::error::Result;
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
-use crate::report::{output, plot, records};
+use crate::report::{output, plot, records, sweep as sweep_report};
 use crate::sweep;
 use clap::Args;
 
@@ -63,23 +64,28 @@ pub fn run(args: MapArgs) -> Result<()> {
         output::write_bytes(path, &records::records_csv(&cells)?)?;
     }
     if let Some(path) = &args.out.plot {
-        let lines = |y: fn(&sweep::MapCell) -> Option<f64>| -> Vec<Series> {
-            moduli
+        // Per modulus, lines through the period-1 cells; other cells marked.
+        let lines = |y: fn(&TapObservables) -> f64| -> Vec<Series> {
+            let located = |e: Option<f64>| -> Vec<sweep_report::Located> {
+                cells
+                    .iter()
+                    .filter(|c| e.is_none_or(|e| c.modulus_pa == e))
+                    .filter_map(|c| {
+                        let o = c.observables.as_ref()?;
+                        Some((o.period, (c.work_of_adhesion_j_m2, y(o))))
+                    })
+                    .collect()
+            };
+            let mut series: Vec<Series> = moduli
                 .iter()
                 .enumerate()
-                .map(|(i, &e)| {
-                    Series::new(
-                        &format!("E* = {:.2} GPa", e * 1e-9),
-                        cells
-                            .iter()
-                            .filter(|c| c.modulus_pa == e)
-                            .filter_map(|c| y(c).map(|v| (c.work_of_adhesion_j_m2, v)))
-                            .collect(),
-                        Style::Line,
-                        i + 1,
-                    )
+                .flat_map(|(i, &e)| {
+                    let name = format!("E* = {:.2} GPa", e * 1e-9);
+                    sweep_report::period_one_lines(&located(Some(e)), &name, Style::Line, i + 1)
                 })
-                .collect()
+                .collect();
+            series.extend(sweep_report::not_period_one(&located(None)));
+            series
         };
         let charts = vec![
             Chart {
@@ -87,7 +93,7 @@ pub fn run(args: MapArgs) -> Result<()> {
                 title: format!("{} law: dissipation per cycle", setup.law),
                 x: Axis::log("work of adhesion Δγ (J/m²)", "work_of_adhesion"),
                 y: Axis::linear("E_ts per cycle (eV)", "e_ts_ev"),
-                series: lines(|c| c.observables.as_ref().map(|o| o.e_ts_ev)),
+                series: lines(|o| o.e_ts_ev),
                 labels: vec![],
                 legend: Corner::UpperLeft,
             },
@@ -96,7 +102,7 @@ pub fn run(args: MapArgs) -> Result<()> {
                 title: format!("{} law: phase", setup.law),
                 x: Axis::log("work of adhesion Δγ (J/m²)", "work_of_adhesion"),
                 y: Axis::linear("phase lag φ (deg)", "phase_deg"),
-                series: lines(|c| c.observables.as_ref().map(|o| o.phase_deg)),
+                series: lines(|o| o.phase_deg),
                 labels: vec![],
                 legend: Corner::UpperLeft,
             },

@@ -21,11 +21,19 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             } else {
                 Style::Dashed
             };
-            let on: Vec<&SweepPoint> = points.iter().filter(|p| p.direction == dir).collect();
-            period_one_lines(&on, &|p| (x(p), y(p)), name, style, color)
+            let on: Vec<Located> = points
+                .iter()
+                .filter(|p| p.direction == dir)
+                .map(|p| locate(p, &|p| (x(p), y(p))))
+                .collect();
+            period_one_lines(&on, name, style, color)
         })
         .collect();
-        out.extend(not_period_one(points, &|p| (x(p), y(p))));
+        let all: Vec<Located> = points
+            .iter()
+            .map(|p| locate(p, &|p| (x(p), y(p))))
+            .collect();
+        out.extend(not_period_one(&all));
         out
     };
     let chart =
@@ -102,7 +110,7 @@ pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint
         y: Axis::linear("phase lag φ (deg)", "phase_deg"),
         series: {
             let xy = |p: &SweepPoint| (p.observables.amplitude_ratio, p.observables.phase_deg);
-            let kept: Vec<Vec<&SweepPoint>> = curves
+            let kept: Vec<Vec<Located>> = curves
                 .iter()
                 .map(|(_, points)| {
                     points
@@ -111,6 +119,7 @@ pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint
                             p.direction == Direction::Approach
                                 && p.observables.amplitude_ratio < 0.999
                         })
+                        .map(|p| locate(p, &xy))
                         .collect()
                 })
                 .collect();
@@ -118,12 +127,10 @@ pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint
                 .iter()
                 .zip(&kept)
                 .enumerate()
-                .flat_map(|(i, ((label, _), on))| {
-                    period_one_lines(on, &xy, label, Style::Line, i + 1)
-                })
+                .flat_map(|(i, ((label, _), on))| period_one_lines(on, label, Style::Line, i + 1))
                 .collect();
-            let others: Vec<SweepPoint> = kept.iter().flatten().map(|p| (*p).clone()).collect();
-            series.extend(not_period_one(&others, &xy));
+            let others: Vec<Located> = kept.concat();
+            series.extend(not_period_one(&others));
             series
         },
         labels: vec![],
@@ -133,20 +140,17 @@ pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint
     chart
 }
 
+/// A value to plot and the period of the motion behind it (`None`: irregular).
+pub type Located = (Option<usize>, (f64, f64));
+
 /// Lines through `points` (in order) that join neighbouring period-1 points only, the
 /// first named `name`: a value of motion that is not period-1 is no point of a smooth
 /// curve ([`not_period_one`] marks those).
-pub fn period_one_lines(
-    points: &[&SweepPoint],
-    xy: &dyn Fn(&SweepPoint) -> (f64, f64),
-    name: &str,
-    style: Style,
-    color: usize,
-) -> Vec<Series> {
+pub fn period_one_lines(points: &[Located], name: &str, style: Style, color: usize) -> Vec<Series> {
     let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for p in points {
-        if p.observables.period == Some(1) {
-            runs.last_mut().expect("a run").push(xy(p));
+    for &(period, xy) in points {
+        if period == Some(1) {
+            runs.last_mut().expect("a run").push(xy);
         } else if !runs.last().expect("a run").is_empty() {
             runs.push(Vec::new());
         }
@@ -160,29 +164,27 @@ pub fn period_one_lines(
 
 /// Points that are not period-1, as markers of their own: periodic orbits of higher
 /// period, and irregular motion (its values averages over a window).
-pub fn not_period_one(
-    points: &[SweepPoint],
-    xy: &dyn Fn(&SweepPoint) -> (f64, f64),
-) -> Vec<Series> {
-    let pick = |keep: &dyn Fn(&SweepPoint) -> bool| -> Vec<(f64, f64)> {
-        points.iter().filter(|p| keep(p)).map(xy).collect()
+pub fn not_period_one(points: &[Located]) -> Vec<Series> {
+    let pick = |keep: &dyn Fn(Option<usize>) -> bool| -> Vec<(f64, f64)> {
+        points.iter().filter(|p| keep(p.0)).map(|p| p.1).collect()
     };
     [
         (
-            pick(&|p| p.observables.period.is_some_and(|n| n > 1)),
+            pick(&|n| n.is_some_and(|n| n > 1)),
             "period-n orbit (n ≥ 2)",
             0,
         ),
-        (
-            pick(&|p| p.observables.period.is_none()),
-            "irregular (window average)",
-            4,
-        ),
+        (pick(&|n| n.is_none()), "irregular (window average)", 4),
     ]
     .into_iter()
     .filter(|(pts, _, _)| !pts.is_empty())
     .map(|(pts, name, color)| Series::new(name, pts, Style::Markers, color))
     .collect()
+}
+
+/// A sweep point located for a plot by `xy`.
+pub fn locate(p: &SweepPoint, xy: &dyn Fn(&SweepPoint) -> (f64, f64)) -> Located {
+    (p.observables.period, xy(p))
 }
 
 /// An approach ramp drawn over an orbit branch: its points as markers, approach and
