@@ -284,9 +284,16 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
     }
     let _ = writeln!(
         md,
-        "| default tap (hybrid, μ = {:.2}): A/A₀ | {:.5} |",
-        o.tabor_mu, o.amplitude_ratio
+        "| default tap (hybrid, μ = {:.2}): motion | {}{} |",
+        o.tabor_mu,
+        o.regime,
+        match o.stable {
+            Some(true) => ", stable",
+            Some(false) => ", unstable",
+            None => "",
+        }
     );
+    let _ = writeln!(md, "| default tap: A/A₀ | {:.5} |", o.amplitude_ratio);
     let _ = writeln!(
         md,
         "| default tap: φ (lock-in / from energy) | {:.4}° / {:.4}° |",
