@@ -36,14 +36,11 @@ pub struct ApproachArgs {
 
 /// Run the subcommand.
 pub fn run(args: ApproachArgs) -> Result<()> {
-    let inputs = args.inputs.with_config()?;
-    let (setup, numerics) = inputs.resolve()?;
-    let numerics = sweep::sweep_numerics(&inputs, numerics);
-    let a0 = setup.cantilever.free_amplitude_m;
-    let (from, to) = args.range.resolve(a0);
+    let start = super::SweepStart::new(args.inputs, &args.range)?;
+    let (setup, numerics, (from, to)) = (&start.setup, &start.sweep_numerics, start.range);
     let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
     let bar = args.out.progress_bar(ramp.len());
-    let points = sweep::approach_curve(&setup, &numerics, &ramp, |done, _| {
+    let points = sweep::approach_curve(setup, numerics, &ramp, |done, _| {
         bar.set_position(done as u64)
     })?;
     bar.finish_and_clear();

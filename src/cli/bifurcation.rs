@@ -35,11 +35,8 @@ pub struct BifurcationArgs {
 
 /// Run the subcommand.
 pub fn run(args: BifurcationArgs) -> Result<()> {
-    let inputs = args.inputs.with_config()?;
-    let (setup, numerics) = inputs.resolve()?;
-    let numerics = sweep::sweep_numerics(&inputs, numerics);
-    let a0 = setup.cantilever.free_amplitude_m;
-    let (from, to) = args.range.resolve(a0);
+    let start = super::SweepStart::new(args.inputs, &args.range)?;
+    let (setup, numerics, (from, to)) = (&start.setup, &start.sweep_numerics, start.range);
     let ramp = sweep::ramp(from, to, args.points, false)?;
     if args.samples == 0 || args.samples > 10_000 {
         return Err(Error::InvalidParameter {
@@ -50,7 +47,7 @@ pub fn run(args: BifurcationArgs) -> Result<()> {
     }
     let separations: Vec<f64> = ramp.iter().map(|r| r.0).collect();
     let bar = args.out.progress_bar(separations.len());
-    let samples = sweep::bifurcation(&setup, &numerics, &separations, args.samples, |done, _| {
+    let samples = sweep::bifurcation(setup, numerics, &separations, args.samples, |done, _| {
         bar.set_position(done as u64)
     })?;
     bar.finish_and_clear();

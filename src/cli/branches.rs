@@ -47,22 +47,20 @@ pub struct BranchesArgs {
 
 /// Run the subcommand.
 pub fn run(args: BranchesArgs) -> Result<()> {
-    let inputs = args.inputs.with_config()?;
-    let (setup, numerics) = inputs.resolve()?;
+    let start = super::SweepStart::new(args.inputs, &args.range)?;
+    let (setup, (from, to)) = (&start.setup, start.range);
     let a0 = setup.cantilever.free_amplitude_m;
-    let (from, to) = args.range.resolve(a0);
     let branch = sweep::orbit_branch(
-        &setup,
-        &numerics,
+        setup,
+        &start.numerics,
         (from, to),
         args.max_step.unwrap_or(0.01 * a0),
     )?;
     let ramp = match args.overlay {
         Some(points) => {
             let ramp = sweep::ramp(from.max(to), from.min(to), points, true)?;
-            let numerics = sweep::sweep_numerics(&inputs, numerics);
             let bar = args.out.progress_bar(ramp.len());
-            let curve = sweep::approach_curve(&setup, &numerics, &ramp, |done, _| {
+            let curve = sweep::approach_curve(setup, &start.sweep_numerics, &ramp, |done, _| {
                 bar.set_position(done as u64)
             })?;
             bar.finish_and_clear();

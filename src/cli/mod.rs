@@ -65,6 +65,39 @@ impl SeparationRange {
     }
 }
 
+/// What a sweep command starts from: the setup of its inputs (over a `--config` file),
+/// the numerics with the per-setpoint defaults of a sweep, and the range of rest
+/// separations.
+pub struct SweepStart {
+    /// The setup.
+    pub setup: crate::dynamics::setup::TapSetup,
+    /// The numerics as given.
+    pub numerics: crate::dynamics::setup::Numerics,
+    /// The numerics with the sweep defaults where unset.
+    pub sweep_numerics: crate::dynamics::setup::Numerics,
+    /// (from, to) in m.
+    pub range: (f64, f64),
+}
+
+impl SweepStart {
+    /// Resolve `inputs` and `range`.
+    pub fn new(
+        inputs: crate::config::TapInputs,
+        range: &SeparationRange,
+    ) -> crate::error::Result<Self> {
+        let inputs = inputs.with_config()?;
+        let (setup, numerics) = inputs.resolve()?;
+        let sweep_numerics = crate::sweep::sweep_numerics(&inputs, numerics);
+        let range = range.resolve(setup.cantilever.free_amplitude_m);
+        Ok(Self {
+            setup,
+            numerics,
+            sweep_numerics,
+            range,
+        })
+    }
+}
+
 /// Output flags shared by the sweep commands (approach, contrast, map).
 #[derive(Debug, clap::Args)]
 pub struct SweepOutput {

@@ -224,17 +224,21 @@ fn jkr_work(alpha_hat: f64) -> f64 {
 mod tests {
     use super::*;
 
-    #[test]
-    fn work_is_the_antiderivative_everywhere() {
-        // A made-up approach branch with a square-root fold at (1, 2).
-        let b = FoldBranch::new(
+    /// A made-up approach branch with a square-root fold at (1, 2).
+    fn made_up_approach() -> FoldBranch {
+        FoldBranch::new(
             (1.0, 2.0),
             Side::Above,
             3.0,
             2001,
             FarField::Decay { kappa: 0.2 },
             |u| 2.0 - u + 0.1 * u * u,
-        );
+        )
+    }
+
+    #[test]
+    fn work_is_the_antiderivative_everywhere() {
+        let b = made_up_approach();
         for &alpha in &[0.2, 0.9, 1.0, 1.3, 5.0, 9.9, 10.5, 40.0] {
             let h = 1e-5;
             let dw = (b.work_hat(alpha + h) - b.work_hat(alpha - h)) / (2.0 * h);
@@ -249,14 +253,7 @@ mod tests {
 
     #[test]
     fn slope_is_the_derivative_of_the_force_everywhere() {
-        let approach = FoldBranch::new(
-            (1.0, 2.0),
-            Side::Above,
-            3.0,
-            2001,
-            FarField::Decay { kappa: 0.2 },
-            |u| 2.0 - u + 0.1 * u * u,
-        );
+        let approach = made_up_approach();
         let contact = FoldBranch::new(
             (jkr::ALPHA_HAT_C, jkr::T_HAT_C),
             Side::Below,
