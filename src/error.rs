@@ -48,6 +48,10 @@ pub enum Error {
         /// What went wrong.
         reason: String,
     },
+    /// Standard output was closed by its reader (`tapsim … | head`): not a failure of
+    /// tapsim's; the command ends quietly.
+    #[error("standard output was closed")]
+    StdoutClosed,
 }
 
 /// Result alias used throughout tapsim.

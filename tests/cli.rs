@@ -814,3 +814,36 @@ fn branches_refuses_steps_that_would_not_finish() {
         );
     }
 }
+
+#[test]
+fn a_closed_pipe_ends_quietly_and_a_full_disk_is_an_error() {
+    use std::process::Stdio;
+    // The reader goes away before anything is written (`tapsim … | head -0`).
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .args(["approach", "--points", "6", "--quiet"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("it ends");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    // A full disk: an error message and exit code 1, no panic.
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        println!("no /dev/full here: the full-disk case is not checked");
+        return;
+    };
+    let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .arg("tap")
+        .stdout(full)
+        .output()
+        .expect("the binary runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("cannot write standard output") && !err.contains("panicked"),
+        "{err}"
+    );
+}

@@ -54,18 +54,25 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         )?;
     }
     if args.out.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&records::columns_json(&points)?).expect("serialises")
         );
     } else {
-        println!(
+        outln!(
             "{:>9} {:>9} {:>10} {:>9} {:>10} {:>11} {:>10} {:>5}",
-            "z_c (nm)", "dir", "motion", "A/A0", "phi (deg)", "E_ts (eV)", "F_pk (nN)", "conv"
+            "z_c (nm)",
+            "dir",
+            "motion",
+            "A/A0",
+            "phi (deg)",
+            "E_ts (eV)",
+            "F_pk (nN)",
+            "conv"
         );
         for p in &points {
             let o = &p.observables;
-            println!(
+            outln!(
                 "{:>9.3} {:>9} {:>10} {:>9.5} {:>10.4} {:>11.4} {:>10.4} {:>5}",
                 p.separation_m * 1e9,
                 match p.direction {

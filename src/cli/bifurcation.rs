@@ -59,15 +59,15 @@ pub fn run(args: BifurcationArgs) -> Result<()> {
         plot::render_stack(&report::bifurcation_charts(&samples, &title), path)?;
     }
     if args.out.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&records::columns_json(&samples)?).expect("serialises")
         );
         return Ok(());
     }
-    println!("{:>10} {:>12}", "z_c (nm)", "motion");
+    outln!("{:>10} {:>12}", "z_c (nm)", "motion");
     for chunk in samples.chunks(args.samples) {
-        println!(
+        outln!(
             "{:>10.4} {:>12}",
             chunk[0].separation_m * 1e9,
             chunk[0].regime

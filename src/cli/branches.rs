@@ -80,7 +80,7 @@ pub fn run(args: BranchesArgs) -> Result<()> {
         if let serde_json::Value::Object(m) = &mut v {
             m.insert("notes".into(), branch.notes.clone().into());
         }
-        println!("{}", serde_json::to_string_pretty(&v).expect("serialises"));
+        outln!("{}", serde_json::to_string_pretty(&v).expect("serialises"));
         return Ok(());
     }
     let stable = branch
@@ -88,14 +88,14 @@ pub fn run(args: BranchesArgs) -> Result<()> {
         .iter()
         .filter(|p| p.observables.stable == Some(true))
         .count();
-    println!(
+    outln!(
         "period-1 orbits of the {} law: {} points ({} stable)",
         setup.law,
         branch.points.len(),
         stable,
     );
     for note in &branch.notes {
-        println!("  {note}");
+        outln!("  {note}");
     }
     let events: Vec<_> = branch
         .points
@@ -103,16 +103,20 @@ pub fn run(args: BranchesArgs) -> Result<()> {
         .filter(|p| p.point != BranchPointKind::Regular)
         .collect();
     if events.is_empty() {
-        println!("no fold and no period doubling on the way");
+        outln!("no fold and no period doubling on the way");
         return Ok(());
     }
-    println!(
+    outln!(
         "{:>16} {:>10} {:>9} {:>10} {:>11}",
-        "", "z_c (nm)", "A/A0", "phi (deg)", "E_ts (eV)"
+        "",
+        "z_c (nm)",
+        "A/A0",
+        "phi (deg)",
+        "E_ts (eV)"
     );
     for p in events {
         let o = &p.observables;
-        println!(
+        outln!(
             "{:>16} {:>10.5} {:>9.5} {:>10.4} {:>11.4}",
             match p.point {
                 BranchPointKind::Fold => "fold",

@@ -154,14 +154,17 @@ pub fn run(args: ContrastArgs) -> Result<()> {
         plot::render_stack(&charts, path)?;
     }
     if args.out.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&rows).expect("serialises")
         );
     } else {
-        println!(
+        outln!(
             "{:>18} {:>8} {:>11} {:>10}  motion",
-            "law", "A/A0", "branch", "Δφ (deg)"
+            "law",
+            "A/A0",
+            "branch",
+            "Δφ (deg)"
         );
         for r in &rows {
             let regimes: Vec<&str> = r
@@ -169,7 +172,7 @@ pub fn run(args: ContrastArgs) -> Result<()> {
                 .iter()
                 .map(|g| g.as_deref().unwrap_or("none"))
                 .collect();
-            println!(
+            outln!(
                 "{:>18} {:>8.3} {:>11} {:>10}  {}",
                 r.law,
                 r.amplitude_ratio,
@@ -190,7 +193,7 @@ pub fn run(args: ContrastArgs) -> Result<()> {
                 if let (Some(j), Some(o)) =
                     (r.delta_phase_deg, same.and_then(|o| o.delta_phase_deg))
                 {
-                    println!(
+                    outln!(
                         "A/A0 = {:.3}, {} branch: Δφ = {j:.3}° under jkr, {o:.3}° under {other} \
                          (jkr {:+.3}°)",
                         r.amplitude_ratio,

@@ -54,12 +54,12 @@ pub fn run(args: FigureArgs) -> Result<()> {
     for n in numbers {
         let chart = figures::figure(n, &opts)?;
         for path in chart.write_all(&args.out)? {
-            println!("{}", path.display());
+            outln!("{}", path.display());
         }
         if n == 3 {
             let path = args.out.join("fig3_lj_vs_fit.csv");
             output::write_bytes(&path, &figures::lj_fit_table(&figures::lj_solutions()?)?)?;
-            println!("{}", path.display());
+            outln!("{}", path.display());
         }
     }
     Ok(())

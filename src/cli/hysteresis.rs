@@ -61,12 +61,12 @@ pub fn run(args: HysteresisArgs) -> Result<()> {
     };
     let report = HysteresisReport::compute(input, support, args.jump_in, mu_is_default)?;
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&report).expect("report serialises")
         );
     } else {
-        print!("{}", report.to_text());
+        out!("{}", report.to_text());
     }
     Ok(())
 }

@@ -52,12 +52,12 @@ pub fn run(args: LjArgs) -> Result<()> {
         r = r.with_spring(&solution, k)?;
     }
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&r).expect("report serialises")
         );
     } else {
-        print!("{}", r.to_text());
+        out!("{}", r.to_text());
     }
     Ok(())
 }

@@ -110,12 +110,12 @@ pub fn run(args: MapArgs) -> Result<()> {
         plot::render_stack(&charts, path)?;
     }
     if args.out.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&records::columns_json(&cells)?).expect("serialises")
         );
     } else if args.out.csv.is_none() && args.out.plot.is_none() {
-        print!(
+        out!(
             "{}",
             String::from_utf8_lossy(&records::records_csv(&cells)?)
         );

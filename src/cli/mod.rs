@@ -1,6 +1,22 @@
 //! The `tapsim` command line: parse, call the library, print. Each subcommand lives in
 //! its own module.
 
+/// `println!` that returns instead of panicking when standard output fails: a closed
+/// pipe ends the command quietly ([`crate::Error::StdoutClosed`]), any other failure (a
+/// full disk) is an error.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::cli::emit(format_args!("{}\n", format_args!($($arg)*)))?
+    };
+}
+
+/// `print!` that returns instead of panicking when standard output fails ([`outln!`]).
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::cli::emit(format_args!($($arg)*))?
+    };
+}
+
 mod approach;
 mod bifurcation;
 mod branches;
@@ -132,6 +148,22 @@ impl SweepOutput {
     }
 }
 
+/// Write to standard output (see [`outln!`]).
+pub fn emit(text: std::fmt::Arguments) -> crate::Result<()> {
+    use std::io::Write;
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_fmt(text)
+        .and_then(|()| stdout.flush())
+        .map_err(|e| match e.kind() {
+            std::io::ErrorKind::BrokenPipe => crate::Error::StdoutClosed,
+            _ => crate::Error::Output {
+                path: "standard output".into(),
+                reason: e.to_string(),
+            },
+        })
+}
+
 /// Run the command line with the process arguments; the exit code to return.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -148,7 +180,7 @@ pub fn main() -> ExitCode {
         Command::Reproduce(args) => reproduce::run(args),
     };
     match outcome {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) | Err(crate::Error::StdoutClosed) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE

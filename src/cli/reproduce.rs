@@ -29,7 +29,7 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         }
     })?;
     for f in files {
-        println!("{}", f.display());
+        outln!("{}", f.display());
     }
     Ok(())
 }

@@ -70,12 +70,12 @@ pub fn run(args: TapArgs) -> Result<()> {
         plot::render_stack(&report::trajectory_charts(&run, &title), path)?;
     }
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&run.observables).expect("observables serialise")
         );
     } else {
-        print!("{}", report::to_text(&setup, &run.observables));
+        out!("{}", report::to_text(&setup, &run.observables));
     }
     Ok(())
 }
