@@ -441,10 +441,29 @@ fn run<S: System<f64, State<N>>, const N: usize>(
     tol: &Tolerances,
     branch: Branch,
 ) -> Result<()> {
+    use ode_solvers::dop_shared::IntegrationError as E;
+    let branch = match branch {
+        Branch::Free => "out-of-contact",
+        Branch::Contact => "contact",
+    };
     dopri(system, from, to, y, h, tol)
         .integrate()
         .map(|_| ())
-        .map_err(|e| Error::Numerical(format!("Dopri5 on the {branch:?} branch: {e:?}")))
+        .map_err(|e| {
+            Error::Numerical(match e {
+                E::StepSizeUnderflow { x } => format!(
+                    "the integrator's step fell to round-off on the {branch} branch at \
+                     τ = {x:.6} (ω₀t): the motion there is too abrupt for the tolerances"
+                ),
+                E::MaxNumStepReached { x, n_step } => format!(
+                    "the {branch} branch needed more than {n_step} integration steps at \
+                     τ = {x:.6} (ω₀t)"
+                ),
+                E::StiffnessDetected { x } => {
+                    format!("the motion on the {branch} branch became stiff at τ = {x:.6} (ω₀t)")
+                }
+            })
+        })
 }
 
 /// Integrate branch `branch` from (`tau0`, `y0`) to `tau_end`, stopping at the first
@@ -741,6 +760,28 @@ mod tests {
                 assert!((a - b).abs() < 1e-7, "{v0}, {i}: {a} {b}");
             }
         }
+    }
+
+    #[test]
+    fn an_integration_failure_is_told_in_words() {
+        // x' = 1/(1 − τ)²: the step must shrink to nothing at τ = 1.
+        struct Blows;
+        impl System<f64, State> for Blows {
+            fn system(&self, tau: f64, _: &State, dy: &mut State) {
+                *dy = State::zeros();
+                dy[X] = 1.0 / ((1.0 - tau) * (1.0 - tau));
+            }
+        }
+        let tol = Tolerances {
+            rtol: 1e-10,
+            atol: 1e-12,
+            h_max: 0.1,
+        };
+        let err = run(Blows, 0.0, 2.0, State::zeros(), 0.0, &tol, Branch::Contact)
+            .expect_err("no step gets past the pole")
+            .to_string();
+        assert!(err.contains("contact branch"), "{err}");
+        assert!(!err.contains('{') && !err.contains("Contact"), "{err}");
     }
 
     #[test]
