@@ -381,11 +381,11 @@ pub fn bifurcation(
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Vec<PoincareSample>> {
     use crate::dynamics::numeric::Ignore;
-    if samples == 0 {
+    if !(1..=10_000).contains(&samples) {
         return Err(Error::InvalidParameter {
             name: "samples",
-            value: 0.0,
-            reason: "must be at least 1",
+            value: samples as f64,
+            reason: "must be from 1 to 10000",
         });
     }
     let p = Prepared::new(setup, numerics)?;

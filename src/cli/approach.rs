@@ -2,7 +2,7 @@
 
 use crate::config::TapInputs;
 use crate::error::Result;
-use crate::report::{output, plot, records, sweep as report};
+use crate::report::{records, sweep as report};
 use crate::sweep::{self, Direction};
 use clap::Args;
 
@@ -44,15 +44,9 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         bar.set_position(done as u64)
     })?;
     bar.finish_and_clear();
-    if let Some(path) = &args.out.csv {
-        output::write_bytes(path, &records::records_csv(&points)?)?;
-    }
-    if let Some(path) = &args.out.plot {
-        plot::render_stack(
-            &report::approach_charts(&points, &format!("{} law", setup.law)),
-            path,
-        )?;
-    }
+    args.out.write_files(&points, || {
+        report::approach_charts(&points, &format!("{} law", setup.law))
+    })?;
     if args.out.json {
         outln!(
             "{}",

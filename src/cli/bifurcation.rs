@@ -1,8 +1,8 @@
 //! `tapsim bifurcation`: Poincaré samples of the settled motion along an approach.
 
 use crate::config::TapInputs;
-use crate::error::{Error, Result};
-use crate::report::{bifurcation as report, output, plot, records};
+use crate::error::Result;
+use crate::report::{bifurcation as report, records};
 use crate::sweep;
 use clap::Args;
 
@@ -38,26 +38,15 @@ pub fn run(args: BifurcationArgs) -> Result<()> {
     let start = super::SweepStart::new(args.inputs, &args.range)?;
     let (setup, numerics, (from, to)) = (&start.setup, &start.sweep_numerics, start.range);
     let ramp = sweep::ramp(from, to, args.points, false)?;
-    if args.samples == 0 || args.samples > 10_000 {
-        return Err(Error::InvalidParameter {
-            name: "--samples",
-            value: args.samples as f64,
-            reason: "must be from 1 to 10000",
-        });
-    }
     let separations: Vec<f64> = ramp.iter().map(|r| r.0).collect();
     let bar = args.out.progress_bar(separations.len());
     let samples = sweep::bifurcation(setup, numerics, &separations, args.samples, |done, _| {
         bar.set_position(done as u64)
     })?;
     bar.finish_and_clear();
-    if let Some(path) = &args.out.csv {
-        output::write_bytes(path, &records::records_csv(&samples)?)?;
-    }
-    if let Some(path) = &args.out.plot {
-        let title = format!("{} law", setup.law);
-        plot::render_stack(&report::bifurcation_charts(&samples, &title), path)?;
-    }
+    args.out.write_files(&samples, || {
+        report::bifurcation_charts(&samples, &format!("{} law", setup.law))
+    })?;
     if args.out.json {
         outln!(
             "{}",

@@ -2,7 +2,7 @@
 
 use crate::config::{TapInputs, length};
 use crate::error::Result;
-use crate::report::{branches as report, output, plot, records};
+use crate::report::{branches as report, records};
 use crate::sweep::{self, BranchPointKind};
 use clap::Args;
 
@@ -68,13 +68,10 @@ pub fn run(args: BranchesArgs) -> Result<()> {
         }
         None => Vec::new(),
     };
-    if let Some(path) = &args.out.csv {
-        output::write_bytes(path, &records::records_csv(&branch.points)?)?;
-    }
-    if let Some(path) = &args.out.plot {
+    args.out.write_files(&branch.points, || {
         let title = format!("{} law, period-1 orbits", setup.law);
-        plot::render_stack(&report::branch_charts(&branch.points, &ramp, &title), path)?;
-    }
+        report::branch_charts(&branch.points, &ramp, &title)
+    })?;
     if args.out.json {
         let mut v = records::columns_json(&branch.points)?;
         if let serde_json::Value::Object(m) = &mut v {

@@ -4,7 +4,7 @@ use crate::config::{TapInputs, pressure, surface_energy};
 use crate::dynamics::observables::TapObservables;
 use crate::error::Result;
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
-use crate::report::{output, plot, records, sweep as sweep_report};
+use crate::report::{records, sweep as sweep_report};
 use crate::sweep;
 use clap::Args;
 
@@ -60,10 +60,7 @@ pub fn run(args: MapArgs) -> Result<()> {
             bar.inc(1)
         })?;
     bar.finish_and_clear();
-    if let Some(path) = &args.out.csv {
-        output::write_bytes(path, &records::records_csv(&cells)?)?;
-    }
-    if let Some(path) = &args.out.plot {
+    args.out.write_files(&cells, || {
         // Per modulus, lines through the period-1 cells; other cells marked.
         let lines = |y: fn(&TapObservables) -> f64| -> Vec<Series> {
             let located = |e: Option<f64>| -> Vec<sweep_report::Located> {
@@ -87,7 +84,7 @@ pub fn run(args: MapArgs) -> Result<()> {
             series.extend(sweep_report::not_period_one(&located(None)));
             series
         };
-        let charts = vec![
+        vec![
             Chart {
                 name: "map_e_ts".into(),
                 title: format!("{} law: dissipation per cycle", setup.law),
@@ -106,9 +103,8 @@ pub fn run(args: MapArgs) -> Result<()> {
                 labels: vec![],
                 legend: Corner::UpperLeft,
             },
-        ];
-        plot::render_stack(&charts, path)?;
-    }
+        ]
+    })?;
     if args.out.json {
         outln!(
             "{}",

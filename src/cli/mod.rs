@@ -146,6 +146,23 @@ impl SweepOutput {
         );
         bar
     }
+
+    /// Write `records` as CSV to --csv and the charts `charts` draws to --plot, where
+    /// they were asked for.
+    pub fn write_files<T: serde::Serialize>(
+        &self,
+        records: &[T],
+        charts: impl FnOnce() -> Vec<crate::report::chart::Chart>,
+    ) -> crate::Result<()> {
+        use crate::report::{output, plot, records};
+        if let Some(path) = &self.csv {
+            output::write_bytes(path, &records::records_csv(records)?)?;
+        }
+        if let Some(path) = &self.plot {
+            plot::render_stack(&charts(), path)?;
+        }
+        Ok(())
+    }
 }
 
 /// Write to standard output (see [`outln!`]).
