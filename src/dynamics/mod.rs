@@ -1,6 +1,6 @@
 //! Tapping-mode dynamics: a point-mass cantilever against a hysteretic tip–sample force
 //! law, with located branch switches, steady-state detection and the observables of one
-//! steady cycle (DESIGN.md §2).
+//! steady cycle (docs/design.md §2).
 
 pub mod base_drive;
 pub mod continuation;

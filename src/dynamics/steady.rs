@@ -734,9 +734,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
     /// the last states nearly repeat with are looked for the same way. Without it, the
     /// motion is only integrated, until the state at the drive phase repeats after n
     /// periods closely enough three times running to lie within `opts.tolerance` of the
-    /// orbit. Either way at most
-    /// `opts.max_cycles` periods are integrated; `converged` says whether the reported
-    /// averages meet their tolerance.
+    /// orbit. Either way at most `opts.max_cycles` periods are integrated; `converged`
+    /// says whether the reported averages meet their tolerance.
     pub fn steady_state(&self, phase: &mut Phase, opts: &SteadyOptions) -> Result<SteadyState> {
         let budget = opts.max_cycles.max(MIN_CYCLES);
         // The search for an orbit gets at most half the budget (seven eighths without

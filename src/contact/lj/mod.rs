@@ -1,5 +1,5 @@
 //! The full Lennard-Jones numerical solution of the adhesive sphere (the paper's §3.1,
-//! DESIGN.md §1): the ground truth the hybrid theory is judged against.
+//! docs/design.md §1): the ground truth the hybrid theory is judged against.
 
 pub mod curve;
 pub mod kernel;
