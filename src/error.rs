@@ -17,7 +17,7 @@ pub enum Error {
         reason: &'static str,
     },
     /// A text value (command-line or config) could not be read as a quantity.
-    #[error("cannot read {name} from {text:?}: {reason}")]
+    #[error("cannot read {name} from {:?}: {reason}", abbreviate(text, 60))]
     Parse {
         /// Parameter name.
         name: &'static str,
@@ -52,6 +52,15 @@ pub enum Error {
     /// tapsim's; the command ends quietly.
     #[error("standard output was closed")]
     StdoutClosed,
+}
+
+/// `text` cut to its first `max` characters (with "…") when longer: long inputs are not
+/// echoed whole in messages.
+pub fn abbreviate(text: &str, max: usize) -> std::borrow::Cow<'_, str> {
+    match text.char_indices().nth(max) {
+        Some((cut, _)) => format!("{}… ({} characters)", &text[..cut], text.chars().count()).into(),
+        None => text.into(),
+    }
 }
 
 /// Result alias used throughout tapsim.

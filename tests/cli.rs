@@ -29,6 +29,7 @@ fn num(v: &serde_json::Value, key: &str) -> f64 {
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("tapsim-test-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
     dir
 }
 
@@ -703,7 +704,8 @@ fn contrast_reports_a_row_per_law_and_setpoint() {
 
 #[test]
 fn branches_lists_the_folds_of_a_bistable_case_and_writes_every_output() {
-    let (csv, png) = (scratch("branches.csv"), scratch("branches.png"));
+    let dir = scratch("branches");
+    let (csv, png) = (dir.join("branches.csv"), dir.join("branches.png"));
     let dmt = [
         "--law",
         "dmt",

@@ -21,8 +21,9 @@ use std::path::PathBuf;
 pub struct FigureArgs {
     /// Figure number (1 to 6) or `all`.
     figure: String,
-    /// Output directory (created if missing).
-    #[arg(long, default_value = "results")]
+    /// Output directory (created if missing; its parent must exist). `tapsim reproduce`
+    /// writes the committed results/.
+    #[arg(long, default_value = "figures")]
     out: PathBuf,
     /// Tabor parameter μ of figure 5.
     #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 5.0)]
@@ -51,6 +52,14 @@ pub fn run(args: FigureArgs) -> Result<()> {
         fig5_k_hat: args.k_hat,
         jump_in: args.jump_in,
     };
+    if let Some(n) = numbers.iter().find(|n| !figures::AVAILABLE.contains(n)) {
+        return Err(Error::Parse {
+            name: "figure",
+            text: n.to_string(),
+            reason: "expected a figure number (1-6) or `all`".into(),
+        });
+    }
+    output::ensure_dir(&args.out)?;
     for n in numbers {
         let chart = figures::figure(n, &opts)?;
         for path in chart.write_all(&args.out)? {

@@ -183,7 +183,26 @@ pub fn emit(text: std::fmt::Arguments) -> crate::Result<()> {
 
 /// Run the command line with the process arguments; the exit code to return.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if e.use_stderr() => {
+            // clap quotes the offending input: not a 10 000-character one whole.
+            let text = e.render().to_string();
+            let shortened: Vec<_> = text
+                .split(' ')
+                .map(|word| crate::error::abbreviate(word, 80))
+                .collect();
+            eprint!("{}", shortened.join(" "));
+            return ExitCode::from(2);
+        }
+        Err(e) => e.exit(),
+    };
+    // An interrupted command leaves no half-written file behind: the exit code is the
+    // shell's for a signal (128 + SIGINT).
+    let _ = ctrlc::set_handler(|| {
+        crate::report::output::remove_partial_files();
+        std::process::exit(130);
+    });
     let outcome = match cli.command {
         Command::Tap(args) => tap::run(args),
         Command::Approach(args) => approach::run(args),

@@ -1,57 +1,278 @@
-//! Atomic file output: write to a hidden temporary file beside the target, then rename,
-//! so a reader never sees a half-written file.
+//! File output that never leaves a half-written file and never replaces what is not a
+//! regular file.
+//!
+//! A regular file (or a path that does not exist yet) is written to a hidden temporary
+//! file beside it and renamed over it, so a reader sees the old file or the new one,
+//! never a mix. A symbolic link is followed and its final target is replaced the same
+//! way; the link stays. A character device (`/dev/null`) or a FIFO is written through,
+//! never replaced. Anything else (a directory, a block device, a socket) is refused, as
+//! is a path whose directory does not exist.
+//!
+//! Temporary files are registered while they exist: [`remove_partial_files`] deletes
+//! them, and the command line calls it when it is interrupted (SIGINT, SIGTERM).
 
 use crate::error::{Error, Result};
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
-/// A temporary path beside `path` with the same extension (some writers pick the
-/// format from it).
-fn temporary_beside(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "output".into());
-    let ext = path
-        .extension()
-        .map(|e| format!(".{}", e.to_string_lossy()))
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.partial-{}{ext}", std::process::id()))
+/// Temporary files being written.
+static PARTIAL: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn partial_files() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    PARTIAL
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
-/// Create `dir` and its parents if needed.
-pub fn ensure_dir(dir: &Path) -> Result<()> {
-    fs::create_dir_all(dir).map_err(|source| Error::Io {
-        path: dir.to_path_buf(),
-        source,
-    })
-}
-
-/// Write `path` by letting `write` produce a temporary file beside it, then renaming.
-/// On any failure the temporary file is removed and `path` is left untouched.
-pub fn write_with(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        ensure_dir(dir)?;
+/// Delete every temporary file still being written (for a signal handler).
+pub fn remove_partial_files() {
+    for path in partial_files().drain(..) {
+        let _ = fs::remove_file(path);
     }
-    let tmp = temporary_beside(path);
-    let outcome = write(&tmp).and_then(|()| {
-        fs::rename(&tmp, path).map_err(|source| Error::Io {
+}
+
+/// A temporary file, registered for [`remove_partial_files`] and deleted when dropped
+/// unless it was renamed into place.
+struct Partial {
+    path: PathBuf,
+}
+
+impl Partial {
+    /// A temporary path beside `target` with the same extension (some writers pick
+    /// the format from it), or in the system's temporary directory if `beside` is
+    /// false.
+    fn new(target: &Path, beside: bool) -> Self {
+        let name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "output".into());
+        let ext = target
+            .extension()
+            .map(|e| format!(".{}", e.to_string_lossy()))
+            .unwrap_or_default();
+        let file = format!(".{name}.partial-{}{ext}", std::process::id());
+        let path = if beside {
+            target.with_file_name(file)
+        } else {
+            std::env::temp_dir().join(file)
+        };
+        partial_files().push(path.clone());
+        Self { path }
+    }
+
+    fn forget(&self) {
+        partial_files().retain(|p| p != &self.path);
+    }
+}
+
+impl Drop for Partial {
+    fn drop(&mut self) {
+        let _ = fs::remove_file(&self.path);
+        self.forget();
+    }
+}
+
+/// How a target is written.
+enum Target {
+    /// Write a temporary file beside this path, rename it over it.
+    Replace(PathBuf),
+    /// Open this path and write into it (a character device or a FIFO).
+    WriteThrough(PathBuf),
+}
+
+fn io(path: &Path, source: std::io::Error) -> Error {
+    Error::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+fn refuse(path: &Path, reason: impl Into<String>) -> Error {
+    Error::Output {
+        path: path.to_path_buf(),
+        reason: reason.into(),
+    }
+}
+
+/// The final target of `path` after following symbolic links (at most 40, as the
+/// kernel does).
+fn follow_links(path: &Path) -> Result<PathBuf> {
+    let mut path = path.to_path_buf();
+    for _ in 0..40 {
+        match fs::symlink_metadata(&path) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                let link = fs::read_link(&path).map_err(|e| io(&path, e))?;
+                path = match path.parent() {
+                    Some(dir) if link.is_relative() => dir.join(link),
+                    _ => link,
+                };
+            }
+            _ => return Ok(path),
+        }
+    }
+    Err(refuse(&path, "too many levels of symbolic links"))
+}
+
+/// Decide how to write `path`.
+fn target(path: &Path) -> Result<Target> {
+    if path.as_os_str().is_empty() {
+        return Err(refuse(path, "the file name is empty"));
+    }
+    let resolved = follow_links(path)?;
+    let dir = match resolved.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    match fs::metadata(&dir) {
+        Ok(meta) if meta.is_dir() => {}
+        Ok(_) => {
+            return Err(refuse(
+                path,
+                format!("{} is not a directory", dir.display()),
+            ));
+        }
+        Err(_) => {
+            return Err(refuse(
+                path,
+                format!(
+                    "the directory {} does not exist (create it first)",
+                    dir.display()
+                ),
+            ));
+        }
+    }
+    let Ok(meta) = fs::metadata(&resolved) else {
+        return Ok(Target::Replace(resolved));
+    };
+    use std::os::unix::fs::FileTypeExt;
+    let kind = meta.file_type();
+    if kind.is_file() {
+        Ok(Target::Replace(resolved))
+    } else if kind.is_char_device() || kind.is_fifo() {
+        Ok(Target::WriteThrough(resolved))
+    } else if kind.is_dir() {
+        Err(refuse(path, "it is a directory; give a file name"))
+    } else {
+        Err(refuse(
+            path,
+            "it is neither a regular file, a character device nor a FIFO",
+        ))
+    }
+}
+
+/// An error about the temporary file told about `path` instead.
+fn about(path: &Path, tmp: &Path, e: Error) -> Error {
+    match e {
+        Error::Io { path: p, source } if p == tmp => Error::Io {
             path: path.to_path_buf(),
             source,
-        })
-    });
-    if outcome.is_err() {
-        let _ = fs::remove_file(&tmp);
+        },
+        Error::Output { path: p, reason } if p == tmp => Error::Output {
+            path: path.to_path_buf(),
+            reason,
+        },
+        other => other,
     }
-    outcome
 }
 
-/// Write `bytes` to `path` atomically.
+/// Write `path` by letting `write` produce a temporary file, then putting it in place
+/// (see the module documentation). On any failure the temporary file is removed and
+/// `path` is left untouched; errors name `path`, never the temporary file.
+pub fn write_with(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    match target(path)? {
+        Target::Replace(target) => {
+            let tmp = Partial::new(&target, true);
+            write(&tmp.path).map_err(|e| about(path, &tmp.path, e))?;
+            fs::rename(&tmp.path, &target).map_err(|e| io(path, e))?;
+            tmp.forget();
+            Ok(())
+        }
+        Target::WriteThrough(target) => {
+            let tmp = Partial::new(&target, false);
+            write(&tmp.path).map_err(|e| about(path, &tmp.path, e))?;
+            let mut from = fs::File::open(&tmp.path).map_err(|e| io(path, e))?;
+            let mut to = fs::OpenOptions::new()
+                .write(true)
+                .open(&target)
+                .map_err(|e| io(path, e))?;
+            std::io::copy(&mut from, &mut to).map_err(|e| io(path, e))?;
+            Ok(())
+        }
+    }
+}
+
+/// Write `bytes` to `path` (see [`write_with`]).
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
-    write_with(path, |tmp| {
-        fs::write(tmp, bytes).map_err(|source| Error::Io {
-            path: tmp.to_path_buf(),
-            source,
-        })
+    write_with(path, |tmp| fs::write(tmp, bytes).map_err(|e| io(tmp, e)))
+}
+
+/// Create the directory `dir` if it does not exist; its parent must.
+pub fn ensure_dir(dir: &Path) -> Result<()> {
+    if dir.is_dir() {
+        return Ok(());
+    }
+    fs::create_dir(dir).map_err(|source| match source.kind() {
+        std::io::ErrorKind::NotFound => {
+            refuse(dir, "its parent directory does not exist (create it first)")
+        }
+        _ => io(dir, source),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("tapsim-output-{name}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn a_symlink_is_followed_and_kept() {
+        let dir = scratch("link");
+        fs::write(dir.join("real.csv"), "old").unwrap();
+        std::os::unix::fs::symlink("real.csv", dir.join("link.csv")).unwrap();
+        write_bytes(&dir.join("link.csv"), b"new").unwrap();
+        assert!(
+            fs::symlink_metadata(dir.join("link.csv"))
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(fs::read_to_string(dir.join("real.csv")).unwrap(), "new");
+        fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn a_failed_write_leaves_nothing_and_names_the_users_path() {
+        let dir = scratch("fail");
+        let path = dir.join("out.png");
+        let e = write_with(&path, |tmp| {
+            fs::write(tmp, "half").unwrap();
+            Err(io(tmp, std::io::Error::other("disk on fire")))
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("out.png") && !e.contains("partial"), "{e}");
+        assert_eq!(fs::read_dir(&dir).unwrap().count(), 0);
+        assert!(partial_files().is_empty());
+        fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn a_missing_directory_is_refused_not_created() {
+        let dir = scratch("missing");
+        let e = write_bytes(&dir.join("no/such/x.csv"), b"x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("does not exist"), "{e}");
+        assert!(!dir.join("no").exists());
+        let e = write_bytes(&dir, b"x").unwrap_err().to_string();
+        assert!(e.contains("directory"), "{e}");
+        fs::remove_dir_all(dir).unwrap();
+    }
 }

@@ -175,6 +175,7 @@ pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
     };
     // A cache that cannot be written only costs time later.
     if let Ok(text) = serde_json::to_string(&solution) {
+        let _ = std::fs::create_dir_all(cache_dir());
         let _ = output::write_bytes(&path, text.as_bytes());
     }
     Ok(solution)
