@@ -208,6 +208,9 @@ pub struct TapInputs {
     pub average_tolerance: Option<f64>,
 }
 
+/// The largest parameter file read, in bytes.
+pub const MAX_CONFIG_BYTES: u64 = 64 * 1024;
+
 /// The TOML keys and the quantity each holds.
 const KEYS: &[(&str, Dimension)] = &[
     ("radius", Dimension::Length),
@@ -273,12 +276,35 @@ impl TapInputs {
     }
 
     /// Read a TOML parameter file (keys as the flags' names).
+    /// Only a regular file of at most [`MAX_CONFIG_BYTES`] is read (a FIFO would block,
+    /// a device never end).
     pub fn from_toml_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        let io = |source| Error::Io {
             path: path.to_path_buf(),
             source,
-        })?;
+        };
+        let refuse = |reason: String| Error::Parse {
+            name: "config",
+            text: path.display().to_string(),
+            reason,
+        };
+        let meta = std::fs::metadata(path).map_err(io)?;
+        if !meta.is_file() {
+            return Err(refuse("not a regular file".into()));
+        }
+        if meta.len() > MAX_CONFIG_BYTES {
+            return Err(refuse(format!(
+                "{} bytes; a parameter file is at most {MAX_CONFIG_BYTES}",
+                meta.len()
+            )));
+        }
+        let text = std::fs::read_to_string(path).map_err(io)?;
         Self::from_toml(&text).map_err(|e| match e {
+            Error::Parse {
+                name: "config",
+                reason,
+                ..
+            } => refuse(reason),
             Error::Parse { name, text, reason } => Error::Parse {
                 name,
                 text,
@@ -293,21 +319,17 @@ impl TapInputs {
         let table: toml::Table = text.parse().map_err(|e: toml::de::Error| Error::Parse {
             name: "config",
             text: String::new(),
-            reason: format!("not valid TOML: {}", e.message()),
+            reason: format!("not valid TOML: {}", e.to_string().trim_end()),
         })?;
         let mut inputs = Self::default();
         for (key, value) in &table {
             if key == "law" {
                 let name = value.as_str().unwrap_or_default();
                 inputs.law = Some(<LawKind as clap::ValueEnum>::from_str(name, true).map_err(
-                    |_| {
-                        Error::Parse {
-                            name: "law",
-                            text: value.to_string(),
-                            reason:
-                                "expected one of hybrid, hybrid-attractive, jkr, dmt, hertz, none"
-                                    .into(),
-                        }
+                    |_| Error::Parse {
+                        name: "law",
+                        text: value.to_string(),
+                        reason: format!("expected one of {}", LawKind::names().join(", ")),
                     },
                 )?);
                 continue;

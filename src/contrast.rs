@@ -184,6 +184,20 @@ pub fn contrast(
             "phase contrast needs at least two materials".into(),
         ));
     }
+    if ratios.is_empty() {
+        return Err(Error::NotApplicable(
+            "phase contrast needs at least one amplitude setpoint".into(),
+        ));
+    }
+    for &r in ratios {
+        if !(r > 0.0 && r < 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "setpoint A/A0",
+                value: r,
+                reason: "an amplitude setpoint lies between 0 and 1 (the free amplitude)",
+            });
+        }
+    }
     let mut curves = Vec::new();
     for m in materials {
         let inputs = m.inputs.clone().or(base.clone());

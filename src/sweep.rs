@@ -50,16 +50,28 @@ pub struct SweepPoint {
     pub observables: TapObservables,
 }
 
+/// Most setpoints of a sweep in each direction (each is a steady state of its own).
+pub const MAX_SWEEP_POINTS: usize = 2000;
+
+/// Most values along each axis of a map (the map has the square of this many cells).
+pub const MAX_MAP_STEPS: usize = 200;
+
+/// Most Poincaré samples of a bifurcation diagram (setpoints × samples per setpoint).
+pub const MAX_POINCARE_SAMPLES: usize = 200_000;
+
+/// Most worker threads of a map.
+pub const MAX_THREADS: usize = 256;
+
 /// Rest separations of an approach from `from_m` down to `to_m` in `points` steps, and
 /// back up unless `retract` is false.
 pub fn ramp(from_m: f64, to_m: f64, points: usize, retract: bool) -> Result<Vec<(f64, Direction)>> {
     finite("--from", from_m)?;
     finite("--to", to_m)?;
-    if points < 2 {
+    if !(2..=MAX_SWEEP_POINTS).contains(&points) {
         return Err(Error::InvalidParameter {
             name: "points",
             value: points as f64,
-            reason: "must be at least 2",
+            reason: "must be from 2 to 2000",
         });
     }
     if to_m >= from_m {
@@ -122,9 +134,10 @@ pub struct MapCell {
 pub fn log_grid(name: &'static str, lo: f64, hi: f64, n: usize) -> Result<Vec<f64>> {
     crate::error::positive(name, lo)?;
     crate::error::positive(name, hi)?;
-    if n < 2 || hi <= lo {
+    if !(2..=MAX_MAP_STEPS).contains(&n) || hi <= lo {
         return Err(Error::NotApplicable(format!(
-            "{name}: need at least 2 points and an upper end above the lower one"
+            "{name}: need from 2 to {MAX_MAP_STEPS} points and an upper end above the lower \
+             one"
         )));
     }
     Ok((0..n)
@@ -145,6 +158,13 @@ pub fn adhesion_modulus_map(
     progress: impl Fn() + Sync,
 ) -> Result<Vec<MapCell>> {
     use rayon::prelude::*;
+    if threads > MAX_THREADS {
+        return Err(Error::InvalidParameter {
+            name: "threads",
+            value: threads as f64,
+            reason: "must be at most 256 (0: one per core)",
+        });
+    }
     let cells: Vec<(f64, f64)> = moduli_pa
         .iter()
         .flat_map(|&e| works_j_m2.iter().map(move |&w| (w, e)))
@@ -388,6 +408,13 @@ pub fn bifurcation(
             reason: "must be from 1 to 10000",
         });
     }
+    if separations_m.len().saturating_mul(samples) > MAX_POINCARE_SAMPLES {
+        return Err(Error::NotApplicable(format!(
+            "{} setpoints × {samples} samples is more than the {MAX_POINCARE_SAMPLES} \
+             Poincaré samples a diagram holds: fewer points or samples",
+            separations_m.len()
+        )));
+    }
     let p = Prepared::new(setup, numerics)?;
     let scale = p.setup.contact.separation_scale_m();
     let a0 = p.setup.cantilever.free_amplitude_m;
@@ -395,18 +422,21 @@ pub fn bifurcation(
     let mut out = Vec::with_capacity(separations_m.len() * samples);
     for (i, &z) in separations_m.iter().enumerate() {
         let sim = p.simulation_at(z)?;
-        let state = sim.steady_state(&mut phase, &p.steady)?;
-        let regime = state.motion.regime();
-        for _ in 0..samples {
-            let deflection_m = phase.x * a0;
-            let c = sim.cycle(&mut phase, &mut Ignore)?;
-            out.push(PoincareSample {
-                separation_m: z,
-                regime: regime.clone(),
-                deflection_m,
-                min_separation_m: c.min_alpha_hat * scale,
-            });
-        }
+        crate::dynamics::budget::budgeted(p.steady.max_steps, || {
+            let state = sim.steady_state(&mut phase, &p.steady)?;
+            let regime = state.motion.regime();
+            for _ in 0..samples {
+                let deflection_m = phase.x * a0;
+                let c = sim.cycle(&mut phase, &mut Ignore)?;
+                out.push(PoincareSample {
+                    separation_m: z,
+                    regime: regime.clone(),
+                    deflection_m,
+                    min_separation_m: c.min_alpha_hat * scale,
+                });
+            }
+            Ok(())
+        })?;
         progress(i + 1, separations_m.len());
     }
     Ok(out)

@@ -52,6 +52,9 @@ const PREFIXES: &[(&str, f64)] = &[
     ("G", 1e9),
 ];
 
+/// The longest text read as a quantity (the number's digits and a unit).
+const MAX_QUANTITY_CHARS: usize = 100;
+
 /// Parse `text` as a quantity of dimension `dim`, returning its value in base SI
 /// units. `name` names the quantity in error messages. Non-finite values are refused.
 pub fn parse(name: &'static str, text: &str, dim: Dimension) -> Result<f64> {
@@ -61,6 +64,12 @@ pub fn parse(name: &'static str, text: &str, dim: Dimension) -> Result<f64> {
         reason,
     };
     let trimmed = text.trim();
+    if trimmed.len() > MAX_QUANTITY_CHARS {
+        return Err(err(format!(
+            "{} characters is too long for a quantity (at most {MAX_QUANTITY_CHARS})",
+            trimmed.chars().count()
+        )));
+    }
     // The longest leading part that reads as a number (so "1.5eV" is 1.5 and "eV").
     let (number, unit) = (1..=trimmed.len())
         .rev()

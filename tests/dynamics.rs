@@ -77,6 +77,7 @@ fn free_response<L: ForceLaw>(law: &L, omega: f64, q: f64) -> (f64, f64) {
         average_tolerance: 1e-3,
         max_cycles: 100_000,
         shooting: false,
+        max_steps: tapsim::dynamics::budget::STEPS,
     };
     let state = sim.steady_state(&mut phase, &opts).unwrap();
     assert!(state.converged);

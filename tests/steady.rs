@@ -43,6 +43,7 @@ fn high_q_orbits_settle_in_a_few_dozen_periods_and_match_the_time_marched_ones()
                 shooting: false,
                 tolerance: 1e-8,
                 max_cycles: 2_000_000,
+                max_steps: u64::MAX,
                 ..Numerics::default()
             },
             0,

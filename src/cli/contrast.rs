@@ -39,8 +39,9 @@ pub struct ContrastArgs {
     /// Laws to compare.
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = [LawKind::Jkr, LawKind::Hybrid, LawKind::Lj])]
     laws: Vec<LawKind>,
-    /// Amplitude setpoints A/A₀.
-    #[arg(long, value_delimiter = ',', default_values_t = [0.9, 0.8, 0.7, 0.6, 0.5])]
+    /// Amplitude setpoints A/A₀, each between 0 and 1.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true,
+          value_parser = crate::config::number, default_values_t = [0.9, 0.8, 0.7, 0.6, 0.5])]
     setpoints: Vec<f64>,
     /// Setpoints on each approach curve.
     #[arg(long, default_value_t = 50)]

@@ -192,6 +192,17 @@ impl<L: ForceLaw> Follower<'_, '_, L> {
         anchor: Vector3<f64>,
         t: &Vector3<f64>,
     ) -> Result<Option<Solved>> {
+        super::budget::budgeted(super::budget::STEPS, || {
+            self.correct_within_budget(from, anchor, t)
+        })
+    }
+
+    fn correct_within_budget(
+        &self,
+        from: &Phase,
+        anchor: Vector3<f64>,
+        t: &Vector3<f64>,
+    ) -> Result<Option<Solved>> {
         let mut u = anchor;
         for _ in 0..8 {
             let Some((r, solved)) = self.evaluate(from, &u)? else {

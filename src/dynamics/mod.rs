@@ -3,6 +3,7 @@
 //! steady cycle (docs/design.md §2).
 
 pub mod base_drive;
+pub mod budget;
 pub mod continuation;
 pub mod free;
 pub mod model;

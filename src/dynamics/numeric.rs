@@ -12,6 +12,7 @@
 //! square-root singularity in α̂ but is smooth in u, so this last stretch takes two or
 //! three smooth steps instead of a cascade of shrinking ones onto the cusp.
 
+use super::budget;
 use super::model::{BASE, COS, Coupling, Oscillator, SIN, State, TANGENT, V, X, rhs, set_phasor};
 use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw};
@@ -383,6 +384,7 @@ fn dopri<S: System<f64, State<N>>, const N: usize>(
     y0: State<N>,
     h0: f64,
     tol: &Tolerances,
+    max_steps: u32,
 ) -> Dopri5<f64, State<N>, S> {
     Dopri5::from_param(
         system,
@@ -398,11 +400,7 @@ fn dopri<S: System<f64, State<N>>, const N: usize>(
         10.0,
         tol.h_max,
         h0,
-        if N == TANGENT {
-            MAX_TANGENT_STEPS
-        } else {
-            u32::MAX
-        },
+        max_steps,
         // No stiffness test: slow base-driven cycles run Dopri5 at its stability limit
         // on purpose (the problem is only mildly stiff there).
         u32::MAX,
@@ -416,6 +414,11 @@ fn dopri<S: System<f64, State<N>>, const N: usize>(
 /// period map is not smooth there anyway: exceeding this is a numerical failure, which
 /// the shooting takes as "no orbit here".
 const MAX_TANGENT_STEPS: u32 = 4000;
+
+/// Most steps of any segment (a segment lasts at most a drive period). Dopri5 keeps every
+/// step of a segment, 8(N + 1) bytes each: this bounds that to 80 MB, and a period that
+/// needs more steps than this is unresolvable in practice.
+const MAX_SEGMENT_STEPS: u32 = 1_000_000;
 
 /// Whether [from, to] is too short for Dopri5 to step at this τ (its step-size underflow
 /// test is 0.1·h ≤ ε·|τ|); such spans are bridged by the Hermite interpolant instead.
@@ -446,24 +449,36 @@ fn run<S: System<f64, State<N>>, const N: usize>(
         Branch::Free => "out-of-contact",
         Branch::Contact => "contact",
     };
-    dopri(system, from, to, y, h, tol)
-        .integrate()
-        .map(|_| ())
-        .map_err(|e| {
+    let segment_cap = if N == TANGENT {
+        MAX_TANGENT_STEPS
+    } else {
+        MAX_SEGMENT_STEPS
+    };
+    let left = budget::left();
+    let max_steps = u32::try_from(left).map_or(segment_cap, |l| l.min(segment_cap));
+    let limited_by_budget = u64::from(max_steps) == left && max_steps < segment_cap;
+    match dopri(system, from, to, y, h, tol, max_steps).integrate() {
+        Ok(stats) => budget::spend(u64::from(stats.accepted_steps + stats.rejected_steps)),
+        Err(E::MaxNumStepReached { .. }) if limited_by_budget => Err(budget::exhausted()),
+        Err(e) => Err({
+            let _ = budget::spend(u64::from(max_steps));
             Error::Numerical(match e {
                 E::StepSizeUnderflow { x } => format!(
                     "the integrator's step fell to round-off on the {branch} branch at \
-                     τ = {x:.6} (ω₀t): the motion there is too abrupt for the tolerances"
+                     τ = {x:.6e} (ω₀t): the motion there is too abrupt for the tolerances"
                 ),
                 E::MaxNumStepReached { x, n_step } => format!(
-                    "the {branch} branch needed more than {n_step} integration steps at \
-                     τ = {x:.6} (ω₀t)"
+                    "the {branch} branch needed more than {n_step} integration steps in \
+                     one drive period at τ = {x:.6e} (ω₀t): the motion is too stiff to \
+                     resolve (a cantilever far softer than the contact, or a drive far \
+                     below resonance)"
                 ),
                 E::StiffnessDetected { x } => {
-                    format!("the motion on the {branch} branch became stiff at τ = {x:.6} (ω₀t)")
+                    format!("the motion on the {branch} branch became stiff at τ = {x:.6e} (ω₀t)")
                 }
             })
-        })
+        }),
+    }
 }
 
 /// Integrate branch `branch` from (`tau0`, `y0`) to `tau_end`, stopping at the first

@@ -1,11 +1,12 @@
 //! Observables of one steady-state cycle in SI units, and the whole tapping run.
 
+use super::budget;
 use super::free::FreeFlight;
 use super::model::{Coupling, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver, hermite};
 use super::setup::{Numerics, Prepared, TapSetup};
 use super::steady::{CycleIntegrals, Motion, SteadyState};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw};
 use crate::params::ELECTRONVOLT_J;
 use serde::Serialize;
@@ -191,10 +192,19 @@ pub struct TrajectorySample {
 pub struct Recorder<'a, L: ForceLaw> {
     /// (τ, x, x', α̂, f_ts, branch).
     pub samples: Vec<(f64, f64, f64, f64, f64, Branch)>,
+    /// Whether samples were dropped at [`MAX_TRAJECTORY_SAMPLES`].
+    pub overflowed: bool,
     law: &'a L,
     cpl: Coupling,
     osc: Oscillator,
 }
+
+/// Most cycles a run records.
+pub const MAX_RECORD_CYCLES: usize = 1000;
+
+/// Most trajectory samples a run records (about 200 bytes each from recording to CSV
+/// or plot, so some 40 MB).
+pub const MAX_TRAJECTORY_SAMPLES: usize = 200_000;
 
 /// Interpolated points per integrator step, and samples per period in free flight.
 const POINTS_PER_STEP: usize = 6;
@@ -228,6 +238,7 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
     pub fn new(law: &'a L, cpl: Coupling, osc: Oscillator) -> Self {
         Self {
             samples: Vec::new(),
+            overflowed: false,
             law,
             cpl,
             osc,
@@ -235,6 +246,10 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
     }
 
     fn push(&mut self, tau: f64, x: f64, v: f64, branch: Branch) {
+        if self.samples.len() >= MAX_TRAJECTORY_SAMPLES {
+            self.overflowed = true;
+            return;
+        }
         let alpha = self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
         // (+ 0.0 turns the −0 of a force-free branch into 0.)
         let f = -self.cpl.f_scale * self.law.t_hat(alpha, branch) + 0.0;
@@ -281,13 +296,31 @@ pub struct TapRun {
 /// then integrate `record_cycles` more cycles recording the trajectory (not counted in
 /// the observables, which are the steady state's).
 pub fn tap(setup: &TapSetup, numerics: &Numerics, record_cycles: usize) -> Result<TapRun> {
+    if record_cycles > MAX_RECORD_CYCLES {
+        return Err(Error::InvalidParameter {
+            name: "record cycles",
+            value: record_cycles as f64,
+            reason: "must be at most 1000 (the trajectory is kept in memory)",
+        });
+    }
     let p = Prepared::new(setup, numerics)?;
     let sim = p.simulation();
     let mut phase = sim.free_steady_start();
     let state = sim.steady_state(&mut phase, &p.steady)?;
     let mut recorder = Recorder::new(&p.law, p.cpl, p.osc);
-    for _ in 0..record_cycles {
-        sim.cycle(&mut phase, &mut recorder)?;
+    for done in 0..record_cycles {
+        budget::budgeted(p.steady.max_steps, || sim.cycle(&mut phase, &mut recorder))?;
+        if recorder.overflowed {
+            let fit = if done == 0 {
+                "not even one cycle fits".to_string()
+            } else {
+                format!("record at most {done} cycles")
+            };
+            return Err(Error::NotApplicable(format!(
+                "the trajectory of {record_cycles} cycles needs more than \
+                 {MAX_TRAJECTORY_SAMPLES} samples, the most tapsim records: {fit}"
+            )));
+        }
     }
     let scale = setup.contact.separation_scale_m();
     Ok(TapRun {

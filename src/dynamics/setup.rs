@@ -1,6 +1,7 @@
 //! SI description of a tapping-mode experiment — cantilever, contact, rest separation and
 //! force law — and its translation into the dimensionless [`Simulation`].
 
+use super::budget;
 use super::model::{Coupling, Drive, Oscillator};
 use super::numeric::Tolerances;
 use super::steady::{MIN_CYCLES, Simulation, SteadyOptions};
@@ -105,6 +106,9 @@ pub struct Numerics {
     /// Look for periodic orbits by Newton's method on the period map (else only
     /// integrate).
     pub shooting: bool,
+    /// The work budget of one steady state, in integrator steps (see
+    /// [`super::budget`]).
+    pub max_steps: u64,
 }
 
 impl Default for Numerics {
@@ -117,6 +121,7 @@ impl Default for Numerics {
             average_tolerance: 1e-3,
             max_cycles: 20_000,
             shooting: true,
+            max_steps: budget::STEPS,
         }
     }
 }
@@ -129,6 +134,34 @@ impl Numerics {
         positive("steps per period", self.min_steps_per_period)?;
         positive("convergence tolerance", self.tolerance)?;
         positive("average tolerance", self.average_tolerance)?;
+        let round_off = "near round-off the integration cannot meet it";
+        Range {
+            what: "relative tolerance rtol",
+            unit: "",
+            lo: 1e-13,
+            hi: 1e-3,
+            why: round_off,
+            meant: None,
+        }
+        .check(self.rtol)?;
+        Range {
+            what: "periodic-orbit tolerance",
+            unit: "",
+            lo: 1e-12,
+            hi: 1e-2,
+            why: round_off,
+            meant: None,
+        }
+        .check(self.tolerance)?;
+        Range {
+            what: "average tolerance",
+            unit: "",
+            lo: 1e-6,
+            hi: 0.5,
+            why: "a standard error below 1e-6 would take billions of periods",
+            meant: None,
+        }
+        .check(self.average_tolerance)?;
         if self.max_cycles < MIN_CYCLES {
             return Err(Error::InvalidParameter {
                 name: "max cycles",
@@ -138,6 +171,209 @@ impl Numerics {
             });
         }
         Ok(self)
+    }
+}
+
+/// `value` to four significant digits, without trailing zeros: 0.5, 1e-13, 3.333e-6.
+fn significant(value: f64) -> String {
+    let magnitude = value.abs();
+    if magnitude == 0.0 || (1e-3..1e5).contains(&magnitude) {
+        let decimals = (3 - magnitude.log10().floor() as i32).clamp(0, 6) as usize;
+        let text = format!("{value:.decimals$}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').into()
+        } else {
+            text
+        }
+    } else {
+        let text = format!("{value:.3e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        format!("{mantissa}e{exponent}")
+    }
+}
+
+/// `value` with an SI prefix where it has a unit: 2e-8 m → "20 nm".
+fn with_prefix(value: f64, unit: &str) -> String {
+    const PREFIXES: [(f64, &str); 9] = [
+        (1e12, "T"),
+        (1e9, "G"),
+        (1e6, "M"),
+        (1e3, "k"),
+        (1.0, ""),
+        (1e-3, "m"),
+        (1e-6, "µ"),
+        (1e-9, "n"),
+        (1e-12, "p"),
+    ];
+    if unit.is_empty() {
+        return significant(value);
+    }
+    let magnitude = value.abs();
+    match PREFIXES.iter().find(|(f, _)| magnitude >= *f * 0.999_999) {
+        Some((f, p)) if magnitude < 1e15 => format!("{} {p}{unit}", significant(value / f)),
+        _ => format!("{} {unit}", significant(value)),
+    }
+}
+
+/// A quantity of a tapping experiment and the range tapsim accepts it in: wide enough
+/// for every AFM, narrow enough that a computation ends within seconds and a bare number
+/// meant in nm or GPa is caught.
+struct Range {
+    what: &'static str,
+    unit: &'static str,
+    lo: f64,
+    hi: f64,
+    /// Who lives at the ends of the range.
+    why: &'static str,
+    /// The unit a user most likely meant with a bare number, and its factor.
+    meant: Option<(&'static str, f64)>,
+}
+
+impl Range {
+    fn check(&self, value: f64) -> Result<()> {
+        if (self.lo..=self.hi).contains(&value) {
+            return Ok(());
+        }
+        let mut message = format!(
+            "{} = {} is outside {} to {} ({})",
+            self.what,
+            with_prefix(value, self.unit),
+            with_prefix(self.lo, self.unit),
+            with_prefix(self.hi, self.unit),
+            self.why
+        );
+        if let Some((unit, factor)) = self.meant {
+            if (self.lo..=self.hi).contains(&(value * factor)) {
+                message += &format!(
+                    "; bare numbers are in {}: did you mean {value}{unit}?",
+                    self.unit
+                );
+            }
+        }
+        Err(Error::NotApplicable(message))
+    }
+}
+
+/// The rest separations tapsim accepts for free amplitude `a0_m`: −10 A₀ to 1000 A₀.
+fn separation_in_range(separation_m: f64, a0_m: f64) -> Result<()> {
+    finite("separation", separation_m)?;
+    if (-10.0 * a0_m..=1000.0 * a0_m).contains(&separation_m) {
+        return Ok(());
+    }
+    Err(Error::NotApplicable(format!(
+        "rest separation z_c = {} is outside −10 A₀ to 1000 A₀ ({} to {}): farther the tip \
+         never reaches the sample, deeper it indents far beyond where the contact models hold",
+        with_prefix(separation_m, "m"),
+        with_prefix(-10.0 * a0_m, "m"),
+        with_prefix(1000.0 * a0_m, "m")
+    )))
+}
+
+impl TapSetup {
+    /// Refuse values outside what an AFM can be (SI slips like `--radius 20`, meaning
+    /// 20 m) and regimes tapsim cannot resolve within seconds; the message explains.
+    pub fn check_plausible(&self) -> Result<()> {
+        let (c, k) = (&self.contact, &self.cantilever);
+        let length = |what, lo, hi, why| Range {
+            what,
+            unit: "m",
+            lo,
+            hi,
+            why,
+            meant: Some(("nm", 1e-9)),
+        };
+        length(
+            "tip radius R",
+            0.5e-9,
+            50e-6,
+            "from the sharpest tips to colloidal probes",
+        )
+        .check(c.radius_m)?;
+        length(
+            "range ε",
+            0.05e-9,
+            5e-9,
+            "the equilibrium gap of surface forces, a fraction of a nm",
+        )
+        .check(c.range_m)?;
+        length(
+            "free amplitude A₀",
+            0.05e-9,
+            10e-6,
+            "from sub-nm small-amplitude work to the largest tapping amplitudes",
+        )
+        .check(k.free_amplitude_m)?;
+        Range {
+            what: "composite modulus E*",
+            unit: "Pa",
+            lo: 1e3,
+            hi: 2e12,
+            why: "from living cells to diamond",
+            meant: Some(("GPa", 1e9)),
+        }
+        .check(c.modulus_pa)?;
+        Range {
+            what: "work of adhesion Δγ",
+            unit: "J/m²",
+            lo: 1e-5,
+            hi: 10.0,
+            why: "from weak van der Waals contacts in liquid to clean metals",
+            meant: Some(("mJ/m^2", 1e-3)),
+        }
+        .check(c.work_of_adhesion_j_m2)?;
+        Range {
+            what: "stiffness k",
+            unit: "N/m",
+            lo: 1e-3,
+            hi: 1e4,
+            why: "from the softest contact-mode cantilevers to the stiffest sensors; far \
+                  softer than the contact, the motion is too stiff to resolve",
+            meant: None,
+        }
+        .check(k.stiffness_n_m)?;
+        Range {
+            what: "resonance frequency f₀",
+            unit: "Hz",
+            lo: 100.0,
+            hi: 1e8,
+            why: "the range of AFM cantilevers",
+            meant: Some(("kHz", 1e3)),
+        }
+        .check(k.resonance_hz)?;
+        Range {
+            what: "quality factor Q",
+            unit: "",
+            lo: 0.5,
+            hi: 1e7,
+            why: "from critical damping, below which the cantilever has no resonance to tap \
+                  with, to the best cantilevers in vacuum",
+            meant: None,
+        }
+        .check(k.quality)?;
+        Range {
+            what: "drive frequency over resonance f/f₀",
+            unit: "",
+            lo: 0.05,
+            hi: 20.0,
+            why: "tapping mode drives near resonance; far from it, a drive period spans \
+                  many free oscillations or a small part of one",
+            meant: None,
+        }
+        .check(k.omega_ratio())?;
+        separation_in_range(self.separation_m, k.free_amplitude_m)?;
+        if let Some(hamaker) = self.hamaker_j {
+            Range {
+                what: "Hamaker constant",
+                unit: "J",
+                lo: 1e-22,
+                hi: 1e-17,
+                why: "the range of real materials, about 1e-20 J",
+                meant: None,
+            }
+            .check(hamaker)?;
+        }
+        Ok(())
     }
 }
 
@@ -169,7 +405,7 @@ impl Prepared {
             setup.contact.work_of_adhesion_j_m2,
             setup.contact.range_m,
         )?;
-        finite("separation", setup.separation_m)?;
+        setup.check_plausible()?;
         let law = AnyLaw::new(setup.law, &c, setup.hamaker_j)?;
         let osc = Oscillator {
             gamma: 0.5 / cantilever.quality,
@@ -194,6 +430,7 @@ impl Prepared {
             average_tolerance: numerics.average_tolerance,
             max_cycles: numerics.max_cycles,
             shooting: numerics.shooting,
+            max_steps: numerics.max_steps,
         };
         Ok(Self {
             setup: TapSetup {
@@ -221,7 +458,7 @@ impl Prepared {
 
     /// The simulation with the rest separation moved to `separation_m` (a sweep step).
     pub fn simulation_at(&self, separation_m: f64) -> Result<Simulation<'_, AnyLaw>> {
-        finite("separation", separation_m)?;
+        separation_in_range(separation_m, self.setup.cantilever.free_amplitude_m)?;
         let mut sim = self.simulation();
         sim.cpl.a0 = separation_m / self.setup.contact.separation_scale_m();
         Ok(sim)

@@ -15,6 +15,7 @@
 //! that settles on no orbit of period ≤ [`MAX_PERIOD`] is `irregular` and averaged over a
 //! window that grows until its batch means agree.
 
+use super::budget;
 use super::free::FreeFlight;
 use super::model::{
     BASE, Coupling, E_DAMP, F_INT, Oscillator, SC, SS, State, TANGENT, V, VIRIAL, X, chain, phi,
@@ -408,6 +409,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         phase: &mut Phase,
         observer: &mut O,
     ) -> Result<(CycleIntegrals, Matrix2x3<f64>)> {
+        budget::spend(1)?;
         let period = self.osc.period();
         let tau_end = phase.tau + period;
         phase.branch = self.consistent_branch(phase);
@@ -736,7 +738,19 @@ impl<L: ForceLaw> Simulation<'_, L> {
     /// periods closely enough three times running to lie within `opts.tolerance` of the
     /// orbit. Either way at most `opts.max_cycles` periods are integrated; `converged`
     /// says whether the reported averages meet their tolerance.
+    /// The search runs on a work budget ([`budget`]): motion too costly to resolve ends
+    /// with an error.
     pub fn steady_state(&self, phase: &mut Phase, opts: &SteadyOptions) -> Result<SteadyState> {
+        budget::budgeted(opts.max_steps, || {
+            self.steady_state_within_budget(phase, opts)
+        })
+    }
+
+    fn steady_state_within_budget(
+        &self,
+        phase: &mut Phase,
+        opts: &SteadyOptions,
+    ) -> Result<SteadyState> {
         let budget = opts.max_cycles.max(MIN_CYCLES);
         // The search for an orbit gets at most half the budget (seven eighths without
         // shooting); the rest is left for averaging.
@@ -1080,6 +1094,8 @@ pub struct SteadyOptions {
     pub max_cycles: usize,
     /// Look for periodic orbits by Newton's method on the period map.
     pub shooting: bool,
+    /// At most this many integrator steps ([`budget`]).
+    pub max_steps: u64,
 }
 
 /// The outcome of [`Simulation::steady_state`].

@@ -81,6 +81,24 @@ pub enum LawKind {
     None,
 }
 
+impl LawKind {
+    /// Every law, in the order of the help.
+    pub const ALL: [LawKind; 7] = [
+        LawKind::Hybrid,
+        LawKind::HybridAttractive,
+        LawKind::Jkr,
+        LawKind::Dmt,
+        LawKind::Hertz,
+        LawKind::Lj,
+        LawKind::None,
+    ];
+
+    /// The names of every law as a user types them.
+    pub fn names() -> Vec<String> {
+        Self::ALL.iter().map(ToString::to_string).collect()
+    }
+}
+
 impl fmt::Display for LawKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
@@ -178,5 +196,16 @@ impl ForceLaw for AnyLaw {
     }
     fn loop_area_hat(&self) -> f64 {
         dispatch!(self, l => l.loop_area_hat())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_law_is_listed_once() {
+        use clap::ValueEnum;
+        assert_eq!(LawKind::ALL.to_vec(), LawKind::value_variants().to_vec());
     }
 }
