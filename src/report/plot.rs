@@ -70,13 +70,23 @@ fn stack_size(n: usize) -> (u32, u32) {
     }
 }
 
+/// Drawn into memory and encoded there, then written like any other output: file
+/// errors are told as such, and a PNG can go to a device or a FIFO like a CSV.
 fn render_stack_png(charts: &[Chart], path: &Path) -> Result<()> {
+    use image::ImageEncoder;
     register_font();
-    output::write_with(path, |tmp| {
-        let root = BitMapBackend::new(tmp, stack_size(charts.len())).into_drawing_area();
+    let (width, height) = stack_size(charts.len());
+    let mut pixels = vec![0u8; 3 * width as usize * height as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
         draw_stack(charts, &root).map_err(|reason| fail(path, reason))?;
-        root.present().map_err(|e| fail(path, e.to_string()))
-    })
+        root.present().map_err(|e| fail(path, e.to_string()))?;
+    }
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(&pixels, width, height, image::ColorType::Rgb8)
+        .map_err(|e| fail(path, format!("PNG encoding failed: {e}")))?;
+    output::write_bytes(path, &bytes)
 }
 
 fn render_stack_svg(charts: &[Chart], path: &Path) -> Result<()> {
