@@ -34,7 +34,7 @@ fn bench(c: &mut Criterion) {
             let state = sim
                 .steady_state(&mut phase, &p.steady)
                 .expect("steady state");
-            let o = TapObservables::new(&p, &state);
+            let o = TapObservables::new(&p, &state).unwrap();
             assert!(
                 o.converged && o.energy_balance_rel < 1e-6,
                 "rtol {rtol}, separation x{factor}: {o:?}"

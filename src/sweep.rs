@@ -106,7 +106,7 @@ pub fn approach_curve(
         out.push(SweepPoint {
             separation_m,
             direction,
-            observables: TapObservables::new(&p, &state),
+            observables: TapObservables::new(&p, &state)?,
         });
         progress(i + 1, ramp.len());
     }
@@ -321,7 +321,7 @@ pub fn orbit_branch(
             ..ContinuationOptions::default()
         };
         let branch = follow_period_one(&sim, &phase, &opts)?;
-        points.extend(branch.points.iter().map(|b| {
+        for b in &branch.points {
             let state = SteadyState {
                 window: b.integrals,
                 cycles: 1,
@@ -332,7 +332,7 @@ pub fn orbit_branch(
                 },
                 std_err: StdErr::default(),
             };
-            BranchRecord {
+            points.push(BranchRecord {
                 separation_m: b.q * a0,
                 segment,
                 point: match b.kind {
@@ -340,9 +340,9 @@ pub fn orbit_branch(
                     PointKind::Fold => BranchPointKind::Fold,
                     PointKind::PeriodDoubling => BranchPointKind::PeriodDoubling,
                 },
-                observables: TapObservables::new(&p, &state),
-            }
-        }));
+                observables: TapObservables::new(&p, &state)?,
+            });
+        }
         match branch.stop {
             Stop::Reached => {
                 notes.push(format!("reached --to ({:.4} nm)", nm(to_m)));

@@ -96,8 +96,58 @@ pub struct TapObservables {
 }
 
 impl TapObservables {
-    /// Observables of `state` for the prepared experiment `p`.
-    pub fn new(p: &Prepared, state: &SteadyState) -> Self {
+    /// Observables of `state` for the prepared experiment `p`; an error, never a NaN or
+    /// an infinity, where one of them could not be computed.
+    pub fn new(p: &Prepared, state: &SteadyState) -> Result<Self> {
+        Self::from_state(p, state).finite()
+    }
+
+    /// Every number finite, else an error naming the first that is not.
+    fn finite(self) -> Result<Self> {
+        let numbers = [
+            ("tabor_mu", self.tabor_mu),
+            ("amplitude_m", self.amplitude_m),
+            ("amplitude_ratio", self.amplitude_ratio),
+            ("phase_deg", self.phase_deg),
+            ("phase_from_energy_deg", self.phase_from_energy_deg),
+            ("e_ts_j", self.e_ts_j),
+            ("e_ts_ev", self.e_ts_ev),
+            ("e_damp_j", self.e_damp_j),
+            ("e_drive_j", self.e_drive_j),
+            ("energy_balance_rel", self.energy_balance_rel),
+            ("virial_j", self.virial_j),
+            ("mean_force_n", self.mean_force_n),
+            ("peak_force_n", self.peak_force_n),
+            ("peak_attractive_force_n", self.peak_attractive_force_n),
+            ("min_separation_m", self.min_separation_m),
+            ("max_indentation_m", self.max_indentation_m),
+            ("contact_fraction", self.contact_fraction),
+            ("jumps_in", self.jumps_in),
+            ("loop_area_j", self.loop_area_j),
+            ("loop_area_hat", self.loop_area_hat),
+            ("frequency_ratio", self.frequency_ratio),
+        ];
+        let multipliers = self.floquet_multipliers.iter().flatten();
+        let bad = numbers
+            .iter()
+            .find(|(_, x)| !x.is_finite())
+            .map(|(name, _)| *name)
+            .or_else(|| {
+                multipliers
+                    .clone()
+                    .any(|x| !x.is_finite())
+                    .then_some("floquet_multipliers")
+            });
+        match bad {
+            None => Ok(self),
+            Some(name) => Err(Error::Numerical(format!(
+                "the steady state gave a non-finite {name}: these parameters are outside \
+                 what the integration can resolve"
+            ))),
+        }
+    }
+
+    fn from_state(p: &Prepared, state: &SteadyState) -> Self {
         let c: &CycleIntegrals = &state.window;
         let periods = f64::from(c.periods);
         let cant = &p.setup.cantilever;
@@ -324,7 +374,7 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, record_cycles: usize) -> Resul
     }
     let scale = setup.contact.separation_scale_m();
     Ok(TapRun {
-        observables: TapObservables::new(&p, &state),
+        observables: TapObservables::new(&p, &state)?,
         trajectory: recorder.to_si(&p),
         switch_separations_m: (
             p.law.jump_in_alpha_hat() * scale,

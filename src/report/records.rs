@@ -5,65 +5,71 @@ use crate::error::{Error, Result};
 use serde::Serialize;
 use serde_json::{Map, Value};
 
-/// Serialise records to JSON objects (one per record).
-fn objects<T: Serialize>(records: &[T]) -> Result<Vec<Map<String, Value>>> {
-    records
-        .iter()
-        .map(|r| match serde_json::to_value(r) {
-            Ok(Value::Object(m)) => Ok(m),
-            Ok(_) => Err(Error::Output {
-                path: "records".into(),
-                reason: "a record is not an object".into(),
-            }),
-            Err(e) => Err(Error::Output {
-                path: "records".into(),
-                reason: e.to_string(),
-            }),
-        })
-        .collect()
-}
-
-/// Every field name of the records, in first-seen order (records may lack some).
-fn field_names(rows: &[Map<String, Value>]) -> Vec<String> {
-    let mut names: Vec<String> = Vec::new();
-    for r in rows {
-        for k in r.keys() {
-            if !names.contains(k) {
-                names.push(k.clone());
-            }
-        }
+/// A record as a JSON object.
+fn object<T: Serialize>(record: &T) -> Result<Map<String, Value>> {
+    let fail = |reason: String| Error::Output {
+        path: "records".into(),
+        reason,
+    };
+    match serde_json::to_value(record) {
+        Ok(Value::Object(m)) => Ok(m),
+        Ok(_) => Err(fail("a record is not an object".into())),
+        Err(e) => Err(fail(e.to_string())),
     }
-    names
 }
 
 /// One JSON object whose fields are arrays (one entry per record, null where a record
-/// lacks the field), in record-field order.
+/// lacks the field), in record-field order. Records are converted one at a time.
 pub fn columns_json<T: Serialize>(records: &[T]) -> Result<Value> {
-    let rows = objects(records)?;
-    let mut out = Map::new();
-    for key in field_names(&rows) {
-        let column = rows
-            .iter()
-            .map(|r| r.get(&key).cloned().unwrap_or(Value::Null))
-            .collect();
-        out.insert(key, Value::Array(column));
+    let mut columns: Vec<(String, Vec<Value>)> = Vec::new();
+    for (i, r) in records.iter().enumerate() {
+        for (key, value) in object(r)? {
+            match columns.iter_mut().find(|(name, _)| *name == key) {
+                Some((_, column)) => {
+                    column.resize(i, Value::Null);
+                    column.push(value);
+                }
+                None => {
+                    let mut column = vec![Value::Null; i];
+                    column.push(value);
+                    columns.push((key, column));
+                }
+            }
+        }
     }
-    Ok(Value::Object(out))
+    Ok(Value::Object(
+        columns
+            .into_iter()
+            .map(|(key, mut column)| {
+                column.resize(records.len(), Value::Null);
+                (key, Value::Array(column))
+            })
+            .collect(),
+    ))
 }
 
-/// The records as CSV, one row each, the fields as columns.
+/// The records as CSV, one row each, the fields as columns. Records are turned into
+/// JSON objects one at a time (twice: once for the columns, once for the row), so memory
+/// holds the CSV text and one record, not every record as an object.
 pub fn records_csv<T: Serialize>(records: &[T]) -> Result<Vec<u8>> {
-    let rows = objects(records)?;
     let fail = |e: csv::Error| Error::Output {
         path: "records.csv".into(),
         reason: e.to_string(),
     };
+    let mut keys: Vec<String> = Vec::new();
+    for r in records {
+        for k in object(r)?.keys() {
+            if !keys.contains(k) {
+                keys.push(k.clone());
+            }
+        }
+    }
     let mut w = csv::Writer::from_writer(Vec::new());
-    let keys = field_names(&rows);
     if !keys.is_empty() {
         w.write_record(&keys).map_err(fail)?;
-        for r in &rows {
-            w.write_record(keys.iter().map(|k| match r.get(k) {
+        for r in records {
+            let row = object(r)?;
+            w.write_record(keys.iter().map(|k| match row.get(k) {
                 Some(Value::String(s)) => s.clone(),
                 Some(Value::Null) | None => String::new(),
                 Some(v) => v.to_string(),
