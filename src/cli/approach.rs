@@ -27,7 +27,7 @@ pub struct ApproachArgs {
     #[command(flatten)]
     range: super::SeparationRange,
     /// Points on the approach (the retract has as many).
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 60)]
     points: usize,
     /// Approach only.
     #[arg(long)]

@@ -26,10 +26,10 @@ pub struct BifurcationArgs {
     #[command(flatten)]
     range: super::SeparationRange,
     /// Rest separations on the ramp.
-    #[arg(long, default_value_t = 120)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 120)]
     points: usize,
     /// Periods sampled at each rest separation.
-    #[arg(long, default_value_t = 32)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 32)]
     samples: usize,
 }
 

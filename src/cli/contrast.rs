@@ -44,7 +44,7 @@ pub struct ContrastArgs {
           value_parser = crate::config::number, default_values_t = [0.9, 0.8, 0.7, 0.6, 0.5])]
     setpoints: Vec<f64>,
     /// Setpoints on each approach curve.
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 50)]
     points: usize,
 }
 

@@ -25,22 +25,22 @@ pub struct MapArgs {
     #[command(flatten)]
     out: super::SweepOutput,
     /// Smallest work of adhesion [J/m²].
-    #[arg(long, value_parser = surface_energy, default_value = "0.02")]
+    #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, default_value = "0.02")]
     adhesion_from: f64,
     /// Largest work of adhesion [J/m²].
-    #[arg(long, value_parser = surface_energy, default_value = "0.2")]
+    #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, default_value = "0.2")]
     adhesion_to: f64,
     /// Smallest composite modulus [Pa].
-    #[arg(long, value_parser = pressure, default_value = "0.3GPa")]
+    #[arg(long, allow_hyphen_values = true, value_parser = pressure, default_value = "0.3GPa")]
     modulus_from: f64,
     /// Largest composite modulus [Pa].
-    #[arg(long, value_parser = pressure, default_value = "3GPa")]
+    #[arg(long, allow_hyphen_values = true, value_parser = pressure, default_value = "3GPa")]
     modulus_to: f64,
     /// Grid points along each axis.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 8)]
     steps: usize,
     /// Worker threads (0: all cores).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
     threads: usize,
 }
 

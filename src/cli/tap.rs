@@ -45,7 +45,7 @@ pub struct TapArgs {
     #[arg(long)]
     plot: Option<PathBuf>,
     /// Cycles recorded for --trajectory and --plot.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 3)]
     record_cycles: usize,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
