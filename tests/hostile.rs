@@ -618,6 +618,9 @@ fn each_reported_hostile_input_is_refused_with_its_reason() {
         ),
         (vec!["reproduce", "--out", "/"], 1, "not empty"),
         (vec!["tap", "--radius", &long], 2, "10000 characters"),
+        // In range, but a cantilever 10⁵ times softer than the contact: the work budget
+        // ends it.
+        (vec!["tap", "--stiffness", "1e-3"], 1, "work budget"),
     ];
     if has_fifo {
         cases.push((

@@ -461,7 +461,9 @@ fn run<S: System<f64, State<N>>, const N: usize>(
         Ok(stats) => budget::spend(u64::from(stats.accepted_steps + stats.rejected_steps)),
         Err(E::MaxNumStepReached { .. }) if limited_by_budget => Err(budget::exhausted()),
         Err(e) => Err({
-            let _ = budget::spend(u64::from(max_steps));
+            if matches!(e, E::MaxNumStepReached { .. }) {
+                let _ = budget::spend(u64::from(max_steps));
+            }
             Error::Numerical(match e {
                 E::StepSizeUnderflow { x } => format!(
                     "the integrator's step fell to round-off on the {branch} branch at \
