@@ -1,6 +1,7 @@
 //! Time to the Lennard-Jones hysteresis Ŵ_LJ(μ) with its error estimate, as
 //! `tapsim lj` computes it without the cache: assembly and continuation on the
-//! production moving mesh and on the 1.5× coarser one (in parallel).
+//! production moving mesh (on one core) and on the 1.5× and 2.25× coarser ones (on the
+//! other).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
@@ -15,7 +16,7 @@ fn bench(c: &mut Criterion) {
         group.bench_function(format!("mu={mu}"), |b| {
             b.iter(|| {
                 let s = lj::solve(mu, false).expect("solved");
-                assert!(s.w_hat.error < 1e-3 * s.w_hat.value, "{:?}", s.w_hat);
+                assert!(s.w_hat.error < 2e-4 * s.w_hat.value, "{:?}", s.w_hat);
                 s.w_hat.value
             })
         });

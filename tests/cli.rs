@@ -849,3 +849,29 @@ fn a_closed_pipe_ends_quietly_and_a_full_disk_is_an_error() {
         "{err}"
     );
 }
+
+#[test]
+fn a_cached_lennard_jones_solution_prints_the_same_bytes_as_a_fresh_one() {
+    let dir = scratch("lj-cache");
+    let run = || {
+        let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
+            .args(["lj", "--mu", "2", "--json"])
+            .env("TAPSIM_CACHE", dir.join("cache"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out.stdout
+    };
+    let cold = run();
+    let cached: Vec<_> = std::fs::read_dir(dir.join("cache")).unwrap().collect();
+    assert_eq!(cached.len(), 1, "one solution cached");
+    let warm = run();
+    assert_eq!(
+        String::from_utf8_lossy(&cold),
+        String::from_utf8_lossy(&warm)
+    );
+}

@@ -130,7 +130,8 @@ impl LjReport {
         );
         let _ = writeln!(
             s,
-            "  mesh: {} nodes (error estimate from {} nodes), {} continuation steps",
+            "  mesh: {} nodes, extrapolated with {} nodes (and fewer for the error \
+             estimate), {} continuation steps",
             self.nodes, self.nodes_coarse, self.steps
         );
         let row = |s: &mut String, name: &str, v: f64, e: f64| {

@@ -115,10 +115,15 @@ fn work_between(points: &[CurvePoint], a: f64, b: f64) -> f64 {
     total
 }
 
-/// The fold in interval range around sample index k (a local extremum of α̂ there).
-fn locate_fold(points: &[CurvePoint], k: usize) -> Result<Fold> {
+/// The point where `field` is stationary between the samples around index k (a local
+/// extremum there), on the cubic through the samples.
+fn locate_extremum(
+    points: &[CurvePoint],
+    k: usize,
+    field: impl Fn(&CurvePoint) -> f64 + Copy,
+) -> Result<Fold> {
     let (lo, hi) = (points[k - 1].s, points[k + 1].s);
-    let slope = |s: f64| cubic(points, interval(points, s), s, |p| p.alpha_hat).1;
+    let slope = |s: f64| cubic(points, interval(points, s), s, field).1;
     let s = bracketed_root("LJ fold", slope, lo, hi, 1e-14)?;
     let kk = interval(points, s);
     Ok(Fold {
@@ -126,6 +131,26 @@ fn locate_fold(points: &[CurvePoint], k: usize) -> Result<Fold> {
         alpha_hat: cubic(points, kk, s, |p| p.alpha_hat).0,
         t_hat: cubic(points, kk, s, |p| p.t_hat).0,
     })
+}
+
+/// The fold around sample index k (a local extremum of α̂ there).
+fn locate_fold(points: &[CurvePoint], k: usize) -> Result<Fold> {
+    locate_extremum(points, k, |p| p.alpha_hat)
+}
+
+/// The load-control pull-off: the largest T̂ on the contact branch, the points after
+/// index `from` (the fold C), interpolated between the samples around the largest one
+/// (a sampled maximum alone would be low by O(chord²)).
+pub fn pull_off(points: &[CurvePoint], from: usize) -> f64 {
+    let Some(k) = (from..points.len()).max_by(|&i, &j| points[i].t_hat.total_cmp(&points[j].t_hat))
+    else {
+        return f64::NAN;
+    };
+    let sampled = points[k].t_hat;
+    if k == 0 || k + 1 >= points.len() {
+        return sampled;
+    }
+    locate_extremum(points, k, |p| p.t_hat).map_or(sampled, |f| f.t_hat.max(sampled))
 }
 
 /// First arclength after `from` (within the sampled range) where α̂ = `level`.

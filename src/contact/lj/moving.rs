@@ -83,13 +83,17 @@ impl MovingSpec {
             .max(jkr::pull_off_point().a_hat)
     }
 
-    /// The same mesh with every spacing multiplied by `factor`.
+    /// The same mesh with every spacing multiplied by `factor`: the grading too (the
+    /// spacing grows as fine + (growth − 1)|ξ − 1|, so growth − 1 scales like a
+    /// spacing), which makes the meshes of one family similar and the discretisation
+    /// error ∝ spacing².
     pub fn scaled(&self, factor: f64) -> Self {
         Self {
             fine: self.fine * factor,
             inner: self.inner * factor,
             near: self.near * factor,
             middle: self.middle * factor,
+            growth: 1.0 + (self.growth - 1.0) * factor,
             ..*self
         }
     }
@@ -315,10 +319,7 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
     }
     let hysteresis = Hysteresis::of(&points)?;
     let k_c = points.partition_point(|p| p.s <= hysteresis.fold_c.s);
-    let pull_off_hat = points[k_c..]
-        .iter()
-        .map(|p| p.t_hat)
-        .fold(hysteresis.fold_c.t_hat, f64::max);
+    let pull_off_hat = super::curve::pull_off(&points, k_c).max(hysteresis.fold_c.t_hat);
     Ok(Curve {
         tabor_mu: mu,
         nodes: problem.len(),
