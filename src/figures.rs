@@ -227,7 +227,7 @@ pub fn fig2(s: &LjSolution) -> Result<Chart> {
         (0.3, 0.3),
     );
     labels.push(label(
-        &format!("Ŵ = {:.4} ± {:.0e}", s.w_hat.value, s.w_hat.error),
+        &format!("Ŵ = {:.5} ± {:.1e}", s.w_hat.value, s.w_hat.error),
         -1.5,
         0.5,
     ));
