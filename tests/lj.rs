@@ -221,3 +221,74 @@ fn the_error_estimate_covers_a_much_finer_extrapolation() {
         assert!(e.error < 2e-4 * e.value.abs(), "{name}: {e:?}");
     }
 }
+
+#[test]
+fn the_contact_edge_gap_is_a_convention_not_a_result() {
+    use tapsim::contact::lj::moving::{MovingOptions, MovingSpec};
+    use tapsim::contact::lj::result::{ELEMENTS_PER_ANNULUS, solve_with};
+    let mu = 2.0;
+    let s = solution(mu);
+    for edge_gap in [1.1, 2.0] {
+        let spec = MovingSpec {
+            edge_gap,
+            ..MovingSpec::for_tabor(mu, ELEMENTS_PER_ANNULUS)
+        };
+        let other = solve_with(&spec, &MovingOptions::default()).unwrap();
+        for name in [
+            "w_hat",
+            "alpha_hat_c",
+            "t_hat_c",
+            "pull_off_hat",
+            "alpha_hat_a",
+            "t_hat_a",
+        ] {
+            let (a, b) = (estimate(s, name), estimate(&other, name));
+            let off = (a.value - b.value).abs();
+            println!(
+                "edge gap {edge_gap}: {name} {:.8} vs {:.8}: {off:.1e}",
+                a.value, b.value
+            );
+            assert!(
+                off < a.error + b.error,
+                "edge gap {edge_gap}, {name}: off by {off:e}"
+            );
+        }
+    }
+}
+
+/// A 100 times tighter Newton tolerance moves every value by less than 1e-6; half the
+/// chord cap moves the folds and the pull-off (located on converged solutions) by less
+/// than 1e-6 and Ŵ (integrated along the sampled curve) by less than 1e-5, a twentieth
+/// of its error estimate.
+#[test]
+fn tighter_continuation_settings_move_the_results_by_less_than_their_error() {
+    use tapsim::contact::lj::moving::{self, MovingOptions, MovingSpec};
+    use tapsim::contact::lj::result::{ELEMENTS_PER_ANNULUS, MESH_RATIO};
+    for mu in [2.0, 5.0] {
+        // The coarsest mesh of the family: the settings, not the mesh, are tested.
+        let spec = MovingSpec::for_tabor(mu, ELEMENTS_PER_ANNULUS).scaled(MESH_RATIO * MESH_RATIO);
+        let base = MovingOptions::default();
+        let tight_newton = MovingOptions {
+            tolerance: 1e-2 * base.tolerance,
+            ..base
+        };
+        let short_chords = MovingOptions {
+            max_chord: 0.5 * base.max_chord,
+            ..base
+        };
+        let a = moving::trace(&spec, &base).unwrap();
+        for (what, opts) in [("newton", tight_newton), ("chord", short_chords)] {
+            let b = moving::trace(&spec, &opts).unwrap();
+            for (name, pick) in QUANTITIES {
+                let moved = (pick(&a) - pick(&b)).abs();
+                println!("mu {mu}, tighter {what}: {name} moves by {moved:.1e}");
+                let bound = if what == "chord" && name == "w_hat" {
+                    1e-5
+                } else {
+                    1e-6
+                };
+                assert!(moved < bound, "mu {mu}, {what}, {name}: moved by {moved:e}");
+            }
+        }
+    }
+}

@@ -212,6 +212,20 @@ impl Hysteresis {
             .ok_or_else(|| Error::Numerical("no jump-out fold found".into()))?;
         let fold_a = locate_fold(points, k_a)?;
         let fold_c = locate_fold(points, k_c)?;
+        Self::between(points, fold_a, fold_c)
+    }
+
+    /// The loop of `points` between the folds `fold_a` and `fold_c` (located on the
+    /// curve or more precisely elsewhere): Ŵ = ∫_{α̂_A}^{α̂_C} (T̂_contact − T̂_approach)
+    /// dα̂, the contact branch from C to where it reaches α̂_A and the approach branch
+    /// from where it passes α̂_C to A. The levels matter: T̂ is large where the contact
+    /// branch crosses α̂_A, so an error δ in α̂_A moves Ŵ by about T̂·δ.
+    pub fn between(points: &[CurvePoint], fold_a: Fold, fold_c: Fold) -> Result<Self> {
+        let n = points.len();
+        let k_a = points.partition_point(|p| p.s < fold_a.s).min(n - 1);
+        let k_c = points
+            .partition_point(|p| p.s <= fold_c.s)
+            .saturating_sub(1);
         let s_land = crossing(points, k_c, n - 1, fold_a.alpha_hat)?;
         let s_app = crossing(points, 0, k_a, fold_c.alpha_hat)?;
         // Along s both pieces run from α̂_C to α̂_A.

@@ -4,17 +4,18 @@
 //! sweeps across hundreds of fine elements while the curve is traced; the nodal gaps then
 //! change abruptly along the curve, predictors fail, and the steps stay tiny. Here the
 //! nodes are x = a·ξ on a fixed mesh in ξ, fine around ξ = 1, and a is the contact
-//! radius, defined by pinning the gap at ξ = 1 to [`EDGE_GAP`]. Stretching the mesh
+//! radius, defined by pinning the gap at ξ = 1 to [`EDGE_GAP`] (or the spec's own
+//! `edge_gap`; the results do not depend on it beyond their error). Stretching the mesh
 //! multiplies the influence matrix by a (no reassembly), the solution varies smoothly
 //! with a, and a grows monotonically from the first contact to deep contact, so plain
 //! natural-parameter continuation in a works.
 //!
 //! Before there is a contact the same mesh is frozen at a = a₀ and the curve is followed
 //! in the central gap h̄(0), which falls monotonically from far out through the jump-in
-//! fold A to the forming contact; once the gap at x = a₀ falls to [`EDGE_GAP`] the
+//! fold A to the forming contact; once the gap at x = a₀ falls to the edge gap the
 //! continuation switches to a.
 
-use super::curve::{Curve, CurvePoint, Hysteresis};
+use super::curve::{Curve, CurvePoint, Fold, Hysteresis};
 use super::solver::{Problem, Solution};
 use crate::contact::hybrid::JumpIn;
 use crate::contact::jkr;
@@ -29,7 +30,8 @@ pub const OUTER_RADIUS: f64 = 50.0;
 /// The softest support spring k̂ whose loop the production trace contains.
 pub const SOFTEST_SPRING: f64 = 0.5;
 
-/// The gap h̄ that marks the contact edge (inside it h̄ ≈ 1, outside it grows fast).
+/// The gap h̄ that marks the contact edge by default (inside it h̄ ≈ 1, outside it
+/// grows fast).
 pub const EDGE_GAP: f64 = 1.2;
 
 /// How the moving mesh is built.
@@ -51,6 +53,8 @@ pub struct MovingSpec {
     /// Contact radius (in x) at which the continuation switches to a; the mesh reaches
     /// x = [`OUTER_RADIUS`] there.
     pub a_start: f64,
+    /// The gap pinned at ξ = 1, which defines the contact radius a of the mesh.
+    pub edge_gap: f64,
 }
 
 impl MovingSpec {
@@ -68,6 +72,7 @@ impl MovingSpec {
             middle: 0.05,
             growth: 1.04,
             a_start: 0.1 * root,
+            edge_gap: EDGE_GAP,
         }
     }
 
@@ -219,6 +224,12 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
     let mut seen_c = false;
     let mut steps = 0;
     let landing_alpha = guess_a - 0.5;
+    // Extremes located on converged solutions: (parameter, α̂, T̂) of the fold A (the
+    // first minimum of α̂ in the central gap), the fold C (the largest maximum of α̂ in
+    // the contact radius) and the pull-off (the largest maximum of T̂ after C).
+    let mut exact_a: Option<(f64, f64, f64)> = None;
+    let mut exact_c: Option<(f64, f64, f64)> = None;
+    let mut exact_pull_off: Option<(f64, f64, f64)> = None;
     loop {
         if steps >= opts.max_steps {
             return Err(Error::Numerical(format!(
@@ -233,7 +244,7 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
         let guess = extrapolate(&history, p_next);
         let (pin, a_next) = match phase {
             Phase::CentralGap => ((0, p_next), a0),
-            Phase::Radius => ((edge, EDGE_GAP), p_next),
+            Phase::Radius => ((edge, spec.edge_gap), p_next),
         };
         let prev = *points.last().expect("never empty");
         let (sol, its) = match problem.solve_pinned(&guess, a_next, pin, tol, &mut lu) {
@@ -258,15 +269,15 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
             step *= 0.8 * max_chord / chord;
             continue;
         }
-        if phase == Phase::CentralGap && sol.gap[edge] <= EDGE_GAP {
+        if phase == Phase::CentralGap && sol.gap[edge] <= spec.edge_gap {
             // The contact has reached x = a₀: pin the edge there (from the two solutions
             // around that point) and follow a from now on.
             let before = &last.gap[edge];
-            let f = (before - EDGE_GAP) / (before - sol.gap[edge]);
+            let f = (before - spec.edge_gap) / (before - sol.gap[edge]);
             let mut guess = last.clone();
             guess.gap.axpy(f, &(&sol.gap - &last.gap), 1.0);
             guess.alpha_bar += f * (sol.alpha_bar - last.alpha_bar);
-            match problem.solve_pinned(&guess, a0, (edge, EDGE_GAP), tol, &mut lu) {
+            match problem.solve_pinned(&guess, a0, (edge, spec.edge_gap), tol, &mut lu) {
                 Ok((sol, its)) => {
                     iterations += its;
                     steps += 1;
@@ -298,6 +309,54 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
         if history.len() > 3 {
             history.pop_front();
         }
+        if history.len() == 3 {
+            let alpha_of = |_: f64, s: &Solution| s.alpha_bar / mu;
+            let problem = &problem;
+            let at = |phase: Phase| {
+                move |p: f64, guess: &Solution| -> Result<Solution> {
+                    let (pin, a) = match phase {
+                        Phase::CentralGap => ((0, p), a0),
+                        Phase::Radius => ((edge, spec.edge_gap), p),
+                    };
+                    let mut lu = None;
+                    Ok(problem.solve_pinned(guess, a, pin, tol, &mut lu)?.0)
+                }
+            };
+            let found = |sign: f64, value: &dyn Fn(f64, &Solution) -> f64| {
+                refine_extremum(&history, &at(phase), value, sign).map(|(p, around)| {
+                    let at_p = |quantity: &dyn Fn(f64, &Solution) -> f64| {
+                        let q =
+                            [0, 1, 2].map(|i| (around[i].0, quantity(around[i].0, &around[i].1)));
+                        quadratic_at(&q, p)
+                    };
+                    let force = |q: f64, s: &Solution| {
+                        let a = if phase == Phase::Radius { q } else { a0 };
+                        problem.force_scaled(&s.gap, a).0
+                    };
+                    (p, at_p(&alpha_of), at_p(&force))
+                })
+            };
+            match phase {
+                Phase::CentralGap if exact_a.is_none() => exact_a = found(-1.0, &alpha_of),
+                Phase::CentralGap => {}
+                Phase::Radius => {
+                    if let Some(c) = found(1.0, &alpha_of) {
+                        if exact_c.is_none_or(|old| c.1 > old.1) {
+                            exact_c = Some(c);
+                            exact_pull_off = None;
+                        }
+                    }
+                    let force_of = |p: f64, s: &Solution| problem.force_scaled(&s.gap, p).0;
+                    if let Some(c) = exact_c {
+                        if let Some(f) = found(1.0, &force_of).filter(|f| f.0 > c.0) {
+                            if exact_pull_off.is_none_or(|old| f.2 > old.2) {
+                                exact_pull_off = Some(f);
+                            }
+                        }
+                    }
+                }
+            }
+        }
         // Step control from the predictor's error (third order for the quadratic
         // extrapolation once three points are known), aiming at PREDICTOR_ERROR.
         let predicted = predictor_error(&guess, &history.back().expect("just pushed").1);
@@ -319,15 +378,32 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
     }
     let hysteresis = Hysteresis::of(&points)?;
     let k_c = points.partition_point(|p| p.s <= hysteresis.fold_c.s);
-    let pull_off_hat = super::curve::pull_off(&points, k_c).max(hysteresis.fold_c.t_hat);
+    // The folds and the pull-off from converged solutions where they were located so
+    // (and agree with the traced curve), else interpolated on the curve.
+    let exact = |fold: Fold, found: Option<(f64, f64, f64)>| match found {
+        Some((_, alpha_hat, t_hat)) if (alpha_hat - fold.alpha_hat).abs() < 1e-2 => Fold {
+            alpha_hat,
+            t_hat,
+            ..fold
+        },
+        _ => fold,
+    };
+    let fold_a = exact(hysteresis.fold_a, exact_a);
+    let fold_c = exact(hysteresis.fold_c, exact_c);
+    let w_hat = Hysteresis::between(&points, fold_a, fold_c)?.w_hat;
+    let interpolated = super::curve::pull_off(&points, k_c).max(hysteresis.fold_c.t_hat);
+    let pull_off_hat = match exact_pull_off {
+        Some((_, _, t_hat)) if (t_hat - interpolated).abs() < 1e-2 => t_hat,
+        _ => interpolated,
+    };
     Ok(Curve {
         tabor_mu: mu,
         nodes: problem.len(),
         points,
-        fold_a: hysteresis.fold_a,
-        fold_c: hysteresis.fold_c,
+        fold_a,
+        fold_c,
         pull_off_hat,
-        w_hat: hysteresis.w_hat,
+        w_hat,
         steps,
         factorisations: problem.factorisations(),
         iterations,
@@ -356,6 +432,87 @@ fn past_landing(points: &[CurvePoint], landing_alpha: f64, opts: &MovingOptions)
         .find(|w| support(&w[1]) > support(&w[0]))
         .map(|w| support(&w[0]));
     first_min.is_some_and(|m| support(q) < m - 0.5)
+}
+
+/// The extremum of `value` (a maximum for `sign` = 1, a minimum for −1) over the
+/// continuation parameter, if the three solutions of `history` bracket one (the middle
+/// one the most extreme), located on converged solutions (`solve` at a parameter from a
+/// guess) by successive parabolic interpolation. Returns the parameter there and three
+/// converged solutions around it, to interpolate any quantity at it.
+///
+/// A fold is a smooth extremum of α̂ in the parameter of its phase, so this converges
+/// fast, where interpolating the sampled curve is limited by how sharply the curve
+/// turns. α̂ is flat at its extremum: points closer than 1e-4 of the first bracket would
+/// let the solver's tolerance move the vertex, so the search stops there and the
+/// answer comes from a stencil 1 % of the bracket wide around it.
+fn refine_extremum(
+    history: &VecDeque<(f64, Solution)>,
+    solve: &dyn Fn(f64, &Solution) -> Result<Solution>,
+    value: &dyn Fn(f64, &Solution) -> f64,
+    sign: f64,
+) -> Option<(f64, VecDeque<(f64, Solution)>)> {
+    let mut pts: Vec<(f64, Solution, f64)> = history
+        .iter()
+        .map(|(p, s)| (*p, s.clone(), sign * value(*p, s)))
+        .collect();
+    pts.sort_by(|x, y| x.0.total_cmp(&y.0));
+    if !(pts[1].2 >= pts[0].2 && pts[1].2 >= pts[2].2 && pts[1].2 > pts[0].2.min(pts[2].2)) {
+        return None;
+    }
+    let vertex = |pts: &[(f64, Solution, f64)]| {
+        let [(p0, v0), (p1, v1), (p2, v2)] = [0, 1, 2].map(|i| (pts[i].0, pts[i].2));
+        let (d0, d2) = (p1 - p0, p1 - p2);
+        let denominator = d0 * (v1 - v2) - d2 * (v1 - v0);
+        let p = p1 - 0.5 * (d0 * d0 * (v1 - v2) - d2 * d2 * (v1 - v0)) / denominator;
+        (p.is_finite() && p > p0 && p < p2).then_some(p)
+    };
+    let closest = 1e-4 * (pts[2].0 - pts[0].0);
+    for _ in 0..30 {
+        let p = vertex(&pts)?;
+        let (p0, p1, p2) = (pts[0].0, pts[1].0, pts[2].0);
+        if (p - p1).abs() < closest || p - p0 < closest || p2 - p < closest {
+            break;
+        }
+        let around: VecDeque<(f64, Solution)> =
+            pts.iter().map(|(p, s, _)| (*p, s.clone())).collect();
+        let sol = solve(p, &extrapolate(&around, p)).ok()?;
+        let v = sign * value(p, &sol);
+        // Keep three points bracketing the extremum, the most extreme in the middle.
+        let new = (p, sol, v);
+        let [lo, mid, hi]: [(f64, Solution, f64); 3] = pts.try_into().ok()?;
+        pts = match (v >= mid.2, p < p1) {
+            (true, true) => vec![lo, new, mid],
+            (true, false) => vec![mid, new, hi],
+            (false, true) => vec![new, mid, hi],
+            (false, false) => vec![lo, mid, new],
+        };
+    }
+    // A last symmetric stencil, wide enough that the solver's tolerance cannot move its
+    // vertex, centred where the extremum now lies.
+    let centre = vertex(&pts)?;
+    let around: VecDeque<(f64, Solution)> = pts.into_iter().map(|(p, s, _)| (p, s)).collect();
+    let delta = 100.0 * closest;
+    let mut stencil = Vec::with_capacity(3);
+    for p in [centre - delta, centre, centre + delta] {
+        let sol = solve(p, &extrapolate(&around, p)).ok()?;
+        let v = sign * value(p, &sol);
+        stencil.push((p, sol, v));
+    }
+    let p = vertex(&stencil).unwrap_or(centre);
+    Some((p, stencil.into_iter().map(|(p, s, _)| (p, s)).collect()))
+}
+
+/// The quadratic through (pᵢ, yᵢ), i < 3, at p.
+fn quadratic_at(points: &[(f64, f64); 3], p: f64) -> f64 {
+    (0..3)
+        .map(|i| {
+            let weight: f64 = (0..3)
+                .filter(|&j| j != i)
+                .map(|j| (p - points[j].0) / (points[i].0 - points[j].0))
+                .product();
+            weight * points[i].1
+        })
+        .sum()
 }
 
 /// Largest relative gap error of the predictor accepted before the step shrinks.

@@ -209,7 +209,20 @@ pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
         }
     }
     let spec = MovingSpec::for_tabor(tabor_mu, ELEMENTS_PER_ANNULUS);
-    let opts = MovingOptions::default();
+    let solution = solve_with(&spec, &MovingOptions::default())?;
+    // A cache that cannot be written only costs time later.
+    if let Ok(text) = serde_json::to_string(&solution) {
+        let _ = std::fs::create_dir_all(cache_dir());
+        let _ = output::write_bytes(&path, text.as_bytes());
+    }
+    Ok(solution)
+}
+
+/// Solve on the mesh family of `spec` (`spec` itself and the meshes 1.5 and 2.25 times
+/// coarser) with the continuation settings `opts`, extrapolating every value
+/// ([`Estimate`]); no cache.
+pub fn solve_with(spec: &MovingSpec, opts: &MovingOptions) -> Result<LjSolution> {
+    let (spec, opts) = (*spec, *opts);
     // The meshes are independent: the fine one on one core, the two coarse ones (together
     // about as costly) on the other.
     let (fine, (coarse, coarser)) = rayon::join(
@@ -225,8 +238,8 @@ pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
     let r = |pick: fn(&super::curve::Curve) -> f64| {
         Estimate::extrapolated(pick(&fine), pick(&coarse), pick(&coarser))
     };
-    let solution = LjSolution {
-        tabor_mu,
+    Ok(LjSolution {
+        tabor_mu: spec.tabor_mu,
         alpha_hat_a: r(|c| c.fold_a.alpha_hat),
         t_hat_a: r(|c| c.fold_a.t_hat),
         alpha_hat_c: r(|c| c.fold_c.alpha_hat),
@@ -239,11 +252,5 @@ pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
         s_a: fine.fold_a.s,
         s_c: fine.fold_c.s,
         curve: fine.points,
-    };
-    // A cache that cannot be written only costs time later.
-    if let Ok(text) = serde_json::to_string(&solution) {
-        let _ = std::fs::create_dir_all(cache_dir());
-        let _ = output::write_bytes(&path, text.as_bytes());
-    }
-    Ok(solution)
+    })
 }
