@@ -290,14 +290,19 @@ fn tabulated_lj_law_dissipates_the_numerical_loop() {
     };
     let o = tap(&setup, &Numerics::default(), 0).unwrap().observables;
     assert!(o.converged && o.jumps_in == 1.0);
-    let s = tapsim::contact::lj::solve(setup.contact.tabor_mu(), true).unwrap();
-    let w = s.w_hat.value * setup.contact.energy_scale_j();
-    let rel = (o.e_ts_j - w).abs() / w;
+    // The law is the production mesh's curve: it dissipates that curve's loop exactly,
+    // which lies within the discretisation error of the extrapolated Ŵ_LJ.
+    let rel = (o.e_ts_j - o.loop_area_j).abs() / o.loop_area_j;
     println!(
-        "E_ts {:.6e} J vs W_LJ·μεRΔγ {w:.6e} J ({rel:.1e})",
-        o.e_ts_j
+        "E_ts {:.6e} J vs the law's loop {:.6e} J ({rel:.1e})",
+        o.e_ts_j, o.loop_area_j
     );
     assert!(rel < 1e-5, "{rel:e}");
+    let s = tapsim::contact::lj::solve(setup.contact.tabor_mu(), true).unwrap();
+    let w = s.w_hat.value * setup.contact.energy_scale_j();
+    let mesh = (o.loop_area_j - w).abs() / w;
+    println!("the law's loop vs the extrapolated W_LJ·μεRΔγ {w:.6e} J: {mesh:.1e}");
+    assert!(mesh < 1e-3, "{mesh:e}");
     assert!(o.energy_balance_rel < 1e-6);
     // At μ = 2.76 the hybrid theory underestimates the loss the LJ law gives.
     let hybrid = run(LawKind::Hybrid, 14.0);
