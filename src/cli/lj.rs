@@ -26,7 +26,7 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct LjArgs {
-    /// Tabor parameter μ, eq. (2) [0.5 to 12; a few seconds above ~6].
+    /// Tabor parameter μ, eq. (2) [0.5 to 10.5; a few seconds above ~6].
     #[arg(long, allow_hyphen_values = true, value_parser = number)]
     mu: f64,
     /// Support stiffness k̂ = μεk/(RΔγ), eq. (22): adds the loss with the support in
