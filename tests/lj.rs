@@ -292,3 +292,13 @@ fn tighter_continuation_settings_move_the_results_by_less_than_their_error() {
         }
     }
 }
+
+#[test]
+fn just_above_the_critical_mu_the_thin_loop_is_found() {
+    // (A shallow fold whose interpolating cubics do not turn between the samples used
+    // to fail with "no sign change" here.)
+    let s = lj::solve(0.71, false).unwrap();
+    println!("W_LJ(0.71) = {:.3e} ± {:.1e}", s.w_hat.value, s.w_hat.error);
+    assert!(s.alpha_hat_c.value > s.alpha_hat_a.value);
+    assert!(s.w_hat.value > 0.0 && s.w_hat.value < 0.01);
+}

@@ -124,7 +124,9 @@ fn locate_extremum(
 ) -> Result<Fold> {
     let (lo, hi) = (points[k - 1].s, points[k + 1].s);
     let slope = |s: f64| cubic(points, interval(points, s), s, field).1;
-    let s = bracketed_root("LJ fold", slope, lo, hi, 1e-14)?;
+    // Where the interpolating cubics do not turn between the neighbours (a shallow
+    // fold near the critical μ), the sample itself.
+    let s = bracketed_root("LJ fold", slope, lo, hi, 1e-14).unwrap_or(points[k].s);
     let kk = interval(points, s);
     Ok(Fold {
         s,
