@@ -29,6 +29,11 @@ pub enum Error {
     /// A model was asked for a result outside the range where it applies.
     #[error("{0}")]
     NotApplicable(String),
+    /// The Lennard-Jones force–separation curve has no loop at this μ: approach and
+    /// retraction follow one curve and nothing is lost (a result, not a failure, for
+    /// `tapsim lj`).
+    #[error("{0}")]
+    NoHysteresis(String),
     /// A numerical procedure failed to converge or bracket its solution.
     #[error("numerical failure: {0}")]
     Numerical(String),

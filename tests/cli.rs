@@ -875,3 +875,13 @@ fn a_cached_lennard_jones_solution_prints_the_same_bytes_as_a_fresh_one() {
         String::from_utf8_lossy(&warm)
     );
 }
+
+#[test]
+fn below_the_critical_mu_lj_reports_no_hysteresis_not_an_error() {
+    let v = json(&["lj", "--mu", "0.6", "--json"]);
+    assert_eq!(v["hysteresis"], false);
+    assert_eq!(num(&v, "w_hat"), 0.0);
+    let v = json(&["lj", "--mu", "0.8", "--json"]);
+    assert_eq!(v["hysteresis"], true);
+    assert!(num(&v, "w_hat") > 0.0);
+}

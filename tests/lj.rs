@@ -139,11 +139,11 @@ fn a_compliant_support_adds_spring_losses_to_the_lj_loop() {
 
 #[test]
 fn below_the_hysteresis_threshold_the_solver_says_so() {
-    match lj::solve(0.6, false) {
-        Err(tapsim::error::Error::NotApplicable(m)) => {
-            assert!(m.contains("no hysteresis"), "{m}")
+    for mu in [0.6, 0.3] {
+        match lj::solve(mu, false) {
+            Err(tapsim::error::Error::NoHysteresis(m)) => assert!(m.contains("0.70"), "{m}"),
+            other => panic!("{other:?}"),
         }
-        other => panic!("{other:?}"),
     }
 }
 

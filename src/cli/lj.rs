@@ -19,14 +19,16 @@ use std::path::PathBuf;
 /// true error). Results are cached, keyed by μ, the mesh and the solver's source (see
 /// README: $TAPSIM_CACHE, else ~/.cache/tapsim); --no-cache recomputes.
 ///
-/// JSON keys (--json): tabor_mu, alpha_hat_a, t_hat_a, alpha_hat_c, t_hat_c,
+/// JSON keys (--json): tabor_mu, hysteresis (false: no loop, and then only w_hat = 0,
+/// w_hat_error and note follow), alpha_hat_a, t_hat_a, alpha_hat_c, t_hat_c,
 /// pull_off_hat, w_hat, w_hat_error (and an _error for each), nodes, w_hat_hybrid,
 /// hybrid_rel_error, alpha_hat_a_fit, fit_rel_error; with --k-hat also k_hat,
 /// w_hat_spring, w_hat_spring_hybrid.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct LjArgs {
-    /// Tabor parameter μ, eq. (2) [0.5 to 10.5; a few seconds above ~6].
+    /// Tabor parameter μ, eq. (2) [up to 10.5; a few seconds above ~6; below the
+    /// critical μ ≈ 0.70 the curve has no loop: "no hysteresis", Ŵ_LJ = 0].
     #[arg(long, allow_hyphen_values = true, value_parser = number)]
     mu: f64,
     /// Support stiffness k̂ = μεk/(RΔγ), eq. (22): adds the loss with the support in
@@ -46,7 +48,22 @@ pub struct LjArgs {
 
 /// Run the subcommand.
 pub fn run(args: LjArgs) -> Result<()> {
-    let solution = lj::solve(args.mu, !args.no_cache)?;
+    let solution = match lj::solve(args.mu, !args.no_cache) {
+        Err(crate::Error::NoHysteresis(why)) => {
+            // Below the critical μ nothing is lost: a result, not an error.
+            let r = report::NoLoopReport::new(args.mu, why);
+            if args.json {
+                outln!(
+                    "{}",
+                    serde_json::to_string_pretty(&r).expect("report serialises")
+                );
+            } else {
+                out!("{}", r.to_text());
+            }
+            return Ok(());
+        }
+        other => other?,
+    };
     if let Some(path) = &args.curve {
         output::write_bytes(path, &report::curve_csv(&solution)?)?;
     }

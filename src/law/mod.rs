@@ -153,8 +153,14 @@ impl AnyLaw {
             LawKind::Dmt => AnyLaw::Dmt(DmtLaw::new(contact, hamaker_j)?),
             LawKind::Hertz => AnyLaw::Hertz(HertzLaw),
             LawKind::Lj => AnyLaw::Adhesive(
-                AdhesiveLaw::lennard_jones(&crate::contact::lj::solve(mu, true)?)
-                    .map_err(|e| refuse(e.to_string()))?,
+                AdhesiveLaw::lennard_jones(&crate::contact::lj::solve(mu, true).map_err(
+                    |e| match e {
+                        // No loop: no hysteretic law to tabulate (a cell a map skips).
+                        Error::NoHysteresis(why) => Error::NotApplicable(why),
+                        other => other,
+                    },
+                )?)
+                .map_err(|e| refuse(e.to_string()))?,
             ),
             LawKind::None => AnyLaw::None(NoForce),
         })

@@ -9,11 +9,50 @@ use crate::error::Result;
 use serde::Serialize;
 use std::fmt::Write as _;
 
+/// The `tapsim lj` report where the curve has no loop: nothing is lost.
+#[derive(Debug, Clone, Serialize)]
+pub struct NoLoopReport {
+    /// Tabor parameter μ.
+    pub tabor_mu: f64,
+    /// Always false.
+    pub hysteresis: bool,
+    /// Ŵ_LJ = 0.
+    pub w_hat: f64,
+    /// 0.
+    pub w_hat_error: f64,
+    /// Why.
+    pub note: String,
+}
+
+impl NoLoopReport {
+    /// The report for μ = `tabor_mu`, with the solver's reason.
+    pub fn new(tabor_mu: f64, note: String) -> Self {
+        Self {
+            tabor_mu,
+            hysteresis: false,
+            w_hat: 0.0,
+            w_hat_error: 0.0,
+            note,
+        }
+    }
+
+    /// A table for people.
+    pub fn to_text(&self) -> String {
+        format!(
+            "Lennard-Jones numerical solution, Tabor parameter μ = {}\n  no hysteresis, \
+             Ŵ_LJ = 0: {}\n",
+            self.tabor_mu, self.note
+        )
+    }
+}
+
 /// Flat JSON view of an [`LjSolution`] with comparisons.
 #[derive(Debug, Clone, Serialize)]
 pub struct LjReport {
     /// Tabor parameter μ.
     pub tabor_mu: f64,
+    /// Whether the curve has a loop (always, for a solution with folds).
+    pub hysteresis: bool,
     /// Jump-in separation α̂_A (fold A).
     pub alpha_hat_a: f64,
     /// Its estimated discretisation error.
@@ -79,6 +118,7 @@ impl LjReport {
         let fit = semi_rigid::alpha_hat_a_fit(mu);
         Self {
             tabor_mu: mu,
+            hysteresis: true,
             alpha_hat_a: s.alpha_hat_a.value,
             alpha_hat_a_error: s.alpha_hat_a.error,
             t_hat_a: s.t_hat_a.value,

@@ -198,10 +198,9 @@ impl Hysteresis {
                     && points[k].alpha_hat <= points[k + 1].alpha_hat
             })
             .ok_or_else(|| {
-                Error::NotApplicable(
-                    "the force-separation curve has no jump-in fold: approach and \
-                     retraction follow the same curve, with no hysteresis (the \
-                     Lennard-Jones loop closes below mu ~ 0.7)"
+                Error::NoHysteresis(
+                    "the force-separation curve has no jump-in fold: approach and retraction \
+                     follow one curve (the Lennard-Jones loop closes at mu ~ 0.70)"
                         .into(),
                 )
             })?;

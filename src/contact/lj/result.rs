@@ -45,6 +45,10 @@ const SOLVER_FINGERPRINT: u64 = {
 /// production mesh.
 pub const ELEMENTS_PER_ANNULUS: f64 = 7.0;
 
+/// Smallest Tabor parameter traced: the loop closes at μ ≈ 0.70, and below this every
+/// μ has none.
+pub const MIN_TABOR_MU: f64 = 0.5;
+
 /// Largest Tabor parameter accepted: beyond it the continuation in the central gap
 /// stalls near the abrupt fold A on the coarsest mesh of the error estimate (from
 /// μ = 11; on the production mesh from μ = 13). At μ = 10.5 a solve takes ~5 s.
@@ -193,13 +197,18 @@ fn cache_path(tabor_mu: f64, per_annulus: f64) -> PathBuf {
 /// still refreshes the cache).
 pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
     positive("Tabor parameter mu", tabor_mu)?;
-    if !(0.5..=MAX_TABOR_MU).contains(&tabor_mu) {
+    if tabor_mu < MIN_TABOR_MU {
+        return Err(Error::NoHysteresis(format!(
+            "the Lennard-Jones loop closes at mu ~ 0.70 (traced down to there), so \
+             mu = {tabor_mu} has none; below {MIN_TABOR_MU} the curve is not traced"
+        )));
+    }
+    if tabor_mu > MAX_TABOR_MU {
         return Err(Error::NotApplicable(format!(
-            "the Lennard-Jones solver covers 0.5 <= mu <= {MAX_TABOR_MU} (mu = {tabor_mu}); \
-             below, the curve has no hysteresis loop; above, the jump onto the contact \
-             branch at A is too abrupt for the continuation on the meshes of the error \
-             estimate; \
-             the hybrid law (--law hybrid) approaches the numerical loss as mu grows"
+            "the Lennard-Jones solver covers mu <= {MAX_TABOR_MU} (mu = {tabor_mu}): above, \
+             the jump onto the contact branch at A is too abrupt for the continuation on \
+             the meshes of the error estimate; the hybrid law (--law hybrid) approaches \
+             the numerical loss as mu grows"
         )));
     }
     let path = cache_path(tabor_mu, ELEMENTS_PER_ANNULUS);
