@@ -302,3 +302,17 @@ fn just_above_the_critical_mu_the_thin_loop_is_found() {
     assert!(s.alpha_hat_c.value > s.alpha_hat_a.value);
     assert!(s.w_hat.value > 0.0 && s.w_hat.value < 0.01);
 }
+
+#[test]
+fn where_the_central_gap_folds_the_continuation_pins_another_node() {
+    use tapsim::contact::lj::moving::{self, MovingOptions, MovingSpec};
+    use tapsim::contact::lj::result::{ELEMENTS_PER_ANNULUS, MESH_RATIO};
+    // On this mesh the central gap stops falling before the contact reaches the edge
+    // node (the continuation in it used to stall at alpha_hat = 0.665).
+    let spec = MovingSpec::for_tabor(11.0, ELEMENTS_PER_ANNULUS).scaled(MESH_RATIO * MESH_RATIO);
+    let c = moving::trace(&spec, &MovingOptions::default()).unwrap();
+    let hybrid = hybrid::w_hat_fit(11.0);
+    println!("mu 11, coarsest mesh: W {:.5}, hybrid {hybrid:.5}", c.w_hat);
+    assert!(c.fold_c.alpha_hat > c.fold_a.alpha_hat);
+    assert!((c.w_hat - hybrid).abs() < 0.01 * hybrid);
+}

@@ -27,7 +27,7 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct LjArgs {
-    /// Tabor parameter μ, eq. (2) [up to 10.5; a few seconds above ~6; below the
+    /// Tabor parameter μ, eq. (2) [up to 20; 5 s at 10, 50 s at 20; below the
     /// critical μ ≈ 0.70 the curve has no loop: "no hysteresis", Ŵ_LJ = 0].
     #[arg(long, allow_hyphen_values = true, value_parser = number)]
     mu: f64,

@@ -220,6 +220,9 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
     // (parameter, solution) of the last few points of the current phase.
     let mut history: VecDeque<(f64, Solution)> = VecDeque::from(vec![(first.gap[0], first)]);
     let mut phase = Phase::CentralGap;
+    // Before contact the gap pinned is the central one, unless that one folds (stops
+    // falling): then the node whose gap changes fastest, in the direction it changes.
+    let (mut pin_node, mut direction) = (0usize, -1.0);
     let mut step = 0.05 * history[0].0;
     let mut seen_c = false;
     let mut steps = 0;
@@ -238,12 +241,12 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
         }
         let (p_last, last) = history.back().expect("never empty");
         let p_next = match phase {
-            Phase::CentralGap => p_last - step,
+            Phase::CentralGap => p_last + direction * step,
             Phase::Radius => p_last + step,
         };
         let guess = extrapolate(&history, p_next);
         let (pin, a_next) = match phase {
-            Phase::CentralGap => ((0, p_next), a0),
+            Phase::CentralGap => ((pin_node, p_next), a0),
             Phase::Radius => ((edge, spec.edge_gap), p_next),
         };
         let prev = *points.last().expect("never empty");
@@ -252,6 +255,27 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
             Err(_) => {
                 lu = None;
                 step *= 0.5;
+                if phase == Phase::CentralGap
+                    && history.len() >= 2
+                    && step < 1e-6 * p_last.abs().max(1.0)
+                {
+                    // The pinned gap folds here: pin the one changing fastest instead.
+                    let (older, newer) =
+                        (&history[history.len() - 2].1, &history[history.len() - 1].1);
+                    let change = |j: usize| (newer.gap[j] - older.gap[j]) / newer.gap[j];
+                    let fastest = (0..newer.gap.len())
+                        .max_by(|&i, &j| change(i).abs().total_cmp(&change(j).abs()))
+                        .expect("nodes");
+                    if fastest != pin_node {
+                        pin_node = fastest;
+                        direction = change(fastest).signum();
+                        step = (newer.gap[fastest] - older.gap[fastest]).abs();
+                        for (p, sol) in history.iter_mut() {
+                            *p = sol.gap[fastest];
+                        }
+                        continue;
+                    }
+                }
                 if step < 1e-9 * p_last.abs().max(1.0) {
                     return Err(Error::Numerical(format!(
                         "LJ continuation stalled at alpha_hat = {:.4}, T_hat = {:.4}",
@@ -315,7 +339,7 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
             let at = |phase: Phase| {
                 move |p: f64, guess: &Solution| -> Result<Solution> {
                     let (pin, a) = match phase {
-                        Phase::CentralGap => ((0, p), a0),
+                        Phase::CentralGap => ((pin_node, p), a0),
                         Phase::Radius => ((edge, spec.edge_gap), p),
                     };
                     let mut lu = None;
