@@ -46,21 +46,26 @@ pub struct LjArgs {
     json: bool,
 }
 
+/// Print `report` as JSON or as the table `text`.
+fn print(report: &impl serde::Serialize, json: bool, text: String) -> Result<()> {
+    if json {
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(report).expect("report serialises")
+        );
+    } else {
+        out!("{text}");
+    }
+    Ok(())
+}
+
 /// Run the subcommand.
 pub fn run(args: LjArgs) -> Result<()> {
     let solution = match lj::solve(args.mu, !args.no_cache) {
         Err(crate::Error::NoHysteresis(why)) => {
             // Below the critical μ nothing is lost: a result, not an error.
             let r = report::NoLoopReport::new(args.mu, why);
-            if args.json {
-                outln!(
-                    "{}",
-                    serde_json::to_string_pretty(&r).expect("report serialises")
-                );
-            } else {
-                out!("{}", r.to_text());
-            }
-            return Ok(());
+            return print(&r, args.json, r.to_text());
         }
         other => other?,
     };
@@ -71,13 +76,5 @@ pub fn run(args: LjArgs) -> Result<()> {
     if let Some(k) = args.k_hat {
         r = r.with_spring(&solution, k)?;
     }
-    if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&r).expect("report serialises")
-        );
-    } else {
-        out!("{}", r.to_text());
-    }
-    Ok(())
+    print(&r, args.json, r.to_text())
 }
