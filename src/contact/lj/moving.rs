@@ -475,14 +475,21 @@ fn refine_extremum(
     value: &dyn Fn(f64, &Solution) -> f64,
     sign: f64,
 ) -> Option<(f64, VecDeque<(f64, Solution)>)> {
-    let mut pts: Vec<(f64, Solution, f64)> = history
+    // Called after every continuation step: decide on the values before copying any
+    // solution.
+    let mut order: Vec<(f64, &Solution, f64)> = history
         .iter()
-        .map(|(p, s)| (*p, s.clone(), sign * value(*p, s)))
+        .map(|(p, s)| (*p, s, sign * value(*p, s)))
         .collect();
-    pts.sort_by(|x, y| x.0.total_cmp(&y.0));
-    if !(pts[1].2 >= pts[0].2 && pts[1].2 >= pts[2].2 && pts[1].2 > pts[0].2.min(pts[2].2)) {
+    order.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let [v0, v1, v2] = [0, 1, 2].map(|i| order[i].2);
+    if !(v1 >= v0 && v1 >= v2 && v1 > v0.min(v2)) {
         return None;
     }
+    let mut pts: Vec<(f64, Solution, f64)> = order
+        .into_iter()
+        .map(|(p, s, v)| (p, s.clone(), v))
+        .collect();
     let vertex = |pts: &[(f64, Solution, f64)]| {
         let [(p0, v0), (p1, v1), (p2, v2)] = [0, 1, 2].map(|i| (pts[i].0, pts[i].2));
         let (d0, d2) = (p1 - p0, p1 - p2);
