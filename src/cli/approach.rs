@@ -2,7 +2,7 @@
 
 use crate::config::TapInputs;
 use crate::error::Result;
-use crate::report::{records, sweep as report};
+use crate::report::sweep as report;
 use crate::sweep::{self, Direction};
 use clap::Args;
 
@@ -48,10 +48,7 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         report::approach_charts(&points, &format!("{} law", setup.law))
     })?;
     if args.out.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&records::columns_json(&points)?).expect("serialises")
-        );
+        args.out.print_json(&points)?;
     } else {
         outln!(
             "{:>9} {:>9} {:>10} {:>9} {:>10} {:>11} {:>10} {:>5}",

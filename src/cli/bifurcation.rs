@@ -2,7 +2,7 @@
 
 use crate::config::TapInputs;
 use crate::error::Result;
-use crate::report::{bifurcation as report, records};
+use crate::report::bifurcation as report;
 use crate::sweep;
 use clap::Args;
 
@@ -48,10 +48,7 @@ pub fn run(args: BifurcationArgs) -> Result<()> {
         report::bifurcation_charts(&samples, &format!("{} law", setup.law))
     })?;
     if args.out.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&records::columns_json(&samples)?).expect("serialises")
-        );
+        args.out.print_json(&samples)?;
         return Ok(());
     }
     outln!("{:>10} {:>12}", "z_c (nm)", "motion");

@@ -106,10 +106,7 @@ pub fn run(args: MapArgs) -> Result<()> {
         ]
     })?;
     if args.out.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&records::columns_json(&cells)?).expect("serialises")
-        );
+        args.out.print_json(&cells)?;
     } else if args.out.csv.is_none() && args.out.plot.is_none() {
         out!(
             "{}",

@@ -163,6 +163,16 @@ impl SweepOutput {
         }
         Ok(())
     }
+
+    /// Print `records` on stdout as one JSON object of equal-length columns (--json).
+    pub fn print_json<T: serde::Serialize>(&self, records: &[T]) -> crate::Result<()> {
+        let columns = crate::report::records::columns_json(records)?;
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&columns).expect("serialises")
+        );
+        Ok(())
+    }
 }
 
 /// Write to standard output (see [`outln!`]).
