@@ -180,7 +180,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
         Chart {
             name: "tap_approach_amplitude".into(),
             title: "Approach curves, polymer A: amplitude".into(),
-            x: Axis::linear("rest separation z_c (nm)", "separation_nm"),
+            x: sweep_report::separation_axis(),
             y: Axis::linear("A/A₀", "amplitude_ratio"),
             series: series_for("polymer A", |p| p.observables.amplitude_ratio, zc),
             labels: vec![],
@@ -189,7 +189,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
         Chart {
             name: "tap_approach_phase".into(),
             title: "Approach curves, polymer A: phase".into(),
-            x: Axis::linear("rest separation z_c (nm)", "separation_nm"),
+            x: sweep_report::separation_axis(),
             y: Axis::linear("phase lag φ (deg)", "phase_deg"),
             series: series_for("polymer A", |p| p.observables.phase_deg, zc),
             labels: vec![],
@@ -198,7 +198,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
         Chart {
             name: "tap_approach_dissipation".into(),
             title: "Approach curves, polymer A: dissipation".into(),
-            x: Axis::linear("rest separation z_c (nm)", "separation_nm"),
+            x: sweep_report::separation_axis(),
             y: Axis::linear("E_ts per cycle (eV)", "e_ts_ev"),
             series: series_for("polymer A", |p| p.observables.e_ts_ev, zc),
             labels: vec![],

@@ -53,7 +53,7 @@ pub fn bifurcation_charts(samples: &[PoincareSample], title: &str) -> Vec<Chart>
             Chart {
                 name: name.into(),
                 title: format!("{title}: {what}"),
-                x: Axis::linear("rest separation z_c (nm)", "separation_nm"),
+                x: super::sweep::separation_axis(),
                 y: Axis::linear(label, column),
                 legend: Corner::quietest(&series),
                 series,

@@ -104,7 +104,7 @@ pub fn branch_charts(points: &[BranchRecord], ramp: &[SweepPoint], title: &str) 
             Chart {
                 name: format!("branch_{name}"),
                 title: format!("{title}: {what}"),
-                x: Axis::linear("rest separation z_c (nm)", "separation_nm"),
+                x: super::sweep::separation_axis(),
                 y: Axis::linear(label, column),
                 legend: Corner::quietest(&series),
                 series,

@@ -4,6 +4,11 @@
 use super::chart::{Axis, Chart, Corner, Series, Style};
 use crate::sweep::{Direction, SweepPoint};
 
+/// The x axis of every chart against the rest separation: z_c in nm.
+pub fn separation_axis() -> Axis {
+    Axis::linear("rest separation z_c (nm)", "separation_nm")
+}
+
 /// Approach-curve charts: A/A₀, φ, E_ts, virial and peak force against z_c, and the
 /// last four against A/A₀; approach and retract as separate series.
 pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
@@ -49,7 +54,6 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
                 labels: vec![],
             }
         };
-    let zc = || Axis::linear("rest separation z_c (nm)", "separation_nm");
     let ratio = |p: &SweepPoint| p.observables.amplitude_ratio;
     // (file stem, caption, axis label, column, value); the first is A/A₀ itself.
     let quantities: [(&str, &str, &str, &str, Pick); 5] = [
@@ -82,7 +86,14 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
         ),
     ];
     let against_separation = quantities.iter().map(|&(name, what, label, column, pick)| {
-        chart(name, what, zc(), &nm, Axis::linear(label, column), pick)
+        chart(
+            name,
+            what,
+            separation_axis(),
+            &nm,
+            Axis::linear(label, column),
+            pick,
+        )
     });
     let against_amplitude = quantities
         .iter()
