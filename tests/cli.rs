@@ -10,6 +10,21 @@ fn tapsim(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// Run `args` with the Lennard-Jones cache in `cache` (a test's own), asserting success.
+fn succeeds_with_cache(args: &[&str], cache: &std::path::Path) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .args(args)
+        .env("TAPSIM_CACHE", cache)
+        .output()
+        .expect("the binary runs");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 fn json(args: &[&str]) -> serde_json::Value {
     let out = tapsim(args);
     assert!(
@@ -252,15 +267,9 @@ fn negative_values_are_refused_with_the_reason() {
 fn figure_all_writes_csv_png_svg_for_each_figure() {
     let dir = scratch("figures");
     // A cache of its own, so the Lennard-Jones points of Figs. 2-4 are computed here.
-    let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
-        .args(["figure", "all", "--out", dir.to_str().unwrap()])
-        .env("TAPSIM_CACHE", dir.join("cache"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = succeeds_with_cache(
+        &["figure", "all", "--out", dir.to_str().unwrap()],
+        &dir.join("cache"),
     );
     let listed: Vec<PathBuf> = String::from_utf8_lossy(&out.stdout)
         .lines()
@@ -549,18 +558,9 @@ fn approach_json_is_one_object_of_equal_length_arrays() {
 #[test]
 fn reproduce_regenerates_every_file_its_readme_lists() {
     let dir = scratch("reproduce");
-    let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
-        .args(["reproduce", "--quiet", "--out", dir.to_str().unwrap()])
-        .env(
-            "TAPSIM_CACHE",
-            std::env::temp_dir().join(format!("tapsim-test-cache-{}", std::process::id())),
-        )
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    succeeds_with_cache(
+        &["reproduce", "--quiet", "--out", dir.to_str().unwrap()],
+        &std::env::temp_dir().join(format!("tapsim-test-cache-{}", std::process::id())),
     );
     let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
     let listed: Vec<&str> = readme
@@ -853,19 +853,7 @@ fn a_closed_pipe_ends_quietly_and_a_full_disk_is_an_error() {
 #[test]
 fn a_cached_lennard_jones_solution_prints_the_same_bytes_as_a_fresh_one() {
     let dir = scratch("lj-cache");
-    let run = || {
-        let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
-            .args(["lj", "--mu", "2", "--json"])
-            .env("TAPSIM_CACHE", dir.join("cache"))
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        out.stdout
-    };
+    let run = || succeeds_with_cache(&["lj", "--mu", "2", "--json"], &dir.join("cache")).stdout;
     let cold = run();
     let cached: Vec<_> = std::fs::read_dir(dir.join("cache")).unwrap().collect();
     assert_eq!(cached.len(), 1, "one solution cached");
