@@ -142,17 +142,15 @@ fn locate_fold(points: &[CurvePoint], k: usize) -> Result<Fold> {
 
 /// The load-control pull-off: the largest T̂ on the contact branch, the points after
 /// index `from` (the fold C), interpolated between the samples around the largest one
-/// (a sampled maximum alone would be low by O(chord²)).
-pub fn pull_off(points: &[CurvePoint], from: usize) -> f64 {
-    let Some(k) = (from..points.len()).max_by(|&i, &j| points[i].t_hat.total_cmp(&points[j].t_hat))
-    else {
-        return f64::NAN;
-    };
+/// (a sampled maximum alone would be low by O(chord²)); `None` if there are no points
+/// after `from`.
+pub fn pull_off(points: &[CurvePoint], from: usize) -> Option<f64> {
+    let k = (from..points.len()).max_by(|&i, &j| points[i].t_hat.total_cmp(&points[j].t_hat))?;
     let sampled = points[k].t_hat;
     if k == 0 || k + 1 >= points.len() {
-        return sampled;
+        return Some(sampled);
     }
-    locate_extremum(points, k, |p| p.t_hat).map_or(sampled, |f| f.t_hat.max(sampled))
+    Some(locate_extremum(points, k, |p| p.t_hat).map_or(sampled, |f| f.t_hat.max(sampled)))
 }
 
 /// First arclength after `from` (within the sampled range) where α̂ = `level`.

@@ -415,7 +415,8 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
     let fold_a = exact(hysteresis.fold_a, exact_a);
     let fold_c = exact(hysteresis.fold_c, exact_c);
     let w_hat = Hysteresis::between(&points, fold_a, fold_c)?.w_hat;
-    let interpolated = super::curve::pull_off(&points, k_c).max(hysteresis.fold_c.t_hat);
+    let interpolated = super::curve::pull_off(&points, k_c)
+        .map_or(hysteresis.fold_c.t_hat, |t| t.max(hysteresis.fold_c.t_hat));
     let pull_off_hat = match exact_pull_off {
         Some((_, _, t_hat)) if (t_hat - interpolated).abs() < 1e-2 => t_hat,
         _ => interpolated,

@@ -232,15 +232,14 @@ pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
 /// coarser) with the continuation settings `opts`, extrapolating every value
 /// ([`Estimate`]); no cache.
 pub fn solve_with(spec: &MovingSpec, opts: &MovingOptions) -> Result<LjSolution> {
-    let (spec, opts) = (*spec, *opts);
     // The meshes are independent: the fine one on one core, the two coarse ones (together
     // about as costly) on the other.
     let (fine, (coarse, coarser)) = rayon::join(
-        || moving::trace(&spec, &opts),
+        || moving::trace(spec, opts),
         || {
             (
-                moving::trace(&spec.scaled(MESH_RATIO), &opts),
-                moving::trace(&spec.scaled(MESH_RATIO * MESH_RATIO), &opts),
+                moving::trace(&spec.scaled(MESH_RATIO), opts),
+                moving::trace(&spec.scaled(MESH_RATIO * MESH_RATIO), opts),
             )
         },
     );
