@@ -110,5 +110,37 @@ fn settle(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, settle);
+/// `tapsim map` on its default ranges (Δγ 0.02–0.2 J/m², E* 0.3–3 GPa, hybrid law) on one
+/// thread: the default 8 × 8 grid and a 10 × 10 one. Every cell is classified (period-n,
+/// irregular or not applicable), checked before timing.
+fn map(c: &mut Criterion) {
+    use tapsim::sweep::{SETPOINT_MAX_CYCLES, SETPOINT_TOLERANCE, adhesion_modulus_map, log_grid};
+    let setup = default_setup();
+    let numerics = Numerics {
+        tolerance: SETPOINT_TOLERANCE,
+        max_cycles: SETPOINT_MAX_CYCLES,
+        ..Numerics::default()
+    };
+    let mut group = c.benchmark_group("map");
+    group.sample_size(10);
+    for steps in [8, 10] {
+        let works = log_grid("work of adhesion", 0.02, 0.2, steps).expect("grid");
+        let moduli = log_grid("modulus", 0.3e9, 3e9, steps).expect("grid");
+        let run = || adhesion_modulus_map(&setup, &numerics, &works, &moduli, 1, || {});
+        let cells = run().expect("map");
+        let periods: usize = cells
+            .iter()
+            .filter_map(|c| c.observables.as_ref())
+            .inspect(|o| assert!(o.converged, "{o:?}"))
+            .map(|o| o.cycles)
+            .sum();
+        eprintln!("map {steps}x{steps}: {periods} periods in all");
+        group.bench_function(format!("{steps}x{steps}, one thread"), |b| {
+            b.iter(|| run().expect("map"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, settle, map);
 criterion_main!(benches);

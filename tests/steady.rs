@@ -120,8 +120,9 @@ fn jkr_on_the_defaults_is_named_and_averaged_over_a_window() {
     assert_eq!(o.stable, None);
     assert!(o.floquet_multipliers.is_empty());
     assert!(o.jumps_in > 0.0 && o.jumps_in < 1.0);
-    // Averaged over at least 16 batches of the oscillator's memory, QΩ/π periods.
-    assert!(o.periods_averaged as f64 >= 16.0 * 400.0 / std::f64::consts::PI);
+    // Averaged over at least 8 batches of the oscillator's memory, QΩ/π periods (8 when
+    // their standard errors are a quarter of the tolerance, else 16 or more).
+    assert!(o.periods_averaged as f64 >= 8.0 * 400.0 / std::f64::consts::PI);
     // Not every period touches, so less than the full loop per period.
     assert!(o.e_ts_j > 0.0 && o.e_ts_j < o.loop_area_j);
     // Each touch dissipates the whole JKR loop.
@@ -152,16 +153,9 @@ fn jkr_on_the_defaults_is_named_and_averaged_over_a_window() {
     assert!((o.phase_from_energy_deg - o.phase_deg).abs() < 0.05);
 }
 
-#[test]
-fn two_windows_of_irregular_motion_agree_within_their_errors() {
-    let (a, b) = (jkr_defaults(1e-3), jkr_defaults(1e-5));
-    assert!(a.converged && a.regime == "irregular" && b.regime == "irregular");
-    assert!(
-        b.periods_averaged > a.periods_averaged,
-        "{} vs {}",
-        a.periods_averaged,
-        b.periods_averaged
-    );
+/// A, φ and E_ts of two runs of the same irregular motion agree within three combined
+/// standard errors.
+fn assert_agree(a: &TapObservables, b: &TapObservables) {
     let agree = |x: f64, y: f64, sx: Option<f64>, sy: Option<f64>, what: &str| {
         let combined = sx.unwrap().hypot(sy.unwrap());
         println!("{what}: {x} vs {y}, combined error {combined:e}");
@@ -191,6 +185,46 @@ fn two_windows_of_irregular_motion_agree_within_their_errors() {
         b.e_ts_std_err_j,
         "E_ts",
     );
+}
+
+#[test]
+fn two_windows_of_irregular_motion_agree_within_their_errors() {
+    let (a, b) = (jkr_defaults(1e-3), jkr_defaults(1e-5));
+    assert!(a.converged && a.regime == "irregular" && b.regime == "irregular");
+    assert!(
+        b.periods_averaged > a.periods_averaged,
+        "{} vs {}",
+        a.periods_averaged,
+        b.periods_averaged
+    );
+    assert_agree(&a, &b);
+}
+
+#[test]
+fn irregular_averages_marched_loosely_agree_with_exact_marching() {
+    // With shooting (the default) irregular motion is marched at 1e-3 of the averages'
+    // tolerance (rtol 1e-6); without, at the integrator's own (1e-9).
+    let setup = TapSetup {
+        law: LawKind::Jkr,
+        ..default_setup()
+    };
+    let loose = jkr_defaults(1e-3);
+    let exact = tap(
+        &setup,
+        &Numerics {
+            shooting: false,
+            ..Numerics::default()
+        },
+        0,
+    )
+    .unwrap()
+    .observables;
+    assert!(loose.converged && exact.converged);
+    assert_eq!(
+        (loose.regime.as_str(), exact.regime.as_str()),
+        ("irregular", "irregular")
+    );
+    assert_agree(&loose, &exact);
 }
 
 #[test]

@@ -618,7 +618,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
             }
             let scale = (radius / length).min(1.0);
             let trial = z + step * scale;
-            match self.period_map(start, trial, n, spent)? {
+            // Inexact Newton: far from the orbit the map need not be exact to the
+            // integrator's tolerance, only well below the residual.
+            match self
+                .loosened(NEWTON_TOLERANCE * norm)
+                .period_map(start, trial, n, spent)?
+            {
                 Some(value) if (value.end.z() - trial).amax() <= (1.0 - 0.1 * scale) * norm => {
                     z = trial;
                     m = value.monodromy();
@@ -768,6 +773,15 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 return Ok(found);
             }
         }
+        // Marched periods serve the averages of irregular motion and the choice of
+        // candidate periods, both far coarser than the integrator's tolerance: they are
+        // integrated at a tolerance set by the averages' (see [`Simulation::marching`]).
+        // Without shooting they must settle the orbit to `opts.tolerance` themselves.
+        let marching = if opts.shooting {
+            self.marching(opts)
+        } else {
+            *self
+        };
         let mut ring = Recurrence::default();
         ring.push(phase);
         // The periods marched while searching are the averaging window's first batches,
@@ -777,7 +791,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         while spent < search_budget {
             for _ in 0..stretch.min(search_budget - spent) {
                 self.rewind(phase);
-                let c = self.cycle(phase, &mut numeric::Ignore)?;
+                let c = marching.cycle(phase, &mut numeric::Ignore)?;
                 spent += 1;
                 ring.push(phase);
                 window.add(&c);
@@ -817,6 +831,31 @@ impl<L: ForceLaw> Simulation<'_, L> {
         self.average(phase, opts, budget, spent, window, ring)
     }
 
+    /// This simulation with the integrator tolerances loosened to
+    /// [`MARCHING_TOLERANCE`] × `opts.average_tolerance` (never tightened): the tolerance
+    /// at which periods are marched for averages. A marched trajectory of irregular
+    /// motion parts from the exact one whatever the tolerance (that is what irregular
+    /// means); what must hold is its statistics, which an integrator error 10⁵ below
+    /// the averages' tolerance does not move (tests/steady.rs checks the averages
+    /// against exact marching), and its energy balance (< 1e-8 at the defaults).
+    fn marching(&self, opts: &SteadyOptions) -> Self {
+        self.loosened(MARCHING_TOLERANCE * opts.average_tolerance)
+    }
+
+    /// This simulation with the integrator's relative tolerance raised to `rtol` (at most
+    /// [`LOOSEST_RTOL`]; never lowered), the absolute one in proportion.
+    fn loosened(&self, rtol: f64) -> Self {
+        let rtol = self.tol.rtol.max(rtol.min(LOOSEST_RTOL));
+        Self {
+            tol: Tolerances {
+                rtol,
+                atol: self.tol.atol * rtol / self.tol.rtol,
+                ..self.tol
+            },
+            ..*self
+        }
+    }
+
     /// The oscillator's memory, the amplitude's relaxation time 2Q (in τ), in periods:
     /// QΩ/π.
     fn memory_periods(&self) -> usize {
@@ -825,13 +864,15 @@ impl<L: ForceLaw> Simulation<'_, L> {
             .clamp(1.0, 1e9) as usize
     }
 
-    /// Average irregular motion over a window of 16 batches (begun during the search for
-    /// an orbit, `window`) whose length doubles (by merging pairs and integrating as
-    /// many again) until the standard errors of the batch means of A (relative), φ (rad)
-    /// and E_ts (relative to E_drive) are below `opts.average_tolerance`, or the budget
-    /// is spent. Whenever a full window starts with a transient ([`transient_batches`]), the motion
-    /// is not yet stationary: orbits are looked for again (with shooting), and the
-    /// transient batches are dropped.
+    /// Average irregular motion, marched at the averages' tolerance ([`Self::marching`]),
+    /// over a window of 16 batches (begun during the search for an orbit, `window`)
+    /// whose length doubles (by merging pairs and integrating as many again) until the
+    /// standard errors of the batch means of A (relative), φ (rad) and E_ts (relative to
+    /// E_drive) are below `opts.average_tolerance`, or the budget is spent; from 8
+    /// batches on, a window whose errors are below a quarter of it ([`EARLY_MARGIN`])
+    /// is accepted. Whenever a window starts with a transient ([`transient_batches`]),
+    /// the motion is not yet stationary: orbits are looked for again (with shooting),
+    /// and the transient batches are dropped.
     fn average(
         &self,
         phase: &mut Phase,
@@ -841,24 +882,34 @@ impl<L: ForceLaw> Simulation<'_, L> {
         mut window: Window,
         mut ring: Recurrence,
     ) -> Result<SteadyState> {
+        let marching = self.marching(opts);
         loop {
             self.rewind(phase);
-            let c = self.cycle(phase, &mut numeric::Ignore)?;
+            let c = marching.cycle(phase, &mut numeric::Ignore)?;
             spent += 1;
             ring.push(phase);
             window.add(&c);
-            let full = window.batches.len() >= BATCHES;
+            let count = window.batches.len();
+            let full = count >= BATCHES;
+            // From MIN_BATCHES batches on, each finished batch is a chance to stop early.
+            let early = window.current_len == 0 && count >= MIN_BATCHES;
             let out_of_budget = spent >= budget;
-            if full || out_of_budget {
+            if full || early || out_of_budget {
                 let (averages, std_err) =
                     batch_statistics(&window.batches, window.current.as_ref());
                 let relative = |x: f64, of: f64| if of > 0.0 { x / of } else { x };
-                let met = window.batches.len() >= 2
-                    && relative(std_err.amplitude, averages.amplitude()) <= opts.average_tolerance
-                    && std_err.phase <= opts.average_tolerance
-                    && relative(std_err.e_ts, averages.e_drive_per_period().abs())
-                        <= opts.average_tolerance;
-                let transient = transient_batches(&window.batches);
+                let within = |tolerance: f64| {
+                    count >= 2
+                        && relative(std_err.amplitude, averages.amplitude()) <= tolerance
+                        && std_err.phase <= tolerance
+                        && relative(std_err.e_ts, averages.e_drive_per_period().abs()) <= tolerance
+                };
+                let met = if full || out_of_budget {
+                    within(opts.average_tolerance)
+                } else {
+                    within(opts.average_tolerance / EARLY_MARGIN)
+                };
+                let transient = transient_batches(&window.batches, opts.average_tolerance);
                 if out_of_budget || (met && transient == 0) {
                     return Ok(SteadyState {
                         window: averages,
@@ -867,6 +918,9 @@ impl<L: ForceLaw> Simulation<'_, L> {
                         motion: Motion::Irregular,
                         std_err,
                     });
+                }
+                if !full && transient == 0 {
+                    continue;
                 }
                 if transient > 0 {
                     // Still a transient (a slow passage, e.g. past a fold's ghost): it
@@ -882,6 +936,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     }
                     window.batches.drain(..transient);
                 } else {
+                    if window.batches.len() % 2 == 1 {
+                        // (More than BATCHES gathered while searching: the oldest goes.)
+                        window.batches.remove(0);
+                    }
                     window.batches = window.batches.chunks(2).map(|p| p[0].then(&p[1])).collect();
                     window.batch_len *= 2;
                 }
@@ -936,10 +994,24 @@ impl Window {
 
 /// Batches of an irregular window.
 const BATCHES: usize = 16;
+/// Batches after which a window may be accepted early: when its standard errors are
+/// below the tolerance over [`EARLY_MARGIN`]. With 7 degrees of freedom the estimate
+/// of a standard error is itself uncertain (below 0.56 of the true value with 5 %
+/// probability) and batches one memory long are still slightly correlated (lag-1
+/// correlation ≲ 0.3, which hides up to a factor 1.3); the margin covers both.
+const MIN_BATCHES: usize = 8;
+const EARLY_MARGIN: f64 = 4.0;
 /// Periods integrated before the first look for orbits of higher period.
 const FIRST_STRETCH: usize = 32;
 /// Periods the search for an orbit may integrate at most (with shooting).
 const SEARCH_PERIODS: usize = 1000;
+/// Marched periods are integrated at this fraction of the averages' tolerance.
+const MARCHING_TOLERANCE: f64 = 1e-5;
+/// Newton's trial maps are integrated at this fraction of the residual they try to
+/// reduce (inexact Newton: the error of the map stays far below what a step must gain).
+const NEWTON_TOLERANCE: f64 = 1e-2;
+/// The loosest relative tolerance any integration runs at.
+const LOOSEST_RTOL: f64 = 1e-5;
 
 /// The window (every batch and the unfinished rest) and the standard errors of the
 /// means of the whole batches.
@@ -985,33 +1057,41 @@ fn batch_statistics(
 /// rule (MSER; White, Simulation 69, 323, 1997): for A, φ and E_ts per period, the cut d
 /// ≤ n/2 that minimises the variance of the remaining batch values over (n − d)², taken
 /// only where it at least halves that of the whole window (a stationary window's
-/// minimum is at d = 0 but for chance); the largest such cut of the three. A transient
-/// that creeps (past a fold's ghost, say) shows up as leading batches far from the rest.
-fn transient_batches(batches: &[CycleIntegrals]) -> usize {
+/// minimum is at d = 0 but for chance) and where dropping the d batches moves the
+/// window's mean by more than `tolerance` (A relative, φ in rad, E_ts relative to
+/// E_drive, as the standard errors are judged): a cut that changes nothing reported is
+/// chance, or a transient too small to matter. The largest such cut of the three. A
+/// transient that creeps (past a fold's ghost, say) shows up as leading batches far
+/// from the rest.
+fn transient_batches(batches: &[CycleIntegrals], tolerance: f64) -> usize {
     let n = batches.len();
     if n < 4 {
         return 0;
     }
     let (window, _) = batch_statistics(batches, None);
     let phase = window.phase();
-    let cut = |value: &dyn Fn(&CycleIntegrals) -> f64| {
+    let cut = |value: &dyn Fn(&CycleIntegrals) -> f64, scale: f64| {
         let ys: Vec<f64> = batches.iter().map(value).collect();
+        let mean = |d: usize| ys[d..].iter().sum::<f64>() / (n - d) as f64;
         let mser = |d: usize| {
-            let rest = &ys[d..];
-            let m = rest.len() as f64;
-            let mean = rest.iter().sum::<f64>() / m;
-            rest.iter().map(|y| (y - mean).powi(2)).sum::<f64>() / (m * m * m)
+            let (rest, m) = (&ys[d..], mean(d));
+            rest.iter().map(|y| (y - m).powi(2)).sum::<f64>() / ((n - d) as f64).powi(3)
         };
         let whole = mser(0);
         let (best, at) = (1..=n / 2)
             .map(|d| (d, mser(d)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .expect("n >= 4");
-        if at < 0.5 * whole { best } else { 0 }
+        let moves = (mean(best) - mean(0)).abs() > tolerance * scale;
+        if at < 0.5 * whole && moves { best } else { 0 }
     };
-    cut(&|b| b.amplitude())
-        .max(cut(&|b| wrap_angle(b.phase() - phase)))
-        .max(cut(&|b| b.e_ts_per_period()))
+    let relative_to = |x: f64| if x > 0.0 { x } else { 1.0 };
+    cut(&|b| b.amplitude(), relative_to(window.amplitude()))
+        .max(cut(&|b| wrap_angle(b.phase() - phase), 1.0))
+        .max(cut(
+            &|b| b.e_ts_per_period(),
+            relative_to(window.e_drive_per_period().abs()),
+        ))
 }
 
 /// An angle difference brought into (−π, π].

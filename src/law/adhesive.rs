@@ -12,6 +12,7 @@ use crate::contact::lj::curve::CurvePoint;
 use crate::contact::semi_rigid::{self, EighthPower};
 use crate::error::{Error, Result, positive};
 use crate::numeric::bracketed_root;
+use std::sync::OnceLock;
 
 /// Nodes of the contact-branch tables (uniform in √(α̂_C − α̂)).
 const CONTACT_NODES: usize = 8193;
@@ -24,23 +25,29 @@ const APPROACH_SPAN: f64 = 60.0;
 
 /// The JKR contact branch T̂(α̂) of eq. (5) on its displacement-stable side, tabulated
 /// against √(α̂_C − α̂) (the closed-form inverse costs a cube root and several square
-/// roots per call; the table one).
+/// roots per call; the table one). It depends on nothing (the hats absorb every
+/// parameter), so it is built once per process and copied: a map builds a law per cell.
 fn jkr_contact() -> FoldBranch {
-    FoldBranch::new(
-        (jkr::ALPHA_HAT_C, jkr::T_HAT_C),
-        Side::Below,
-        CONTACT_SPAN.sqrt(),
-        CONTACT_NODES,
-        FarField::JkrShift { shift: 0.0 },
-        |u| {
-            if u == 0.0 {
-                // At the fold the inverse is ill-conditioned: take C of eq. (8).
-                return jkr::T_HAT_C;
-            }
-            let alpha = jkr::ALPHA_HAT_C - u * u;
-            jkr::force_hat(jkr::a_hat_from_separation(alpha).unwrap_or(jkr::A_HAT_C))
-        },
-    )
+    static TABLE: OnceLock<FoldBranch> = OnceLock::new();
+    TABLE
+        .get_or_init(|| {
+            FoldBranch::new(
+                (jkr::ALPHA_HAT_C, jkr::T_HAT_C),
+                Side::Below,
+                CONTACT_SPAN.sqrt(),
+                CONTACT_NODES,
+                FarField::JkrShift { shift: 0.0 },
+                |u| {
+                    if u == 0.0 {
+                        // At the fold the inverse is ill-conditioned: take C of eq. (8).
+                        return jkr::T_HAT_C;
+                    }
+                    let alpha = jkr::ALPHA_HAT_C - u * u;
+                    jkr::force_hat(jkr::a_hat_from_separation(alpha).unwrap_or(jkr::A_HAT_C))
+                },
+            )
+        })
+        .clone()
 }
 
 /// An adhesive law: approach branch (force-free or tabulated), jump-in at its fold or
