@@ -5,18 +5,16 @@
 
 use crate::contact::hybrid::{self, JumpIn};
 use crate::contact::jkr::{self, JkrPoint};
-use crate::contact::lj::{self, LjSolution, curve::Hysteresis};
+use crate::contact::lj::{LjSolution, Reach};
 use crate::contact::semi_rigid::{self, EighthPower};
 use crate::contact::spring;
 use crate::error::{Error, Result};
+use crate::lj_cache;
 use crate::quasistatic::{self, Segment};
 use crate::report::chart::{Axis, Chart, Corner, Label, Series, Style};
 
 /// The figure numbers this build can draw.
 pub const AVAILABLE: [u32; 6] = [1, 2, 3, 4, 5, 6];
-
-/// The largest μ of Fig. 6 given numerical Lennard-Jones points.
-const FIG6_LJ_MAX_MU: f64 = 10.0;
 
 /// Tabor parameters of the numerical points of Figs. 3 and 4.
 pub const LJ_MUS: [f64; 10] = [1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0];
@@ -26,7 +24,10 @@ pub const FIG2_MU: f64 = 5.0;
 
 /// The numerical solutions of Figs. 3 and 4 (from the cache when there).
 pub fn lj_solutions() -> Result<Vec<LjSolution>> {
-    LJ_MUS.iter().map(|&mu| lj::solve(mu, true)).collect()
+    LJ_MUS
+        .iter()
+        .map(|&mu| lj_cache::solve(mu, Reach::Rigid, true))
+        .collect()
 }
 
 /// Tabor parameters of the curves of Fig. 6.
@@ -102,20 +103,20 @@ impl Default for FigureOptions {
 pub fn figure(number: u32, opts: &FigureOptions) -> Result<Chart> {
     match number {
         1 => Ok(fig1()),
-        2 => fig2(&lj::solve(FIG2_MU, true)?),
+        2 => fig2(
+            &lj_cache::solve(FIG2_MU, Reach::Rigid, true)?,
+            &lj_cache::solve(FIG2_MU, Reach::Springs, true)?,
+        ),
         3 => fig3(&lj_solutions()?),
         4 => fig4(opts.jump_in, &lj_solutions()?),
         5 => fig5(opts.fig5_mu, opts.fig5_k_hat, opts.jump_in),
-        6 => {
-            // (μ = 20 takes the solver ~50 s: its points are left to `tapsim lj`.)
-            let covered = FIG6_MUS.iter().filter(|&&mu| mu <= FIG6_LJ_MAX_MU);
-            fig6(
-                opts.jump_in,
-                &covered
-                    .map(|&mu| lj::solve(mu, true))
-                    .collect::<Result<Vec<_>>>()?,
-            )
-        }
+        6 => fig6(
+            opts.jump_in,
+            &FIG6_MUS
+                .iter()
+                .map(|&mu| lj_cache::solve(mu, Reach::Springs, true))
+                .collect::<Result<Vec<_>>>()?,
+        ),
         n => Err(Error::NotApplicable(format!(
             "the paper has figures 1 to 6; there is no figure {n}"
         ))),
@@ -191,14 +192,16 @@ pub fn fig1() -> Chart {
 const FIG2_ALPHA_MAX: f64 = 4.0;
 
 /// Fig. 2: the Lennard-Jones force–separation curve for μ = 5 (numerical), with its
-/// folds A and C, the jumps, and the JKR curve (5) for comparison.
-pub fn fig2(s: &LjSolution) -> Result<Chart> {
+/// folds A and C, the jumps, and the JKR curve (5) for comparison: the folds and Ŵ of
+/// `s` (the rigid-support solution `tapsim lj` reports), the curve of `traced` (the
+/// same μ traced for springs, deeper into contact).
+pub fn fig2(s: &LjSolution, traced: &LjSolution) -> Result<Chart> {
     let c = jkr::point_c();
     let jkr_curve: Vec<(f64, f64)> = grid(c.a_hat, 2.4, 300, false)
         .map(|a| (jkr::separation_hat(a), jkr::force_hat(a)))
         .collect();
-    // The trace starts far out (for soft support springs); the figure shows the loop.
-    let lj_curve: Vec<(f64, f64)> = s
+    // That trace starts far out (for soft support springs); the figure shows the loop.
+    let lj_curve: Vec<(f64, f64)> = traced
         .curve
         .iter()
         .filter(|p| p.alpha_hat <= FIG2_ALPHA_MAX)
@@ -211,11 +214,11 @@ pub fn fig2(s: &LjSolution) -> Result<Chart> {
     // Where the jumps land: the contact branch at α̂_A, the approach branch at α̂_C.
     let b = (
         a.0,
-        LjSolution::force_on(s.contact_branch(), a.0).unwrap_or(f64::NAN),
+        LjSolution::force_on(traced.contact_branch(), a.0).unwrap_or(f64::NAN),
     );
     let d = (
         cc.0,
-        LjSolution::force_on(s.approach_branch(), cc.0).unwrap_or(f64::NAN),
+        LjSolution::force_on(traced.approach_branch(), cc.0).unwrap_or(f64::NAN),
     );
     let mut series = vec![
         Series::new("JKR (5)", jkr_curve, Style::Line, 0),
@@ -430,12 +433,14 @@ pub fn fig5(tabor_mu: f64, k_hat: f64, jump_in: JumpIn) -> Result<Chart> {
 }
 
 /// Support stiffnesses of the numerical points of Fig. 6.
-pub const FIG6_LJ_K_HATS: [f64; 9] = [0.5, 1.0, 2.0, 5.0, 10.0, 30.0, 100.0, 300.0, 1000.0];
+pub const FIG6_LJ_K_HATS: [f64; 12] = [
+    0.01, 0.03, 0.1, 0.3, 1.0, 2.0, 5.0, 10.0, 30.0, 100.0, 300.0, 1000.0,
+];
 
 /// Fig. 6: hysteresis Ŵ(k̂) (26) for μ = 2, 5, 10, 20, with the soft-support asymptote
 /// (27), the rigid-grip levels (18), and the numerical Lennard-Jones loss through the
-/// same spring (the S-curve seen in α̂ + T̂/k̂) for each solution in `lj` (μ of
-/// [`FIG6_MUS`] up to 10: μ = 20 takes the solver ~50 s).
+/// same spring (the S-curve seen in α̂ + T̂/k̂, [`LjSolution::spring_loop`]) for each
+/// solution in `lj` (those of [`FIG6_MUS`]).
 pub fn fig6(jump_in: JumpIn, lj: &[LjSolution]) -> Result<Chart> {
     let (k_lo, k_hi) = (1e-2, 1e3);
     let mut series = Vec::new();
@@ -459,7 +464,7 @@ pub fn fig6(jump_in: JumpIn, lj: &[LjSolution]) -> Result<Chart> {
         if let Some(solution) = lj.iter().find(|s| s.tabor_mu == mu) {
             let points = FIG6_LJ_K_HATS
                 .iter()
-                .map(|&k| Ok((k, Hysteresis::with_spring(&solution.curve, k)?.w_hat)))
+                .map(|&k| Ok((k, solution.spring_loop(k)?.w_hat)))
                 .collect::<Result<Vec<_>>>()?;
             series.push(Series::new(
                 &format!("μ = {mu}, Lennard-Jones (10), numerical"),

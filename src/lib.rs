@@ -16,6 +16,7 @@ pub mod dynamics;
 pub mod error;
 pub mod figures;
 pub mod law;
+pub mod lj_cache;
 pub mod numeric;
 pub mod params;
 pub mod quasistatic;

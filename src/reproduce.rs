@@ -3,7 +3,7 @@
 
 use crate::contact::hybrid;
 use crate::contact::jkr;
-use crate::contact::lj;
+use crate::contact::lj::Reach;
 use crate::contact::semi_rigid;
 use crate::dynamics::observables::tap;
 use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
@@ -268,7 +268,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
 
     // Headline numbers and the README.
     progress("README.md");
-    let lj5 = lj::solve(5.0, true)?;
+    let lj5 = crate::lj_cache::solve(5.0, Reach::Rigid, true)?;
     let w_jkr = jkr::w_hat_jkr();
     let w_h5 = hybrid::w_hat_fit(5.0);
     let o = &run.observables;

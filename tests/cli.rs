@@ -331,8 +331,8 @@ fn fig6_csv_holds_the_curves_of_eq_26() {
         }
     }
     assert_eq!(checked, 200);
-    // The numerical Lennard-Jones points through the same spring, for μ = 2, 5, 10.
-    let solution = tapsim::contact::lj::solve(5.0, true).unwrap();
+    // The numerical Lennard-Jones points through the same spring, for μ = 2, 5, 10, 20.
+    let solution = tapsim::contact::lj::solve(5.0, tapsim::contact::lj::Reach::Springs).unwrap();
     let mut r = csv::Reader::from_path(dir.join("fig6_hysteresis_vs_stiffness.csv")).unwrap();
     let mut lj = std::collections::BTreeMap::new();
     for row in r.records() {
@@ -341,16 +341,14 @@ fn fig6_csv_holds_the_curves_of_eq_26() {
             *lj.entry(row[0].to_string()).or_insert(0) += 1;
             if row[0].starts_with("μ = 5,") {
                 let (k, w): (f64, f64) = (row[1].parse().unwrap(), row[2].parse().unwrap());
-                let expect =
-                    tapsim::contact::lj::curve::Hysteresis::with_spring(&solution.curve, k)
-                        .unwrap()
-                        .w_hat;
+                let expect = solution.spring_loop(k).unwrap().w_hat;
                 assert!((w - expect).abs() <= 1e-12 * expect, "{k}: {w} {expect}");
             }
         }
     }
-    assert_eq!(lj.len(), 3, "{lj:?}");
-    assert!(lj.values().all(|&n| n == 9), "{lj:?}");
+    assert_eq!(lj.len(), 4, "{lj:?}");
+    let per_mu = tapsim::figures::FIG6_LJ_K_HATS.len();
+    assert!(lj.values().all(|&n| n == per_mu), "{lj:?}");
     std::fs::remove_dir_all(dir).unwrap();
 }
 

@@ -207,6 +207,8 @@ pub fn main() -> ExitCode {
         }
         Err(e) => e.exit(),
     };
+    // Solutions of the Lennard-Jones problem come from the on-disk cache.
+    crate::lj_cache::install();
     // An interrupted command leaves no half-written file behind: the exit code is the
     // shell's for a signal (128 + SIGINT).
     let _ = ctrlc::set_handler(|| {

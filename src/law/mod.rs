@@ -18,6 +18,7 @@ pub use fold_branch::{FarField, FoldBranch, Side};
 pub use table::UniformTable;
 
 use crate::contact::hybrid::JumpIn;
+use crate::contact::lj::Reach;
 use crate::error::{Error, Result};
 use crate::params::Contact;
 use serde::{Deserialize, Serialize};
@@ -153,13 +154,13 @@ impl AnyLaw {
             LawKind::Dmt => AnyLaw::Dmt(DmtLaw::new(contact, hamaker_j)?),
             LawKind::Hertz => AnyLaw::Hertz(HertzLaw),
             LawKind::Lj => AnyLaw::Adhesive(
-                AdhesiveLaw::lennard_jones(&crate::contact::lj::solve(mu, true).map_err(
-                    |e| match e {
+                AdhesiveLaw::lennard_jones(
+                    &crate::contact::lj::obtain(mu, Reach::Springs).map_err(|e| match e {
                         // No loop: no hysteretic law to tabulate (a cell a map skips).
                         Error::NoHysteresis(why) => Error::NotApplicable(why),
                         other => other,
-                    },
-                )?)
+                    })?,
+                )
                 .map_err(|e| refuse(e.to_string()))?,
             ),
             LawKind::None => AnyLaw::None(NoForce),

@@ -150,7 +150,7 @@ impl LjReport {
     /// Add the loss with a support of stiffness k̂ in series.
     pub fn with_spring(mut self, s: &LjSolution, k_hat: f64) -> Result<Self> {
         crate::params::k_hat(k_hat)?;
-        let loop_ = crate::contact::lj::curve::Hysteresis::with_spring(&s.curve, k_hat)?;
+        let loop_ = s.spring_loop(k_hat)?;
         self.k_hat = Some(k_hat);
         self.w_hat_spring = Some(loop_.w_hat);
         self.w_hat_spring_hybrid =

@@ -251,8 +251,7 @@ impl Hysteresis {
         Self::of(&support).map_err(|e| {
             Error::NotApplicable(format!(
                 "with k_hat = {k_hat} the traced curve does not contain the whole loop ({e}); \
-                 the solver traces the contact branch deep enough for k_hat >= {}",
-                super::moving::SOFTEST_SPRING
+                 a trace for springs (Reach::Springs, LjSolution::spring_loop) does"
             ))
         })
     }

@@ -7,4 +7,5 @@ pub mod moving;
 pub mod result;
 pub mod solver;
 
-pub use result::{Estimate, LjSolution, solve};
+pub use moving::Reach;
+pub use result::{Estimate, LjSolution, obtain, solve};

@@ -43,11 +43,10 @@ pub struct MovingSpec {
     pub fine: f64,
     /// Largest spacing in ξ inside the contact.
     pub inner: f64,
-    /// Largest spacing in x, at a = a₀, out to x = 3 (where a distant, nearly rigid tip
-    /// feels most of its attraction).
-    pub near: f64,
-    /// Largest spacing in x, at a = a₀, out to x = 10.
-    pub middle: f64,
+    /// Largest spacing in x, at a = a₀, outside the contact. Up to it the spacing grows
+    /// with the distance from the edge alone: the gap outside varies on a length that
+    /// grows with that distance, before contact as after.
+    pub outer: f64,
     /// Growth ratio of neighbouring elements.
     pub growth: f64,
     /// Contact radius (in x) at which the continuation switches to a; the mesh reaches
@@ -68,10 +67,13 @@ impl MovingSpec {
             tabor_mu,
             fine: width / a_max / per_width,
             inner: 0.02,
-            near: 0.02,
-            middle: 0.05,
+            outer: 2.0,
             growth: 1.04,
-            a_start: 0.1 * root,
+            // The contact first forms at a radius that shrinks as μ grows; the frozen
+            // mesh of the central-gap phase would follow its growth up to a₀ node by
+            // node (re-pinning, hundreds of tiny steps at μ ≥ 10), so a₀ shrinks too:
+            // 0.1√μ up to μ ≈ 3, then ≈ 0.5/μ.
+            a_start: 0.1 * root * (5.0 / tabor_mu.powf(1.5)).min(1.0),
             edge_gap: EDGE_GAP,
         }
     }
@@ -96,8 +98,7 @@ impl MovingSpec {
         Self {
             fine: self.fine * factor,
             inner: self.inner * factor,
-            near: self.near * factor,
-            middle: self.middle * factor,
+            outer: self.outer * factor,
             growth: 1.0 + (self.growth - 1.0) * factor,
             ..*self
         }
@@ -107,19 +108,13 @@ impl MovingSpec {
     /// index of that one.
     pub fn nodes(&self) -> (Vec<f64>, usize) {
         let xi_max = OUTER_RADIUS / self.a_start;
-        let xi_near = 3.0 / self.a_start;
-        let xi_middle = 10.0 / self.a_start;
         let spacing = |xi: f64| -> f64 {
             let s = self.fine + (self.growth - 1.0) * (xi - 1.0).abs();
-            if xi < 1.0 {
-                s.min(self.inner)
-            } else if xi < xi_near {
-                s.min(self.near / self.a_start)
-            } else if xi < xi_middle {
-                s.min(self.middle / self.a_start)
+            s.min(if xi < 1.0 {
+                self.inner
             } else {
-                s.min(2.0 / self.a_start)
-            }
+                self.outer / self.a_start
+            })
         };
         let mut inner = vec![1.0];
         let mut xi: f64 = 1.0;
@@ -147,6 +142,33 @@ impl MovingSpec {
     }
 }
 
+/// How much of the S-curve a solution traces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Reach {
+    /// The loop under a rigid support: the approach branch from α̂ = [`RIGID_START`] (or
+    /// twice the jump-in separation) through A, C and the pull-off, down the contact
+    /// branch past the jump-in's landing. What Ŵ_LJ, the folds and the pull-off need.
+    Rigid,
+    /// Also every support spring down to k̂ = [`SOFTEST_SPRING`]: the approach branch
+    /// from far enough out for the softest spring's jump-out, the contact branch deep
+    /// enough for its landing. What the tabulated law and the spring losses use.
+    Springs,
+}
+
+impl Reach {
+    /// The softest support spring whose loop the trace contains (∞: rigid only).
+    pub fn softest_spring(self) -> f64 {
+        match self {
+            Reach::Rigid => f64::INFINITY,
+            Reach::Springs => SOFTEST_SPRING,
+        }
+    }
+}
+
+/// Where a rigid trace starts on the approach branch (α̂), at least: Fig. 2's range.
+pub const RIGID_START: f64 = 4.0;
+
 /// Settings of the continuation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MovingOptions {
@@ -157,8 +179,28 @@ pub struct MovingOptions {
     /// Most continuation steps.
     pub max_steps: usize,
     /// How far past the jump-in separation the contact branch is followed (in α̂), so
-    /// that a support spring down to k̂ = `softest_spring` still finds its landing.
+    /// that a support spring down to k̂ = `softest_spring` still finds its landing (∞:
+    /// a rigid support only).
     pub softest_spring: f64,
+}
+
+impl MovingOptions {
+    /// The default settings, tracing what `reach` asks for.
+    pub fn reaching(reach: Reach) -> Self {
+        Self {
+            softest_spring: reach.softest_spring(),
+            ..Self::default()
+        }
+    }
+
+    /// What these settings trace.
+    pub fn reach(&self) -> Reach {
+        if self.softest_spring.is_finite() {
+            Reach::Springs
+        } else {
+            Reach::Rigid
+        }
+    }
 }
 
 impl Default for MovingOptions {
@@ -193,7 +235,7 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
     // Far enough out that the softest spring's jump-out (at α̂ + T̂/k̂ of the fold C,
     // T̂ there below ~1.2 times the JKR pull-off 3π/2) lies on the traced approach.
     let alpha_start = (2.0 * guess_a)
-        .max(2.5)
+        .max(RIGID_START)
         .max(jkr::ALPHA_HAT_C + 1.2 * 1.5 * std::f64::consts::PI / opts.softest_spring + 1.0);
     let tol = opts.tolerance;
     let point = |sol: &Solution, a: f64, s: f64| CurvePoint {
@@ -396,7 +438,11 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
         if q.alpha_hat > guess_a + 0.3 {
             seen_c = true;
         }
-        if seen_c && phase == Phase::Radius && past_landing(&points, landing_alpha, opts) {
+        if seen_c
+            && phase == Phase::Radius
+            && past_landing(&points, landing_alpha, opts)
+            && past_pull_off(&points)
+        {
             break;
         }
     }
@@ -443,7 +489,8 @@ fn chord_cap(opts: &MovingOptions, alpha_hat: f64) -> f64 {
 }
 
 /// Whether the contact branch has gone below `landing_alpha` and, seen through the
-/// softest support spring, below the spring's own jump-in landing too.
+/// softest support spring, below the spring's own jump-in landing too (and, for springs,
+/// to where T̂ < 0, below the landing of any softer spring).
 fn past_landing(points: &[CurvePoint], landing_alpha: f64, opts: &MovingOptions) -> bool {
     let q = points.last().expect("never empty");
     if q.alpha_hat >= landing_alpha {
@@ -456,7 +503,20 @@ fn past_landing(points: &[CurvePoint], landing_alpha: f64, opts: &MovingOptions)
         .windows(2)
         .find(|w| support(&w[1]) > support(&w[0]))
         .map(|w| support(&w[0]));
-    first_min.is_some_and(|m| support(q) < m - 0.5)
+    // (A softer spring lands where the contact branch still pulls, T̂ > 0: a trace for
+    // springs goes on until it pushes.)
+    // (No minimum at all: no fold, no loop; the trace need only pass `landing_alpha`.)
+    first_min.is_none_or(|m| support(q) < m - 0.5) && (k.is_infinite() || q.t_hat < 0.0)
+}
+
+/// Whether the contact branch has passed its largest T̂ (the load-control pull-off):
+/// the last point lies 1e-3 below the largest T̂ traced.
+fn past_pull_off(points: &[CurvePoint]) -> bool {
+    let peak = points
+        .iter()
+        .map(|p| p.t_hat)
+        .fold(f64::NEG_INFINITY, f64::max);
+    points.last().is_some_and(|q| q.t_hat < peak - 1e-3)
 }
 
 /// The extremum of `value` (a maximum for `sign` = 1, a minimum for −1) over the

@@ -1,45 +1,12 @@
-//! The Lennard-Jones results for one μ with their discretisation errors, cached on disk.
+//! The Lennard-Jones results for one μ with their discretisation errors. Pure: no file
+//! or environment access (the application keeps a cache, `crate::lj_cache`, and may
+//! hand it to the laws through [`set_source`]).
 
-use super::curve::CurvePoint;
-use super::moving::{self, MovingOptions, MovingSpec};
+use super::curve::{CurvePoint, Hysteresis};
+use super::moving::{self, MovingOptions, MovingSpec, Reach};
 use crate::error::{Error, Result, positive};
-use crate::report::output;
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
-
-/// Layout version of the cached data: bump when [`LjSolution`] changes shape.
-const CACHE_VERSION: u32 = 4;
-
-/// Every source file a solution depends on: the cache key carries their fingerprint, so
-/// a cache written by a build with other numerics is never read.
-const SOLVER_SOURCES: [&str; 9] = [
-    include_str!("curve.rs"),
-    include_str!("kernel.rs"),
-    include_str!("moving.rs"),
-    include_str!("result.rs"),
-    include_str!("solver.rs"),
-    include_str!("../jkr.rs"),
-    include_str!("../hybrid.rs"),
-    include_str!("../semi_rigid.rs"),
-    include_str!("../../numeric.rs"),
-];
-
-/// FNV-1a over [`SOLVER_SOURCES`], computed at compile time.
-const SOLVER_FINGERPRINT: u64 = {
-    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut f = 0;
-    while f < SOLVER_SOURCES.len() {
-        let bytes = SOLVER_SOURCES[f].as_bytes();
-        let mut i = 0;
-        while i < bytes.len() {
-            hash ^= bytes[i] as u64;
-            hash = hash.wrapping_mul(0x0100_0000_01b3);
-            i += 1;
-        }
-        f += 1;
-    }
-    hash
-};
+use std::sync::OnceLock;
 
 /// Elements across the tensile annulus (at the largest contact radius traced) in the
 /// production mesh.
@@ -49,10 +16,9 @@ pub const ELEMENTS_PER_ANNULUS: f64 = 7.0;
 /// μ has none.
 pub const MIN_TABOR_MU: f64 = 0.5;
 
-/// Largest Tabor parameter accepted: at μ = 20 a solve takes ~50 s (10 s at μ = 12,
-/// 5 s at μ = 10) and the continuation needs ~1100 steps; from μ = 30 it needs more
-/// than its 2000.
-pub const MAX_TABOR_MU: f64 = 20.0;
+/// Largest Tabor parameter accepted: a solve takes 3.5 s at μ = 50 (the thin tensile
+/// annulus needs ~670 nodes); the hybrid law is within 0.2 % of Ŵ_LJ from μ = 10 on.
+pub const MAX_TABOR_MU: f64 = 50.0;
 
 /// Spacing ratio between the three similar meshes of the error estimate (spacings 1, r
 /// and r² times the production mesh's).
@@ -107,6 +73,8 @@ pub fn observed_order(fine: f64, coarse: f64, coarser: f64) -> f64 {
 pub struct LjSolution {
     /// Tabor parameter μ.
     pub tabor_mu: f64,
+    /// How much of the curve was traced.
+    pub reach: Reach,
     /// Jump-in fold A: separation.
     pub alpha_hat_a: Estimate,
     /// Jump-in fold A: force.
@@ -134,6 +102,61 @@ pub struct LjSolution {
 }
 
 impl LjSolution {
+    /// The loop seen through a support spring of stiffness k̂ in series, for any k̂ > 0
+    /// (eqs. (22)–(23); the Lennard-Jones counterpart of (26)): the traced curve in the
+    /// support separation α̂ + T̂/k̂ ([`Hysteresis::with_spring`]). A soft spring lets go
+    /// near the pull-off and lands far out on the approach branch, beyond where it was
+    /// traced: there the sphere is as good as rigid, and the branch continues as the
+    /// rigid sphere's force ([`rigid_sphere_t_hat`]), scaled to meet the traced branch.
+    /// Its landing on the contact branch lies where T̂ > 0, which a trace of
+    /// [`Reach::Springs`] passes.
+    pub fn spring_loop(&self, k_hat: f64) -> Result<Hysteresis> {
+        positive("k_hat", k_hat)?;
+        let first = self.curve[0];
+        let far = self
+            .curve
+            .iter()
+            .map(|p| p.alpha_hat + p.t_hat / k_hat)
+            .fold(f64::NEG_INFINITY, f64::max);
+        // (The fold lies between samples, a little beyond the largest.)
+        let far = far + 0.01 * far.abs() + 1.0;
+        if !far.is_finite() {
+            return Err(Error::NotApplicable(format!(
+                "k_hat = {k_hat} is too soft: the support moves further than a float holds"
+            )));
+        }
+        if far <= first.alpha_hat {
+            return Hysteresis::with_spring(&self.curve, k_hat);
+        }
+        // From `far` in to the first traced point, evenly in ln(α̂ + 1/μ) (T̂ falls as
+        // its −2nd power), 2 % apart.
+        let mu = self.tabor_mu;
+        let scale = first.t_hat / rigid_sphere_t_hat(first.alpha_hat, mu);
+        let (from, to) = ((far + 1.0 / mu).ln(), (first.alpha_hat + 1.0 / mu).ln());
+        let count = ((from - to) / 0.02).ceil() as usize;
+        let mut curve: Vec<CurvePoint> = (0..count)
+            .map(|i| {
+                let alpha_hat = (from + (to - from) * i as f64 / count as f64).exp() - 1.0 / mu;
+                CurvePoint {
+                    s: 0.0,
+                    alpha_hat,
+                    t_hat: scale * rigid_sphere_t_hat(alpha_hat, mu),
+                    central_gap: mu * alpha_hat + 1.0,
+                }
+            })
+            .collect();
+        // Arclength continues backwards from the first traced point.
+        let mut s = first.s;
+        let mut next = first;
+        for p in curve.iter_mut().rev() {
+            s -= (next.alpha_hat - p.alpha_hat).hypot(next.t_hat - p.t_hat);
+            p.s = s;
+            next = *p;
+        }
+        curve.extend_from_slice(&self.curve);
+        Hysteresis::with_spring(&curve, k_hat)
+    }
+
     /// The approach branch: the points before the fold A.
     pub fn approach_branch(&self) -> &[CurvePoint] {
         let k = self.curve.partition_point(|p| p.s < self.s_a);
@@ -164,38 +187,19 @@ impl LjSolution {
     }
 }
 
-/// Where cached solutions live: `$TAPSIM_CACHE`, else `$XDG_CACHE_HOME/tapsim`, else
-/// `$HOME/.cache/tapsim`, else `.tapsim-cache`.
-pub fn cache_dir() -> PathBuf {
-    if let Some(dir) = std::env::var_os("TAPSIM_CACHE") {
-        return PathBuf::from(dir);
-    }
-    if let Some(dir) = std::env::var_os("XDG_CACHE_HOME") {
-        return PathBuf::from(dir).join("tapsim");
-    }
-    if let Some(home) = std::env::var_os("HOME") {
-        return PathBuf::from(home).join(".cache").join("tapsim");
-    }
-    PathBuf::from(".tapsim-cache")
+/// T̂ of a rigid sphere at separation α̂: the traction (10) over the parabolic gap
+/// h̄ = μα̂ + 1 + x²/2, ∫ f(h̄) x dx = h̄₀⁻²/2 − h̄₀⁻⁸/8, times 16π/3 (the solver's
+/// normalisation). The far approach branch, where the deformation no longer matters.
+pub fn rigid_sphere_t_hat(alpha_hat: f64, tabor_mu: f64) -> f64 {
+    let h0 = tabor_mu * alpha_hat + 1.0;
+    16.0 * std::f64::consts::PI / 3.0 * (0.5 * h0.powi(-2) - 0.125 * h0.powi(-8))
 }
 
-/// The cache file of a solution: keyed by everything that determines it (μ, the mesh,
-/// the continuation settings and the solver's source).
-fn cache_path(tabor_mu: f64, per_annulus: f64) -> PathBuf {
-    let opts = MovingOptions::default();
-    cache_dir().join(format!(
-        "lj-v{CACHE_VERSION}-{SOLVER_FINGERPRINT:016x}-mu{:016x}-q{:016x}-t{:016x}-c{:016x}.json",
-        tabor_mu.to_bits(),
-        per_annulus.to_bits(),
-        opts.tolerance.to_bits(),
-        opts.max_chord.to_bits()
-    ))
-}
-
-/// Solve the Lennard-Jones problem for `tabor_mu` on the production mesh and a coarse
-/// one, or read the result from the cache. `use_cache = false` always computes (and
-/// still refreshes the cache).
-pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
+/// Solve the Lennard-Jones problem for `tabor_mu` on the production mesh family (the
+/// production mesh and the ones 1.5 and 2.25 times coarser), tracing as much of the
+/// curve as `reach` asks for. Below [`MIN_TABOR_MU`] there is no loop
+/// ([`Error::NoHysteresis`]); above [`MAX_TABOR_MU`] the solver does not go.
+pub fn solve(tabor_mu: f64, reach: Reach) -> Result<LjSolution> {
     positive("Tabor parameter mu", tabor_mu)?;
     if tabor_mu < MIN_TABOR_MU {
         return Err(Error::NoHysteresis(format!(
@@ -205,27 +209,31 @@ pub fn solve(tabor_mu: f64, use_cache: bool) -> Result<LjSolution> {
     }
     if tabor_mu > MAX_TABOR_MU {
         return Err(Error::NotApplicable(format!(
-            "the Lennard-Jones solver covers mu <= {MAX_TABOR_MU} (mu = {tabor_mu}): above, \
-             the continuation takes too long; the hybrid law (--law hybrid) is within \
-             0.03 % of the numerical loss from mu = 12 on"
+            "the Lennard-Jones solver covers {MIN_TABOR_MU} <= mu <= {MAX_TABOR_MU} \
+             (mu = {tabor_mu}); from mu = 10 on the hybrid law (--law hybrid) is within \
+             0.2 % of the numerical loss, and closer as mu grows"
         )));
     }
-    let path = cache_path(tabor_mu, ELEMENTS_PER_ANNULUS);
-    if use_cache {
-        if let Ok(text) = std::fs::read_to_string(&path) {
-            if let Ok(cached) = serde_json::from_str::<LjSolution>(&text) {
-                return Ok(cached);
-            }
-        }
-    }
     let spec = MovingSpec::for_tabor(tabor_mu, ELEMENTS_PER_ANNULUS);
-    let solution = solve_with(&spec, &MovingOptions::default())?;
-    // A cache that cannot be written only costs time later.
-    if let Ok(text) = serde_json::to_string(&solution) {
-        let _ = std::fs::create_dir_all(cache_dir());
-        let _ = output::write_bytes(&path, text.as_bytes());
-    }
-    Ok(solution)
+    solve_with(&spec, &MovingOptions::reaching(reach))
+}
+
+/// Where solutions come from for those who do not solve themselves (the tabulated law):
+/// [`solve`], unless the application has installed another source with [`set_source`].
+pub type Source = fn(f64, Reach) -> Result<LjSolution>;
+
+static SOURCE: OnceLock<Source> = OnceLock::new();
+
+/// Install the source of solutions (e.g. a cache in front of [`solve`]) for the rest of
+/// the process; a second call is ignored.
+pub fn set_source(source: Source) {
+    let _ = SOURCE.set(source);
+}
+
+/// The solution for `tabor_mu` and `reach` from the installed source ([`set_source`]),
+/// else computed.
+pub fn obtain(tabor_mu: f64, reach: Reach) -> Result<LjSolution> {
+    SOURCE.get().copied().unwrap_or(solve)(tabor_mu, reach)
 }
 
 /// Solve on the mesh family of `spec` (`spec` itself and the meshes 1.5 and 2.25 times
@@ -249,6 +257,7 @@ pub fn solve_with(spec: &MovingSpec, opts: &MovingOptions) -> Result<LjSolution>
     };
     Ok(LjSolution {
         tabor_mu: spec.tabor_mu,
+        reach: opts.reach(),
         alpha_hat_a: r(|c| c.fold_a.alpha_hat),
         t_hat_a: r(|c| c.fold_a.t_hat),
         alpha_hat_c: r(|c| c.fold_c.alpha_hat),
