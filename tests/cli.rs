@@ -590,6 +590,37 @@ fn reproduce_regenerates_every_file_its_readme_lists() {
     for needle in ["Ŵ_JKR", "Ŵ_LJ(μ = 5)", "fit (17)", "default tap"] {
         assert!(readme.contains(needle), "{needle}");
     }
+    // And it is what `results/` holds: `results/` cannot drift from the code that
+    // writes it. The README exactly; every CSV cell alike, numbers to 1e-9 relative.
+    let committed = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
+    assert_eq!(
+        readme,
+        std::fs::read_to_string(committed.join("README.md")).unwrap(),
+        "results/README.md is stale: run `tapsim reproduce --out results`"
+    );
+    for name in listed.iter().filter(|n| n.ends_with(".csv")) {
+        let read = |dir: &std::path::Path| -> Vec<csv::StringRecord> {
+            let mut r = csv::Reader::from_path(dir.join(name)).unwrap();
+            let mut rows = vec![r.headers().unwrap().clone()];
+            rows.extend(r.records().map(|r| r.unwrap()));
+            rows
+        };
+        let (fresh, old) = (read(&dir), read(&committed));
+        assert_eq!(fresh.len(), old.len(), "{name}: rows");
+        for (i, (a, b)) in fresh.iter().zip(&old).enumerate() {
+            assert_eq!(a.len(), b.len(), "{name}, row {i}");
+            for (x, y) in a.iter().zip(b.iter()) {
+                match (x.parse::<f64>(), y.parse::<f64>()) {
+                    (Ok(x), Ok(y)) => assert!(
+                        (x - y).abs() <= 1e-9 * x.abs().max(y.abs()) || x == y,
+                        "{name}, row {i}: {x} now, {y} in results/ \
+                         (run `tapsim reproduce --out results`)"
+                    ),
+                    _ => assert_eq!(x, y, "{name}, row {i}"),
+                }
+            }
+        }
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }
 
