@@ -17,7 +17,9 @@ use crate::report::chart::{Axis, Chart, Corner, Label, Series, Style};
 pub const AVAILABLE: [u32; 6] = [1, 2, 3, 4, 5, 6];
 
 /// Tabor parameters of the numerical points of Figs. 3 and 4.
-pub const LJ_MUS: [f64; 10] = [1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0];
+pub const LJ_MUS: [f64; 13] = [
+    1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0, 20.0, 30.0, 50.0,
+];
 
 /// Tabor parameter of Fig. 2.
 pub const FIG2_MU: f64 = 5.0;
@@ -271,10 +273,13 @@ pub fn lj_fit_table(solutions: &[LjSolution]) -> Result<Vec<u8>> {
     crate::report::records::records_csv(&rows)
 }
 
+/// The paper's range of μ in Fig. 3 (the table `fig3_lj_vs_fit.csv` goes on to 50).
+const FIG3_MAX_MU: f64 = 10.0;
+
 /// Fig. 3: jump-in separation α̂_A vs μ — the numerical Lennard-Jones points, the exact
 /// semi-rigid turning point (14)–(15), the closed form (16) and the fit (17).
 pub fn fig3(solutions: &[LjSolution]) -> Result<Chart> {
-    let mus: Vec<f64> = grid(1.0, 10.0, 181, false).collect();
+    let mus: Vec<f64> = grid(1.0, FIG3_MAX_MU, 181, false).collect();
     let exact = mus
         .iter()
         .map(|&mu| {
@@ -308,6 +313,7 @@ pub fn fig3(solutions: &[LjSolution]) -> Result<Chart> {
                 "Lennard-Jones (10), numerical",
                 solutions
                     .iter()
+                    .filter(|s| s.tabor_mu <= FIG3_MAX_MU)
                     .map(|s| (s.tabor_mu, s.alpha_hat_a.value))
                     .collect(),
                 Style::Markers,

@@ -106,7 +106,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
     output::write_bytes(&table, &figures::lj_fit_table(&solutions)?)?;
     add(
         vec![table],
-        "numerical alpha_A and W_LJ for mu = 1 ... 5 against the fit (17) and the hybrid (18)",
+        "numerical alpha_A and W_LJ for mu = 1 ... 50 against the fit (17) and the hybrid (18)",
         &mut entries,
     );
 

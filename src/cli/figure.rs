@@ -14,8 +14,8 @@ use std::path::PathBuf;
 /// 3 (jump-in separation vs μ, eqs. 14-17, with numerical points), 4 (hysteresis vs μ,
 /// eq. 18, with numerical points), 5 (cycle with a compliant support, eqs. 22-26),
 /// 6 (hysteresis vs support stiffness, eqs. 26-27), or `all`.
-/// Figures 2-4 need the Lennard-Jones solutions for μ = 1 ... 5: about a minute the
-/// first time, then instant from the cache.
+/// Figures 2-4 and 6 need the Lennard-Jones solutions for μ = 1 ... 50: about 15 s
+/// the first time, then instant from the cache.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct FigureArgs {

@@ -47,19 +47,25 @@ pub fn render_svg(chart: &Chart, path: &Path) -> Result<()> {
     render_stack_svg(std::slice::from_ref(chart), path)
 }
 
+/// Where a chart was drawn: its plotting area (backend pixels, x and y ranges) and how
+/// much of its data its legend covers (0: none).
+#[derive(Debug, Clone, PartialEq)]
+struct Drawn {
+    area: (std::ops::Range<i32>, std::ops::Range<i32>),
+    legend_covers: usize,
+}
+
 /// Draw `charts` one above the other on `root`.
 fn draw_stack<DB: DrawingBackend>(
     charts: &[Chart],
     root: &DrawingArea<DB, Shift>,
-) -> std::result::Result<(), String> {
+) -> std::result::Result<Vec<Drawn>, String> {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    for (chart, area) in charts
+    charts
         .iter()
         .zip(root.split_evenly((charts.len().max(1), 1)))
-    {
-        draw(chart, &area)?;
-    }
-    Ok(())
+        .map(|(chart, area)| draw(chart, &area))
+        .collect()
 }
 
 fn stack_size(n: usize) -> (u32, u32) {
@@ -74,19 +80,29 @@ fn stack_size(n: usize) -> (u32, u32) {
 /// errors are told as such, and a PNG can go to a device or a FIFO like a CSV.
 fn render_stack_png(charts: &[Chart], path: &Path) -> Result<()> {
     use image::ImageEncoder;
-    register_font();
-    let (width, height) = stack_size(charts.len());
-    let mut pixels = vec![0u8; 3 * width as usize * height as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
-        draw_stack(charts, &root).map_err(|reason| fail(path, reason))?;
-        root.present().map_err(|e| fail(path, e.to_string()))?;
-    }
+    let (pixels, (width, height), _) = rasterize(charts).map_err(|reason| fail(path, reason))?;
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(&pixels, width, height, image::ColorType::Rgb8)
         .map_err(|e| fail(path, format!("PNG encoding failed: {e}")))?;
     output::write_bytes(path, &bytes)
+}
+
+/// RGB pixels, their width and height, and where each chart went.
+type Raster = (Vec<u8>, (u32, u32), Vec<Drawn>);
+
+/// `charts` drawn one above the other into RGB pixels.
+fn rasterize(charts: &[Chart]) -> std::result::Result<Raster, String> {
+    register_font();
+    let (width, height) = stack_size(charts.len());
+    let mut pixels = vec![0u8; 3 * width as usize * height as usize];
+    let drawn = {
+        let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
+        let drawn = draw_stack(charts, &root)?;
+        root.present().map_err(|e| e.to_string())?;
+        drawn
+    };
+    Ok((pixels, (width, height), drawn))
 }
 
 fn render_stack_svg(charts: &[Chart], path: &Path) -> Result<()> {
@@ -153,7 +169,7 @@ fn data_range(chart: &Chart, pick: impl Fn(&(f64, f64)) -> f64, scale: Scale) ->
 fn draw<DB: DrawingBackend>(
     chart: &Chart,
     root: &DrawingArea<DB, Shift>,
-) -> std::result::Result<(), String> {
+) -> std::result::Result<Drawn, String> {
     let xr = chart
         .x
         .range
@@ -180,7 +196,7 @@ fn draw_in<DB, X, Y>(
     root: &DrawingArea<DB, Shift>,
     xr: X,
     yr: Y,
-) -> std::result::Result<(), String>
+) -> std::result::Result<Drawn, String>
 where
     DB: DrawingBackend,
     X: AsRangedCoord<Value = f64>,
@@ -197,7 +213,11 @@ where
         .y_label_area_size(80)
         .build_cartesian_2d(xr, yr)
         .map_err(|e| err(&e))?;
+    let fx = |v: &f64| tick_label(*v, chart.x.scale);
+    let fy = |v: &f64| tick_label(*v, chart.y.scale);
     ctx.configure_mesh()
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
         .x_desc(chart.x.label.as_str())
         .y_desc(chart.y.label.as_str())
         .axis_desc_style(("sans-serif", 22))
@@ -262,19 +282,149 @@ where
         )))
         .map_err(|e| err(&e))?;
     }
+    let legend = place_legend(&ctx, chart, &clip)?;
     ctx.configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(RGBColor(160, 160, 160))
-        .label_font(("sans-serif", 17))
-        .position(match chart.legend {
-            Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
-            Corner::UpperRight => SeriesLabelPosition::UpperRight,
-            Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
-            Corner::LowerRight => SeriesLabelPosition::LowerRight,
-        })
+        .label_font(("sans-serif", LEGEND_FONT))
+        .position(SeriesLabelPosition::Coordinate(legend.0, legend.1))
         .draw()
         .map_err(|e| err(&e))?;
-    Ok(())
+    let area = ctx.plotting_area().get_pixel_range();
+    Ok(Drawn {
+        area,
+        legend_covers: legend.2,
+    })
+}
+
+/// A tick label: decades of a log axis as 0.1, 1, 10, then 10², 10³, … (10⁻², …);
+/// anything else with up to six decimals, trailing zeros dropped ("140", "0.25"), or
+/// far from 1 as a mantissa and exponent ("2.5e-18").
+fn tick_label(v: f64, scale: Scale) -> String {
+    if scale == Scale::Log && v > 0.0 {
+        let k = v.log10().round();
+        if (v.log10() - k).abs() < 1e-9 && !(-1.0..=1.0).contains(&k) {
+            const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+            let exponent: String = (k.abs() as i64)
+                .to_string()
+                .chars()
+                .map(|c| DIGITS[c.to_digit(10).unwrap_or(0) as usize])
+                .collect();
+            return format!("10{}{exponent}", if k < 0.0 { "⁻" } else { "" });
+        }
+    }
+    if v != 0.0 && !(1e-3..1e7).contains(&v.abs()) {
+        // Far from 1: a mantissa with its exponent ("2.5e-18").
+        let text = format!("{v:.4e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        return format!("{mantissa}e{exponent}");
+    }
+    let text = format!("{v:.6}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.into()
+    }
+}
+
+/// Font size of legend entries.
+const LEGEND_FONT: u32 = 17;
+
+/// Where the legend goes, in the plotting area's pixels, and how many markers and line
+/// segments of the data its box covers: of the positions along the plot's edges (the
+/// chart's preferred corner first, then the other corners, then the middles of the
+/// edges), the first that covers nothing, else the one that covers least. The box is
+/// measured as plotters will draw it (the same text layout, a 30-pixel key, 10-pixel
+/// margins).
+fn place_legend<DB, X, Y>(
+    ctx: &ChartContext<DB, Cartesian2d<X, Y>>,
+    chart: &Chart,
+    clip: &Clip,
+) -> std::result::Result<(i32, i32, usize), String>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let style: TextStyle = ("sans-serif", LEGEND_FONT).into_font().into();
+    let mut text = MultiLineText::<_, &str>::new((0, 0), &style);
+    // Labelled as drawn: a line only if some of it is inside the box.
+    for series in chart.series.iter().filter(|s| !s.name.is_empty()) {
+        if series.style == Style::Markers || !clip.runs(&series.points).is_empty() {
+            text.push_line(series.name.as_str());
+        }
+    }
+    let (w, h) = text.estimate_dimension().map_err(|e| e.to_string())?;
+    let (w, h) = (w + 30 + 20, h + 20);
+    let area = ctx.plotting_area();
+    let (aw, ah) = area.dim_in_pixel();
+    let (aw, ah) = (aw as i32, ah as i32);
+    let base = area.get_base_pixel();
+    let local = |p: (f64, f64)| {
+        let (x, y) = ctx.backend_coord(&p);
+        ((x - base.0) as f64, (y - base.1) as f64)
+    };
+    let markers: Vec<(f64, f64)> = chart
+        .series
+        .iter()
+        .filter(|s| s.style == Style::Markers)
+        .flat_map(|s| s.points.iter().copied().filter(|&p| clip.contains(p)))
+        .map(local)
+        .collect();
+    let segments: Vec<((f64, f64), (f64, f64))> = chart
+        .series
+        .iter()
+        .filter(|s| s.style != Style::Markers)
+        .flat_map(|s| clip.runs(&s.points))
+        .flat_map(|run| {
+            let px: Vec<_> = run.into_iter().map(local).collect();
+            px.windows(2).map(|w| (w[0], w[1])).collect::<Vec<_>>()
+        })
+        .collect();
+    let covers = |(x, y): (i32, i32)| {
+        // The box grown by a marker's radius and a line's half width.
+        let (x0, x1, y0, y1) = (x as f64, (x + w) as f64, y as f64, (y + h) as f64);
+        let m = markers
+            .iter()
+            .filter(|p| p.0 >= x0 - 7.0 && p.0 <= x1 + 7.0 && p.1 >= y0 - 7.0 && p.1 <= y1 + 7.0)
+            .count();
+        let l = segments
+            .iter()
+            .filter(|(a, b)| {
+                liang_barsky(*a, *b, (x0 - 2.0, x1 + 2.0), (y0 - 2.0, y1 + 2.0)).is_some()
+            })
+            .count();
+        m + l
+    };
+    let (left, right, mid_x) = (5, aw - w - 5, (aw - w) / 2);
+    let (top, bottom, mid_y) = (5, ah - h - 5, (ah - h) / 2);
+    let corners = [
+        (Corner::UpperRight, (right, top)),
+        (Corner::UpperLeft, (left, top)),
+        (Corner::LowerRight, (right, bottom)),
+        (Corner::LowerLeft, (left, bottom)),
+    ];
+    let preferred = corners.iter().filter(|c| c.0 == chart.legend);
+    let others = corners.iter().filter(|c| c.0 != chart.legend);
+    let candidates = preferred.chain(others).map(|c| c.1).chain([
+        (right, mid_y),
+        (left, mid_y),
+        (mid_x, top),
+        (mid_x, bottom),
+    ]);
+    let mut best = (right, top, usize::MAX);
+    for at in candidates {
+        let n = covers(at);
+        if n < best.2 {
+            best = (at.0, at.1, n);
+        }
+        if n == 0 {
+            break;
+        }
+    }
+    Ok(best)
 }
 
 /// Clipping of polylines to the plotted box (plotters would clamp out-of-range points
@@ -392,6 +542,130 @@ mod tests {
         let (p, q) = (runs[0][0], runs[0][1]);
         assert!((p.0 - 10.0).abs() < 1e-9 && (p.1 - 100.0).abs() < 1e-9);
         assert!((q.0 - 100.0).abs() < 1e-9 && (q.1 - 10.0).abs() < 1e-9);
+    }
+
+    use crate::report::chart::{Axis, Series};
+
+    fn chart(x: Axis, y: Axis, series: Vec<Series>, legend: Corner) -> Chart {
+        Chart {
+            name: "test".into(),
+            title: "test".into(),
+            x,
+            y,
+            series,
+            labels: Vec::new(),
+            legend,
+        }
+    }
+
+    /// Pixels of exactly `color` outside the drawn charts' plotting areas (grown by a
+    /// pixel for a line's half width).
+    fn strays(charts: &[Chart], color: RGBColor) -> usize {
+        let (pixels, (width, _), drawn) = rasterize(charts).unwrap();
+        pixels
+            .chunks(3)
+            .enumerate()
+            .filter(|(_, p)| (p[0], p[1], p[2]) == (color.0, color.1, color.2))
+            .filter(|&(i, _)| {
+                let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
+                !drawn.iter().any(|d| {
+                    (d.area.0.start - 1..d.area.0.end + 1).contains(&x)
+                        && (d.area.1.start - 1..d.area.1.end + 1).contains(&y)
+                })
+            })
+            .count()
+    }
+
+    #[test]
+    fn no_drawn_pixel_of_a_series_leaves_its_plot_area() {
+        // Thick lines that run far outside fixed ranges, solid and dashed, on linear and
+        // log axes, one chart and a stack (plotters' bitmap backend draws wide strokes
+        // as polygons it does not clip).
+        let wild = vec![(-5.0, 3.0), (0.5, 0.5), (5.0, -3.0), (0.2, 9.0), (0.9, 0.1)];
+        let color = PALETTE[7];
+        let lines = |style| Series::new("wild", wild.clone(), style, 7);
+        let linear = chart(
+            Axis::linear("x", "x").with_range(0.0, 1.0),
+            Axis::linear("y", "y").with_range(0.0, 1.0),
+            vec![lines(Style::Line), lines(Style::Dashed)],
+            Corner::UpperRight,
+        );
+        let positive: Vec<(f64, f64)> = wild
+            .iter()
+            .map(|p| (p.0.abs() + 1e-3, p.1.abs() + 1e-3))
+            .collect();
+        let log = chart(
+            Axis::log("x", "x").with_range(0.1, 1.0),
+            Axis::log("y", "y").with_range(0.1, 1.0),
+            vec![Series::new("wild", positive, Style::Dotted, 7)],
+            Corner::LowerLeft,
+        );
+        assert!(strays(std::slice::from_ref(&linear), color) == 0);
+        assert!(strays(&[linear.clone(), log.clone(), linear], color) == 0);
+        // (Not vacuous: the series is drawn, in that colour.)
+        let (pixels, _, _) = rasterize(&[log]).unwrap();
+        assert!(
+            pixels
+                .chunks(3)
+                .any(|p| (p[0], p[1], p[2]) == (color.0, color.1, color.2))
+        );
+    }
+
+    #[test]
+    fn the_legend_goes_where_it_covers_no_data() {
+        // A line through the preferred (upper right) corner and markers in the upper left.
+        let diagonal: Vec<(f64, f64)> = (0..=50)
+            .map(|i| (i as f64 / 50.0, i as f64 / 50.0))
+            .collect();
+        let upper_left: Vec<(f64, f64)> = (0..10)
+            .map(|i| (0.02 * i as f64, 0.98 - 0.02 * i as f64))
+            .collect();
+        let busy = chart(
+            Axis::linear("x", "x").with_range(0.0, 1.0),
+            Axis::linear("y", "y").with_range(0.0, 1.0),
+            vec![
+                Series::new("diagonal", diagonal, Style::Line, 1),
+                Series::new("corner", upper_left, Style::Markers, 2),
+            ],
+            Corner::UpperRight,
+        );
+        let (_, _, drawn) = rasterize(&[busy]).unwrap();
+        assert_eq!(drawn[0].legend_covers, 0);
+        // The paper's figures that need no Lennard-Jones solution: clear legends too.
+        for n in [1, 5] {
+            let c = crate::figures::figure(n, &Default::default()).unwrap();
+            let (_, _, drawn) = rasterize(&[c]).unwrap();
+            assert_eq!(drawn[0].legend_covers, 0, "figure {n}");
+        }
+    }
+
+    #[test]
+    fn tick_labels_read_as_people_write_them() {
+        let log = |v| tick_label(v, Scale::Log);
+        let lin = |v| tick_label(v, Scale::Linear);
+        assert_eq!(
+            [
+                log(0.01),
+                log(0.1),
+                log(1.0),
+                log(10.0),
+                log(100.0),
+                log(1e3),
+                log(2e3)
+            ],
+            ["10⁻²", "0.1", "1", "10", "10²", "10³", "2000"]
+        );
+        assert_eq!(
+            [
+                lin(140.0),
+                lin(0.25),
+                lin(0.1 + 0.2),
+                lin(-0.0),
+                lin(-2.5),
+                lin(2.5e-18)
+            ],
+            ["140", "0.25", "0.3", "0", "-2.5", "2.5e-18"]
+        );
     }
 
     #[test]
