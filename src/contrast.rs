@@ -63,6 +63,8 @@ pub enum PhaseBranch {
 pub struct ContrastRow {
     /// Force law.
     pub law: String,
+    /// The materials, in the order of `phase_deg`.
+    pub materials: Vec<String>,
     /// Amplitude setpoint A/A₀.
     pub amplitude_ratio: f64,
     /// The branch the phases belong to (where a setpoint is bistable, both have a row).
@@ -74,6 +76,9 @@ pub struct ContrastRow {
     /// family (stable orbits), else the regime of the approach-curve points it is
     /// interpolated between ("irregular", "period-3", …).
     pub regime: Vec<Option<String>>,
+    /// Whether each φ comes from steady states that met their tolerance (both ends of
+    /// the interpolation).
+    pub converged: Vec<Option<bool>>,
     /// φ(last material) − φ(first material), degrees, where both are on this branch.
     pub delta_phase_deg: Option<f64>,
 }
@@ -84,6 +89,7 @@ struct AtSetpoint {
     branch: PhaseBranch,
     phase_deg: f64,
     regime: String,
+    converged: bool,
 }
 
 /// Linear interpolation of (A/A₀, φ) pairs at A/A₀ = `r`, if `a` and `b` bracket it.
@@ -116,11 +122,19 @@ fn states_at(
                 && w[0].observables.stable == Some(true)
                 && w[1].observables.stable == Some(true)
         })
-        .filter_map(|w| crossing(pair(&w[0].observables), pair(&w[1].observables), r))
-        .map(|phase_deg| AtSetpoint {
+        .filter_map(|w| {
+            crossing(pair(&w[0].observables), pair(&w[1].observables), r).map(|phase| {
+                (
+                    phase,
+                    w[0].observables.converged && w[1].observables.converged,
+                )
+            })
+        })
+        .map(|(phase_deg, converged)| AtSetpoint {
             branch: branch_of(phase_deg),
             phase_deg,
             regime: "period-1".into(),
+            converged,
         })
         .collect();
     let approach: Vec<&SweepPoint> = ramp
@@ -144,6 +158,7 @@ fn states_at(
                     branch,
                     phase_deg,
                     regime: nearer.regime.clone(),
+                    converged: a.converged && b.converged,
                 });
             }
         }
@@ -245,6 +260,7 @@ pub fn contrast(
                     on.iter().map(|s| s.map(|a| a.phase_deg)).collect();
                 rows.push(ContrastRow {
                     law: law.to_string(),
+                    materials: of_law.iter().map(|c| c.material.clone()).collect(),
                     amplitude_ratio: r,
                     branch,
                     delta_phase_deg: match (phase_deg[0], phase_deg[phase_deg.len() - 1]) {
@@ -252,6 +268,7 @@ pub fn contrast(
                         _ => None,
                     },
                     regime: on.iter().map(|s| s.map(|a| a.regime.clone())).collect(),
+                    converged: on.iter().map(|s| s.map(|a| a.converged)).collect(),
                     phase_deg,
                 });
             }

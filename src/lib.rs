@@ -26,3 +26,8 @@ pub mod sweep;
 pub mod units;
 
 pub use error::{Error, Result};
+
+/// The README's Rust blocks, compiled and run as doctests so its numbers stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -902,3 +902,50 @@ fn below_the_critical_mu_lj_reports_no_hysteresis_not_an_error() {
     assert_eq!(v["hysteresis"], true);
     assert!(num(&v, "w_hat") > 0.0);
 }
+
+#[test]
+fn map_json_is_a_grid_and_its_plot_a_heat_map() {
+    let v = json(&["map", "--steps", "3", "--json", "--quiet"]);
+    let axis = |k: &str| v[k].as_array().unwrap().len();
+    assert_eq!((axis("work_of_adhesion_j_m2"), axis("modulus_pa")), (3, 3));
+    let phase = v["grid"]["phase_deg"].as_array().unwrap();
+    assert_eq!(phase.len(), 3);
+    assert!(phase.iter().all(|row| row.as_array().unwrap().len() == 3));
+    // A cell where the law does not apply is null, with its note beside it.
+    assert!(phase[2][0].is_null());
+    assert!(
+        v["grid"]["note"][2][0]
+            .as_str()
+            .unwrap()
+            .contains("does not apply")
+    );
+    assert_eq!(v["grid"]["modulus_pa"][1][2], v["modulus_pa"][1]);
+    let dir = scratch("heatmap");
+    for ext in ["png", "svg"] {
+        let path = dir.join(format!("map.{ext}"));
+        let out = tapsim(&[
+            "map",
+            "--steps",
+            "3",
+            "--quiet",
+            "--plot",
+            path.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(std::fs::metadata(&path).unwrap().len() > 10_000);
+    }
+    let svg = std::fs::read_to_string(dir.join("map.svg")).unwrap();
+    for needle in [
+        "E_ts per cycle (eV)",
+        "phase lag φ (deg)",
+        "A/A₀",
+        "not period-1",
+    ] {
+        assert!(svg.contains(needle), "{needle}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

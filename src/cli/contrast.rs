@@ -26,6 +26,10 @@ use clap::Args;
 /// is taken only between materials on the same branch; where a setpoint is bistable,
 /// both branches get a row. The table names the motion behind every φ and compares
 /// JKR's contrast with the other laws', branch by branch.
+///
+/// JSON (--json): one object per law, setpoint and branch with law, materials,
+/// amplitude_ratio, branch, phase_deg, regime and converged (one entry per material,
+/// null where it has no steady state on that branch) and delta_phase_deg.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct ContrastArgs {

@@ -3,8 +3,8 @@
 use crate::config::{TapInputs, pressure, surface_energy};
 use crate::dynamics::observables::TapObservables;
 use crate::error::Result;
-use crate::report::chart::{Axis, Chart, Corner, Series, Style};
-use crate::report::{records, sweep as sweep_report};
+use crate::report::heatmap::{Cell, HeatMap};
+use crate::report::{output, plot, records};
 use crate::sweep;
 use clap::Args;
 
@@ -13,10 +13,14 @@ use clap::Args;
 /// parallel. The result is the same whatever the number of threads. Every `tapsim tap`
 /// option applies (--modulus and --work-of-adhesion are replaced by the grid).
 ///
-/// Output: CSV (--csv) and JSON (--json: one object of equal-length arrays) with
-/// work_of_adhesion_j_m2, modulus_pa, tabor_mu and the tap observables per cell (empty
-/// where the law does not apply, with a note); --plot draws E_ts and φ against Δγ, one
-/// line per modulus.
+/// Output: CSV (--csv, one row per cell; without --csv, --json or --plot it goes to
+/// stdout) with work_of_adhesion_j_m2, modulus_pa, tabor_mu and the tap observables
+/// per cell (empty where the law does not apply, with a note). JSON (--json): law, the
+/// two axes work_of_adhesion_j_m2 and modulus_pa, and grid: per column of the CSV an
+/// array of rows, one per modulus, each with one value per work of adhesion (null
+/// where the law does not apply); --plot draws heat maps of E_ts, φ and A/A₀ over the grid (log axes, a
+/// viridis colour bar each; grey where the law does not apply, cells that are not
+/// period-1 marked with a circle).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct MapArgs {
@@ -60,53 +64,59 @@ pub fn run(args: MapArgs) -> Result<()> {
             bar.inc(1)
         })?;
     bar.finish_and_clear();
-    args.out.write_files(&cells, || {
-        // Per modulus, lines through the period-1 cells; other cells marked.
-        let lines = |y: fn(&TapObservables) -> f64| -> Vec<Series> {
-            let located = |e: Option<f64>| -> Vec<sweep_report::Located> {
-                cells
-                    .iter()
-                    .filter(|c| e.is_none_or(|e| c.modulus_pa == e))
-                    .filter_map(|c| {
-                        let o = c.observables.as_ref()?;
-                        Some((o.period, (c.work_of_adhesion_j_m2, y(o))))
-                    })
-                    .collect()
-            };
-            let mut series: Vec<Series> = moduli
+    if let Some(path) = &args.out.csv {
+        output::write_bytes(path, &records::records_csv(&cells)?)?;
+    }
+    if let Some(path) = &args.out.plot {
+        let law = setup.law;
+        let map = |title: &str, value_label: &str, value: fn(&TapObservables) -> f64| HeatMap {
+            title: format!("{law} law: {title}"),
+            x_label: "work of adhesion Δγ (J/m²)".into(),
+            y_label: "composite modulus E* (GPa)".into(),
+            value_label: value_label.into(),
+            x: works.clone(),
+            y: moduli.iter().map(|e| e * 1e-9).collect(),
+            cells: moduli
                 .iter()
-                .enumerate()
-                .flat_map(|(i, &e)| {
-                    let name = format!("E* = {:.2} GPa", e * 1e-9);
-                    sweep_report::period_one_lines(&located(Some(e)), &name, Style::Line, i + 1)
+                .map(|&e| {
+                    works
+                        .iter()
+                        .map(|&w| {
+                            cells
+                                .iter()
+                                .find(|c| c.modulus_pa == e && c.work_of_adhesion_j_m2 == w)
+                                .and_then(|c| c.observables.as_ref())
+                                .map_or(Cell::NotApplicable, |o| Cell::Value {
+                                    value: value(o),
+                                    period_one: o.period == Some(1),
+                                })
+                        })
+                        .collect()
                 })
-                .collect();
-            series.extend(sweep_report::not_period_one(&located(None)));
-            series
+                .collect(),
         };
-        vec![
-            Chart {
-                name: "map_e_ts".into(),
-                title: format!("{} law: dissipation per cycle", setup.law),
-                x: Axis::log("work of adhesion Δγ (J/m²)", "work_of_adhesion"),
-                y: Axis::linear("E_ts per cycle (eV)", "e_ts_ev"),
-                series: lines(|o| o.e_ts_ev),
-                labels: vec![],
-                legend: Corner::UpperLeft,
-            },
-            Chart {
-                name: "map_phase".into(),
-                title: format!("{} law: phase", setup.law),
-                x: Axis::log("work of adhesion Δγ (J/m²)", "work_of_adhesion"),
-                y: Axis::linear("phase lag φ (deg)", "phase_deg"),
-                series: lines(|o| o.phase_deg),
-                labels: vec![],
-                legend: Corner::UpperLeft,
-            },
-        ]
-    })?;
+        plot::render_heatmaps(
+            &[
+                map("dissipation per cycle", "E_ts per cycle (eV)", |o| {
+                    o.e_ts_ev
+                }),
+                map("phase", "phase lag φ (deg)", |o| o.phase_deg),
+                map("amplitude", "A/A₀", |o| o.amplitude_ratio),
+            ],
+            path,
+        )?;
+    }
     if args.out.json {
-        args.out.print_json(&cells)?;
+        let json = serde_json::json!({
+            "law": setup.law.to_string(),
+            "work_of_adhesion_j_m2": works,
+            "modulus_pa": moduli,
+            "grid": records::grid_json(&cells, works.len())?,
+        });
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&json).expect("serialises")
+        );
     } else if args.out.csv.is_none() && args.out.plot.is_none() {
         out!(
             "{}",

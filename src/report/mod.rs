@@ -4,6 +4,7 @@
 pub mod bifurcation;
 pub mod branches;
 pub mod chart;
+pub mod heatmap;
 pub mod hysteresis;
 pub mod lj;
 pub mod output;

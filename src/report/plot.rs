@@ -2,6 +2,7 @@
 //! embedded font (DejaVu Sans) so no system font configuration is needed.
 
 use super::chart::{Chart, Corner, Scale, Style};
+use super::heatmap::{Cell, HeatMap, viridis};
 use super::output;
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
@@ -128,6 +129,201 @@ pub fn render_stack(charts: &[Chart], path: &Path) -> Result<()> {
         Some("svg") => render_stack_svg(charts, path),
         _ => Err(fail(path, "the plot file must end in .png or .svg".into())),
     }
+}
+
+/// Render heat maps one above the other into `path`, PNG or SVG by its extension.
+pub fn render_heatmaps(maps: &[HeatMap], path: &Path) -> Result<()> {
+    register_font();
+    let size = stack_size(maps.len());
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("png") => {
+            use image::ImageEncoder;
+            let mut pixels = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+            {
+                let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
+                draw_heatmaps(maps, &root).map_err(|reason| fail(path, reason))?;
+                root.present().map_err(|e| fail(path, e.to_string()))?;
+            }
+            let mut bytes = Vec::new();
+            image::codecs::png::PngEncoder::new(&mut bytes)
+                .write_image(&pixels, size.0, size.1, image::ColorType::Rgb8)
+                .map_err(|e| fail(path, format!("PNG encoding failed: {e}")))?;
+            output::write_bytes(path, &bytes)
+        }
+        Some("svg") => {
+            let mut text = String::new();
+            {
+                let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+                draw_heatmaps(maps, &root).map_err(|reason| fail(path, reason))?;
+                root.present().map_err(|e| fail(path, e.to_string()))?;
+            }
+            output::write_bytes(path, text.as_bytes())
+        }
+        _ => Err(fail(path, "the plot file must end in .png or .svg".into())),
+    }
+}
+
+fn draw_heatmaps<DB: DrawingBackend>(
+    maps: &[HeatMap],
+    root: &DrawingArea<DB, Shift>,
+) -> std::result::Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    for (map, area) in maps.iter().zip(root.split_evenly((maps.len().max(1), 1))) {
+        draw_heatmap(map, &area)?;
+    }
+    Ok(())
+}
+
+/// Ticks of a log axis over [lo, hi]: 1, 2 and 5 times each power of ten inside, or
+/// 1, 2, 3 and 5 times, or every integer multiple, the first that gives four or more.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let within = |multiples: &[f64]| -> Vec<f64> {
+        let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (first..=last)
+            .flat_map(|d| {
+                // (3/10, not 3·0.1: the tick is the decimal number.)
+                multiples.iter().map(move |m| {
+                    if d < 0 {
+                        m / 10f64.powi(-d)
+                    } else {
+                        m * 10f64.powi(d)
+                    }
+                })
+            })
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    [
+        &[1.0, 2.0, 5.0][..],
+        &[1.0, 2.0, 3.0, 5.0],
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+    ]
+    .iter()
+    .map(|m| within(m))
+    .find(|t| t.len() >= 4)
+    .unwrap_or_else(|| within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]))
+}
+
+/// One heat map: the cells on log axes, and beside them the colour bar with a key to
+/// the grey (the law does not apply) and the marked (not period-1) cells.
+fn draw_heatmap<DB: DrawingBackend>(
+    map: &HeatMap,
+    area: &DrawingArea<DB, Shift>,
+) -> std::result::Result<(), String> {
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let (width, _) = area.dim_in_pixel();
+    let (main, side) = area.split_horizontally(width as i32 * 4 / 5);
+    let (xe, ye) = (HeatMap::edges(&map.x), HeatMap::edges(&map.y));
+    if xe.len() < 2 || ye.len() < 2 {
+        return Err("a heat map needs at least one cell".into());
+    }
+    let mut ctx = ChartBuilder::on(&main)
+        .caption(&map.title, ("sans-serif", 26))
+        .margin(18)
+        .x_label_area_size(60)
+        .y_label_area_size(80)
+        .build_cartesian_2d(
+            (xe[0]..xe[xe.len() - 1])
+                .log_scale()
+                .with_key_points(log_ticks(xe[0], xe[xe.len() - 1])),
+            (ye[0]..ye[ye.len() - 1])
+                .log_scale()
+                .with_key_points(log_ticks(ye[0], ye[ye.len() - 1])),
+        )
+        .map_err(|e| err(&e))?;
+    let log = |v: &f64| tick_label(*v, Scale::Log);
+    ctx.configure_mesh()
+        .disable_mesh()
+        .x_label_formatter(&log)
+        .y_label_formatter(&log)
+        .x_desc(map.x_label.as_str())
+        .y_desc(map.y_label.as_str())
+        .axis_desc_style(("sans-serif", 22))
+        .label_style(("sans-serif", 17))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let (lo, hi) = map.value_range().unwrap_or((0.0, 1.0));
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let colour = |v: f64| {
+        let (r, g, b) = viridis((v - lo) / span);
+        RGBColor(r, g, b)
+    };
+    let grey = RGBColor(225, 225, 225);
+    for (j, row) in map.cells.iter().enumerate() {
+        for (i, cell) in row.iter().enumerate() {
+            let corners = [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])];
+            let fill = match *cell {
+                Cell::Value { value, .. } => colour(value),
+                Cell::NotApplicable => grey,
+            };
+            ctx.draw_series(std::iter::once(Rectangle::new(corners, fill.filled())))
+                .map_err(|e| err(&e))?;
+            if let Cell::Value {
+                period_one: false, ..
+            } = cell
+            {
+                let centre = (map.x[i], map.y[j]);
+                ctx.draw_series([
+                    Circle::new(centre, 6, WHITE.filled()),
+                    Circle::new(centre, 6, BLACK.stroke_width(2)),
+                ])
+                .map_err(|e| err(&e))?;
+            }
+        }
+    }
+    // The colour bar, level with the plotting area, and the key below it.
+    let top = ctx.plotting_area().get_pixel_range().1.start - area.get_base_pixel().1;
+    let bottom = ctx.plotting_area().get_pixel_range().1.end - area.get_base_pixel().1;
+    let (_, side_height) = side.dim_in_pixel();
+    let mut bar = ChartBuilder::on(&side)
+        .margin_top(top.max(0) as u32)
+        .margin_bottom((side_height as i32 - bottom).max(0) as u32)
+        .margin_right(10)
+        .y_label_area_size(90)
+        .build_cartesian_2d(0.0..1.0, lo..lo + span)
+        .map_err(|e| err(&e))?;
+    let plain = |v: &f64| tick_label(*v, Scale::Linear);
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_label_formatter(&plain)
+        .y_desc(map.value_label.as_str())
+        .axis_desc_style(("sans-serif", 20))
+        .label_style(("sans-serif", 17))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let steps = 100;
+    bar.draw_series((0..steps).map(|k| {
+        let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
+        Rectangle::new(
+            [(0.0, lo + a * span), (1.0, lo + b * span)],
+            colour(lo + 0.5 * (a + b) * span).filled(),
+        )
+    }))
+    .map_err(|e| err(&e))?;
+    let key = ("sans-serif", 16).into_font().color(&BLACK);
+    let at = |dy: i32| (10, bottom + 14 + dy);
+    side.draw(&Circle::new(at(8), 6, BLACK.stroke_width(2)))
+        .map_err(|e| err(&e))?;
+    side.draw(&Text::new(
+        "not period-1",
+        (at(0).0 + 14, at(0).1),
+        key.clone(),
+    ))
+    .map_err(|e| err(&e))?;
+    side.draw(&Rectangle::new(
+        [at(24), (at(24).0 + 12, at(24).1 + 12)],
+        grey.filled(),
+    ))
+    .map_err(|e| err(&e))?;
+    side.draw(&Text::new("law n/a", (at(24).0 + 18, at(24).1), key))
+        .map_err(|e| err(&e))?;
+    Ok(())
 }
 
 fn fail(path: &Path, reason: String) -> Error {
@@ -666,6 +862,55 @@ mod tests {
             ],
             ["140", "0.25", "0.3", "0", "-2.5", "2.5e-18"]
         );
+    }
+
+    #[test]
+    fn a_heat_map_colours_cells_greys_the_inapplicable_and_marks_the_irregular() {
+        let map = HeatMap {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            value_label: "v".into(),
+            x: vec![1.0, 10.0],
+            y: vec![1.0, 10.0],
+            cells: vec![
+                vec![
+                    Cell::Value {
+                        value: 0.0,
+                        period_one: true,
+                    },
+                    Cell::Value {
+                        value: 1.0,
+                        period_one: false,
+                    },
+                ],
+                vec![
+                    Cell::NotApplicable,
+                    Cell::Value {
+                        value: 0.5,
+                        period_one: true,
+                    },
+                ],
+            ],
+        };
+        let size = SIZE;
+        let mut pixels = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+        {
+            register_font();
+            let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
+            draw_heatmaps(std::slice::from_ref(&map), &root).unwrap();
+            root.present().unwrap();
+        }
+        let count = |c: (u8, u8, u8)| pixels.chunks(3).filter(|p| (p[0], p[1], p[2]) == c).count();
+        // A quarter of a ~600 x 500 plot each, and the ends of the colour bar.
+        assert!(count(viridis(0.0)) > 20_000, "{}", count(viridis(0.0)));
+        assert!(count(viridis(1.0)) > 20_000);
+        assert!(count(viridis(0.5)) > 20_000);
+        assert!(count((225, 225, 225)) > 20_000);
+        // The marked cell has a white disc in it.
+        assert!(count((255, 255, 255)) > 0);
+        assert_eq!(log_ticks(0.017, 0.23), [0.02, 0.05, 0.1, 0.2]);
+        assert_eq!(log_ticks(0.26, 3.5), [0.3, 0.5, 1.0, 2.0, 3.0]);
     }
 
     #[test]

@@ -82,3 +82,26 @@ pub fn records_csv<T: Serialize>(records: &[T]) -> Result<Vec<u8>> {
         reason: e.to_string(),
     })
 }
+
+/// `records` laid out row by row on a grid `columns` wide (row-major, as a map's cells
+/// are: one row per value of the slow axis): one object with, per key, an array of rows.
+pub fn grid_json<T: Serialize>(records: &[T], columns: usize) -> Result<Value> {
+    let Value::Object(flat) = columns_json(records)? else {
+        unreachable!("columns_json returns an object")
+    };
+    let width = columns.max(1);
+    Ok(Value::Object(
+        flat.into_iter()
+            .map(|(key, column)| {
+                let Value::Array(values) = column else {
+                    unreachable!("columns are arrays")
+                };
+                let rows = values
+                    .chunks(width)
+                    .map(|row| Value::Array(row.to_vec()))
+                    .collect();
+                (key, Value::Array(rows))
+            })
+            .collect(),
+    ))
+}

@@ -1,0 +1,127 @@
+//! A quantity over a two-dimensional grid of parameters, drawn as a heat map: one
+//! coloured cell per grid point on a perceptually uniform scale (viridis) with its colour
+//! bar, cells where the law does not apply left grey, cells whose motion is not
+//! period-1 marked.
+
+/// One cell of a heat map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Cell {
+    /// A value, and whether it comes from a period-1 orbit (else from an orbit of
+    /// higher period or a window of irregular motion: marked).
+    Value {
+        /// The value.
+        value: f64,
+        /// Whether the motion is period-1.
+        period_one: bool,
+    },
+    /// The law does not apply here.
+    NotApplicable,
+}
+
+/// A heat map over log-spaced axes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeatMap {
+    /// Title above the panel.
+    pub title: String,
+    /// x axis label (with units).
+    pub x_label: String,
+    /// y axis label (with units).
+    pub y_label: String,
+    /// Label of the colour bar (the quantity, with units).
+    pub value_label: String,
+    /// Grid values along x, increasing.
+    pub x: Vec<f64>,
+    /// Grid values along y, increasing.
+    pub y: Vec<f64>,
+    /// Cells, `cells[j][i]` at (x[i], y[j]).
+    pub cells: Vec<Vec<Cell>>,
+}
+
+impl HeatMap {
+    /// The range of the values (both ends equal if there is one value; `None` if none).
+    pub fn value_range(&self) -> Option<(f64, f64)> {
+        let values = self.cells.iter().flatten().filter_map(|c| match c {
+            Cell::Value { value, .. } if value.is_finite() => Some(*value),
+            _ => None,
+        });
+        values.fold(None, |r, v| match r {
+            None => Some((v, v)),
+            Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+        })
+    }
+
+    /// Cell edges along a log-spaced axis: geometric midpoints between the values, and
+    /// half a step beyond the first and the last.
+    pub fn edges(values: &[f64]) -> Vec<f64> {
+        match values {
+            [] => Vec::new(),
+            [v] => vec![v / 1.1, v * 1.1],
+            _ => {
+                let n = values.len();
+                let mut e = Vec::with_capacity(n + 1);
+                e.push(values[0] * (values[0] / values[1]).sqrt());
+                e.extend(values.windows(2).map(|w| (w[0] * w[1]).sqrt()));
+                e.push(values[n - 1] * (values[n - 1] / values[n - 2]).sqrt());
+                e
+            }
+        }
+    }
+}
+
+/// The viridis colour map (van der Walt & Smith, matplotlib) at nine stops, linearly
+/// interpolated: perceptually uniform and readable in grey scale.
+const VIRIDIS: [(u8, u8, u8); 9] = [
+    (68, 1, 84),
+    (71, 44, 122),
+    (59, 81, 139),
+    (44, 113, 142),
+    (33, 144, 141),
+    (39, 173, 129),
+    (92, 200, 99),
+    (170, 220, 50),
+    (253, 231, 37),
+];
+
+/// The colour of fraction `t` ∈ [0, 1] of the scale (clamped).
+pub fn viridis(t: f64) -> (u8, u8, u8) {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * (VIRIDIS.len() - 1) as f64;
+    let i = (x.floor() as usize).min(VIRIDIS.len() - 2);
+    let f = x - i as f64;
+    let (a, b) = (VIRIDIS[i], VIRIDIS[i + 1]);
+    let mix = |p: u8, q: u8| (p as f64 + f * (q as f64 - p as f64)).round() as u8;
+    (mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn viridis_runs_from_dark_to_light() {
+        assert_eq!(viridis(0.0), VIRIDIS[0]);
+        assert_eq!(viridis(1.0), VIRIDIS[8]);
+        let lightness = |c: (u8, u8, u8)| 0.3 * c.0 as f64 + 0.59 * c.1 as f64 + 0.11 * c.2 as f64;
+        let l: Vec<f64> = (0..=20)
+            .map(|i| lightness(viridis(i as f64 / 20.0)))
+            .collect();
+        assert!(l.windows(2).all(|w| w[1] > w[0]), "{l:?}");
+    }
+
+    #[test]
+    fn edges_enclose_each_log_spaced_value() {
+        let e = HeatMap::edges(&[1.0, 10.0, 100.0]);
+        assert_eq!(e.len(), 4);
+        let expect = [
+            10f64.powf(-0.5),
+            10f64.powf(0.5),
+            10f64.powf(1.5),
+            10f64.powf(2.5),
+        ];
+        assert!(e.iter().zip(expect).all(|(a, b)| (a - b).abs() < 1e-12 * b));
+    }
+}
