@@ -3,7 +3,7 @@
 
 use crate::contact::hybrid;
 use crate::contact::jkr;
-use crate::contact::lj::Reach;
+use crate::contact::lj::{self, Reach};
 use crate::contact::semi_rigid;
 use crate::dynamics::observables::tap;
 use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
@@ -28,9 +28,29 @@ pub fn second_material() -> Contact {
 }
 
 /// One generated file and what it shows.
-struct Entry {
-    file: String,
-    what: String,
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Entry {
+    /// File name in the output directory.
+    pub file: String,
+    /// What it shows.
+    pub what: String,
+}
+
+/// What `reproduce` wrote and the headline numbers of its README, for machines.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Manifest {
+    /// Every file written, in order (README.md last).
+    pub files: Vec<Entry>,
+    /// Ŵ_JKR, eq. (9).
+    pub w_hat_jkr: f64,
+    /// Ŵ_LJ(μ = 5) with its error estimate.
+    pub w_hat_lj_mu5: lj::Estimate,
+    /// Ŵ_hybrid(μ = 5), eq. (18).
+    pub w_hat_hybrid_mu5: f64,
+    /// The pull-off at μ = 5 over JKR's 3π/2.
+    pub pull_off_over_jkr_mu5: f64,
+    /// The default tap's observables.
+    pub default_tap: crate::dynamics::observables::TapObservables,
 }
 
 fn approach(setup: &TapSetup, law: LawKind, points: usize) -> Result<Vec<SweepPoint>> {
@@ -69,7 +89,7 @@ fn check_out_dir(out: &Path) -> Result<()> {
 
 /// Regenerate everything into `out`; `progress` is told what is being made. Returns the
 /// files written (README.md last).
-pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathBuf>> {
+pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest> {
     check_out_dir(out)?;
     output::ensure_dir(out)?;
     let mut entries: Vec<Entry> = Vec::new();
@@ -345,5 +365,17 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
     let readme = out.join("README.md");
     output::write_bytes(&readme, md.as_bytes())?;
     written.push(readme);
-    Ok(written)
+    entries.push(Entry {
+        file: "README.md".into(),
+        what: "this list and the headline numbers".into(),
+    });
+    debug_assert_eq!(written.len(), entries.len());
+    Ok(Manifest {
+        files: entries,
+        w_hat_jkr: w_jkr,
+        w_hat_lj_mu5: lj5.w_hat,
+        w_hat_hybrid_mu5: w_h5,
+        pull_off_over_jkr_mu5: lj5.pull_off_hat.value / jkr::PULL_OFF_T_HAT,
+        default_tap: run.observables.clone(),
+    })
 }

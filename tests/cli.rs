@@ -556,10 +556,17 @@ fn approach_json_is_one_object_of_equal_length_arrays() {
 #[test]
 fn reproduce_regenerates_every_file_its_readme_lists() {
     let dir = scratch("reproduce");
-    succeeds_with_cache(
-        &["reproduce", "--quiet", "--out", dir.to_str().unwrap()],
+    let out = succeeds_with_cache(
+        &[
+            "reproduce",
+            "--quiet",
+            "--json",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
         &std::env::temp_dir().join(format!("tapsim-test-cache-{}", std::process::id())),
     );
+    let manifest: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
     let listed: Vec<&str> = readme
         .lines()
@@ -590,6 +597,18 @@ fn reproduce_regenerates_every_file_its_readme_lists() {
     for needle in ["Ŵ_JKR", "Ŵ_LJ(μ = 5)", "fit (17)", "default tap"] {
         assert!(readme.contains(needle), "{needle}");
     }
+    // The manifest (--json) lists the same files, README.md last, and its numbers.
+    let files: Vec<&str> = manifest["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["file"].as_str().unwrap())
+        .collect();
+    assert_eq!(files[..files.len() - 1], listed[..]);
+    assert_eq!(files.last(), Some(&"README.md"));
+    let w = num(&manifest["w_hat_lj_mu5"], "value");
+    assert!(readme.contains(&format!("{w:.5}")), "{w}");
+    assert_eq!(manifest["default_tap"]["regime"], "period-1");
     // And it is what `results/` holds: `results/` cannot drift from the code that
     // writes it. The README exactly; every CSV cell alike, numbers to 1e-9 relative.
     let committed = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
@@ -946,6 +965,21 @@ fn map_json_is_a_grid_and_its_plot_a_heat_map() {
         "not period-1",
     ] {
         assert!(svg.contains(needle), "{needle}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn figure_json_is_a_manifest_of_the_files_written() {
+    let dir = scratch("figure-json");
+    let v = json(&["figure", "1", "--json", "--out", dir.to_str().unwrap()]);
+    let fig = &v["figures"][0];
+    assert_eq!(fig["number"], 1);
+    assert!(fig["title"].as_str().unwrap().starts_with("Fig. 1"));
+    let files = fig["files"].as_array().unwrap();
+    assert_eq!(files.len(), 3);
+    for f in files {
+        assert!(std::path::Path::new(f.as_str().unwrap()).is_file(), "{f}");
     }
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -34,6 +34,10 @@ pub struct FigureArgs {
     /// Jump-in variant for figures 4-6.
     #[arg(long, value_enum, default_value_t = JumpIn::Fit)]
     jump_in: JumpIn,
+    /// Print a manifest as JSON on stdout (per figure: number, title, files) instead of
+    /// the paths written.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Run the subcommand.
@@ -60,16 +64,33 @@ pub fn run(args: FigureArgs) -> Result<()> {
         });
     }
     output::ensure_dir(&args.out)?;
+    let mut manifest = Vec::new();
     for n in numbers {
         let chart = figures::figure(n, &opts)?;
-        for path in chart.write_all(&args.out)? {
-            outln!("{}", path.display());
-        }
+        let mut files = chart.write_all(&args.out)?;
         if n == 3 {
             let path = args.out.join("fig3_lj_vs_fit.csv");
             output::write_bytes(&path, &figures::lj_fit_table(&figures::lj_solutions()?)?)?;
-            outln!("{}", path.display());
+            files.push(path);
         }
+        if args.json {
+            manifest.push(serde_json::json!({
+                "number": n,
+                "title": chart.title,
+                "files": files,
+            }));
+        } else {
+            for path in files {
+                outln!("{}", path.display());
+            }
+        }
+    }
+    if args.json {
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({ "figures": manifest }))
+                .expect("serialises")
+        );
     }
     Ok(())
 }
