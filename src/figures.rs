@@ -76,7 +76,8 @@ fn add_jumps(
         label("A", a.0 + 0.04, a.1 - drop),
         label("B", b.0 + 0.04, b.1 + rise),
         label("C", c.0 + 0.04, c.1 + rise),
-        label("D", d.0 + 0.04, d.1 - drop),
+        // (Above D: D lies on the far approach branch, near T̂ = 0 and the axis.)
+        label("D", d.0 + 0.04, d.1 + rise),
     ]);
 }
 

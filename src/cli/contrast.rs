@@ -149,8 +149,21 @@ pub fn run(args: ContrastArgs) -> Result<()> {
                             .filter_map(|r| r.delta_phase_deg.map(|d| (r.amplitude_ratio, d)))
                             .collect();
                         let name = format!("{law}, {}", branch_name(branch));
-                        (!pts.is_empty()).then(|| Series::new(&name, pts, style, i + 1))
+                        // Markers at the setpoints, circles and squares by turns, so a
+                        // law whose Δφ coincides with another's still shows.
+                        let marks = if i % 2 == 0 {
+                            Style::Markers
+                        } else {
+                            Style::Squares
+                        };
+                        (!pts.is_empty()).then(|| {
+                            [
+                                Series::new(&name, pts.clone(), style, i + 1),
+                                Series::new("", pts, marks, i + 1),
+                            ]
+                        })
                     })
+                    .flatten()
                 })
                 .collect(),
             labels: vec![],

@@ -64,6 +64,16 @@ pub enum Style {
     Dotted,
     /// Circles at the points, no line.
     Markers,
+    /// Squares at the points, no line (a second kind of marker, to tell coinciding
+    /// sets apart).
+    Squares,
+}
+
+impl Style {
+    /// Whether points are marked rather than joined.
+    pub fn is_marker(self) -> bool {
+        matches!(self, Style::Markers | Style::Squares)
+    }
 }
 
 /// A named set of (x, y) points.

@@ -56,7 +56,8 @@ struct Drawn {
     legend_covers: usize,
 }
 
-/// Draw `charts` one above the other on `root`.
+/// Draw `charts` on `root`: one above the other up to three, else row by row in two
+/// columns ([`grid`]).
 fn draw_stack<DB: DrawingBackend>(
     charts: &[Chart],
     root: &DrawingArea<DB, Shift>,
@@ -64,16 +65,26 @@ fn draw_stack<DB: DrawingBackend>(
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     charts
         .iter()
-        .zip(root.split_evenly((charts.len().max(1), 1)))
+        .zip(root.split_evenly(grid(charts.len())))
         .map(|(chart, area)| draw(chart, &area))
         .collect()
 }
 
+/// Rows and columns of a figure of `n` charts.
+fn grid(n: usize) -> (usize, usize) {
+    if n <= 3 {
+        (n.max(1), 1)
+    } else {
+        (n.div_ceil(2), 2)
+    }
+}
+
 fn stack_size(n: usize) -> (u32, u32) {
+    let (rows, columns) = grid(n);
     if n <= 1 {
         SIZE
     } else {
-        (SIZE.0, (SIZE.1 * 2 / 3) * n as u32)
+        (SIZE.0 * columns as u32, (SIZE.1 * 2 / 3) * rows as u32)
     }
 }
 
@@ -173,7 +184,7 @@ fn draw_heatmaps<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
 ) -> std::result::Result<(), String> {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    for (map, area) in maps.iter().zip(root.split_evenly((maps.len().max(1), 1))) {
+    for (map, area) in maps.iter().zip(root.split_evenly(grid(maps.len()))) {
         draw_heatmap(map, &area)?;
     }
     Ok(())
@@ -442,6 +453,17 @@ where
                         .legend(move |(x, y)| Circle::new((x + 10, y), 5, style));
                 }
             }
+            Style::Squares => {
+                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
+                let square =
+                    move |p| EmptyElement::at(p) + Rectangle::new([(-7, -7), (7, 7)], style);
+                let anno = ctx.draw_series(inside.map(square)).map_err(|e| err(&e))?;
+                if !series.name.is_empty() {
+                    anno.label(series.name.as_str()).legend(move |(x, y)| {
+                        Rectangle::new([(x + 3, y - 7), (x + 17, y + 7)], style)
+                    });
+                }
+            }
             Style::Line | Style::Dashed | Style::Dotted => {
                 let (dash, gap) = match series.style {
                     Style::Dashed => (12, 8),
@@ -548,7 +570,7 @@ where
     let mut text = MultiLineText::<_, &str>::new((0, 0), &style);
     // Labelled as drawn: a line only if some of it is inside the box.
     for series in chart.series.iter().filter(|s| !s.name.is_empty()) {
-        if series.style == Style::Markers || !clip.runs(&series.points).is_empty() {
+        if series.style.is_marker() || !clip.runs(&series.points).is_empty() {
             text.push_line(series.name.as_str());
         }
     }
@@ -565,14 +587,14 @@ where
     let markers: Vec<(f64, f64)> = chart
         .series
         .iter()
-        .filter(|s| s.style == Style::Markers)
+        .filter(|s| s.style.is_marker())
         .flat_map(|s| s.points.iter().copied().filter(|&p| clip.contains(p)))
         .map(local)
         .collect();
     let segments: Vec<((f64, f64), (f64, f64))> = chart
         .series
         .iter()
-        .filter(|s| s.style != Style::Markers)
+        .filter(|s| !s.style.is_marker())
         .flat_map(|s| clip.runs(&s.points))
         .flat_map(|run| {
             let px: Vec<_> = run.into_iter().map(local).collect();

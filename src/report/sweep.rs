@@ -10,7 +10,8 @@ pub fn separation_axis() -> Axis {
 }
 
 /// Approach-curve charts: A/A₀, φ, E_ts, virial and peak force against z_c, and the
-/// last four against A/A₀; approach and retract as separate series.
+/// last four against A/A₀; approach and retract as separate series. The peak force
+/// is left out where it is zero at every setpoint (no repulsive contact).
 pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
     type Pick = fn(&SweepPoint) -> f64;
     let nm = |p: &SweepPoint| p.separation_m * 1e9;
@@ -108,7 +109,18 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
                 pick,
             )
         });
-    against_separation.chain(against_amplitude).collect()
+    // A quantity that is zero throughout (a peak repulsive force where the tip never
+    // presses into the sample: the attractive regime) gets no panels.
+    let flat = |column: &str| {
+        quantities
+            .iter()
+            .find(|q| q.3 == column)
+            .is_some_and(|q| points.iter().all(|p| q.4(p) == 0.0))
+    };
+    against_separation
+        .chain(against_amplitude)
+        .filter(|c| !flat(&c.y.column))
+        .collect()
 }
 
 /// φ against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999 left out), one series
@@ -134,11 +146,26 @@ pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint
                         .collect()
                 })
                 .collect();
+            // A jump between the attractive and the repulsive branch is no part of
+            // either: the line breaks where φ changes by more than JUMP_DEG between
+            // neighbouring setpoints.
             let mut series: Vec<Series> = curves
                 .iter()
                 .zip(&kept)
                 .enumerate()
-                .flat_map(|(i, ((label, _), on))| period_one_lines(on, label, Style::Line, i + 1))
+                .flat_map(|(i, ((label, _), on))| {
+                    split_at_jumps(on)
+                        .into_iter()
+                        .enumerate()
+                        .flat_map(move |(k, part)| {
+                            period_one_lines(
+                                &part,
+                                if k == 0 { label } else { "" },
+                                Style::Line,
+                                i + 1,
+                            )
+                        })
+                })
                 .collect();
             let others: Vec<Located> = kept.concat();
             series.extend(not_period_one(&others));
@@ -153,6 +180,23 @@ pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint
 
 /// A value to plot and the period of the motion behind it (`None`: irregular).
 pub type Located = (Option<usize>, (f64, f64));
+
+/// A change of φ between neighbouring setpoints (degrees) that is a jump between
+/// branches, not a slope.
+const JUMP_DEG: f64 = 20.0;
+
+/// `points` in pieces, cut between neighbours whose values differ by more than
+/// [`JUMP_DEG`].
+fn split_at_jumps(points: &[Located]) -> Vec<Vec<Located>> {
+    let mut parts: Vec<Vec<Located>> = vec![Vec::new()];
+    for (k, &p) in points.iter().enumerate() {
+        if k > 0 && (p.1.1 - points[k - 1].1.1).abs() > JUMP_DEG {
+            parts.push(Vec::new());
+        }
+        parts.last_mut().expect("a part").push(p);
+    }
+    parts
+}
 
 /// Lines through `points` (in order) that join neighbouring period-1 points only, the
 /// first named `name`: a value of motion that is not period-1 is no point of a smooth
