@@ -182,10 +182,11 @@ pub fn fig1() -> Chart {
             ),
         ],
         labels: vec![
-            label("O", 0.05, -0.25),
+            // (O and D above the T = 0 line, clear of the axis.)
+            label("O", -0.12, 0.35),
             label("B", 0.05, b.t_hat + 0.35),
             label("C", c.alpha_hat + 0.05, c.t_hat + 0.35),
-            label("D", c.alpha_hat + 0.05, -0.25),
+            label("D", c.alpha_hat + 0.05, 0.35),
         ],
         legend: Corner::UpperLeft,
     }
