@@ -10,7 +10,7 @@ fn bench(c: &mut Criterion) {
     let setup = default_setup();
     let a0 = setup.cantilever.free_amplitude_m;
     let ramp = sweep::ramp(1.2 * a0, 0.4 * a0, 100, true).expect("valid ramp");
-    let numerics = sweep::sweep_numerics(&Default::default(), Numerics::default());
+    let numerics = sweep::sweep_numerics(Numerics::default(), (false, false));
     let mut group = c.benchmark_group("approach_hybrid");
     group
         .sample_size(10)

@@ -8,7 +8,7 @@ fn main() -> tapsim::Result<()> {
     let setup = default_setup();
     let a0 = setup.cantilever.free_amplitude_m;
     let ramp = sweep::ramp(1.2 * a0, 0.4 * a0, 20, true)?;
-    let numerics = sweep::sweep_numerics(&Default::default(), Numerics::default());
+    let numerics = sweep::sweep_numerics(Numerics::default(), (false, false));
     let points = sweep::approach_curve(&setup, &numerics, &ramp, |_, _| {})?;
     println!(
         "{:>9} {:>9} {:>8} {:>9} {:>9}",

@@ -1,17 +1,19 @@
 //! Phase contrast between a soft and a stiffer polymer under the classic JKR law and the
 //! paper's hybrid law. Run with `cargo run --release --example contrast`.
 
-use tapsim::config::TapInputs;
-use tapsim::contrast::{Material, contrast};
+use tapsim::config::{MaterialSpec, TapInputs};
+use tapsim::contrast::contrast;
 use tapsim::law::LawKind;
 
 fn main() -> tapsim::Result<()> {
     let materials = [
-        Material::parse("soft:sample-modulus=0.5GPa,work-of-adhesion=0.1")?,
-        Material::parse("stiff:sample-modulus=1GPa,work-of-adhesion=0.08")?,
-    ];
+        MaterialSpec::parse("soft:sample-modulus=0.5GPa,work-of-adhesion=0.1")?,
+        MaterialSpec::parse("stiff:sample-modulus=1GPa,work-of-adhesion=0.08")?,
+    ]
+    .iter()
+    .map(|m| m.resolve(&TapInputs::default()))
+    .collect::<tapsim::Result<Vec<_>>>()?;
     let (rows, _) = contrast(
-        &TapInputs::default(),
         &materials,
         &[LawKind::Jkr, LawKind::Hybrid],
         &[0.9, 0.8, 0.7],

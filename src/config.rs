@@ -371,6 +371,15 @@ impl TapInputs {
         }
     }
 
+    /// `numerics` with the sweep defaults per setpoint ([`crate::sweep::sweep_numerics`])
+    /// for whichever of --tolerance and --max-cycles these inputs leave unset.
+    pub fn sweep_numerics(&self, numerics: Numerics) -> Numerics {
+        crate::sweep::sweep_numerics(
+            numerics,
+            (self.tolerance.is_some(), self.max_cycles.is_some()),
+        )
+    }
+
     /// Flags over the `--config` file, if one was given.
     pub fn with_config(self) -> Result<Self> {
         Ok(match self.config.clone() {
@@ -471,5 +480,55 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("hybrid"), "{e}");
+    }
+}
+
+/// A material of `tapsim contrast` as given on the command line: a name and the inputs
+/// that differ from the common setup.
+#[derive(Debug, Clone)]
+pub struct MaterialSpec {
+    /// Name used in tables and legends.
+    pub name: String,
+    /// Inputs overriding the common ones (contact keys).
+    pub inputs: TapInputs,
+}
+
+impl MaterialSpec {
+    /// Parse `name:key=value,key=value` (keys: the flags' names, values with units),
+    /// e.g. `b:sample-modulus=1GPa,work-of-adhesion=0.08`.
+    pub fn parse(text: &str) -> Result<Self> {
+        let bad = |reason: &str| Error::Parse {
+            name: "material",
+            text: text.to_string(),
+            reason: reason.into(),
+        };
+        let (name, rest) = text
+            .split_once(':')
+            .ok_or_else(|| bad("expected name:key=value,key=value"))?;
+        if name.trim().is_empty() {
+            return Err(bad("the material needs a name before ':'"));
+        }
+        let mut inputs = TapInputs::default();
+        for pair in rest.split(',').filter(|p| !p.trim().is_empty()) {
+            let (key, value) = pair
+                .split_once('=')
+                .ok_or_else(|| bad("each property is key=value"))?;
+            inputs.set(key.trim(), value.trim())?;
+        }
+        Ok(Self {
+            name: name.trim().to_string(),
+            inputs,
+        })
+    }
+
+    /// The material's setup and sweep numerics: its inputs over `base`'s.
+    pub fn resolve(&self, base: &TapInputs) -> Result<crate::contrast::Material> {
+        let inputs = self.inputs.clone().or(base.clone());
+        let (setup, numerics) = inputs.resolve()?;
+        Ok(crate::contrast::Material {
+            name: self.name.clone(),
+            setup,
+            numerics: inputs.sweep_numerics(numerics),
+        })
     }
 }

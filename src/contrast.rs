@@ -2,49 +2,22 @@
 //! or more samples, for several force laws side by side — how much contrast the classic
 //! JKR law overstates against the hybrid and the exact Lennard-Jones law.
 
-use crate::config::TapInputs;
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
 use crate::law::LawKind;
 use crate::sweep::{self, Direction, SweepPoint};
 use serde::Serialize;
 
-/// A named material: the contact inputs that differ from the base setup.
+/// A named material: the whole setup and numerics of its sweeps (the application builds
+/// them from a base and the material's own inputs).
 #[derive(Debug, Clone)]
 pub struct Material {
     /// Name used in tables and legends.
     pub name: String,
-    /// Inputs overriding the base setup (contact keys).
-    pub inputs: TapInputs,
-}
-
-impl Material {
-    /// Parse `name:key=value,key=value` (keys: the flags' names, values with units),
-    /// e.g. `b:sample-modulus=1GPa,work-of-adhesion=0.08`.
-    pub fn parse(text: &str) -> Result<Self> {
-        let bad = |reason: &str| Error::Parse {
-            name: "material",
-            text: text.to_string(),
-            reason: reason.into(),
-        };
-        let (name, rest) = text
-            .split_once(':')
-            .ok_or_else(|| bad("expected name:key=value,key=value"))?;
-        if name.trim().is_empty() {
-            return Err(bad("the material needs a name before ':'"));
-        }
-        let mut inputs = TapInputs::default();
-        for pair in rest.split(',').filter(|p| !p.trim().is_empty()) {
-            let (key, value) = pair
-                .split_once('=')
-                .ok_or_else(|| bad("each property is key=value"))?;
-            inputs.set(key.trim(), value.trim())?;
-        }
-        Ok(Self {
-            name: name.trim().to_string(),
-            inputs,
-        })
-    }
+    /// The setup (its law is replaced by each law compared).
+    pub setup: TapSetup,
+    /// Numerics of each setpoint ([`sweep::sweep_numerics`]).
+    pub numerics: Numerics,
 }
 
 /// The regime an oscillating tip is in, told by its phase: attractive where φ lies above
@@ -187,7 +160,6 @@ pub struct LawCurve {
 /// (attractive, repulsive) on which some material has a steady state, with Δφ between
 /// materials on the same branch. `progress` is told what is being computed.
 pub fn contrast(
-    base: &TapInputs,
     materials: &[Material],
     laws: &[LawKind],
     ratios: &[f64],
@@ -215,9 +187,7 @@ pub fn contrast(
     }
     let mut curves = Vec::new();
     for m in materials {
-        let inputs = m.inputs.clone().or(base.clone());
-        let (setup, numerics): (TapSetup, Numerics) = inputs.resolve()?;
-        let numerics = sweep::sweep_numerics(&inputs, numerics);
+        let (setup, numerics) = (&m.setup, &m.numerics);
         let a0 = setup.cantilever.free_amplitude_m;
         let ramp = sweep::ramp(1.2 * a0, 0.3 * a0, points, false)?;
         let (w, q) = (setup.cantilever.omega_ratio(), setup.cantilever.quality);
@@ -231,8 +201,8 @@ pub fn contrast(
             curves.push(LawCurve {
                 material: m.name.clone(),
                 law,
-                points: sweep::approach_curve(&s, &numerics, &ramp, |_, _| {})?,
-                family: sweep::orbit_branch(&s, &numerics, (1.2 * a0, 0.3 * a0), 0.01 * a0)?.points,
+                points: sweep::approach_curve(&s, numerics, &ramp, |_, _| {})?,
+                family: sweep::orbit_branch(&s, numerics, (1.2 * a0, 0.3 * a0), 0.01 * a0)?.points,
                 free_phase_deg,
             });
         }

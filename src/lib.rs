@@ -8,21 +8,31 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod cli;
-pub mod config;
+// The physics library: no file system, no environment, no command line.
 pub mod contact;
 pub mod contrast;
 pub mod dynamics;
 pub mod error;
-pub mod figures;
 pub mod law;
-pub mod lj_cache;
 pub mod numeric;
 pub mod params;
 pub mod quasistatic;
-pub mod report;
-pub mod reproduce;
 pub mod sweep;
+
+// The application on top (feature `app`, on by default).
+#[cfg(feature = "app")]
+pub mod cli;
+#[cfg(feature = "app")]
+pub mod config;
+#[cfg(feature = "app")]
+pub mod figures;
+#[cfg(feature = "app")]
+pub mod lj_cache;
+#[cfg(feature = "app")]
+pub mod report;
+#[cfg(feature = "app")]
+pub mod reproduce;
+#[cfg(feature = "app")]
 pub mod units;
 
 pub use error::{Error, Result};

@@ -60,7 +60,7 @@ fn approach(setup: &TapSetup, law: LawKind, points: usize) -> Result<Vec<SweepPo
     };
     let a0 = setup.cantilever.free_amplitude_m;
     let ramp = sweep::ramp(1.2 * a0, 0.4 * a0, points, true)?;
-    let numerics = sweep::sweep_numerics(&Default::default(), Numerics::default());
+    let numerics = sweep::sweep_numerics(Numerics::default(), (false, false));
     sweep::approach_curve(&setup, &numerics, &ramp, |_, _| {})
 }
 

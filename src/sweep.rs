@@ -16,13 +16,14 @@ pub const SETPOINT_TOLERANCE: f64 = 1e-7;
 /// thousands, and a ramp that has just left a fold may take thousands to settle.
 pub const SETPOINT_MAX_CYCLES: usize = 20_000;
 
-/// The numerics of a sweep: `numerics` with the sweep defaults for whatever `inputs` left
-/// unset (tolerance and cycle cap per setpoint).
-pub fn sweep_numerics(inputs: &crate::config::TapInputs, mut numerics: Numerics) -> Numerics {
-    if inputs.tolerance.is_none() {
+/// The numerics of a sweep: `numerics` with the sweep defaults (tolerance and cycle cap
+/// per setpoint, [`SETPOINT_TOLERANCE`], [`SETPOINT_MAX_CYCLES`]) where `keep` does not
+/// say the caller set them: `(tolerance, max_cycles)` kept as given when true.
+pub fn sweep_numerics(mut numerics: Numerics, keep: (bool, bool)) -> Numerics {
+    if !keep.0 {
         numerics.tolerance = SETPOINT_TOLERANCE;
     }
-    if inputs.max_cycles.is_none() {
+    if !keep.1 {
         numerics.max_cycles = SETPOINT_MAX_CYCLES;
     }
     numerics

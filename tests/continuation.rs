@@ -86,7 +86,7 @@ fn a_bistable_branch_has_two_folds_where_the_ramps_jump() {
     let points = ((from - (approach_fold - 0.05)) / step).ceil() as usize + 1;
     let to = from - step * (points - 1) as f64;
     let ramp = sweep::ramp(from * 1e-9, to * 1e-9, points, true).unwrap();
-    let numerics = sweep::sweep_numerics(&Default::default(), Numerics::default());
+    let numerics = sweep::sweep_numerics(Numerics::default(), (false, false));
     let curve = sweep::approach_curve(&setup, &numerics, &ramp, |_, _| {}).unwrap();
     assert!(curve.iter().all(|p| p.observables.regime == "period-1"));
     let jump = |dir: Direction| {

@@ -83,7 +83,7 @@ fn dmt_bistability_has_a_hysteresis_window_on_retract() {
     setup.hamaker_j = Some(1.5e-19);
     setup.contact.modulus_pa = tapsim::params::composite_modulus(169e9, 0.28, 2e9, 0.4).unwrap();
     let ramp = sweep::ramp(22e-9, 14e-9, 17, true).unwrap();
-    let numerics = sweep::sweep_numerics(&Default::default(), Numerics::default());
+    let numerics = sweep::sweep_numerics(Numerics::default(), (false, false));
     let points = sweep::approach_curve(&setup, &numerics, &ramp, |_, _| {}).unwrap();
     let phase = |dir: Direction| -> Vec<(f64, f64)> {
         let mut v: Vec<(f64, f64)> = points

@@ -1,7 +1,8 @@
 //! `tapsim contrast`: phase contrast between materials under several laws.
 
+use crate::config::MaterialSpec;
 use crate::config::TapInputs;
-use crate::contrast::{self, Material, PhaseBranch};
+use crate::contrast::{self, PhaseBranch};
 use crate::error::Result;
 use crate::law::LawKind;
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
@@ -38,8 +39,8 @@ pub struct ContrastArgs {
     #[command(flatten)]
     out: super::SweepOutput,
     /// A material, name:key=value,... (repeat; at least two).
-    #[arg(long = "material", value_parser = Material::parse)]
-    materials: Vec<Material>,
+    #[arg(long = "material", value_parser = MaterialSpec::parse)]
+    materials: Vec<MaterialSpec>,
     /// Laws to compare.
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = [LawKind::Jkr, LawKind::Hybrid, LawKind::Lj])]
     laws: Vec<LawKind>,
@@ -57,15 +58,18 @@ pub fn run(args: ContrastArgs) -> Result<()> {
     let base = args.inputs.with_config()?;
     let materials = if args.materials.is_empty() {
         vec![
-            Material::parse("A:sample-modulus=0.5GPa,work-of-adhesion=0.1")?,
-            Material::parse("B:sample-modulus=1GPa,work-of-adhesion=0.08")?,
+            MaterialSpec::parse("A:sample-modulus=0.5GPa,work-of-adhesion=0.1")?,
+            MaterialSpec::parse("B:sample-modulus=1GPa,work-of-adhesion=0.08")?,
         ]
     } else {
         args.materials.clone()
     };
     let quiet = args.out.quiet;
+    let materials = materials
+        .iter()
+        .map(|m| m.resolve(&base))
+        .collect::<Result<Vec<_>>>()?;
     let (rows, curves) = contrast::contrast(
-        &base,
         &materials,
         &args.laws,
         &args.setpoints,

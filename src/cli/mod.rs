@@ -103,7 +103,7 @@ impl SweepStart {
     ) -> crate::error::Result<Self> {
         let inputs = inputs.with_config()?;
         let (setup, numerics) = inputs.resolve()?;
-        let sweep_numerics = crate::sweep::sweep_numerics(&inputs, numerics);
+        let sweep_numerics = inputs.sweep_numerics(numerics);
         let range = range.resolve(setup.cantilever.free_amplitude_m);
         Ok(Self {
             setup,

@@ -9,7 +9,8 @@ use serde::Serialize;
 use std::fmt;
 
 /// How the jump-in separation α̂_A is obtained.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum JumpIn {
     /// The curve fit to the numerical solution, eq. (17) (the paper's choice).

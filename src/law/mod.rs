@@ -58,7 +58,8 @@ pub trait ForceLaw: Send + Sync {
 }
 
 /// The laws on offer.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum LawKind {
     /// The paper's hybrid law: force-free approach, jump-in at α̂_A from (17), JKR contact
@@ -211,6 +212,7 @@ mod tests {
     use super::*;
 
     #[test]
+    #[cfg(feature = "app")]
     fn every_law_is_listed_once() {
         use clap::ValueEnum;
         assert_eq!(LawKind::ALL.to_vec(), LawKind::value_variants().to_vec());

@@ -1,0 +1,73 @@
+//! The physics library stands on its own: no command line, plots or progress bars in
+//! its dependencies (checked in CI with `cargo build --lib --no-default-features` and
+//! `cargo tree`), and no file or environment access in its modules.
+
+use std::path::{Path, PathBuf};
+
+/// The library's modules (everything outside the `app` feature).
+const LIBRARY: [&str; 10] = [
+    "src/lib.rs",
+    "src/contact",
+    "src/contrast.rs",
+    "src/dynamics",
+    "src/error.rs",
+    "src/law",
+    "src/numeric.rs",
+    "src/params.rs",
+    "src/quasistatic.rs",
+    "src/sweep.rs",
+];
+
+fn sources(path: &Path, out: &mut Vec<PathBuf>) {
+    if path.is_dir() {
+        for entry in std::fs::read_dir(path).unwrap() {
+            sources(&entry.unwrap().path(), out);
+        }
+    } else if path.extension().is_some_and(|e| e == "rs") {
+        out.push(path.to_path_buf());
+    }
+}
+
+#[test]
+fn library_modules_touch_no_file_and_no_environment() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for part in LIBRARY {
+        sources(&root.join(part), &mut files);
+    }
+    assert!(files.len() > 30, "{files:?}");
+    let forbidden = [
+        "std::fs",
+        "fs::",
+        "std::env",
+        "env::var",
+        "File::",
+        "clap",
+        "plotters",
+        "indicatif",
+        "crate::config",
+        "crate::report",
+        "crate::cli",
+        "crate::figures",
+        "crate::units",
+    ];
+    for file in &files {
+        let text = std::fs::read_to_string(file).unwrap();
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            // (Test modules may use the application: they are not the library.)
+            if line.trim_start().starts_with("#[cfg(test)]") {
+                break;
+            }
+            for word in forbidden {
+                let allowed = word == "clap" && line.contains("cfg_attr(feature = \"app\"");
+                assert!(
+                    !code.contains(word) || allowed,
+                    "{}:{}: `{word}` in the library: {line}",
+                    file.display(),
+                    n + 1
+                );
+            }
+        }
+    }
+}
