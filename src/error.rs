@@ -3,8 +3,9 @@
 
 use std::path::PathBuf;
 
-/// Errors raised by tapsim.
+/// Errors raised by tapsim. New kinds may be added: match with a wildcard arm.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A parameter is outside its physical domain (NaN, negative, zero, ...).
     #[error("invalid {name} = {value}: {reason}")]

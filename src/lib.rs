@@ -35,7 +35,12 @@ pub mod reproduce;
 #[cfg(feature = "app")]
 pub mod units;
 
+pub use contact::lj::{LjSolution, Reach};
+pub use dynamics::observables::{TapObservables, tap};
+pub use dynamics::setup::{Cantilever, Numerics, TapSetup, default_setup};
 pub use error::{Error, Result};
+pub use law::LawKind;
+pub use params::Contact;
 
 /// The README's Rust blocks, compiled and run as doctests so its numbers stay true.
 #[cfg(doctest)]

@@ -175,7 +175,7 @@ impl SweepOutput {
     }
 }
 
-/// Write to standard output (see [`outln!`]).
+/// Write to standard output (what the `outln!` macro calls).
 pub fn emit(text: std::fmt::Arguments) -> crate::Result<()> {
     use std::io::Write;
     let mut stdout = std::io::stdout().lock();

@@ -77,6 +77,15 @@ pub struct HybridHysteresis {
 
 /// Hybrid loss Ŵ(μ): eq. (9) with its lower limit â_B replaced by â_A, the root of
 /// α̂_A = √(2πâ_A) − â_A² (18) on the stable contact branch, α̂_A from `jump_in`.
+///
+/// ```
+/// use tapsim::contact::hybrid::{JumpIn, hysteresis};
+///
+/// // The paper's case μ = 5: 3.206, against JKR's 7.092 (eq. 9).
+/// let h = hysteresis(5.0, JumpIn::Fit)?;
+/// assert!((h.w_hat - 3.2062).abs() < 1e-4);
+/// # Ok::<(), tapsim::Error>(())
+/// ```
 pub fn hysteresis(tabor_mu: f64, jump_in: JumpIn) -> Result<HybridHysteresis> {
     let alpha_hat_a = jump_in.alpha_hat_a(tabor_mu)?;
     let c = jkr::point_c();

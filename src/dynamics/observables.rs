@@ -345,6 +345,19 @@ pub struct TapRun {
 /// from the sample, when the rest separation is set) to the steady state it settles on,
 /// then integrate `record_cycles` more cycles recording the trajectory (not counted in
 /// the observables, which are the steady state's).
+///
+/// ```
+/// use tapsim::{LawKind, Numerics, TapSetup, default_setup, tap};
+///
+/// // The built-in silicon cantilever on a polymer, with the paper's hybrid law.
+/// let setup = TapSetup { law: LawKind::Hybrid, ..default_setup() };
+/// let o = tap(&setup, &Numerics::default(), 0)?.observables;
+/// assert_eq!(o.regime, "period-1");
+/// assert!(o.energy_balance_rel < 1e-6);
+/// // Each period dissipates the hybrid loop: Ŵ_hybrid(μ)·μεRΔγ.
+/// assert!((o.e_ts_j / o.loop_area_j - 1.0).abs() < 1e-6);
+/// # Ok::<(), tapsim::Error>(())
+/// ```
 pub fn tap(setup: &TapSetup, numerics: &Numerics, record_cycles: usize) -> Result<TapRun> {
     if record_cycles > MAX_RECORD_CYCLES {
         return Err(Error::InvalidParameter {

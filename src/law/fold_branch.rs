@@ -139,7 +139,7 @@ impl FoldBranch {
     }
 
     /// Slope dT̂/dα̂ at α̂: (dT̂/du)·σ/(2u). It grows as 1/√(distance) towards the fold,
-    /// where it is capped at the value a distance [`FOLD_SLOPE_FLOOR_U`]² away (an
+    /// where it is capped at the value a distance `FOLD_SLOPE_FLOOR_U`² away (an
     /// integrable singularity: the cap changes ∫ (dT̂/dα̂) dτ by O(that distance)).
     #[inline]
     pub fn slope_hat(&self, alpha_hat: f64) -> f64 {

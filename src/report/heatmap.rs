@@ -33,7 +33,7 @@ pub struct HeatMap {
     pub x: Vec<f64>,
     /// Grid values along y, increasing.
     pub y: Vec<f64>,
-    /// Cells, `cells[j][i]` at (x[i], y[j]).
+    /// Cells, `cells[j][i]` at `(x[i], y[j])`.
     pub cells: Vec<Vec<Cell>>,
 }
 
