@@ -211,67 +211,66 @@ pub struct TapInputs {
 /// The largest parameter file read, in bytes.
 pub const MAX_CONFIG_BYTES: u64 = 64 * 1024;
 
-/// The TOML keys and the quantity each holds.
-const KEYS: &[(&str, Dimension)] = &[
-    ("radius", Dimension::Length),
-    ("modulus", Dimension::Pressure),
-    ("tip-modulus", Dimension::Pressure),
-    ("tip-poisson", Dimension::Dimensionless),
-    ("sample-modulus", Dimension::Pressure),
-    ("sample-poisson", Dimension::Dimensionless),
-    ("work-of-adhesion", Dimension::SurfaceEnergy),
-    ("range", Dimension::Length),
-    ("hamaker", Dimension::Energy),
-    ("stiffness", Dimension::Stiffness),
-    ("resonance", Dimension::Frequency),
-    ("quality", Dimension::Dimensionless),
-    ("free-amplitude", Dimension::Length),
-    ("drive-frequency", Dimension::Frequency),
-    ("separation", Dimension::Length),
-    ("rtol", Dimension::Dimensionless),
-    ("max-cycles", Dimension::Dimensionless),
-    ("tolerance", Dimension::Dimensionless),
-    ("average-tolerance", Dimension::Dimensionless),
+/// A settable quantity: its key (a flag's name, also the TOML key), its dimension, and
+/// where it lives in [`TapInputs`].
+type Field = (
+    &'static str,
+    Dimension,
+    fn(&mut TapInputs) -> &mut Option<f64>,
+);
+
+/// One list of every numeric key: `key => Dimension => |inputs| place`.
+macro_rules! fields {
+    ($($key:literal => $dim:ident => |$i:ident| $place:expr),* $(,)?) => {
+        &[$((
+            $key,
+            Dimension::$dim,
+            {
+                fn slot($i: &mut TapInputs) -> &mut Option<f64> {
+                    &mut $place
+                }
+                slot
+            },
+        )),*]
+    };
+}
+
+/// The numeric keys of the command line and of parameter files.
+const FIELDS: &[Field] = fields![
+    "radius" => Length => |i| i.contact.radius,
+    "modulus" => Pressure => |i| i.contact.modulus,
+    "tip-modulus" => Pressure => |i| i.contact.tip_modulus,
+    "tip-poisson" => Dimensionless => |i| i.contact.tip_poisson,
+    "sample-modulus" => Pressure => |i| i.contact.sample_modulus,
+    "sample-poisson" => Dimensionless => |i| i.contact.sample_poisson,
+    "work-of-adhesion" => SurfaceEnergy => |i| i.contact.work_of_adhesion,
+    "range" => Length => |i| i.contact.range,
+    "hamaker" => Energy => |i| i.hamaker,
+    "stiffness" => Stiffness => |i| i.stiffness,
+    "resonance" => Frequency => |i| i.resonance,
+    "quality" => Dimensionless => |i| i.quality,
+    "free-amplitude" => Length => |i| i.free_amplitude,
+    "drive-frequency" => Frequency => |i| i.drive_frequency,
+    "separation" => Length => |i| i.separation,
+    "rtol" => Dimensionless => |i| i.rtol,
+    "max-cycles" => Dimensionless => |i| i.max_cycles,
+    "tolerance" => Dimensionless => |i| i.tolerance,
+    "average-tolerance" => Dimensionless => |i| i.average_tolerance,
 ];
 
 impl TapInputs {
-    fn slot(&mut self, key: &str) -> &mut Option<f64> {
-        let c = &mut self.contact;
-        match key {
-            "radius" => &mut c.radius,
-            "modulus" => &mut c.modulus,
-            "tip-modulus" => &mut c.tip_modulus,
-            "tip-poisson" => &mut c.tip_poisson,
-            "sample-modulus" => &mut c.sample_modulus,
-            "sample-poisson" => &mut c.sample_poisson,
-            "work-of-adhesion" => &mut c.work_of_adhesion,
-            "range" => &mut c.range,
-            "hamaker" => &mut self.hamaker,
-            "stiffness" => &mut self.stiffness,
-            "resonance" => &mut self.resonance,
-            "quality" => &mut self.quality,
-            "free-amplitude" => &mut self.free_amplitude,
-            "drive-frequency" => &mut self.drive_frequency,
-            "separation" => &mut self.separation,
-            "rtol" => &mut self.rtol,
-            "tolerance" => &mut self.tolerance,
-            "average-tolerance" => &mut self.average_tolerance,
-            _ => &mut self.max_cycles,
-        }
-    }
-
     /// Set the quantity named `key` (a flag's name) from `text` (a number with an
     /// optional unit).
     pub fn set(&mut self, key: &str, text: &str) -> Result<()> {
-        let Some(&(name, dim)) = KEYS.iter().find(|(k, _)| *k == key) else {
-            let known: Vec<&str> = KEYS.iter().map(|(k, _)| *k).collect();
+        let Some(&(name, dim, slot)) = FIELDS.iter().find(|(k, _, _)| *k == key) else {
+            let known: Vec<&str> = FIELDS.iter().map(|(k, _, _)| *k).collect();
             return Err(Error::Parse {
                 name: "key",
                 text: key.to_string(),
                 reason: format!("unknown key; known keys: law, {}", known.join(", ")),
             });
         };
-        *self.slot(name) = Some(units::parse(name, text, dim)?);
+        *slot(self) = Some(units::parse(name, text, dim)?);
         Ok(())
     }
 
@@ -444,6 +443,32 @@ impl TapInputs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_numeric_flag_is_a_key_and_every_key_a_flag() {
+        use clap::{Args, Command};
+        let command = TapInputs::augment_args(Command::new("tap"));
+        let mut flags: Vec<String> = command
+            .get_arguments()
+            .filter_map(|a| a.get_long().map(str::to_string))
+            .filter(|long| !["config", "law"].contains(&long.as_str()))
+            .collect();
+        let mut keys: Vec<String> = FIELDS.iter().map(|f| f.0.to_string()).collect();
+        flags.sort();
+        keys.sort();
+        assert_eq!(flags, keys);
+        // And each key reaches its own field.
+        for (key, _, slot) in FIELDS {
+            let mut inputs = TapInputs::default();
+            *slot(&mut inputs) = Some(1.0);
+            let set: Vec<&str> = FIELDS
+                .iter()
+                .filter(|(_, _, other)| other(&mut inputs).is_some())
+                .map(|f| f.0)
+                .collect();
+            assert_eq!(set, [*key]);
+        }
+    }
 
     #[test]
     fn toml_with_units_and_flags_over_it() {
