@@ -66,8 +66,8 @@ pub const MAX_THREADS: usize = 256;
 /// Rest separations of an approach from `from_m` down to `to_m` in `points` steps, and
 /// back up unless `retract` is false.
 pub fn ramp(from_m: f64, to_m: f64, points: usize, retract: bool) -> Result<Vec<(f64, Direction)>> {
-    finite("--from", from_m)?;
-    finite("--to", to_m)?;
+    finite("start separation (from)", from_m)?;
+    finite("end separation (to)", to_m)?;
     if !(2..=MAX_SWEEP_POINTS).contains(&points) {
         return Err(Error::InvalidParameter {
             name: "points",
@@ -77,7 +77,8 @@ pub fn ramp(from_m: f64, to_m: f64, points: usize, retract: bool) -> Result<Vec<
     }
     if to_m >= from_m {
         return Err(Error::NotApplicable(format!(
-            "an approach runs from far to near: --from ({from_m:e} m) must exceed --to ({to_m:e} m)"
+            "an approach runs from far to near: the start separation ({from_m:e} m) must exceed \
+             the end separation ({to_m:e} m)"
         )));
     }
     let at = |i: usize| from_m + (to_m - from_m) * i as f64 / (points - 1) as f64;
@@ -261,18 +262,19 @@ pub fn orbit_branch(
 ) -> Result<OrbitBranch> {
     use crate::dynamics::continuation::{ContinuationOptions, PointKind, Stop, follow_period_one};
     use crate::dynamics::steady::{Motion, StdErr, SteadyState};
-    finite("--from", from_m)?;
-    finite("--to", to_m)?;
-    crate::error::positive("--max-step", max_step_m)?;
+    finite("start separation (from)", from_m)?;
+    finite("end separation (to)", to_m)?;
+    crate::error::positive("largest step (max step)", max_step_m)?;
     let range = (from_m - to_m).abs();
     if range == 0.0 {
         return Err(Error::NotApplicable(
-            "--from and --to must differ: the branch is followed between them".into(),
+            "the start and end separations must differ: the branch is followed between them".into(),
         ));
     }
     if !(max_step_m <= range && max_step_m >= 1e-4 * range) {
         return Err(Error::NotApplicable(format!(
-            "--max-step ({:e} m) must lie between 1e-4 of the range from --from to --to \
+            "the largest step (max step, {:e} m) must lie between 1e-4 of the range from the \
+             start to the end separation \
              and the whole of it ({:e} m)",
             max_step_m, range
         )));
@@ -293,7 +295,7 @@ pub fn orbit_branch(
         if settled.motion.period() != Some(1) || !settled.converged {
             if segment == 0 && points.is_empty() && at == from_m {
                 notes.push(format!(
-                    "at --from ({:.4} nm) the motion settles as {}, not on a period-1 orbit",
+                    "at the start separation ({:.4} nm) the motion settles as {}, not on a period-1 orbit",
                     nm(at),
                     settled.motion.regime()
                 ));
@@ -301,7 +303,7 @@ pub fn orbit_branch(
             at += toward * max_step_m;
             if (at - to_m) * toward > 0.0 {
                 notes.push(format!(
-                    "no stable period-1 orbit from there to --to ({:.4} nm)",
+                    "no stable period-1 orbit from there to the end separation ({:.4} nm)",
                     nm(to_m)
                 ));
                 break;
@@ -346,15 +348,15 @@ pub fn orbit_branch(
         }
         match branch.stop {
             Stop::Reached => {
-                notes.push(format!("reached --to ({:.4} nm)", nm(to_m)));
+                notes.push(format!("reached the end separation ({:.4} nm)", nm(to_m)));
                 break;
             }
             Stop::TurnedBack => {
-                notes.push("turned back past --from".into());
+                notes.push("turned back past the start separation".into());
                 break;
             }
             Stop::PointCap => {
-                notes.push("stopped at the point cap (raise --max-step)".into());
+                notes.push("stopped at the point cap (raise the largest step)".into());
                 break;
             }
             Stop::NotSmooth(q) => {

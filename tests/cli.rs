@@ -504,7 +504,7 @@ fn tap_bad_input_is_a_clear_error() {
         (&["tap", "--plot", "/tmp/x.gif"], ".png or .svg"),
         (
             &["tap", "--work-of-adhesion", "0.01", "--modulus", "3GPa"],
-            "use --law dmt",
+            "use the DMT law",
         ),
     ];
     for (args, needle) in cases {
@@ -782,7 +782,7 @@ fn branches_lists_the_folds_of_a_bistable_case_and_writes_every_output() {
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(text.matches("fold").count(), 2, "{text}");
-    assert!(text.contains("reached --to"), "{text}");
+    assert!(text.contains("reached the end separation"), "{text}");
     assert!(std::fs::read_to_string(&csv).unwrap().lines().count() > 20);
     assert!(std::fs::metadata(&png).unwrap().len() > 1000);
     let mut args = vec!["branches", "--json"];
@@ -859,7 +859,7 @@ fn branches_refuses_steps_that_would_not_finish() {
         assert_eq!(out.status.code(), Some(1), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(
-            err.contains("--max-step") || err.contains("must differ"),
+            err.contains("max step") || err.contains("must differ"),
             "{err}"
         );
     }

@@ -274,7 +274,7 @@ fn laws_refuse_where_they_do_not_apply() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("does not apply") && err.contains("dmt"),
+        err.contains("does not apply") && err.contains("DMT"),
         "{err}"
     );
     setup.law = LawKind::Dmt;

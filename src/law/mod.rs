@@ -141,7 +141,7 @@ impl AnyLaw {
         let refuse = |why: String| {
             Error::NotApplicable(format!(
                 "the {kind} law does not apply at Tabor parameter mu = {mu:.4}: {why}; \
-                 use --law dmt (small mu) or --law jkr"
+                 use the DMT law (small mu) or JKR"
             ))
         };
         Ok(match kind {
