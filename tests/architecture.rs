@@ -1,6 +1,7 @@
 //! The physics library stands on its own: no command line, plots or progress bars in
 //! its dependencies (checked in CI with `cargo build --lib --no-default-features` and
-//! `cargo tree`), and no file or environment access in its modules.
+//! `cargo tree`), no file or environment access in its modules, and no command-line
+//! flag in its messages.
 
 use std::path::{Path, PathBuf};
 
@@ -29,7 +30,7 @@ fn sources(path: &Path, out: &mut Vec<PathBuf>) {
 }
 
 #[test]
-fn library_modules_touch_no_file_and_no_environment() {
+fn library_modules_touch_no_file_no_environment_and_name_no_flag() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
     for part in LIBRARY {
@@ -59,6 +60,16 @@ fn library_modules_touch_no_file_and_no_environment() {
             if line.trim_start().starts_with("#[cfg(test)]") {
                 break;
             }
+            // Library errors name parameters, not the command line's flags.
+            let flag = code
+                .match_indices("--")
+                .any(|(at, _)| code[at + 2..].starts_with(|c: char| c.is_ascii_lowercase()));
+            assert!(
+                !flag,
+                "{}:{}: a command-line flag in the library: {line}",
+                file.display(),
+                n + 1
+            );
             for word in forbidden {
                 let allowed = word == "clap" && line.contains("cfg_attr(feature = \"app\"");
                 assert!(

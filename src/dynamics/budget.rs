@@ -63,7 +63,7 @@ pub(crate) fn exhausted() -> Error {
     Error::Numerical(format!(
         "gave up after {} integration steps (the work budget of one steady state): \
          the motion is too costly to resolve with these parameters. Usual causes: a \
-         cantilever far softer than the contact (raise --stiffness), a drive far from \
+         cantilever far softer than the contact (raise its stiffness), a drive far from \
          resonance, a Q far outside 1 to 10⁶, or a relative tolerance (rtol) near round-off",
         TOTAL.get()
     ))

@@ -220,7 +220,7 @@ pub fn solve(tabor_mu: f64, reach: Reach) -> Result<LjSolution> {
     if tabor_mu > MAX_TABOR_MU {
         return Err(Error::NotApplicable(format!(
             "the Lennard-Jones solver covers {MIN_TABOR_MU} <= mu <= {MAX_TABOR_MU} \
-             (mu = {tabor_mu}); from mu = 10 on the hybrid law (--law hybrid) is within \
+             (mu = {tabor_mu}); from mu = 10 on the hybrid law is within \
              0.2 % of the numerical loss, and closer as mu grows"
         )));
     }
