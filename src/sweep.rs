@@ -150,7 +150,8 @@ pub fn log_grid(name: &'static str, lo: f64, hi: f64, n: usize) -> Result<Vec<f6
 /// E_ts and φ over a grid of (Δγ, E*) at the setup's setpoint, one independent steady
 /// state per cell (each from the free steady state), computed in parallel on `threads`
 /// threads (0: all cores). Cells are independent, so the result does not depend on the
-/// thread count. `progress` is called (from any thread) after each cell.
+/// thread count. `progress` is called (from any thread) after each cell. The cells come
+/// row by row: for each modulus in turn, every work of adhesion.
 pub fn adhesion_modulus_map(
     setup: &TapSetup,
     numerics: &Numerics,

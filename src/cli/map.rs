@@ -18,9 +18,9 @@ use clap::Args;
 /// per cell (empty where the law does not apply, with a note). JSON (--json): law, the
 /// two axes work_of_adhesion_j_m2 and modulus_pa, and grid: per column of the CSV an
 /// array of rows, one per modulus, each with one value per work of adhesion (null
-/// where the law does not apply); --plot draws heat maps of E_ts, φ and A/A₀ over the grid (log axes, a
-/// viridis colour bar each; grey where the law does not apply, cells that are not
-/// period-1 marked with a circle).
+/// where the law does not apply); --plot draws heat maps of E_ts, φ and A/A₀ over the
+/// grid (log axes, a viridis colour bar each; grey where the law does not apply, cells
+/// that are not period-1 marked with a circle).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct MapArgs {
@@ -76,16 +76,14 @@ pub fn run(args: MapArgs) -> Result<()> {
             value_label: value_label.into(),
             x: works.clone(),
             y: moduli.iter().map(|e| e * 1e-9).collect(),
-            cells: moduli
-                .iter()
-                .map(|&e| {
-                    works
-                        .iter()
-                        .map(|&w| {
-                            cells
-                                .iter()
-                                .find(|c| c.modulus_pa == e && c.work_of_adhesion_j_m2 == w)
-                                .and_then(|c| c.observables.as_ref())
+            // The cells come row by row, one row per modulus (as --json lays them out).
+            cells: cells
+                .chunks(works.len())
+                .map(|row| {
+                    row.iter()
+                        .map(|c| {
+                            c.observables
+                                .as_ref()
                                 .map_or(Cell::NotApplicable, |o| Cell::Value {
                                     value: value(o),
                                     period_one: o.period == Some(1),
