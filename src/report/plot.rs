@@ -48,7 +48,7 @@ pub fn render_svg(chart: &Chart, path: &Path) -> Result<()> {
     render_stack_svg(std::slice::from_ref(chart), path)
 }
 
-/// Where a chart was drawn: its plotting area (backend pixels, x and y ranges) and how
+/// Where a panel was drawn: its plotting area (backend pixels, x and y ranges) and how
 /// much of its data its legend covers (0: none).
 #[derive(Debug, Clone, PartialEq)]
 struct Drawn {
@@ -56,17 +56,44 @@ struct Drawn {
     legend_covers: usize,
 }
 
-/// Draw `charts` on `root`: one above the other up to three, else row by row in two
+/// One panel of a figure: a chart or a heat map.
+trait Panel {
+    /// Draw into `area`; where the plotting area went.
+    fn draw_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<Drawn, String>;
+}
+
+impl Panel for Chart {
+    fn draw_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<Drawn, String> {
+        draw(self, area)
+    }
+}
+
+impl Panel for HeatMap {
+    fn draw_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<Drawn, String> {
+        draw_heatmap(self, area)
+    }
+}
+
+/// Draw `panels` on `root`: one above the other up to three, else row by row in two
 /// columns ([`grid`]).
-fn draw_stack<DB: DrawingBackend>(
-    charts: &[Chart],
+fn draw_stack<DB: DrawingBackend, P: Panel>(
+    panels: &[P],
     root: &DrawingArea<DB, Shift>,
 ) -> std::result::Result<Vec<Drawn>, String> {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    charts
+    panels
         .iter()
-        .zip(root.split_evenly(grid(charts.len())))
-        .map(|(chart, area)| draw(chart, &area))
+        .zip(root.split_evenly(grid(panels.len())))
+        .map(|(panel, area)| panel.draw_panel(&area))
         .collect()
 }
 
@@ -90,9 +117,9 @@ fn stack_size(n: usize) -> (u32, u32) {
 
 /// Drawn into memory and encoded there, then written like any other output: file
 /// errors are told as such, and a PNG can go to a device or a FIFO like a CSV.
-fn render_stack_png(charts: &[Chart], path: &Path) -> Result<()> {
+fn render_stack_png<P: Panel>(panels: &[P], path: &Path) -> Result<()> {
     use image::ImageEncoder;
-    let (pixels, (width, height), _) = rasterize(charts).map_err(|reason| fail(path, reason))?;
+    let (pixels, (width, height), _) = rasterize(panels).map_err(|reason| fail(path, reason))?;
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(&pixels, width, height, image::ColorType::Rgb8)
@@ -100,29 +127,29 @@ fn render_stack_png(charts: &[Chart], path: &Path) -> Result<()> {
     output::write_bytes(path, &bytes)
 }
 
-/// RGB pixels, their width and height, and where each chart went.
+/// RGB pixels, their width and height, and where each panel went.
 type Raster = (Vec<u8>, (u32, u32), Vec<Drawn>);
 
-/// `charts` drawn one above the other into RGB pixels.
-fn rasterize(charts: &[Chart]) -> std::result::Result<Raster, String> {
+/// `panels` drawn into RGB pixels ([`draw_stack`]).
+fn rasterize<P: Panel>(panels: &[P]) -> std::result::Result<Raster, String> {
     register_font();
-    let (width, height) = stack_size(charts.len());
+    let (width, height) = stack_size(panels.len());
     let mut pixels = vec![0u8; 3 * width as usize * height as usize];
     let drawn = {
         let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
-        let drawn = draw_stack(charts, &root)?;
+        let drawn = draw_stack(panels, &root)?;
         root.present().map_err(|e| e.to_string())?;
         drawn
     };
     Ok((pixels, (width, height), drawn))
 }
 
-fn render_stack_svg(charts: &[Chart], path: &Path) -> Result<()> {
+fn render_stack_svg<P: Panel>(panels: &[P], path: &Path) -> Result<()> {
     register_font();
     let mut text = String::new();
     {
-        let root = SVGBackend::with_string(&mut text, stack_size(charts.len())).into_drawing_area();
-        draw_stack(charts, &root).map_err(|reason| fail(path, reason))?;
+        let root = SVGBackend::with_string(&mut text, stack_size(panels.len())).into_drawing_area();
+        draw_stack(panels, &root).map_err(|reason| fail(path, reason))?;
         root.present().map_err(|e| fail(path, e.to_string()))?;
     }
     output::write_bytes(path, text.as_bytes())
@@ -130,64 +157,26 @@ fn render_stack_svg(charts: &[Chart], path: &Path) -> Result<()> {
 
 /// Render `charts` one above the other into `path`, PNG or SVG by its extension.
 pub fn render_stack(charts: &[Chart], path: &Path) -> Result<()> {
-    match path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("png") => render_stack_png(charts, path),
-        Some("svg") => render_stack_svg(charts, path),
-        _ => Err(fail(path, "the plot file must end in .png or .svg".into())),
-    }
+    render(charts, path)
 }
 
 /// Render heat maps one above the other into `path`, PNG or SVG by its extension.
 pub fn render_heatmaps(maps: &[HeatMap], path: &Path) -> Result<()> {
-    register_font();
-    let size = stack_size(maps.len());
+    render(maps, path)
+}
+
+/// `panels` into `path`, PNG or SVG by its extension.
+fn render<P: Panel>(panels: &[P], path: &Path) -> Result<()> {
     match path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .as_deref()
     {
-        Some("png") => {
-            use image::ImageEncoder;
-            let mut pixels = vec![0u8; 3 * size.0 as usize * size.1 as usize];
-            {
-                let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
-                draw_heatmaps(maps, &root).map_err(|reason| fail(path, reason))?;
-                root.present().map_err(|e| fail(path, e.to_string()))?;
-            }
-            let mut bytes = Vec::new();
-            image::codecs::png::PngEncoder::new(&mut bytes)
-                .write_image(&pixels, size.0, size.1, image::ColorType::Rgb8)
-                .map_err(|e| fail(path, format!("PNG encoding failed: {e}")))?;
-            output::write_bytes(path, &bytes)
-        }
-        Some("svg") => {
-            let mut text = String::new();
-            {
-                let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
-                draw_heatmaps(maps, &root).map_err(|reason| fail(path, reason))?;
-                root.present().map_err(|e| fail(path, e.to_string()))?;
-            }
-            output::write_bytes(path, text.as_bytes())
-        }
+        Some("png") => render_stack_png(panels, path),
+        Some("svg") => render_stack_svg(panels, path),
         _ => Err(fail(path, "the plot file must end in .png or .svg".into())),
     }
-}
-
-fn draw_heatmaps<DB: DrawingBackend>(
-    maps: &[HeatMap],
-    root: &DrawingArea<DB, Shift>,
-) -> std::result::Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    for (map, area) in maps.iter().zip(root.split_evenly(grid(maps.len()))) {
-        draw_heatmap(map, &area)?;
-    }
-    Ok(())
 }
 
 /// Ticks of a log axis over [lo, hi]: 1, 2 and 5 times each power of ten inside, or
@@ -225,7 +214,7 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
 fn draw_heatmap<DB: DrawingBackend>(
     map: &HeatMap,
     area: &DrawingArea<DB, Shift>,
-) -> std::result::Result<(), String> {
+) -> std::result::Result<Drawn, String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let (width, _) = area.dim_in_pixel();
     let (main, side) = area.split_horizontally(width as i32 * 4 / 5);
@@ -334,7 +323,10 @@ fn draw_heatmap<DB: DrawingBackend>(
     .map_err(|e| err(&e))?;
     side.draw(&Text::new("law n/a", (at(24).0 + 18, at(24).1), key))
         .map_err(|e| err(&e))?;
-    Ok(())
+    Ok(Drawn {
+        area: ctx.plotting_area().get_pixel_range(),
+        legend_covers: 0,
+    })
 }
 
 fn fail(path: &Path, reason: String) -> Error {
@@ -915,14 +907,7 @@ mod tests {
                 ],
             ],
         };
-        let size = SIZE;
-        let mut pixels = vec![0u8; 3 * size.0 as usize * size.1 as usize];
-        {
-            register_font();
-            let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
-            draw_heatmaps(std::slice::from_ref(&map), &root).unwrap();
-            root.present().unwrap();
-        }
+        let (pixels, _, _) = rasterize(&[map]).unwrap();
         let count = |c: (u8, u8, u8)| pixels.chunks(3).filter(|p| (p[0], p[1], p[2]) == c).count();
         // A quarter of a ~600 x 500 plot each, and the ends of the colour bar.
         assert!(count(viridis(0.0)) > 20_000, "{}", count(viridis(0.0)));
