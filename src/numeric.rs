@@ -25,6 +25,19 @@ pub const GAUSS_LEGENDRE_8: [(f64, f64); 8] = [
     (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
 ];
 
+/// The polynomial through `points` (distinct abscissae) at `x`, in Lagrange form.
+pub fn lagrange(points: &[(f64, f64)], x: f64) -> f64 {
+    (0..points.len())
+        .map(|i| {
+            let weight: f64 = (0..points.len())
+                .filter(|&j| j != i)
+                .map(|j| (x - points[j].0) / (points[i].0 - points[j].0))
+                .product();
+            weight * points[i].1
+        })
+        .sum()
+}
+
 /// Distance from `x` to the interval [lo, hi] (0 inside it).
 #[inline]
 pub fn distance_to_interval(x: f64, lo: f64, hi: f64) -> f64 {

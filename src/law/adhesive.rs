@@ -11,7 +11,7 @@ use crate::contact::lj::LjSolution;
 use crate::contact::lj::curve::CurvePoint;
 use crate::contact::semi_rigid::{self, EighthPower};
 use crate::error::{Error, Result, positive};
-use crate::numeric::bracketed_root;
+use crate::numeric::{bracketed_root, lagrange};
 use std::sync::OnceLock;
 
 /// Nodes of the contact-branch tables (uniform in √(α̂_C − α̂)).
@@ -207,16 +207,7 @@ impl AdhesiveLaw {
 fn local_cubic(points: &[(f64, f64)], u: f64) -> f64 {
     let k = points.partition_point(|p| p.0 < u);
     let start = k.saturating_sub(2).min(points.len() - 4);
-    let p = &points[start..start + 4];
-    (0..4)
-        .map(|i| {
-            let li: f64 = (0..4)
-                .filter(|&j| j != i)
-                .map(|j| (u - p[j].0) / (p[i].0 - p[j].0))
-                .product();
-            li * p[i].1
-        })
-        .sum()
+    lagrange(&points[start..start + 4], u)
 }
 
 impl ForceLaw for AdhesiveLaw {

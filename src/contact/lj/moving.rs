@@ -20,6 +20,7 @@ use super::solver::{Problem, Solution};
 use crate::contact::hybrid::JumpIn;
 use crate::contact::jkr;
 use crate::error::{Error, Result};
+use crate::numeric::lagrange;
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -393,7 +394,7 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
                     let at_p = |quantity: &dyn Fn(f64, &Solution) -> f64| {
                         let q =
                             [0, 1, 2].map(|i| (around[i].0, quantity(around[i].0, &around[i].1)));
-                        quadratic_at(&q, p)
+                        lagrange(&q, p)
                     };
                     let force = |q: f64, s: &Solution| {
                         let a = if phase == Phase::Radius { q } else { a0 };
@@ -592,19 +593,6 @@ fn refine_extremum(
     }
     let p = vertex(&stencil).unwrap_or(centre);
     Some((p, stencil.into_iter().map(|(p, s, _)| (p, s)).collect()))
-}
-
-/// The quadratic through (pᵢ, yᵢ), i < 3, at p.
-fn quadratic_at(points: &[(f64, f64); 3], p: f64) -> f64 {
-    (0..3)
-        .map(|i| {
-            let weight: f64 = (0..3)
-                .filter(|&j| j != i)
-                .map(|j| (p - points[j].0) / (points[i].0 - points[j].0))
-                .product();
-            weight * points[i].1
-        })
-        .sum()
 }
 
 /// Largest relative gap error of the predictor accepted before the step shrinks.
