@@ -86,41 +86,39 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             |p| p.observables.peak_force_n * 1e9,
         ),
     ];
-    let against_separation = quantities.iter().map(|&(name, what, label, column, pick)| {
-        chart(
-            name,
-            what,
-            separation_axis(),
-            &nm,
-            Axis::linear(label, column),
-            pick,
-        )
-    });
-    let against_amplitude = quantities
-        .iter()
-        .skip(1)
-        .map(|&(name, what, label, column, pick)| {
-            chart(
-                &format!("{name}_vs_amplitude"),
-                &format!("{what} vs amplitude"),
-                Axis::linear("A/A₀", "amplitude_ratio"),
-                &ratio,
-                Axis::linear(label, column),
-                pick,
-            )
-        });
     // A quantity that is zero throughout (a peak repulsive force where the tip never
     // presses into the sample: the attractive regime) gets no panels.
-    let flat = |column: &str| {
+    let shown = |q: &&(&str, &str, &str, &str, Pick)| !points.iter().all(|p| q.4(p) == 0.0);
+    let against_separation =
         quantities
             .iter()
-            .find(|q| q.3 == column)
-            .is_some_and(|q| points.iter().all(|p| q.4(p) == 0.0))
-    };
-    against_separation
-        .chain(against_amplitude)
-        .filter(|c| !flat(&c.y.column))
-        .collect()
+            .filter(shown)
+            .map(|&(name, what, label, column, pick)| {
+                chart(
+                    name,
+                    what,
+                    separation_axis(),
+                    &nm,
+                    Axis::linear(label, column),
+                    pick,
+                )
+            });
+    let against_amplitude =
+        quantities
+            .iter()
+            .skip(1)
+            .filter(shown)
+            .map(|&(name, what, label, column, pick)| {
+                chart(
+                    &format!("{name}_vs_amplitude"),
+                    &format!("{what} vs amplitude"),
+                    Axis::linear("A/A₀", "amplitude_ratio"),
+                    &ratio,
+                    Axis::linear(label, column),
+                    pick,
+                )
+            });
+    against_separation.chain(against_amplitude).collect()
 }
 
 /// φ against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999 left out), one series
