@@ -198,15 +198,18 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
             .filter(|v| (lo..=hi).contains(v))
             .collect()
     };
-    [
+    let mut ticks = Vec::new();
+    for multiples in [
         &[1.0, 2.0, 5.0][..],
         &[1.0, 2.0, 3.0, 5.0],
         &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
-    ]
-    .iter()
-    .map(|m| within(m))
-    .find(|t| t.len() >= 4)
-    .unwrap_or_else(|| within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]))
+    ] {
+        ticks = within(multiples);
+        if ticks.len() >= 4 {
+            break;
+        }
+    }
+    ticks
 }
 
 /// One heat map: the cells on log axes, and beside them the colour bar with a key to
