@@ -66,7 +66,7 @@ fn bench(c: &mut Criterion) {
 /// Q = 1e5 (time-marching needs ~580 000 periods there). The periods each takes are
 /// printed and bounded (20 and 60) before timing.
 fn settle(c: &mut Criterion) {
-    use tapsim::dynamics::observables::tap;
+    use tapsim::dynamics::observables::{Observe, tap};
     use tapsim::dynamics::setup::{Cantilever, TapSetup};
     use tapsim::law::LawKind;
     use tapsim::params::{Contact, composite_modulus};
@@ -94,7 +94,7 @@ fn settle(c: &mut Criterion) {
         ("hybrid defaults", default_setup(), 20),
         ("dforce hertz Q=1e5", hertz, 60),
     ] {
-        let o = tap(&setup, &Numerics::default(), 0)
+        let o = tap(&setup, &Numerics::default(), Observe::default())
             .expect("tap")
             .observables;
         eprintln!("{name}: {} in {} periods", o.regime, o.cycles);
@@ -104,7 +104,7 @@ fn settle(c: &mut Criterion) {
             o.cycles
         );
         group.bench_function(name, |b| {
-            b.iter(|| tap(&setup, &Numerics::default(), 0).expect("tap"))
+            b.iter(|| tap(&setup, &Numerics::default(), Observe::default()).expect("tap"))
         });
     }
     group.finish();

@@ -2,7 +2,7 @@
 //!
 //! Run with `cargo run --release --example tap`.
 
-use tapsim::dynamics::observables::tap;
+use tapsim::dynamics::observables::{Observe, tap};
 use tapsim::dynamics::setup::{Numerics, default_setup};
 use tapsim::law::LawKind;
 
@@ -24,7 +24,7 @@ fn main() -> tapsim::Result<()> {
             ..default_setup()
         };
         let start = std::time::Instant::now();
-        let o = tap(&setup, &Numerics::default(), 0)?.observables;
+        let o = tap(&setup, &Numerics::default(), Observe::default())?.observables;
         println!(
             "{:>18} {:>8.5} {:>9.4} {:>9.4} {:>10.4} {:>10.4} {:>8.1e} {:>7} {:?}",
             o.law,

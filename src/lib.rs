@@ -36,7 +36,7 @@ pub mod reproduce;
 pub mod units;
 
 pub use contact::lj::{LjSolution, Reach};
-pub use dynamics::observables::{TapObservables, tap};
+pub use dynamics::observables::{Observe, TapObservables, TapRun, tap};
 pub use dynamics::setup::{Cantilever, Numerics, TapSetup, default_setup};
 pub use error::{Error, Result};
 pub use law::LawKind;

@@ -5,7 +5,7 @@ use crate::contact::hybrid;
 use crate::contact::jkr;
 use crate::contact::lj::{self, Reach};
 use crate::contact::semi_rigid;
-use crate::dynamics::observables::tap;
+use crate::dynamics::observables::{Observe, tap};
 use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
 use crate::error::{Error, Result};
 use crate::figures::{self, FigureOptions};
@@ -133,7 +133,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
     // Tapping: one trajectory on the defaults.
     progress("default tap");
     let setup = default_setup();
-    let run = tap(&setup, &Numerics::default(), 3)?;
+    let run = tap(&setup, &Numerics::default(), Observe::recording(3))?;
     let charts = tap_report::trajectory_charts(&run, "hybrid law, defaults");
     for ext in ["png", "svg"] {
         let path = out.join(format!("tap_trajectory.{ext}"));

@@ -184,7 +184,11 @@ pub fn adhesion_modulus_map(
                 s.contact.work_of_adhesion_j_m2 = w;
                 s.contact.modulus_pa = e;
                 let tabor_mu = s.contact.tabor_mu();
-                let cell = match crate::dynamics::observables::tap(&s, numerics, 0) {
+                let cell = match crate::dynamics::observables::tap(
+                    &s,
+                    numerics,
+                    crate::dynamics::observables::Observe::default(),
+                ) {
                     Ok(run) => MapCell {
                         work_of_adhesion_j_m2: w,
                         modulus_pa: e,

@@ -394,6 +394,18 @@ fn tap_json_has_the_documented_keys() {
     assert_eq!(v["period"], 1);
     assert_eq!(v["periods_averaged"], 1);
     assert_eq!(v["stable"], serde_json::Value::Bool(true));
+    // Harmonics 2…10 of the orbit, each with its amplitudes and phases.
+    let harmonics = v["harmonics"].as_array().expect("harmonics");
+    assert_eq!(harmonics.len(), 9);
+    for (n, h) in (2..).zip(harmonics) {
+        assert_eq!(h["order"], n);
+        for key in ["deflection_amplitude_m", "force_amplitude_n"] {
+            assert!(num(h, key) > 0.0, "harmonic {n}: {key}");
+        }
+        for key in ["deflection_phase_deg", "force_phase_deg"] {
+            assert!(num(h, key).abs() <= 180.0, "harmonic {n}: {key}");
+        }
+    }
     let multipliers = v["floquet_multipliers"].as_array().unwrap();
     assert_eq!(multipliers.len(), 2);
     for m in multipliers {

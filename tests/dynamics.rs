@@ -6,7 +6,7 @@ use tapsim::contact::hybrid::JumpIn;
 use tapsim::dynamics::base_drive::{self, BaseDriveOptions};
 use tapsim::dynamics::model::{Coupling, Drive, Oscillator};
 use tapsim::dynamics::numeric::Tolerances;
-use tapsim::dynamics::observables::{TapObservables, tap};
+use tapsim::dynamics::observables::{Observe, TapObservables, tap};
 use tapsim::dynamics::setup::{Numerics, TapSetup, default_setup};
 use tapsim::dynamics::steady::{Phase, Simulation, SteadyOptions};
 use tapsim::law::{Branch, ForceLaw, LawKind, NoForce};
@@ -17,7 +17,9 @@ fn run(law: LawKind, separation_nm: f64) -> TapObservables {
         separation_m: separation_nm * 1e-9,
         ..default_setup()
     };
-    let o = tap(&setup, &Numerics::default(), 0).unwrap().observables;
+    let o = tap(&setup, &Numerics::default(), Observe::default())
+        .unwrap()
+        .observables;
     assert!(o.converged, "{law} at {separation_nm} nm did not converge");
     o
 }
@@ -270,7 +272,7 @@ fn laws_refuse_where_they_do_not_apply() {
     setup.contact.work_of_adhesion_j_m2 = 0.02;
     setup.contact.modulus_pa = 2e9;
     assert!(setup.contact.tabor_mu() < 1.0);
-    let err = tap(&setup, &Numerics::default(), 0)
+    let err = tap(&setup, &Numerics::default(), Observe::default())
         .unwrap_err()
         .to_string();
     assert!(
@@ -278,7 +280,7 @@ fn laws_refuse_where_they_do_not_apply() {
         "{err}"
     );
     setup.law = LawKind::Dmt;
-    assert!(tap(&setup, &Numerics::default(), 0).is_ok());
+    assert!(tap(&setup, &Numerics::default(), Observe::default()).is_ok());
 }
 
 #[test]
@@ -288,7 +290,9 @@ fn tabulated_lj_law_dissipates_the_numerical_loop() {
         separation_m: 14e-9,
         ..default_setup()
     };
-    let o = tap(&setup, &Numerics::default(), 0).unwrap().observables;
+    let o = tap(&setup, &Numerics::default(), Observe::default())
+        .unwrap()
+        .observables;
     assert!(o.converged && o.jumps_in == 1.0);
     // The law is the production mesh's curve: it dissipates that curve's loop exactly,
     // which lies within the discretisation error of the extrapolated Ŵ_LJ.
@@ -326,14 +330,16 @@ fn shooting_finds_the_same_steady_state_as_the_transient() {
             separation_m: z * 1e-9,
             ..default_setup()
         };
-        let fast = tap(&setup, &Numerics::default(), 0).unwrap().observables;
+        let fast = tap(&setup, &Numerics::default(), Observe::default())
+            .unwrap()
+            .observables;
         let slow = tap(
             &setup,
             &Numerics {
                 shooting: false,
                 ..Numerics::default()
             },
-            0,
+            Observe::default(),
         )
         .unwrap()
         .observables;
@@ -356,6 +362,66 @@ fn shooting_finds_the_same_steady_state_as_the_transient() {
             "{law} {z}: {} vs {} cycles",
             fast.cycles,
             slow.cycles
+        );
+    }
+}
+
+/// The harmonics observer against the equation of motion: on a periodic orbit the n-th
+/// harmonic of the deflection is the force's n-th harmonic through the point-mass
+/// transfer function, X_n = F_n/(k(1 − (nΩ)² + 2iγnΩ)) for n ≥ 2 (no drive there). The
+/// two are integrated independently (the force from the law at the interpolated
+/// separation), so this checks the integration and the quadrature together.
+#[test]
+fn deflection_harmonics_are_the_force_harmonics_through_the_transfer_function() {
+    type Complex64 = nalgebra::Complex<f64>;
+    for (law, separation_nm) in [
+        (LawKind::Hybrid, 16.0),
+        (LawKind::Jkr, 14.0),
+        (LawKind::Dmt, 14.0),
+        (LawKind::Hertz, 12.0),
+        (LawKind::Lj, 14.0),
+    ] {
+        let setup = TapSetup {
+            law,
+            separation_m: separation_nm * 1e-9,
+            ..default_setup()
+        };
+        let observe = Observe {
+            harmonics: true,
+            ..Observe::default()
+        };
+        let run = tap(&setup, &Numerics::default(), observe).unwrap();
+        assert_eq!(run.observables.regime, "period-1", "{law}");
+        let harmonics = run.harmonics.expect("a periodic orbit has harmonics");
+        assert_eq!(
+            harmonics.iter().map(|h| h.order).collect::<Vec<_>>(),
+            (2..=10).collect::<Vec<_>>()
+        );
+        let cant = &setup.cantilever;
+        let (omega, gamma) = (
+            cant.drive_frequency_hz / cant.resonance_hz,
+            0.5 / cant.quality,
+        );
+        let a0 = cant.free_amplitude_m;
+        let mut worst: f64 = 0.0;
+        for h in &harmonics {
+            let w = h.order as f64 * omega;
+            let transfer = Complex64::new(1.0 - w * w, 2.0 * gamma * w).inv();
+            let x = Complex64::from_polar(
+                h.deflection_amplitude_m,
+                -h.deflection_phase_deg.to_radians(),
+            );
+            let f = Complex64::from_polar(h.force_amplitude_n, -h.force_phase_deg.to_radians());
+            let predicted = transfer * f / cant.stiffness_n_m;
+            worst = worst.max((x - predicted).norm() / a0);
+        }
+        // In units of the free amplitude; the second harmonic is ~1e-3 of it.
+        let second = harmonics[0].deflection_amplitude_m / a0;
+        eprintln!("{law}: worst |X_n - H F_n| = {worst:.1e} A0 (second harmonic {second:.1e} A0)");
+        assert!(worst < 1e-6, "{law}: {worst:e}");
+        assert!(
+            second > 1e-5,
+            "{law}: a tapping orbit has a second harmonic ({second:e})"
         );
     }
 }

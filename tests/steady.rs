@@ -1,7 +1,7 @@
 //! Steady states that are not period-1: Newton's method on the period map with its exact
 //! derivative, the classification of the motion, and what is reported for it.
 
-use tapsim::dynamics::observables::{TapObservables, tap};
+use tapsim::dynamics::observables::{Observe, TapObservables, tap};
 use tapsim::dynamics::setup::{Cantilever, Numerics, TapSetup, default_setup};
 use tapsim::law::LawKind;
 use tapsim::params::{Contact, composite_modulus};
@@ -34,7 +34,9 @@ fn dforce_hertz(quality: f64) -> TapSetup {
 fn high_q_orbits_settle_in_a_few_dozen_periods_and_match_the_time_marched_ones() {
     for quality in [1e3, 1e4, 1e5] {
         let setup = dforce_hertz(quality);
-        let shot = tap(&setup, &Numerics::default(), 0).unwrap().observables;
+        let shot = tap(&setup, &Numerics::default(), Observe::default())
+            .unwrap()
+            .observables;
         // Brute force: integrate until the state at the drive phase lies within 1e-8 of
         // the orbit (~Q ln(1e8)/π periods).
         let marched = tap(
@@ -46,7 +48,7 @@ fn high_q_orbits_settle_in_a_few_dozen_periods_and_match_the_time_marched_ones()
                 max_steps: u64::MAX,
                 ..Numerics::default()
             },
-            0,
+            Observe::default(),
         )
         .unwrap()
         .observables;
@@ -90,7 +92,9 @@ fn jkr_with(numerics: Numerics) -> TapObservables {
         law: LawKind::Jkr,
         ..default_setup()
     };
-    tap(&setup, &numerics, 0).unwrap().observables
+    tap(&setup, &numerics, Observe::default())
+        .unwrap()
+        .observables
 }
 
 fn jkr_defaults(average_tolerance: f64) -> TapObservables {
@@ -236,7 +240,9 @@ fn no_value_is_one_period_of_motion_that_is_not_period_one() {
         setup.separation_m = z_nm * 1e-9;
         setup.cantilever.stiffness_n_m = 1.0;
         setup.cantilever.quality = 5.0;
-        let o = tap(&setup, &Numerics::default(), 0).unwrap().observables;
+        let o = tap(&setup, &Numerics::default(), Observe::default())
+            .unwrap()
+            .observables;
         println!("{law} {z_nm} nm: {} over {}", o.regime, o.periods_averaged);
         match o.period {
             Some(n) => {

@@ -1,7 +1,7 @@
 //! `tapsim tap`: one tapping-mode simulation to its steady state.
 
 use crate::config::TapInputs;
-use crate::dynamics::observables::tap;
+use crate::dynamics::observables::{Observe, tap};
 use crate::error::Result;
 use crate::report::{output, plot, tap as report};
 use clap::Args;
@@ -30,7 +30,10 @@ use std::path::PathBuf;
 /// e_ts_j, e_ts_ev, e_damp_j, e_drive_j, energy_balance_rel, virial_j, mean_force_n,
 /// peak_force_n, min_separation_m, contact_fraction, jumps_in, loop_area_j, tabor_mu,
 /// regime, period, periods_averaged, stable, floquet_multipliers, amplitude_std_err_m,
-/// phase_std_err_deg, e_ts_std_err_j, cycles, converged, and more (see README).
+/// phase_std_err_deg, e_ts_std_err_j, cycles, converged, harmonics (harmonics 2…10 of
+/// the deflection and the force over a periodic orbit: order, deflection_amplitude_m,
+/// deflection_phase_deg, force_amplitude_n, force_phase_deg; absent for irregular
+/// motion), and more (see README).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct TapArgs {
@@ -61,7 +64,11 @@ pub fn run(args: TapArgs) -> Result<()> {
     } else {
         0
     };
-    let run = tap(&setup, &numerics, record)?;
+    let observe = Observe {
+        record_cycles: record,
+        harmonics: true,
+    };
+    let run = tap(&setup, &numerics, observe)?;
     if let Some(path) = &args.trajectory {
         output::write_bytes(path, &report::trajectory_csv(&run.trajectory)?)?;
     }
@@ -72,10 +79,10 @@ pub fn run(args: TapArgs) -> Result<()> {
     if args.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&run.observables).expect("observables serialise")
+            serde_json::to_string_pretty(&run).expect("observables serialise")
         );
     } else {
-        out!("{}", report::to_text(&setup, &run.observables));
+        out!("{}", report::to_text(&setup, &run));
     }
     Ok(())
 }

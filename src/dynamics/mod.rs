@@ -6,6 +6,7 @@ pub mod base_drive;
 pub mod budget;
 pub mod continuation;
 pub mod free;
+pub mod harmonics;
 pub mod model;
 pub mod numeric;
 pub mod observables;

@@ -67,6 +67,28 @@ impl StepObserver for Ignore {
     fn step<const N: usize>(&mut self, _: &StepEnd<N>, _: &StepEnd<N>, _: Branch) {}
 }
 
+/// An observer lent out: the owner reads it afterwards.
+impl<O: StepObserver> StepObserver for &mut O {
+    fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch) {
+        (**self).step(from, to, branch);
+    }
+    fn free_flight(&mut self, flight: &super::free::FreeFlight, from: f64, to: f64) {
+        (**self).free_flight(flight, from, to);
+    }
+}
+
+/// Two observers watching the same integration, each told everything.
+impl<A: StepObserver, B: StepObserver> StepObserver for (A, B) {
+    fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch) {
+        self.0.step(from, to, branch);
+        self.1.step(from, to, branch);
+    }
+    fn free_flight(&mut self, flight: &super::free::FreeFlight, from: f64, to: f64) {
+        self.0.free_flight(flight, from, to);
+        self.1.free_flight(flight, from, to);
+    }
+}
+
 /// Cubic Hermite interpolation of component `i` on the step [a, b] at τ.
 #[inline]
 pub fn hermite<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, i: usize, tau: f64) -> f64 {

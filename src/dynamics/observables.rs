@@ -2,6 +2,7 @@
 
 use super::budget;
 use super::free::FreeFlight;
+use super::harmonics::{Harmonic, HarmonicsObserver};
 use super::model::{Coupling, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver, hermite};
 use super::setup::{Numerics, Prepared, TapSetup};
@@ -327,12 +328,37 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
     }
 }
 
+/// What a tapping run observes beyond the steady state's observables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Observe {
+    /// Drive periods of trajectory to record after the steady state (at most
+    /// [`MAX_RECORD_CYCLES`]; 0: none).
+    pub record_cycles: usize,
+    /// Whether to compute the higher harmonics of a periodic orbit (one more orbit
+    /// integrated; nothing for irregular motion).
+    pub harmonics: bool,
+}
+
+impl Observe {
+    /// Record `cycles` drive periods of trajectory, nothing else.
+    pub fn recording(cycles: usize) -> Self {
+        Self {
+            record_cycles: cycles,
+            ..Self::default()
+        }
+    }
+}
+
 /// A complete tapping run: observables and, if asked for, the trajectory of the last
-/// recorded cycles.
+/// recorded cycles and the higher harmonics.
 #[derive(Debug, Clone, Serialize)]
 pub struct TapRun {
     /// Observables of the reported cycle.
+    #[serde(flatten)]
     pub observables: TapObservables,
+    /// Harmonics 2…10 of the deflection and the force over the periodic orbit, if asked
+    /// for and the motion is periodic (null otherwise).
+    pub harmonics: Option<Vec<Harmonic>>,
     /// Trajectory samples (empty unless recorded).
     #[serde(skip)]
     pub trajectory: Vec<TrajectorySample>,
@@ -343,22 +369,24 @@ pub struct TapRun {
 
 /// Simulate `setup` from the free steady state (the cantilever oscillating freely, far
 /// from the sample, when the rest separation is set) to the steady state it settles on,
-/// then integrate `record_cycles` more cycles recording the trajectory (not counted in
-/// the observables, which are the steady state's).
+/// then observe what `observe` asks for: the n periods of a period-n orbit once more for
+/// its harmonics, and `observe.record_cycles` more cycles recording the trajectory
+/// (neither counted in the observables, which are the steady state's).
 ///
 /// ```
-/// use tapsim::{LawKind, Numerics, TapSetup, default_setup, tap};
+/// use tapsim::{LawKind, Numerics, Observe, TapSetup, default_setup, tap};
 ///
 /// // The built-in silicon cantilever on a polymer, with the paper's hybrid law.
 /// let setup = TapSetup { law: LawKind::Hybrid, ..default_setup() };
-/// let o = tap(&setup, &Numerics::default(), 0)?.observables;
+/// let o = tap(&setup, &Numerics::default(), Observe::default())?.observables;
 /// assert_eq!(o.regime, "period-1");
 /// assert!(o.energy_balance_rel < 1e-6);
 /// // Each period dissipates the hybrid loop: Ŵ_hybrid(μ)·μεRΔγ.
 /// assert!((o.e_ts_j / o.loop_area_j - 1.0).abs() < 1e-6);
 /// # Ok::<(), tapsim::Error>(())
 /// ```
-pub fn tap(setup: &TapSetup, numerics: &Numerics, record_cycles: usize) -> Result<TapRun> {
+pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<TapRun> {
+    let record_cycles = observe.record_cycles;
     if record_cycles > MAX_RECORD_CYCLES {
         return Err(Error::InvalidParameter {
             name: "record cycles",
@@ -370,6 +398,22 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, record_cycles: usize) -> Resul
     let sim = p.simulation();
     let mut phase = sim.free_steady_start();
     let state = sim.steady_state(&mut phase, &p.steady)?;
+    let harmonics = match state.motion.period() {
+        Some(n) if observe.harmonics => {
+            let mut observer = HarmonicsObserver::new(&p.law, p.cpl, p.osc);
+            for _ in 0..n {
+                budget::budgeted(p.steady.max_steps, || sim.cycle(&mut phase, &mut observer))?;
+            }
+            let cant = &setup.cantilever;
+            let a0 = cant.free_amplitude_m;
+            Some(Harmonic::list(
+                &observer.finish(),
+                a0,
+                cant.stiffness_n_m * a0,
+            ))
+        }
+        _ => None,
+    };
     let mut recorder = Recorder::new(&p.law, p.cpl, p.osc);
     for done in 0..record_cycles {
         budget::budgeted(p.steady.max_steps, || sim.cycle(&mut phase, &mut recorder))?;
@@ -388,6 +432,7 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, record_cycles: usize) -> Resul
     let scale = setup.contact.separation_scale_m();
     Ok(TapRun {
         observables: TapObservables::new(&p, &state)?,
+        harmonics,
         trajectory: recorder.to_si(&p),
         switch_separations_m: (
             p.law.jump_in_alpha_hat() * scale,

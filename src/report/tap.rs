@@ -2,14 +2,16 @@
 //! trajectory charts (deflection and force vs time, force vs separation).
 
 use super::chart::{Axis, Chart, Corner, Series, Style};
+use crate::dynamics::harmonics::Harmonic;
 use crate::dynamics::observables::{TapObservables, TapRun, TrajectorySample};
 use crate::dynamics::setup::TapSetup;
 use crate::error::Result;
 use crate::law::Branch;
 use std::fmt::Write as _;
 
-/// A table of the setup and the observables.
-pub fn to_text(setup: &TapSetup, o: &TapObservables) -> String {
+/// A table of the setup and the observables (and the harmonics, if computed).
+pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
+    let o = &run.observables;
     let c = &setup.contact;
     let k = &setup.cantilever;
     let mut s = String::new();
@@ -114,6 +116,23 @@ pub fn to_text(setup: &TapSetup, o: &TapObservables) -> String {
     );
     line("contact fraction", format!("{:.4}", o.contact_fraction));
     line("jumps into contact per cycle", format!("{:.4}", o.jumps_in));
+    if let Some(h) = &run.harmonics {
+        let amplitudes = |pick: fn(&Harmonic) -> f64, scale: f64| {
+            h.iter()
+                .take(3)
+                .map(|h| format!("{:.3}", pick(h) * scale))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        line(
+            "harmonics 2–4 of z (of F_ts)",
+            format!(
+                "{} pm ({} nN); 2–10 in --json",
+                amplitudes(|h| h.deflection_amplitude_m, 1e12),
+                amplitudes(|h| h.force_amplitude_n, 1e9)
+            ),
+        );
+    }
     if !o.converged {
         let _ = writeln!(
             s,
