@@ -86,8 +86,7 @@ fn settle(c: &mut Criterion) {
             drive_frequency_hz: 100e3,
         },
         separation_m: 9e-9,
-        law: LawKind::Hertz,
-        hamaker_j: None,
+        law: LawKind::Hertz.into(),
     };
     let mut group = c.benchmark_group("settle");
     for (name, setup, most) in [

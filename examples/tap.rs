@@ -20,7 +20,7 @@ fn main() -> tapsim::Result<()> {
         LawKind::None,
     ] {
         let setup = tapsim::dynamics::setup::TapSetup {
-            law,
+            law: law.into(),
             ..default_setup()
         };
         let start = std::time::Instant::now();

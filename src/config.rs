@@ -14,7 +14,7 @@
 
 use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
 use crate::error::{Error, Result};
-use crate::law::LawKind;
+use crate::law::{LawKind, LawSpec};
 use crate::params::{self, Contact};
 use crate::units::{self, Dimension};
 use clap::Args;
@@ -41,6 +41,8 @@ unit_parser!(/// A frequency (Hz).
     frequency, "frequency", Dimension::Frequency);
 unit_parser!(/// An energy (J or eV).
     energy, "energy", Dimension::Energy);
+unit_parser!(/// A viscosity (Pa·s).
+    viscosity, "viscosity", Dimension::Viscosity);
 unit_parser!(/// A plain number.
     number, "value", Dimension::Dimensionless);
 
@@ -158,6 +160,17 @@ impl ContactInputs {
     }
 }
 
+/// `--law` takes the registry's names and shows its help.
+impl clap::ValueEnum for LawKind {
+    fn value_variants<'a>() -> &'a [Self] {
+        &LawKind::ALL
+    }
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        let info = self.info();
+        Some(clap::builder::PossibleValue::new(info.name).help(info.help))
+    }
+}
+
 /// Everything a tapping simulation takes, every field optional (defaults fill in).
 #[derive(Debug, Clone, Default, Args)]
 pub struct TapInputs {
@@ -174,6 +187,10 @@ pub struct TapInputs {
     /// Hamaker constant for the dmt law [J or eV; default 12πε²Δγ].
     #[arg(long, allow_hyphen_values = true, value_parser = energy, help_heading = "Contact (SI)")]
     pub hamaker: Option<f64>,
+    /// Kelvin–Voigt viscosity η of the sample, a force η√(Rδ)·dδ/dt against the
+    /// indentation rate added to the law (e.g. 50Pa·s) [Pa·s; default: none, elastic].
+    #[arg(long, allow_hyphen_values = true, value_parser = viscosity, help_heading = "Contact (SI)")]
+    pub viscosity: Option<f64>,
     /// Cantilever spring constant k [N/m; default 40].
     #[arg(long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Cantilever")]
     pub stiffness: Option<f64>,
@@ -246,6 +263,7 @@ const FIELDS: &[Field] = fields![
     "work-of-adhesion" => SurfaceEnergy => |i| i.contact.work_of_adhesion,
     "range" => Length => |i| i.contact.range,
     "hamaker" => Energy => |i| i.hamaker,
+    "viscosity" => Viscosity => |i| i.viscosity,
     "stiffness" => Stiffness => |i| i.stiffness,
     "resonance" => Frequency => |i| i.resonance,
     "quality" => Dimensionless => |i| i.quality,
@@ -324,13 +342,11 @@ impl TapInputs {
         for (key, value) in &table {
             if key == "law" {
                 let name = value.as_str().unwrap_or_default();
-                inputs.law = Some(<LawKind as clap::ValueEnum>::from_str(name, true).map_err(
-                    |_| Error::Parse {
-                        name: "law",
-                        text: value.to_string(),
-                        reason: format!("expected one of {}", LawKind::names().join(", ")),
-                    },
-                )?);
+                inputs.law = Some(LawKind::from_name(name).ok_or_else(|| Error::Parse {
+                    name: "law",
+                    text: value.to_string(),
+                    reason: format!("expected one of {}", LawKind::names().join(", ")),
+                })?);
                 continue;
             }
             let text = match value {
@@ -357,6 +373,7 @@ impl TapInputs {
             law: self.law.or(base.law),
             contact: self.contact.or(base.contact),
             hamaker: self.hamaker.or(base.hamaker),
+            viscosity: self.viscosity.or(base.viscosity),
             stiffness: self.stiffness.or(base.stiffness),
             resonance: self.resonance.or(base.resonance),
             quality: self.quality.or(base.quality),
@@ -411,8 +428,11 @@ impl TapInputs {
             contact,
             cantilever,
             separation_m: self.separation.unwrap_or(d.separation_m),
-            law: self.law.unwrap_or(d.law),
-            hamaker_j: self.hamaker.or(d.hamaker_j),
+            law: LawSpec {
+                kind: self.law.unwrap_or(d.law.kind),
+                hamaker_j: self.hamaker.or(d.law.hamaker_j),
+                viscosity_pa_s: self.viscosity.or(d.law.viscosity_pa_s),
+            },
         };
         let mut numerics = Numerics::default();
         if let Some(rtol) = self.rtol {
@@ -481,7 +501,7 @@ mod tests {
             ..Default::default()
         };
         let (setup, _) = flags.or(file).resolve().unwrap();
-        assert_eq!(setup.law, LawKind::Dmt);
+        assert_eq!(setup.law.kind, LawKind::Dmt);
         assert!((setup.contact.radius_m - 10e-9).abs() < 1e-20);
         assert_eq!(setup.cantilever.stiffness_n_m, 5.0);
         let e = params::composite_modulus(169e9, 0.28, 2e9, 0.4).unwrap();

@@ -195,7 +195,7 @@ pub fn contrast(
         for &law in laws {
             progress(&format!("{}, {law}", m.name));
             let s = TapSetup {
-                law,
+                law: setup.law.with_kind(law),
                 ..setup.clone()
             };
             curves.push(LawCurve {

@@ -55,7 +55,7 @@ pub struct Manifest {
 
 fn approach(setup: &TapSetup, law: LawKind, points: usize) -> Result<Vec<SweepPoint>> {
     let setup = TapSetup {
-        law,
+        law: law.into(),
         ..setup.clone()
     };
     let a0 = setup.cantilever.free_amplitude_m;

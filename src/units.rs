@@ -19,6 +19,8 @@ pub enum Dimension {
     Frequency,
     /// Joules (or electronvolts).
     Energy,
+    /// Pascal seconds (written Pa·s, Pa*s, Pa s or Pas).
+    Viscosity,
     /// A plain number.
     Dimensionless,
 }
@@ -32,6 +34,7 @@ impl Dimension {
             Dimension::Stiffness => &[("N/m", 1.0)],
             Dimension::Frequency => &[("Hz", 1.0)],
             Dimension::Energy => &[("J", 1.0), ("eV", crate::params::ELECTRONVOLT_J)],
+            Dimension::Viscosity => &[("Pa·s", 1.0), ("Pa*s", 1.0), ("Pa s", 1.0), ("Pas", 1.0)],
             Dimension::Dimensionless => &[],
         }
     }
@@ -135,6 +138,12 @@ mod tests {
             parse("w", "1.5eV", Dimension::Energy).unwrap(),
             1.5 * crate::params::ELECTRONVOLT_J
         ));
+        for text in ["50Pa·s", "50 Pa*s", "0.05 kPa s", "50000mPas"] {
+            assert!(
+                close(parse("eta", text, Dimension::Viscosity).unwrap(), 50.0),
+                "{text}"
+            );
+        }
     }
 
     #[test]

@@ -995,3 +995,44 @@ fn figure_json_is_a_manifest_of_the_files_written() {
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn a_viscous_sample_is_a_law_parameter_checked_against_the_law() {
+    // Flag and parameter file alike; the law's name says the sample is viscous.
+    let v = json(&["tap", "--law", "hertz", "--viscosity", "50 Pa·s", "--json"]);
+    assert_eq!(v["law"], "hertz+kelvin-voigt");
+    assert!(num(&v, "e_ts_j") > 0.0 && num(&v, "energy_balance_rel") < 1e-6);
+    let dir = scratch("viscous-config");
+    let cfg = dir.join("sample.toml");
+    std::fs::write(&cfg, "law = \"hertz\"\nviscosity = \"50Pa*s\"\n").unwrap();
+    let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
+    assert_eq!(w["e_ts_j"], v["e_ts_j"]);
+    // A parameter the law does not take is refused, naming the laws that take it.
+    for (args, needle) in [
+        (
+            vec!["tap", "--law", "none", "--viscosity", "5"],
+            "the none law takes no viscosity parameter",
+        ),
+        (
+            vec!["tap", "--law", "hertz", "--hamaker", "1e-20"],
+            "the hertz law takes no hamaker parameter (the laws that do: dmt)",
+        ),
+        (
+            vec!["tap", "--viscosity", "1e9"],
+            "sample viscosity = 1 GPa·s is outside",
+        ),
+        (vec!["tap", "--viscosity", "5kg"], "unknown unit"),
+    ] {
+        let out = tapsim(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(needle),
+            "{args:?}: {err}"
+        );
+    }
+    // `--law` lists every registered law with its help.
+    let help = String::from_utf8_lossy(&tapsim(&["tap", "--help"]).stdout).to_string();
+    for law in tapsim::law::LAWS {
+        assert!(help.contains(&format!("- {}:", law.name)), "{}", law.name);
+    }
+}

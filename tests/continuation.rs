@@ -33,8 +33,8 @@ fn nm(setup: &TapSetup, q: f64) -> f64 {
 /// coexist over a window of rest separations.
 fn bistable_dmt() -> TapSetup {
     let mut setup = default_setup();
-    setup.law = LawKind::Dmt;
-    setup.hamaker_j = Some(1.5e-19);
+    setup.law = LawKind::Dmt.into();
+    setup.law.hamaker_j = Some(1.5e-19);
     setup.contact.modulus_pa = tapsim::params::composite_modulus(169e9, 0.28, 2e9, 0.4).unwrap();
     setup
 }
@@ -113,7 +113,7 @@ fn a_bistable_branch_has_two_folds_where_the_ramps_jump() {
 #[test]
 fn pure_hertz_has_no_fold() {
     let setup = TapSetup {
-        law: LawKind::Hertz,
+        law: LawKind::Hertz.into(),
         ..default_setup()
     };
     let branch = follow(&setup, 22.0, 6.0);
@@ -134,7 +134,7 @@ fn pure_hertz_has_no_fold() {
 fn a_period_doubling_gives_way_to_a_period_two_orbit() {
     // A soft cantilever (1 N/m, Q = 100) driven below resonance on a Hertz sample.
     let mut setup = default_setup();
-    setup.law = LawKind::Hertz;
+    setup.law = LawKind::Hertz.into();
     setup.cantilever.stiffness_n_m = 1.0;
     setup.cantilever.quality = 100.0;
     setup.cantilever.drive_frequency_hz = 0.9 * setup.cantilever.resonance_hz;

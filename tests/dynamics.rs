@@ -9,11 +9,11 @@ use tapsim::dynamics::numeric::Tolerances;
 use tapsim::dynamics::observables::{Observe, TapObservables, tap};
 use tapsim::dynamics::setup::{Numerics, TapSetup, default_setup};
 use tapsim::dynamics::steady::{Phase, Simulation, SteadyOptions};
-use tapsim::law::{Branch, ForceLaw, LawKind, NoForce};
+use tapsim::law::{Branch, ForceLaw, LawKind, LawSpec, NoForce};
 
 fn run(law: LawKind, separation_nm: f64) -> TapObservables {
     let setup = TapSetup {
-        law,
+        law: law.into(),
         separation_m: separation_nm * 1e-9,
         ..default_setup()
     };
@@ -279,14 +279,14 @@ fn laws_refuse_where_they_do_not_apply() {
         err.contains("does not apply") && err.contains("DMT"),
         "{err}"
     );
-    setup.law = LawKind::Dmt;
+    setup.law = LawKind::Dmt.into();
     assert!(tap(&setup, &Numerics::default(), Observe::default()).is_ok());
 }
 
 #[test]
 fn tabulated_lj_law_dissipates_the_numerical_loop() {
     let setup = TapSetup {
-        law: LawKind::Lj,
+        law: LawKind::Lj.into(),
         separation_m: 14e-9,
         ..default_setup()
     };
@@ -326,7 +326,7 @@ fn shooting_finds_the_same_steady_state_as_the_transient() {
         (LawKind::Hertz, 14.0),
     ] {
         let setup = TapSetup {
-            law,
+            law: law.into(),
             separation_m: z * 1e-9,
             ..default_setup()
         };
@@ -374,12 +374,18 @@ fn shooting_finds_the_same_steady_state_as_the_transient() {
 #[test]
 fn deflection_harmonics_are_the_force_harmonics_through_the_transfer_function() {
     type Complex64 = nalgebra::Complex<f64>;
+    let viscous = |kind: LawKind| LawSpec {
+        viscosity_pa_s: Some(50.0),
+        ..kind.into()
+    };
     for (law, separation_nm) in [
-        (LawKind::Hybrid, 16.0),
-        (LawKind::Jkr, 14.0),
-        (LawKind::Dmt, 14.0),
-        (LawKind::Hertz, 12.0),
-        (LawKind::Lj, 14.0),
+        (LawKind::Hybrid.into(), 16.0),
+        (LawKind::Jkr.into(), 14.0),
+        (LawKind::Dmt.into(), 14.0),
+        (LawKind::Hertz.into(), 12.0),
+        (LawKind::Lj.into(), 14.0),
+        (viscous(LawKind::Hertz), 12.0),
+        (viscous(LawKind::Hybrid), 14.0),
     ] {
         let setup = TapSetup {
             law,
@@ -424,4 +430,98 @@ fn deflection_harmonics_are_the_force_harmonics_through_the_transfer_function() 
             "{law}: a tapping orbit has a second harmonic ({second:e})"
         );
     }
+}
+
+/// A Kelvin–Voigt sample on every contact law: the viscous work is carried as an
+/// integral, so the energy balance (drive = damping + E_ts) checks it; E_ts exceeds the
+/// elastic law's own loss; and the viscous force does what it should, adding loss.
+#[test]
+fn a_viscous_sample_adds_loss_and_keeps_the_energy_balance_on_every_law() {
+    for kind in [
+        LawKind::Hybrid,
+        LawKind::HybridAttractive,
+        LawKind::Jkr,
+        LawKind::Dmt,
+        LawKind::Hertz,
+        LawKind::Lj,
+    ] {
+        let at = |viscosity: Option<f64>| {
+            let setup = TapSetup {
+                law: LawSpec {
+                    viscosity_pa_s: viscosity,
+                    ..kind.into()
+                },
+                separation_m: 12e-9,
+                ..default_setup()
+            };
+            tap(&setup, &Numerics::default(), Observe::default())
+                .unwrap()
+                .observables
+        };
+        let (elastic, viscous) = (at(None), at(Some(20.0)));
+        assert!(viscous.converged, "{kind}");
+        assert_eq!(viscous.law, format!("{kind}+kelvin-voigt"));
+        assert!(
+            viscous.energy_balance_rel < 1e-6,
+            "{kind}: {:e}",
+            viscous.energy_balance_rel
+        );
+        // Per touch the elastic law loses its loop; the sample adds to it.
+        let elastic_loss = viscous.loop_area_j * viscous.jumps_in;
+        assert!(
+            viscous.e_ts_j > elastic_loss + 1e-3 * viscous.e_ts_j,
+            "{kind}: {:e} vs {:e}",
+            viscous.e_ts_j,
+            elastic_loss
+        );
+        assert!(viscous.e_ts_j > elastic.e_ts_j, "{kind}");
+        eprintln!(
+            "{kind}: E_ts {:.3} eV elastic, {:.3} eV with 20 Pa·s; phase {:.2}° → {:.2}°",
+            elastic.e_ts_ev, viscous.e_ts_ev, elastic.phase_deg, viscous.phase_deg
+        );
+    }
+}
+
+/// At small viscosity the viscous loss is η times the integral ∮√(Rδ)·δ̇² dt over the
+/// elastic orbit (first order in η): the carried integral against a quadrature of the
+/// recorded elastic trajectory.
+#[test]
+fn a_small_viscosity_loses_eta_times_the_elastic_orbits_rate_integral() {
+    let base = TapSetup {
+        law: LawKind::Hertz.into(),
+        separation_m: 12e-9,
+        ..default_setup()
+    };
+    let elastic = tap(&base, &Numerics::default(), Observe::recording(1)).unwrap();
+    // ∮ √(R δ) δ̇² dt by the trapezoidal rule on the recorded samples (δ = −α).
+    let radius = base.contact.radius_m;
+    let integrand = |s: &tapsim::dynamics::observables::TrajectorySample| {
+        let delta = (-s.alpha_m).max(0.0);
+        (radius * delta).sqrt() * s.v_m_s * s.v_m_s
+    };
+    let rate_integral: f64 = elastic
+        .trajectory
+        .windows(2)
+        .map(|w| 0.5 * (integrand(&w[0]) + integrand(&w[1])) * (w[1].t_s - w[0].t_s))
+        .sum();
+    let mut ratios = Vec::new();
+    for eta in [1e-1, 1e-2, 1e-3] {
+        let setup = TapSetup {
+            law: LawSpec {
+                viscosity_pa_s: Some(eta),
+                ..base.law
+            },
+            ..base.clone()
+        };
+        let o = tap(&setup, &Numerics::default(), Observe::default())
+            .unwrap()
+            .observables;
+        ratios.push(o.e_ts_j / (eta * rate_integral));
+    }
+    eprintln!("E_visc/(eta I) at eta = 0.1, 0.01, 0.001 Pa·s: {ratios:?}");
+    // First order: the ratio tends to 1 (to the trapezoidal rule's error on the recorded
+    // samples, ~1e-4), and its departure is linear in η (tenfold per decade).
+    assert!((ratios[2] - 1.0).abs() < 2e-4, "{ratios:?}");
+    let decade = (ratios[0] - ratios[1]) / (ratios[1] - ratios[2]);
+    assert!((decade - 10.0).abs() < 1.0, "{decade}: {ratios:?}");
 }

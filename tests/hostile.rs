@@ -122,7 +122,7 @@ fn quantity() -> impl Strategy<Value = String> {
         number(),
         prop::sample::select(vec![
             "", "", "", "nm", "pm", "um", "m", "GPa", "Pa", "Hz", "kHz", "MHz", "N/m", "J/m^2",
-            "mJ/m^2", "eV", "J", "furlongs", " nm",
+            "mJ/m^2", "eV", "J", "Pa·s", "mPas", "furlongs", " nm",
         ]),
     )
         .prop_map(|(n, u)| format!("{n}{u}"))
@@ -139,6 +139,7 @@ const INPUTS: &[&str] = &[
     "--work-of-adhesion",
     "--range",
     "--hamaker",
+    "--viscosity",
     "--stiffness",
     "--resonance",
     "--quality",

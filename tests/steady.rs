@@ -25,8 +25,7 @@ fn dforce_hertz(quality: f64) -> TapSetup {
             drive_frequency_hz: 100e3,
         },
         separation_m: 9e-9,
-        law: LawKind::Hertz,
-        hamaker_j: None,
+        law: LawKind::Hertz.into(),
     }
 }
 
@@ -89,7 +88,7 @@ fn high_q_orbits_settle_in_a_few_dozen_periods_and_match_the_time_marched_ones()
 /// JKR on the defaults with `numerics`.
 fn jkr_with(numerics: Numerics) -> TapObservables {
     let setup = TapSetup {
-        law: LawKind::Jkr,
+        law: LawKind::Jkr.into(),
         ..default_setup()
     };
     tap(&setup, &numerics, Observe::default())
@@ -236,7 +235,7 @@ fn no_value_is_one_period_of_motion_that_is_not_period_one() {
         (LawKind::Hybrid, 14.0),
     ] {
         let mut setup = default_setup();
-        setup.law = law;
+        setup.law = law.into();
         setup.separation_m = z_nm * 1e-9;
         setup.cantilever.stiffness_n_m = 1.0;
         setup.cantilever.quality = 5.0;
@@ -264,12 +263,19 @@ fn the_period_map_derivative_matches_finite_differences_across_switches() {
     use tapsim::dynamics::steady::Phase;
     // In contact for part of the period, with the force jumping at both switches
     // (hybrid, jkr), continuous (dmt, hertz), or tabulated with an attractive approach.
+    // And with a viscous sample: a force that depends on the velocity too.
+    let viscous = |kind: LawKind| tapsim::law::LawSpec {
+        viscosity_pa_s: Some(20.0),
+        ..kind.into()
+    };
     for (law, z_nm) in [
-        (LawKind::Hybrid, 16.0),
-        (LawKind::Jkr, 12.0),
-        (LawKind::HybridAttractive, 15.0),
-        (LawKind::Dmt, 14.0),
-        (LawKind::Hertz, 14.0),
+        (LawKind::Hybrid.into(), 16.0),
+        (LawKind::Jkr.into(), 12.0),
+        (LawKind::HybridAttractive.into(), 15.0),
+        (LawKind::Dmt.into(), 14.0),
+        (LawKind::Hertz.into(), 14.0),
+        (viscous(LawKind::Hertz), 14.0),
+        (viscous(LawKind::Hybrid), 14.0),
     ] {
         let setup = TapSetup {
             law,

@@ -51,8 +51,8 @@ fn bad_ramps_are_refused() {
 fn dmt_approach_jumps_from_the_attractive_to_the_repulsive_regime() {
     // Weak attraction on a stiffer sample: the phase falls through 90° on approach.
     let mut setup = default_setup();
-    setup.law = tapsim::law::LawKind::Dmt;
-    setup.hamaker_j = Some(5e-20);
+    setup.law = tapsim::law::LawKind::Dmt.into();
+    setup.law.hamaker_j = Some(5e-20);
     setup.contact.modulus_pa = tapsim::params::composite_modulus(169e9, 0.28, 2e9, 0.4).unwrap();
     let ramp = sweep::ramp(24e-9, 8e-9, 16, true).unwrap();
     // This ramp once ended in a Dopri5 step-size underflow (a switch located at the very
@@ -79,8 +79,8 @@ fn dmt_approach_jumps_from_the_attractive_to_the_repulsive_regime() {
 #[test]
 fn dmt_bistability_has_a_hysteresis_window_on_retract() {
     let mut setup = default_setup();
-    setup.law = tapsim::law::LawKind::Dmt;
-    setup.hamaker_j = Some(1.5e-19);
+    setup.law = tapsim::law::LawKind::Dmt.into();
+    setup.law.hamaker_j = Some(1.5e-19);
     setup.contact.modulus_pa = tapsim::params::composite_modulus(169e9, 0.28, 2e9, 0.4).unwrap();
     let ramp = sweep::ramp(22e-9, 14e-9, 17, true).unwrap();
     let numerics = sweep::sweep_numerics(Numerics::default(), (false, false));

@@ -16,9 +16,9 @@ use std::path::PathBuf;
 /// rest separation z_c = 16 nm, the paper's hybrid law. Every value can be changed
 /// by a flag or a TOML file (--config; keys are the flags' names, flags win).
 ///
-/// Laws: hybrid (default; jump-in at α̂_A of eq. 17, JKR contact, jump-out at α̂_C),
-/// hybrid-attractive (semi-rigid attraction (12), (14) before contact), jkr (jump-in
-/// at α = 0), dmt, hertz, none.
+/// Laws (--law; each explained under it below): hybrid (default), hybrid-attractive,
+/// jkr, dmt, hertz, lj, none. A viscous sample (--viscosity, Kelvin–Voigt) adds to any
+/// of them but none.
 ///
 /// The motion starts from the free oscillation and settles on a steady state, which is
 /// named: a period-n orbit (n ≤ 8; its Floquet multipliers say whether it is stable) or

@@ -2,7 +2,7 @@
 //! force: x'' + 2γx' + x = f₀ cos Ωτ. Exact, so free flight costs no integration steps,
 //! and so are the carried integrals.
 
-use super::model::{Drive, E_DAMP, Oscillator, SC, SS, State, TANGENT, V, X, phi, set_phi};
+use super::model::{Carried, Drive, Oscillator, State, V, X, has_tangent, phi, set_phi};
 use crate::numeric::newton_bracketed;
 use nalgebra::{Complex, Matrix2};
 
@@ -130,7 +130,7 @@ impl FreeFlight {
     /// the drive's work follows from them by parts, ∫ f₀ cos Ωτ x' dτ =
     /// f₀([x cos Ωτ] + Ω ∫ x sin Ωτ dτ), and damping takes the rest of the energy balance
     /// (the tip feels no force). The tip–sample integrals do not change. The variational
-    /// matrix of a [`TANGENT`] state is carried by [`FreeFlight::transition`].
+    /// matrix of a state with a tangent ([`super::model::has_tangent`]) is carried by [`FreeFlight::transition`].
     pub fn advance<const N: usize>(&self, y: &mut State<N>, tau_a: f64, tau_b: f64) {
         let (sc, ss) = self.fourier(tau_a, tau_b);
         let (x_a, v_a) = self.at(tau_a);
@@ -141,10 +141,10 @@ impl FreeFlight {
         let mechanical = 0.5 * (x_b * x_b + v_b * v_b) - 0.5 * (x_a * x_a + v_a * v_a);
         y[X] = x_b;
         y[V] = v_b;
-        y[E_DAMP] += drive - mechanical;
-        y[SC] += sc;
-        y[SS] += ss;
-        if N == TANGENT {
+        y[Carried::Damping] += drive - mechanical;
+        y[Carried::CosProjection] += sc;
+        y[Carried::SinProjection] += ss;
+        if has_tangent(N) {
             set_phi(y, &(self.transition(tau_b - tau_a) * phi(y)));
         }
     }
@@ -292,9 +292,21 @@ mod tests {
         }
         let mut y = State::<BASE>::zeros();
         f.advance(&mut y, a, b);
-        assert!((y[SC] - sc).abs() < 1e-9, "{} {sc}", y[SC]);
-        assert!((y[SS] - ss).abs() < 1e-9, "{} {ss}", y[SS]);
-        assert!((y[E_DAMP] - damp).abs() < 1e-9, "{} {damp}", y[E_DAMP]);
+        assert!(
+            (y[Carried::CosProjection] - sc).abs() < 1e-9,
+            "{} {sc}",
+            y[Carried::CosProjection]
+        );
+        assert!(
+            (y[Carried::SinProjection] - ss).abs() < 1e-9,
+            "{} {ss}",
+            y[Carried::SinProjection]
+        );
+        assert!(
+            (y[Carried::Damping] - damp).abs() < 1e-9,
+            "{} {damp}",
+            y[Carried::Damping]
+        );
     }
 
     #[test]

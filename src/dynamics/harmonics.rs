@@ -13,7 +13,7 @@
 use super::free::FreeFlight;
 use super::model::{Coupling, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver};
-use crate::law::{Branch, ForceLaw};
+use crate::law::{Branch, ContactState, ForceLaw};
 use nalgebra::Complex;
 use serde::Serialize;
 
@@ -53,17 +53,28 @@ const FREE_PIECES_PER_PERIOD: f64 = 40.0;
 
 /// The value at step fraction t of the quintic Hermite interpolant with values p₀, p₁,
 /// first derivatives m₀, m₁ and second derivatives c₀, c₁ at t = 0 and 1 (derivatives
-/// with respect to t).
+/// with respect to t), and its derivative there.
 #[inline]
-fn quintic_hermite(t: f64, (p0, m0, c0): (f64, f64, f64), (p1, m1, c1): (f64, f64, f64)) -> f64 {
+fn quintic_hermite(
+    t: f64,
+    (p0, m0, c0): (f64, f64, f64),
+    (p1, m1, c1): (f64, f64, f64),
+) -> (f64, f64) {
     let (t2, t3) = (t * t, t * t * t);
     let (t4, t5) = (t3 * t, t3 * t2);
-    p0 * (1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5)
+    let value = p0 * (1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5)
         + m0 * (t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5)
         + c0 * 0.5 * (t2 - 3.0 * t3 + 3.0 * t4 - t5)
         + c1 * 0.5 * (t3 - 2.0 * t4 + t5)
         + m1 * (-4.0 * t3 + 7.0 * t4 - 3.0 * t5)
-        + p1 * (10.0 * t3 - 15.0 * t4 + 6.0 * t5)
+        + p1 * (10.0 * t3 - 15.0 * t4 + 6.0 * t5);
+    let slope = p0 * (-30.0 * t2 + 60.0 * t3 - 30.0 * t4)
+        + m0 * (1.0 - 18.0 * t2 + 32.0 * t3 - 15.0 * t4)
+        + c0 * 0.5 * (2.0 * t - 9.0 * t2 + 12.0 * t3 - 5.0 * t4)
+        + c1 * 0.5 * (3.0 * t2 - 8.0 * t3 + 5.0 * t4)
+        + m1 * (-12.0 * t2 + 28.0 * t3 - 15.0 * t4)
+        + p1 * (30.0 * t2 - 60.0 * t3 + 30.0 * t4);
+    (value, slope)
 }
 
 /// Accumulates ∫ x e^{−inΩτ} dτ and ∫ f_ts e^{−inΩτ} dτ for n = 1…[`HIGHEST_HARMONIC`]
@@ -126,9 +137,14 @@ impl<L: ForceLaw> StepObserver for HarmonicsObserver<'_, L> {
         let (start, finish) = (end(from), end(to));
         for (t, w) in GAUSS_NODES {
             let tau = from.tau + t * h;
-            let x = quintic_hermite(t, start, finish);
-            let alpha = self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
-            let f = -self.cpl.f_scale * self.law.t_hat(alpha, branch);
+            let (x, dx_dt) = quintic_hermite(t, start, finish);
+            let (x_b, v_b) = self.osc.base_at(tau);
+            let state = ContactState {
+                alpha_hat: self.cpl.alpha_hat(x, x_b),
+                rate_hat: self.cpl.a1 * (dx_dt / h + v_b),
+                branch,
+            };
+            let f = -self.cpl.f_scale * self.law.force_hat(&state);
             self.add(tau, w * h, x, f);
         }
         self.span += h;
@@ -218,8 +234,10 @@ mod tests {
         let dp = |t: f64| -1.2 + 1.4 * t + 6.0 * t * t - 4.4 * t.powi(3) + 2.0 * t.powi(4);
         let ddp = |t: f64| 1.4 + 12.0 * t - 13.2 * t * t + 8.0 * t.powi(3);
         for t in [0.0, 0.13, 0.5, 0.77, 1.0] {
-            let q = quintic_hermite(t, (p(0.0), dp(0.0), ddp(0.0)), (p(1.0), dp(1.0), ddp(1.0)));
+            let (q, dq) =
+                quintic_hermite(t, (p(0.0), dp(0.0), ddp(0.0)), (p(1.0), dp(1.0), ddp(1.0)));
             assert!((q - p(t)).abs() < 1e-14, "{t}: {q} vs {}", p(t));
+            assert!((dq - dp(t)).abs() < 1e-13, "{t}: {dq} vs {}", dp(t));
         }
     }
 

@@ -8,50 +8,152 @@
 //! with f_ts = −T̂·RΔγ/(kL) and the tip–sample separation α̂ = a₀ + a₁(x + x_b(τ)),
 //! where x_b is the support displacement of a base drive (zero for a force drive).
 
-use crate::law::{Branch, ForceLaw};
+use crate::law::{Branch, ContactState, ForceLaw};
 use nalgebra::{Matrix2x3, SVector};
+use std::ops::{Index, IndexMut};
 
-/// ODE state: deflection, velocity, the per-cycle integrals carried along, and the drive
-/// phasor (cos Ωτ, sin Ωτ), integrated as a rotation so the right-hand side needs no
-/// trigonometric calls (it is reset to the exact values at every segment start). With
-/// `N` = [`TANGENT`] it also carries the variational matrix Φ = ∂(x, x')/∂(x₀, x₀', q)
-/// from [`PHI`] on, q = z_c/L the rest separation (α̂ = a₁(q + x + x_b)), for the
-/// derivative of the period map; with `N` = [`BASE`] it does not, and the hot path pays
-/// nothing for it.
+/// ODE state: each cantilever mode's deflection and velocity, the per-cycle integrals
+/// carried along, and the drive phasor (cos Ωτ, sin Ωτ), integrated as a rotation so the
+/// right-hand side needs no trigonometric calls (it is reset to the exact values at every
+/// segment start). Four layouts, by `N`:
 ///
-/// Two energies are not carried: the contact's E_ts is exact from the law's branch work
-/// functions at the segment ends, and the drive's work follows from the Fourier
-/// projections by parts ([`Oscillator::drive_work`]).
+/// - [`BASE`]: just that, for a law whose force depends on the separation alone;
+/// - [`TANGENT`]: also the variational matrix Φ = ∂(x, x')/∂(x₀, x₀', q) after the base
+///   parts (q = z_c/L the rest separation, α̂ = a₁(q + x + x_b)), for the derivative of
+///   the period map;
+/// - [`RATE`] and [`RATE_TANGENT`]: the same with, last, the work done against a
+///   rate-dependent force ([`dissipative_work_index`]).
+///
+/// The hot path of a law pays only for what it needs (the integrator's error norm, and
+/// so every number, of an elastic law is that of its nine components). Parts are
+/// addressed by name: `y[Part::Deflection(0)]` (or [`X`]), `y[Carried::Damping]`. One
+/// mode today ([`MODES`]); the layout places further modes' deflections and velocities
+/// before the carried integrals.
+///
+/// The contact's elastic E_ts is not carried: it is exact from the branch work functions
+/// at the segment ends. The drive's work follows from the Fourier projections by parts
+/// ([`Oscillator::drive_work`]).
 pub type State<const N: usize = BASE> = SVector<f64, N>;
 
-/// Components of the plain state.
-pub const BASE: usize = 9;
-/// Components of the state with the variational matrix.
-pub const TANGENT: usize = 15;
+/// Cantilever modes in the state.
+pub const MODES: usize = 1;
 
-/// Index of the deflection x in [`State`].
-pub const X: usize = 0;
-/// Velocity x'.
-pub const V: usize = 1;
-/// Energy dissipated by damping, ∫ 2γ x'² dτ.
-pub const E_DAMP: usize = 2;
-/// Fourier projection ∫ x cos Ωτ dτ.
-pub const SC: usize = 3;
-/// Fourier projection ∫ x sin Ωτ dτ.
-pub const SS: usize = 4;
-/// ∫ f_ts dτ (mean force).
-pub const F_INT: usize = 5;
-/// ∫ f_ts x dτ (virial).
-pub const VIRIAL: usize = 6;
-/// cos Ωτ.
-pub const COS: usize = 7;
-/// sin Ωτ.
-pub const SIN: usize = 8;
+/// A per-cycle integral carried in every layout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Carried {
+    /// Energy dissipated by damping, ∫ 2γ x'² dτ.
+    Damping,
+    /// Fourier projection ∫ x cos Ωτ dτ.
+    CosProjection,
+    /// Fourier projection ∫ x sin Ωτ dτ.
+    SinProjection,
+    /// ∫ f_ts dτ (mean force).
+    Force,
+    /// ∫ f_ts x dτ (virial).
+    Virial,
+}
+
+impl Carried {
+    /// How many there are.
+    pub const COUNT: usize = 5;
+}
+
+/// A named part of the state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    /// Deflection of cantilever mode m (0: the first).
+    Deflection(usize),
+    /// Velocity of mode m.
+    Velocity(usize),
+    /// A carried integral.
+    Carried(Carried),
+    /// cos Ωτ.
+    DriveCos,
+    /// sin Ωτ.
+    DriveSin,
+}
+
+impl Part {
+    /// Where this part lives in the state vector.
+    #[inline]
+    pub const fn index(self) -> usize {
+        match self {
+            Part::Deflection(mode) => 2 * mode,
+            Part::Velocity(mode) => 2 * mode + 1,
+            Part::Carried(c) => 2 * MODES + c as usize,
+            Part::DriveCos => 2 * MODES + Carried::COUNT,
+            Part::DriveSin => 2 * MODES + Carried::COUNT + 1,
+        }
+    }
+}
+
+impl<const N: usize> Index<Part> for SVector<f64, N> {
+    type Output = f64;
+    #[inline]
+    fn index(&self, part: Part) -> &f64 {
+        &self[part.index()]
+    }
+}
+
+impl<const N: usize> IndexMut<Part> for SVector<f64, N> {
+    #[inline]
+    fn index_mut(&mut self, part: Part) -> &mut f64 {
+        &mut self[part.index()]
+    }
+}
+
+impl<const N: usize> Index<Carried> for SVector<f64, N> {
+    type Output = f64;
+    #[inline]
+    fn index(&self, c: Carried) -> &f64 {
+        &self[Part::Carried(c)]
+    }
+}
+
+impl<const N: usize> IndexMut<Carried> for SVector<f64, N> {
+    #[inline]
+    fn index_mut(&mut self, c: Carried) -> &mut f64 {
+        &mut self[Part::Carried(c)]
+    }
+}
+
+/// The first mode's deflection x.
+pub const X: Part = Part::Deflection(0);
+/// The first mode's velocity x'.
+pub const V: Part = Part::Velocity(0);
+
+/// Components of the plain state.
+pub const BASE: usize = 2 * MODES + Carried::COUNT + 2;
+/// Components of the state with the variational matrix.
+pub const TANGENT: usize = BASE + 6;
+/// Components of the plain state of a rate-dependent law.
+pub const RATE: usize = BASE + 1;
+/// Components of the state of a rate-dependent law with the variational matrix.
+pub const RATE_TANGENT: usize = TANGENT + 1;
+
+/// Whether layout `N` carries the variational matrix Φ.
+#[inline]
+pub const fn has_tangent(n: usize) -> bool {
+    n == TANGENT || n == RATE_TANGENT
+}
+
+/// Where layout `N` carries the work done against a rate-dependent force,
+/// ∫ T̂_d dα̂ (dimensionless, the contact's units; what a viscous sample dissipates): the
+/// last component of [`RATE`] and [`RATE_TANGENT`], nowhere in the others.
+#[inline]
+pub const fn dissipative_work_index(n: usize) -> Option<usize> {
+    if n == RATE || n == RATE_TANGENT {
+        Some(n - 1)
+    } else {
+        None
+    }
+}
+
 /// First of the six entries of Φ, column by column: ∂(x, x')/∂x₀, ∂(x, x')/∂x₀',
 /// ∂(x, x')/∂q.
-pub const PHI: usize = 9;
+const PHI: usize = BASE;
 
-/// Φ of a [`TANGENT`] state as a matrix.
+/// Φ of a state with a tangent ([`has_tangent`]) as a matrix.
 #[inline]
 pub fn phi<const N: usize>(y: &State<N>) -> Matrix2x3<f64> {
     Matrix2x3::from_column_slice(&y.as_slice()[PHI..PHI + 6])
@@ -81,8 +183,8 @@ pub fn chain(first: &Matrix2x3<f64>, then: &Matrix2x3<f64>) -> Matrix2x3<f64> {
 #[inline]
 pub fn set_phasor<const N: usize>(osc: &Oscillator, tau: f64, y: &mut State<N>) {
     let (s, c) = (osc.omega * tau).sin_cos();
-    y[COS] = c;
-    y[SIN] = s;
+    y[Part::DriveCos] = c;
+    y[Part::DriveSin] = s;
 }
 
 /// How the cantilever is driven.
@@ -208,8 +310,9 @@ impl Coupling {
 }
 
 /// The right-hand side of the equation of motion and of the carried integrals; for a
-/// [`TANGENT`] state also of the variational equations δx'' + 2γδx' + δx = (∂f_ts/∂x)δx
-/// (+ ∂f_ts/∂q for the q column), ∂f_ts/∂x = ∂f_ts/∂q = −f_scale·a₁·dT̂/dα̂.
+/// [`TANGENT`] state also of the variational equations δx'' + 2γδx' + δx =
+/// (∂f_ts/∂x)δx + (∂f_ts/∂x')δx' (+ ∂f_ts/∂q for the q column), ∂f_ts/∂x = ∂f_ts/∂q =
+/// −f_scale·a₁·∂T̂/∂α̂, ∂f_ts/∂x' = −f_scale·a₁·∂T̂/∂(dα̂/dτ) (a rate-dependent law's).
 #[inline]
 pub fn rhs<L: ForceLaw, const N: usize>(
     law: &L,
@@ -222,28 +325,47 @@ pub fn rhs<L: ForceLaw, const N: usize>(
 ) {
     let _ = tau;
     let (x, v) = (y[X], y[V]);
-    let (s, c) = (y[SIN], y[COS]);
+    let (s, c) = (y[Part::DriveSin], y[Part::DriveCos]);
     let (drive, x_b) = osc.drive_from(c);
     let alpha = cpl.alpha_hat(x, x_b);
-    let f = -cpl.f_scale * law.t_hat(alpha, branch);
-    if N == TANGENT {
-        let stiffness = -cpl.f_scale * cpl.a1 * law.slope_hat(alpha, branch);
+    let elastic = law.t_hat(alpha, branch);
+    let mut state = None;
+    let dissipative = if law.is_rate_dependent() {
+        let at = ContactState {
+            alpha_hat: alpha,
+            rate_hat: cpl.a1 * (v + osc.base_from((s, c)).1),
+            branch,
+        };
+        state = Some(at);
+        law.dissipative_t_hat(&at)
+    } else {
+        0.0
+    };
+    let f = -cpl.f_scale * (elastic + dissipative);
+    if has_tangent(N) {
+        let (d_alpha, d_rate) = state.map_or((0.0, 0.0), |at| law.dissipative_slopes_hat(&at));
+        let k = -cpl.f_scale * cpl.a1;
+        let stiffness = k * (law.slope_hat(alpha, branch) + d_alpha);
+        let damping = k * d_rate;
         for col in [PHI, PHI + 2, PHI + 4] {
             let (dx, dv) = (y[col], y[col + 1]);
             dy[col] = dv;
-            dy[col + 1] = -2.0 * osc.gamma * dv - dx + stiffness * dx;
+            dy[col + 1] = -2.0 * osc.gamma * dv - dx + stiffness * dx + damping * dv;
         }
         dy[PHI + 5] += stiffness;
     }
     dy[X] = v;
     dy[V] = -2.0 * osc.gamma * v - x + f + drive;
-    dy[E_DAMP] = 2.0 * osc.gamma * v * v;
-    dy[SC] = x * c;
-    dy[SS] = x * s;
-    dy[F_INT] = f;
-    dy[VIRIAL] = f * x;
-    dy[COS] = -osc.omega * s;
-    dy[SIN] = osc.omega * c;
+    dy[Carried::Damping] = 2.0 * osc.gamma * v * v;
+    dy[Carried::CosProjection] = x * c;
+    dy[Carried::SinProjection] = x * s;
+    dy[Carried::Force] = f;
+    dy[Carried::Virial] = f * x;
+    if let (Some(i), Some(at)) = (dissipative_work_index(N), state) {
+        dy[i] = dissipative * at.rate_hat;
+    }
+    dy[Part::DriveCos] = -osc.omega * s;
+    dy[Part::DriveSin] = osc.omega * c;
 }
 
 #[cfg(test)]

@@ -13,13 +13,14 @@
 //! three smooth steps instead of a cascade of shrinking ones onto the cusp.
 
 use super::budget;
-use super::model::{BASE, COS, Coupling, Oscillator, SIN, State, TANGENT, V, X, rhs, set_phasor};
+use super::model::{BASE, Coupling, Oscillator, Part, State, V, X, has_tangent, rhs, set_phasor};
 use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw};
 use crate::numeric::bracketed_root;
 use ode_solvers::dop_shared::{OutputType, System};
 use ode_solvers::dopri5::Dopri5;
 use std::cell::Cell;
+use std::ops::Index;
 
 /// Tolerances and step limits of the integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -89,9 +90,12 @@ impl<A: StepObserver, B: StepObserver> StepObserver for (A, B) {
     }
 }
 
-/// Cubic Hermite interpolation of component `i` on the step [a, b] at τ.
+/// Cubic Hermite interpolation of part `i` on the step [a, b] at τ.
 #[inline]
-pub fn hermite<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, i: usize, tau: f64) -> f64 {
+pub fn hermite<const N: usize, I: Copy>(a: &StepEnd<N>, b: &StepEnd<N>, i: I, tau: f64) -> f64
+where
+    State<N>: Index<I, Output = f64>,
+{
     let h = b.tau - a.tau;
     let t = (tau - a.tau) / h;
     let (t2, t3) = (t * t, t * t * t);
@@ -289,7 +293,7 @@ impl<L: ForceLaw, const N: usize> Approach<'_, L, N> {
     fn tau_form(&self, w: f64, y: &State<N>) -> (f64, State<N>) {
         let u = self.u0 - w;
         let alpha = self.level - self.sigma * u * u;
-        let (x_b, _) = self.osc.base_from((y[SIN], y[COS]));
+        let (x_b, _) = self.osc.base_from((y[Part::DriveSin], y[Part::DriveCos]));
         let mut z = *y;
         z[X] = self.cpl.x_at(alpha) - x_b;
         (y[X], z)
@@ -301,7 +305,7 @@ impl<L: ForceLaw, const N: usize> System<f64, State<N>> for Approach<'_, L, N> {
     fn system(&self, w: f64, y: &State<N>, dy: &mut State<N>) {
         let (tau, z) = self.tau_form(w, y);
         rhs(self.law, self.osc, self.cpl, self.branch, tau, &z, dy);
-        let (_, v_b) = self.osc.base_from((z[SIN], z[COS]));
+        let (_, v_b) = self.osc.base_from((z[Part::DriveSin], z[Part::DriveCos]));
         let mut rate = self.sigma * self.cpl.a1 * (z[V] + v_b);
         if rate.is_nan() || rate < self.min_rate {
             self.landing.failed.set(true);
@@ -471,7 +475,7 @@ fn run<S: System<f64, State<N>>, const N: usize>(
         Branch::Free => "out-of-contact",
         Branch::Contact => "contact",
     };
-    let segment_cap = if N == TANGENT {
+    let segment_cap = if has_tangent(N) {
         MAX_TANGENT_STEPS
     } else {
         MAX_SEGMENT_STEPS
@@ -706,7 +710,7 @@ impl<L: ForceLaw> Span<'_, L> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::model::{BASE, Drive, E_DAMP, SC, SS};
+    use crate::dynamics::model::{BASE, Carried, Drive};
 
     /// Free branch force-free; contact branch with a square-root fold at α̂ = LEVEL,
     /// continued past it by point reflection, like the JKR branch at C.
@@ -794,9 +798,14 @@ mod tests {
             assert!((located.y[X] - LEVEL).abs() < 2e-8, "{}", located.y[X]);
             let (t1, t2) = (landed.tau, located.tau);
             assert!((t1 - t2).abs() < 1e-7, "{v0}: {t1} {t2}");
-            for i in [V, E_DAMP, SC, SS] {
+            for i in [
+                V,
+                Part::Carried(Carried::Damping),
+                Part::Carried(Carried::CosProjection),
+                Part::Carried(Carried::SinProjection),
+            ] {
                 let (a, b) = (landed.y[i], located.y[i]);
-                assert!((a - b).abs() < 1e-7, "{v0}, {i}: {a} {b}");
+                assert!((a - b).abs() < 1e-7, "{v0}, {i:?}: {a} {b}");
             }
         }
     }

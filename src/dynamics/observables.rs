@@ -8,7 +8,7 @@ use super::numeric::{StepEnd, StepObserver, hermite};
 use super::setup::{Numerics, Prepared, TapSetup};
 use super::steady::{CycleIntegrals, Motion, SteadyState};
 use crate::error::{Error, Result};
-use crate::law::{Branch, ForceLaw};
+use crate::law::{Branch, ContactState, ForceLaw};
 use crate::params::ELECTRONVOLT_J;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -301,9 +301,15 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
             self.overflowed = true;
             return;
         }
-        let alpha = self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
+        let (x_b, v_b) = self.osc.base_at(tau);
+        let alpha = self.cpl.alpha_hat(x, x_b);
+        let state = ContactState {
+            alpha_hat: alpha,
+            rate_hat: self.cpl.a1 * (v + v_b),
+            branch,
+        };
         // (+ 0.0 turns the −0 of a force-free branch into 0.)
-        let f = -self.cpl.f_scale * self.law.t_hat(alpha, branch) + 0.0;
+        let f = -self.cpl.f_scale * self.law.force_hat(&state) + 0.0;
         self.samples.push((tau, x, v, alpha, f, branch));
     }
 
@@ -377,7 +383,7 @@ pub struct TapRun {
 /// use tapsim::{LawKind, Numerics, Observe, TapSetup, default_setup, tap};
 ///
 /// // The built-in silicon cantilever on a polymer, with the paper's hybrid law.
-/// let setup = TapSetup { law: LawKind::Hybrid, ..default_setup() };
+/// let setup = TapSetup { law: LawKind::Hybrid.into(), ..default_setup() };
 /// let o = tap(&setup, &Numerics::default(), Observe::default())?.observables;
 /// assert_eq!(o.regime, "period-1");
 /// assert!(o.energy_balance_rel < 1e-6);

@@ -6,7 +6,7 @@ use super::model::{Coupling, Drive, Oscillator};
 use super::numeric::Tolerances;
 use super::steady::{MIN_CYCLES, Simulation, SteadyOptions};
 use crate::error::{Error, Result, finite, positive};
-use crate::law::{AnyLaw, LawKind};
+use crate::law::{AnyLaw, LawKind, LawSpec};
 use crate::params::{Contact, composite_modulus};
 use serde::{Deserialize, Serialize};
 
@@ -59,10 +59,8 @@ pub struct TapSetup {
     pub cantilever: Cantilever,
     /// Rest separation z_c in m (α = z_c + z).
     pub separation_m: f64,
-    /// Tip–sample force law.
-    pub law: LawKind,
-    /// Hamaker constant for the DMT law in J (default 12πε²Δγ).
-    pub hamaker_j: Option<f64>,
+    /// Tip–sample force law, with its own parameters.
+    pub law: LawSpec,
 }
 
 /// Built-in defaults: a silicon tapping cantilever (k = 40 N/m, f₀ = 300 kHz, Q = 400,
@@ -81,8 +79,7 @@ pub fn default_setup() -> TapSetup {
             drive_frequency_hz: 300e3,
         },
         separation_m: 16e-9,
-        law: LawKind::Hybrid,
-        hamaker_j: None,
+        law: LawKind::Hybrid.into(),
     }
 }
 
@@ -364,17 +361,21 @@ impl TapSetup {
         }
         .check(k.omega_ratio())?;
         separation_in_range(self.separation_m, k.free_amplitude_m)?;
-        if let Some(hamaker) = self.hamaker_j {
-            Range {
-                what: "Hamaker constant",
-                unit: "J",
-                lo: 1e-22,
-                hi: 1e-17,
-                why: "the range of real materials, about 1e-20 J",
-                meant: None,
+        for (param, value) in self.law.params() {
+            if let Some(value) = value {
+                let (lo, hi, why) = param.range;
+                Range {
+                    what: param.name,
+                    unit: param.unit,
+                    lo,
+                    hi,
+                    why,
+                    meant: None,
+                }
+                .check(value)?;
             }
-            .check(hamaker)?;
         }
+        self.law.check()?;
         Ok(())
     }
 }
@@ -408,7 +409,7 @@ impl Prepared {
             setup.contact.range_m,
         )?;
         setup.check_plausible()?;
-        let law = AnyLaw::new(setup.law, &c, setup.hamaker_j)?;
+        let law = AnyLaw::new(&setup.law, &c, cantilever.resonance_hz)?;
         let osc = Oscillator {
             gamma: 0.5 / cantilever.quality,
             omega: cantilever.omega_ratio(),

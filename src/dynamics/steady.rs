@@ -18,12 +18,12 @@
 use super::budget;
 use super::free::FreeFlight;
 use super::model::{
-    BASE, Coupling, E_DAMP, F_INT, Oscillator, SC, SS, State, TANGENT, V, VIRIAL, X, chain, phi,
-    phi_start, set_phi,
+    BASE, Carried, Coupling, Oscillator, RATE, RATE_TANGENT, State, TANGENT, V, X, chain,
+    dissipative_work_index, has_tangent, phi, phi_start, set_phi,
 };
 use super::numeric::{self, Crossing, StepEnd, StepObserver, Tolerances, hermite};
 use crate::error::{Error, Result};
-use crate::law::{Branch, ForceLaw};
+use crate::law::{Branch, ContactState, ForceLaw};
 use nalgebra::{Complex, Matrix2, Matrix2x3, Vector2};
 
 /// Where the oscillator is: time, deflection, velocity and contact branch.
@@ -68,8 +68,9 @@ pub struct CycleIntegrals {
     pub periods: u32,
     /// Length of the span in τ (`periods` drive periods).
     pub period: f64,
-    /// Energy dissipated in the contact, ∮ −f_ts dα, summed from the branch work functions
-    /// between the located switches (exact for the computed path).
+    /// Energy dissipated in the contact, ∮ −f_ts dα: the elastic part summed from the
+    /// branch work functions between the located switches (exact for the computed path),
+    /// a rate-dependent part from its carried integral.
     pub e_ts: f64,
     /// Energy dissipated by damping.
     pub e_damp: f64,
@@ -163,14 +164,20 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
         // derivative (a quadratic in the step fraction) vanishes.
         // The force there is an extreme too when the law is monotonic on the branch, as
         // every contact branch is: sampling step ends alone would miss the peak.
-        self.max_f = self.max_f.max(b.dy[F_INT]);
-        self.min_f = self.min_f.min(b.dy[F_INT]);
+        self.max_f = self.max_f.max(b.dy[Carried::Force]);
+        self.min_f = self.min_f.min(b.dy[Carried::Force]);
         if a.y[V] < 0.0 && b.y[V] > 0.0 {
             let t = hermite_minimum(a, b);
             let tau = a.tau + t * (b.tau - a.tau);
             let turn = alpha(tau, hermite(a, b, X, tau));
             lowest = lowest.min(turn);
-            let f = -self.cpl.f_scale * self.law.t_hat(turn, branch);
+            // (The tip is at rest there; the support may not be.)
+            let state = ContactState {
+                alpha_hat: turn,
+                rate_hat: self.cpl.a1 * self.osc.base_at(tau).1,
+                branch,
+            };
+            let f = -self.cpl.f_scale * self.law.force_hat(&state);
             self.max_f = self.max_f.max(f);
             self.min_f = self.min_f.min(f);
         }
@@ -347,7 +354,11 @@ impl<L: ForceLaw> Simulation<'_, L> {
         phase: &mut Phase,
         observer: &mut O,
     ) -> Result<CycleIntegrals> {
-        Ok(self.cycle_in::<BASE, O>(phase, observer)?.0)
+        Ok(if self.law.is_rate_dependent() {
+            self.cycle_in::<RATE, O>(phase, observer)?.0
+        } else {
+            self.cycle_in::<BASE, O>(phase, observer)?.0
+        })
     }
 
     /// Integrate one drive period from `phase`, updating it, with the derivative of the
@@ -359,7 +370,11 @@ impl<L: ForceLaw> Simulation<'_, L> {
         &self,
         phase: &mut Phase,
     ) -> Result<(CycleIntegrals, Matrix2x3<f64>)> {
-        self.cycle_in::<TANGENT, _>(phase, &mut numeric::Ignore)
+        if self.law.is_rate_dependent() {
+            self.cycle_in::<RATE_TANGENT, _>(phase, &mut numeric::Ignore)
+        } else {
+            self.cycle_in::<TANGENT, _>(phase, &mut numeric::Ignore)
+        }
     }
 
     /// Move `phase` back by whole drive periods to τ in [0, T): the drive is periodic,
@@ -387,12 +402,17 @@ impl<L: ForceLaw> Simulation<'_, L> {
 
     /// Apply the saltation matrix of a switch `from` → `to` in state `y` at τ.
     fn saltation<const N: usize>(&self, tau: f64, y: &mut State<N>, from: Branch, to: Branch) {
-        if N != TANGENT {
+        if !has_tangent(N) {
             return;
         }
         let (x_b, v_b) = self.osc.base_at(tau);
-        let alpha = self.cpl.alpha_hat(y[X], x_b);
-        let jump = -self.cpl.f_scale * (self.law.t_hat(alpha, to) - self.law.t_hat(alpha, from));
+        let at = |branch| ContactState {
+            alpha_hat: self.cpl.alpha_hat(y[X], x_b),
+            rate_hat: self.cpl.a1 * (y[V] + v_b),
+            branch,
+        };
+        let jump =
+            -self.cpl.f_scale * (self.law.force_hat(&at(to)) - self.law.force_hat(&at(from)));
         if jump == 0.0 {
             return;
         }
@@ -416,7 +436,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let mut y = State::<N>::zeros();
         y[X] = phase.x;
         y[V] = phase.v;
-        if N == TANGENT {
+        if has_tangent(N) {
             set_phi(&mut y, &phi_start());
         }
         let mechanical = |y: &State<N>| 0.5 * (y[X] * y[X] + y[V] * y[V]);
@@ -503,6 +523,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 phase.branch = next;
             }
         }
+        // A rate-dependent force's work, carried along (zero for every other law).
+        if let Some(i) = dissipative_work_index(N) {
+            e_ts += work_scale * y[i];
+        }
         phase.tau = tau_end;
         phase.x = y[X];
         phase.v = y[V];
@@ -510,13 +534,18 @@ impl<L: ForceLaw> Simulation<'_, L> {
             periods: 1,
             period,
             e_ts,
-            e_damp: y[E_DAMP],
-            e_drive: self.osc.drive_work(start, (tau, y[X], y[V]), y[SC], y[SS]),
+            e_damp: y[Carried::Damping],
+            e_drive: self.osc.drive_work(
+                start,
+                (tau, y[X], y[V]),
+                y[Carried::CosProjection],
+                y[Carried::SinProjection],
+            ),
             delta_mechanical: mechanical(&y) - e0,
-            sc: y[SC],
-            ss: y[SS],
-            f_int: y[F_INT],
-            virial_int: y[VIRIAL],
+            sc: y[Carried::CosProjection],
+            ss: y[Carried::SinProjection],
+            f_int: y[Carried::Force],
+            virial_int: y[Carried::Virial],
             contact_time,
             min_alpha_hat: tracker.min_alpha,
             max_force: tracker.max_f,
@@ -524,7 +553,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             jumps_in,
             jumps_out,
         };
-        let derivative = if N == TANGENT { phi(&y) } else { phi_start() };
+        let derivative = if has_tangent(N) { phi(&y) } else { phi_start() };
         Ok((integrals, derivative))
     }
 

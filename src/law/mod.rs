@@ -10,12 +10,16 @@
 mod adhesive;
 mod conservative;
 mod fold_branch;
+mod registry;
 mod table;
+mod viscous;
 
 pub use adhesive::AdhesiveLaw;
 pub use conservative::{DmtLaw, HertzLaw, NoForce};
 pub use fold_branch::{FarField, FoldBranch, Side};
+pub use registry::{LAW_PARAMS, LAWS, LawInfo, LawParam, LawSpec};
 pub use table::UniformTable;
+pub use viscous::KelvinVoigt;
 
 use crate::contact::hybrid::JumpIn;
 use crate::contact::lj::Reach;
@@ -34,7 +38,23 @@ pub enum Branch {
     Contact,
 }
 
+/// What a law sees of the contact at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactState {
+    /// Separation α̂.
+    pub alpha_hat: f64,
+    /// Its rate dα̂/dτ (τ = ω₀t).
+    pub rate_hat: f64,
+    /// The branch.
+    pub branch: Branch,
+}
+
 /// A two-branch tip–sample force law in dimensionless variables.
+///
+/// The force is T̂(α̂, branch) + T̂_d(state): an elastic (possibly hysteretic) part with a
+/// work function per branch, and a rate-dependent part, zero unless the law says
+/// otherwise, whose work the integrator carries as an integral (a viscous sample has no
+/// work function).
 pub trait ForceLaw: Send + Sync {
     /// Force T̂ (tensile positive) at separation α̂ on `branch`. Finite for every finite
     /// α̂, including past a branch's own end (integrator trial stages overshoot).
@@ -55,31 +75,51 @@ pub trait ForceLaw: Send + Sync {
     fn free_branch_is_force_free(&self) -> bool;
     /// Area of the force loop, ∮ T̂ dα̂ over one full traversal (Ŵ; 0 if conservative).
     fn loop_area_hat(&self) -> f64;
+    /// Whether the force has a rate-dependent part (if not, the integrator never asks
+    /// for it).
+    fn is_rate_dependent(&self) -> bool {
+        false
+    }
+    /// The rate-dependent part T̂_d of the force at `state` (0 by default). Zero at
+    /// zero rate, and continuous across the branch switches.
+    fn dissipative_t_hat(&self, _state: &ContactState) -> f64 {
+        0.0
+    }
+    /// ∂T̂_d/∂α̂ and ∂T̂_d/∂(dα̂/dτ) at `state`, for the variational equations (finite
+    /// everywhere).
+    fn dissipative_slopes_hat(&self, _state: &ContactState) -> (f64, f64) {
+        (0.0, 0.0)
+    }
+    /// The whole force T̂ + T̂_d at `state`.
+    #[inline]
+    fn force_hat(&self, state: &ContactState) -> f64 {
+        let elastic = self.t_hat(state.alpha_hat, state.branch);
+        if self.is_rate_dependent() {
+            elastic + self.dissipative_t_hat(state)
+        } else {
+            elastic
+        }
+    }
 }
 
-/// The laws on offer.
+/// The laws on offer (their names and help text are in the registry, [`LAWS`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "app", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum LawKind {
-    /// The paper's hybrid law: force-free approach, jump-in at α̂_A from (17), JKR contact
-    /// branch (5), jump-out at α̂_C (8). Loop area Ŵ_hybrid (18).
+    /// The paper's hybrid law, eqs. (17), (5), (8), (18).
     #[default]
     Hybrid,
-    /// The hybrid law with Greenwood's semi-rigid attraction (12), (14) on the approach
-    /// branch, jumping in at that curve's own fold (15).
+    /// The hybrid law with Greenwood's semi-rigid attraction, eqs. (12), (14), (15).
     HybridAttractive,
-    /// Classic JKR: no force before contact, jump-in at α̂ = 0, jump-out at α̂_C.
+    /// Classic JKR.
     Jkr,
-    /// DMT as VEDA and dForce define it: −HR/(6d²) outside, Hertz plus constant adhesion
-    /// inside, d = α + a₀, a₀ = ε. Conservative.
+    /// DMT as VEDA and dForce define it.
     Dmt,
-    /// Hertz: repulsion (4/3)E*√R δ^{3/2} for indentation δ = −α > 0. Conservative.
+    /// Hertz.
     Hertz,
-    /// The Lennard-Jones law (10), tabulated from the full numerical solution (both
-    /// branches, jumps at its folds A and C; first use per μ solves it, then cached).
+    /// The Lennard-Jones law (10), tabulated from the full numerical solution.
     Lj,
-    /// No tip–sample force (free cantilever).
+    /// No tip–sample force.
     None,
 }
 
@@ -95,23 +135,29 @@ impl LawKind {
         LawKind::None,
     ];
 
+    /// What the registry says of this law.
+    pub fn info(self) -> &'static LawInfo {
+        LAWS.iter()
+            .find(|l| l.kind == self)
+            .expect("every law is registered")
+    }
+
+    /// The law a user names (as `--law` takes it), if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        LAWS.iter()
+            .find(|l| l.name.eq_ignore_ascii_case(name.trim()))
+            .map(|l| l.kind)
+    }
+
     /// The names of every law as a user types them.
     pub fn names() -> Vec<String> {
-        Self::ALL.iter().map(ToString::to_string).collect()
+        LAWS.iter().map(|l| l.name.to_string()).collect()
     }
 }
 
 impl fmt::Display for LawKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            LawKind::Hybrid => "hybrid",
-            LawKind::HybridAttractive => "hybrid-attractive",
-            LawKind::Jkr => "jkr",
-            LawKind::Dmt => "dmt",
-            LawKind::Hertz => "hertz",
-            LawKind::Lj => "lj",
-            LawKind::None => "none",
-        })
+        f.write_str(self.info().name)
     }
 }
 
@@ -131,12 +177,18 @@ pub enum AnyLaw {
     Hertz(HertzLaw),
     /// none.
     None(NoForce),
+    /// Any of the above with a Kelvin–Voigt viscous sample.
+    Viscous(Box<KelvinVoigt<AnyLaw>>),
 }
 
 impl AnyLaw {
-    /// Build law `kind` for `contact`; `hamaker_j` overrides the DMT Hamaker constant
-    /// H = 12πε²Δγ. Refuses, naming a law that applies, where `kind` does not apply.
-    pub fn new(kind: LawKind, contact: &Contact, hamaker_j: Option<f64>) -> Result<Self> {
+    /// Build the law `spec` asks for on `contact`, for a cantilever resonating at
+    /// `resonance_hz` (the time scale of a rate-dependent force). Refuses, naming a law
+    /// that applies, where the law does not apply, and names a parameter the law does
+    /// not take.
+    pub fn new(spec: &LawSpec, contact: &Contact, resonance_hz: f64) -> Result<Self> {
+        spec.check()?;
+        let kind = spec.kind;
         let mu = contact.tabor_mu();
         let refuse = |why: String| {
             Error::NotApplicable(format!(
@@ -144,7 +196,7 @@ impl AnyLaw {
                  use the DMT law (small mu) or JKR"
             ))
         };
-        Ok(match kind {
+        let elastic = match kind {
             LawKind::Hybrid => AnyLaw::Adhesive(
                 AdhesiveLaw::hybrid(mu, JumpIn::Fit).map_err(|e| refuse(e.to_string()))?,
             ),
@@ -152,7 +204,7 @@ impl AnyLaw {
                 AdhesiveLaw::hybrid_attractive(mu).map_err(|e| refuse(e.to_string()))?,
             ),
             LawKind::Jkr => AnyLaw::Adhesive(AdhesiveLaw::jkr()),
-            LawKind::Dmt => AnyLaw::Dmt(DmtLaw::new(contact, hamaker_j)?),
+            LawKind::Dmt => AnyLaw::Dmt(DmtLaw::new(contact, spec.hamaker_j)?),
             LawKind::Hertz => AnyLaw::Hertz(HertzLaw),
             LawKind::Lj => AnyLaw::Adhesive(
                 AdhesiveLaw::lennard_jones(
@@ -165,6 +217,15 @@ impl AnyLaw {
                 .map_err(|e| refuse(e.to_string()))?,
             ),
             LawKind::None => AnyLaw::None(NoForce),
+        };
+        Ok(match spec.viscosity_pa_s {
+            Some(eta) => AnyLaw::Viscous(Box::new(KelvinVoigt::new(
+                elastic,
+                eta,
+                contact,
+                resonance_hz,
+            )?)),
+            None => elastic,
         })
     }
 }
@@ -177,6 +238,7 @@ macro_rules! dispatch {
             AnyLaw::Dmt($l) => $e,
             AnyLaw::Hertz($l) => $e,
             AnyLaw::None($l) => $e,
+            AnyLaw::Viscous($l) => $e,
         }
     };
 }
@@ -205,6 +267,17 @@ impl ForceLaw for AnyLaw {
     fn loop_area_hat(&self) -> f64 {
         dispatch!(self, l => l.loop_area_hat())
     }
+    #[inline]
+    fn is_rate_dependent(&self) -> bool {
+        matches!(self, AnyLaw::Viscous(_))
+    }
+    #[inline]
+    fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
+        dispatch!(self, l => l.dissipative_t_hat(state))
+    }
+    fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
+        dispatch!(self, l => l.dissipative_slopes_hat(state))
+    }
 }
 
 #[cfg(test)]
@@ -212,9 +285,17 @@ mod tests {
     use super::*;
 
     #[test]
-    #[cfg(feature = "app")]
-    fn every_law_is_listed_once() {
-        use clap::ValueEnum;
-        assert_eq!(LawKind::ALL.to_vec(), LawKind::value_variants().to_vec());
+    fn every_law_is_registered_once_under_a_name_that_parses_back() {
+        for kind in LawKind::ALL {
+            assert_eq!(
+                LAWS.iter().filter(|l| l.kind == kind).count(),
+                1,
+                "{kind:?}"
+            );
+            assert_eq!(LawKind::from_name(&kind.to_string()), Some(kind));
+        }
+        assert_eq!(LAWS.len(), LawKind::ALL.len());
+        assert_eq!(LawKind::from_name(" JKR "), Some(LawKind::Jkr));
+        assert_eq!(LawKind::from_name("jkr2"), None);
     }
 }

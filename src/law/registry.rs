@@ -1,0 +1,176 @@
+//! The registry of force laws: each law's name, help and parameters, and the
+//! specification a setup carries ([`LawSpec`]). Everything that lists, names, parses or
+//! documents laws (the command line, parameter files, reports) reads it from here.
+
+use super::LawKind;
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// What the registry says of one law.
+#[derive(Debug)]
+pub struct LawInfo {
+    /// The law.
+    pub kind: LawKind,
+    /// Its name as a user types it.
+    pub name: &'static str,
+    /// One paragraph of help.
+    pub help: &'static str,
+}
+
+/// Every law, in the order of the help.
+pub const LAWS: [LawInfo; 7] = [
+    LawInfo {
+        kind: LawKind::Hybrid,
+        name: "hybrid",
+        help: "the paper's hybrid law: force-free approach, jump-in at α̂_A of eq. (17), \
+               JKR contact branch (5), jump-out at α̂_C (8); loop area Ŵ_hybrid (18)",
+    },
+    LawInfo {
+        kind: LawKind::HybridAttractive,
+        name: "hybrid-attractive",
+        help: "the hybrid law with Greenwood's semi-rigid attraction (12), (14) on the \
+               approach branch, jumping in at that curve's own fold (15)",
+    },
+    LawInfo {
+        kind: LawKind::Jkr,
+        name: "jkr",
+        help: "classic JKR: no force before contact, jump-in at α = 0, jump-out at α̂_C (8)",
+    },
+    LawInfo {
+        kind: LawKind::Dmt,
+        name: "dmt",
+        help: "DMT as VEDA and dForce define it: −HR/(6d²) outside, Hertz plus constant \
+               adhesion inside, d = α + ε; conservative",
+    },
+    LawInfo {
+        kind: LawKind::Hertz,
+        name: "hertz",
+        help: "Hertz repulsion (4/3)E*√R δ^{3/2} for indentation δ = −α > 0; conservative",
+    },
+    LawInfo {
+        kind: LawKind::Lj,
+        name: "lj",
+        help: "the Lennard-Jones law (10) tabulated from the full numerical solution: both \
+               branches, jumps at its folds A and C (first use per μ solves it)",
+    },
+    LawInfo {
+        kind: LawKind::None,
+        name: "none",
+        help: "no tip–sample force (a free cantilever)",
+    },
+];
+
+/// A parameter some laws take beyond the contact's own.
+#[derive(Debug)]
+pub struct LawParam {
+    /// Its key (the flag's and the parameter file's name).
+    pub key: &'static str,
+    /// What it is, as messages name it.
+    pub name: &'static str,
+    /// Its SI unit.
+    pub unit: &'static str,
+    /// One line of help.
+    pub help: &'static str,
+    /// Whether `law` takes it.
+    pub taken_by: fn(LawKind) -> bool,
+    /// Its plausible range (lo, hi) in the SI unit, and why.
+    pub range: (f64, f64, &'static str),
+}
+
+/// Every law parameter.
+pub const LAW_PARAMS: [LawParam; 2] = [
+    LawParam {
+        key: "hamaker",
+        name: "Hamaker constant",
+        unit: "J",
+        help: "Hamaker constant H of the dmt law (default 12πε²Δγ, whose pull-off is 2πRΔγ)",
+        taken_by: |law| law == LawKind::Dmt,
+        range: (1e-22, 1e-17, "the range of real materials, about 1e-20 J"),
+    },
+    LawParam {
+        key: "viscosity",
+        name: "sample viscosity",
+        unit: "Pa·s",
+        help: "Kelvin–Voigt viscosity η of the sample: a force η√(Rδ)·dδ/dt opposing the \
+               indentation rate, added to any contact law (dForce's and pyDAMPF's form)",
+        taken_by: |law| law != LawKind::None,
+        range: (
+            1e-6,
+            1e6,
+            "from water (1e-3 Pa·s) to polymer melts; 0 is no viscosity (leave it out)",
+        ),
+    },
+];
+
+/// A force law with its own parameters: what a setup asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct LawSpec {
+    /// The law.
+    pub kind: LawKind,
+    /// DMT's Hamaker constant H in J (default 12πε²Δγ).
+    pub hamaker_j: Option<f64>,
+    /// Kelvin–Voigt viscosity η of the sample in Pa·s (none: elastic).
+    pub viscosity_pa_s: Option<f64>,
+}
+
+impl From<LawKind> for LawSpec {
+    fn from(kind: LawKind) -> Self {
+        Self {
+            kind,
+            ..Self::default()
+        }
+    }
+}
+
+impl LawSpec {
+    /// Each law parameter with its value in this spec (`None`: not set).
+    pub fn params(&self) -> [(&'static LawParam, Option<f64>); 2] {
+        [
+            (&LAW_PARAMS[0], self.hamaker_j),
+            (&LAW_PARAMS[1], self.viscosity_pa_s),
+        ]
+    }
+
+    /// The same parameters for law `kind`, leaving out those it does not take (a sweep
+    /// over laws on one material).
+    pub fn with_kind(&self, kind: LawKind) -> Self {
+        let keep = |i: usize, value: Option<f64>| value.filter(|_| (LAW_PARAMS[i].taken_by)(kind));
+        Self {
+            kind,
+            hamaker_j: keep(0, self.hamaker_j),
+            viscosity_pa_s: keep(1, self.viscosity_pa_s),
+        }
+    }
+
+    /// Refuse a parameter the law does not take, naming the laws that do.
+    pub fn check(&self) -> Result<()> {
+        for (param, value) in self.params() {
+            if value.is_some() && !(param.taken_by)(self.kind) {
+                return Err(Error::NotApplicable(format!(
+                    "the {} law takes no {} parameter (the laws that do: {})",
+                    self.kind,
+                    param.key,
+                    LawKind::ALL
+                        .iter()
+                        .filter(|k| (param.taken_by)(**k))
+                        .map(ToString::to_string)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for LawSpec {
+    /// The law's name, with "+kelvin-voigt" for a viscous sample.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.kind)?;
+        if self.viscosity_pa_s.is_some() {
+            f.write_str("+kelvin-voigt")?;
+        }
+        Ok(())
+    }
+}
