@@ -17,6 +17,7 @@ pub mod law;
 pub mod numeric;
 pub mod params;
 pub mod quasistatic;
+pub mod summary;
 pub mod sweep;
 
 // The application on top (feature `app`, on by default).
@@ -39,8 +40,9 @@ pub use contact::lj::{LjSolution, Reach};
 pub use dynamics::observables::{Observe, TapObservables, TapRun, tap};
 pub use dynamics::setup::{Cantilever, Numerics, TapSetup, default_setup};
 pub use error::{Error, Result};
-pub use law::LawKind;
+pub use law::{LawKind, LawSpec};
 pub use params::Contact;
+pub use summary::{HysteresisSummary, LjSummary};
 
 /// The README's Rust blocks, compiled and run as doctests so its numbers stay true.
 #[cfg(doctest)]

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 /// The library's modules (everything outside the `app` feature).
-const LIBRARY: [&str; 10] = [
+const LIBRARY: [&str; 11] = [
     "src/lib.rs",
     "src/contact",
     "src/contrast.rs",
@@ -16,8 +16,31 @@ const LIBRARY: [&str; 10] = [
     "src/numeric.rs",
     "src/params.rs",
     "src/quasistatic.rs",
+    "src/summary.rs",
     "src/sweep.rs",
 ];
+
+#[test]
+fn every_module_outside_the_app_feature_is_checked_as_library() {
+    let lib =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("src/lib.rs")).unwrap();
+    let mut behind_app = false;
+    for line in lib.lines().map(str::trim) {
+        if let Some(name) = line
+            .strip_prefix("pub mod ")
+            .and_then(|l| l.strip_suffix(';'))
+        {
+            let listed = LIBRARY
+                .iter()
+                .any(|p| *p == format!("src/{name}.rs") || *p == format!("src/{name}"));
+            assert_eq!(
+                listed, !behind_app,
+                "module {name}: library modules are listed here, application ones are not"
+            );
+        }
+        behind_app = line == "#[cfg(feature = \"app\")]";
+    }
+}
 
 fn sources(path: &Path, out: &mut Vec<PathBuf>) {
     if path.is_dir() {

@@ -3,7 +3,7 @@
 use crate::config::{ContactInputs, number, stiffness};
 use crate::contact::hybrid::JumpIn;
 use crate::error::Result;
-use crate::report::hysteresis::{HysteresisReport, Input, Support};
+use crate::summary::{HysteresisSummary, Input, Support};
 use clap::Args;
 
 /// Tabor parameter used when neither --mu nor an SI contact is given.
@@ -59,7 +59,7 @@ pub fn run(args: HysteresisArgs) -> Result<()> {
         (None, Some(k)) => Support::NewtonsPerMetre(k),
         (None, None) => Support::Rigid,
     };
-    let report = HysteresisReport::compute(input, support, args.jump_in, mu_is_default)?;
+    let report = HysteresisSummary::compute(input, support, args.jump_in, mu_is_default)?;
     if args.json {
         outln!(
             "{}",

@@ -4,6 +4,7 @@ use crate::config::number;
 use crate::contact::lj::Reach;
 use crate::error::Result;
 use crate::report::{lj as report, output};
+use crate::summary::{LjSummary, NoLoopSummary};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -74,7 +75,7 @@ pub fn run(args: LjArgs) -> Result<()> {
     let solution = match crate::lj_cache::solve(args.mu, reach, !args.no_cache) {
         Err(crate::Error::NoHysteresis(why)) => {
             // Below the critical μ nothing is lost: a result, not an error.
-            let r = report::NoLoopReport::new(args.mu, why);
+            let r = NoLoopSummary::new(args.mu, why);
             return print(&r, args.json, r.to_text());
         }
         other => other?,
@@ -82,7 +83,7 @@ pub fn run(args: LjArgs) -> Result<()> {
     if let Some(path) = &args.curve {
         output::write_bytes(path, &report::curve_csv(&solution)?)?;
     }
-    let mut r = report::LjReport::new(&solution);
+    let mut r = LjSummary::new(&solution);
     if let Some(k) = args.k_hat {
         r = r.with_spring(&solution, k)?;
     }

@@ -1,10 +1,8 @@
 //! `tapsim map`: dissipation and phase over a grid of work of adhesion and modulus.
 
 use crate::config::{TapInputs, pressure, surface_energy};
-use crate::dynamics::observables::TapObservables;
 use crate::error::Result;
-use crate::report::heatmap::{Cell, HeatMap};
-use crate::report::{output, plot, records};
+use crate::report::{map as report, output, plot, records};
 use crate::sweep;
 use clap::Args;
 
@@ -68,49 +66,11 @@ pub fn run(args: MapArgs) -> Result<()> {
         output::write_bytes(path, &records::records_csv(&cells)?)?;
     }
     if let Some(path) = &args.out.plot {
-        let law = setup.law;
-        let map = |title: &str, value_label: &str, value: fn(&TapObservables) -> f64| HeatMap {
-            title: format!("{law} law: {title}"),
-            x_label: "work of adhesion Δγ (J/m²)".into(),
-            y_label: "composite modulus E* (GPa)".into(),
-            value_label: value_label.into(),
-            x: works.clone(),
-            y: moduli.iter().map(|e| e * 1e-9).collect(),
-            // The cells come row by row, one row per modulus (as --json lays them out).
-            cells: cells
-                .chunks(works.len())
-                .map(|row| {
-                    row.iter()
-                        .map(|c| {
-                            c.observables
-                                .as_ref()
-                                .map_or(Cell::NotApplicable, |o| Cell::Value {
-                                    value: value(o),
-                                    period_one: o.period == Some(1),
-                                })
-                        })
-                        .collect()
-                })
-                .collect(),
-        };
-        plot::render_heatmaps(
-            &[
-                map("dissipation per cycle", "E_ts per cycle (eV)", |o| {
-                    o.e_ts_ev
-                }),
-                map("phase", "phase lag φ (deg)", |o| o.phase_deg),
-                map("amplitude", "A/A₀", |o| o.amplitude_ratio),
-            ],
-            path,
-        )?;
+        let law = setup.law.to_string();
+        plot::render_heatmaps(&report::heat_maps(&law, &works, &moduli, &cells), path)?;
     }
     if args.out.json {
-        let json = serde_json::json!({
-            "law": setup.law.to_string(),
-            "work_of_adhesion_j_m2": works,
-            "modulus_pa": moduli,
-            "grid": records::grid_json(&cells, works.len())?,
-        });
+        let json = report::map_json(&setup.law.to_string(), &works, &moduli, &cells)?;
         outln!(
             "{}",
             serde_json::to_string_pretty(&json).expect("serialises")

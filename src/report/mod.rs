@@ -4,9 +4,11 @@
 pub mod bifurcation;
 pub mod branches;
 pub mod chart;
+pub mod contrast;
 pub mod heatmap;
 pub mod hysteresis;
 pub mod lj;
+pub mod map;
 pub mod output;
 pub mod plot;
 pub mod records;

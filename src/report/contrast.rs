@@ -1,0 +1,161 @@
+//! The `tapsim contrast` outputs: the Δφ table as CSV and for people, and the charts
+//! (phase against amplitude per law, Δφ per law and branch).
+
+use super::chart::{Axis, Chart, Corner, Series, Style};
+use super::sweep::phase_vs_amplitude;
+use crate::contrast::{ContrastRow, LawCurve, Material, PhaseBranch};
+use crate::law::LawKind;
+use std::fmt::Write as _;
+
+/// How a branch is named in every output.
+pub fn branch_name(b: PhaseBranch) -> &'static str {
+    match b {
+        PhaseBranch::Attractive => "attractive",
+        PhaseBranch::Repulsive => "repulsive",
+    }
+}
+
+/// The rows as CSV: law, setpoint, branch, each material's phase and regime, Δφ. An
+/// error is the CSV writer's reason.
+pub fn contrast_csv(
+    rows: &[ContrastRow],
+    materials: &[Material],
+) -> std::result::Result<Vec<u8>, String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["law".to_string(), "amplitude_ratio".into(), "branch".into()];
+    header.extend(materials.iter().map(|m| format!("phase_deg_{}", m.name)));
+    header.extend(materials.iter().map(|m| format!("regime_{}", m.name)));
+    header.push("delta_phase_deg".into());
+    w.write_record(&header).map_err(|e| e.to_string())?;
+    for r in rows {
+        let cell = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
+        let mut rec = vec![
+            r.law.clone(),
+            r.amplitude_ratio.to_string(),
+            branch_name(r.branch).into(),
+        ];
+        rec.extend(r.phase_deg.iter().map(|&p| cell(p)));
+        rec.extend(r.regime.iter().map(|g| g.clone().unwrap_or_default()));
+        rec.push(cell(r.delta_phase_deg));
+        w.write_record(&rec).map_err(|e| e.to_string())?;
+    }
+    w.into_inner().map_err(|e| e.to_string())
+}
+
+/// Phase against amplitude for each law (a curve per material), then Δφ against the
+/// setpoint for every law and branch.
+pub fn contrast_charts(
+    laws: &[LawKind],
+    materials: &[Material],
+    rows: &[ContrastRow],
+    curves: &[LawCurve],
+) -> Vec<Chart> {
+    let mut charts: Vec<Chart> = laws
+        .iter()
+        .map(|law| {
+            let per_material: Vec<(&str, &[crate::sweep::SweepPoint])> = curves
+                .iter()
+                .filter(|c| c.law == *law)
+                .map(|c| (c.material.as_str(), c.points.as_slice()))
+                .collect();
+            phase_vs_amplitude(
+                &format!("phase_{law}"),
+                &format!("{law} law: phase vs amplitude"),
+                &per_material,
+            )
+        })
+        .collect();
+    charts.push(Chart {
+        name: "contrast".into(),
+        title: format!(
+            "phase contrast Δφ = φ({}) − φ({})",
+            materials[materials.len() - 1].name,
+            materials[0].name
+        ),
+        x: Axis::linear("amplitude setpoint A/A₀", "amplitude_ratio"),
+        y: Axis::linear("Δφ (deg)", "delta_phase_deg"),
+        series: laws
+            .iter()
+            .enumerate()
+            .flat_map(|(i, law)| {
+                [
+                    (PhaseBranch::Attractive, Style::Line),
+                    (PhaseBranch::Repulsive, Style::Dashed),
+                ]
+                .into_iter()
+                .filter_map(move |(branch, style)| {
+                    let pts: Vec<(f64, f64)> = rows
+                        .iter()
+                        .filter(|r| r.law == law.to_string() && r.branch == branch)
+                        .filter_map(|r| r.delta_phase_deg.map(|d| (r.amplitude_ratio, d)))
+                        .collect();
+                    let name = format!("{law}, {}", branch_name(branch));
+                    // Markers at the setpoints, circles and squares by turns, so a law
+                    // whose Δφ coincides with another's still shows.
+                    let marks = if i % 2 == 0 {
+                        Style::Markers
+                    } else {
+                        Style::Squares
+                    };
+                    (!pts.is_empty()).then(|| {
+                        [
+                            Series::new(&name, pts.clone(), style, i + 1),
+                            Series::new("", pts, marks, i + 1),
+                        ]
+                    })
+                })
+                .flatten()
+            })
+            .collect(),
+        labels: vec![],
+        legend: Corner::UpperRight,
+    });
+    charts
+}
+
+/// The table for people, then how much more (or less) contrast JKR shows than each
+/// other law, branch by branch (only materials on the same branch are compared).
+pub fn contrast_text(laws: &[LawKind], rows: &[ContrastRow]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:>18} {:>8} {:>11} {:>10}  motion",
+        "law", "A/A0", "branch", "Δφ (deg)"
+    );
+    for r in rows {
+        let regimes: Vec<&str> = r
+            .regime
+            .iter()
+            .map(|g| g.as_deref().unwrap_or("none"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "{:>18} {:>8.3} {:>11} {:>10}  {}",
+            r.law,
+            r.amplitude_ratio,
+            branch_name(r.branch),
+            r.delta_phase_deg.map_or("—".into(), |d| format!("{d:.3}")),
+            regimes.join(", ")
+        );
+    }
+    for other in laws.iter().filter(|l| **l != LawKind::Jkr) {
+        for r in rows.iter().filter(|r| r.law == "jkr") {
+            let same = rows.iter().find(|o| {
+                o.law == other.to_string()
+                    && o.branch == r.branch
+                    && o.amplitude_ratio == r.amplitude_ratio
+            });
+            if let (Some(j), Some(o)) = (r.delta_phase_deg, same.and_then(|o| o.delta_phase_deg)) {
+                let _ = writeln!(
+                    s,
+                    "A/A0 = {:.3}, {} branch: Δφ = {j:.3}° under jkr, {o:.3}° under {other} \
+                     (jkr {:+.3}°)",
+                    r.amplitude_ratio,
+                    branch_name(r.branch),
+                    j.abs() - o.abs(),
+                );
+            }
+        }
+    }
+    s
+}
