@@ -62,7 +62,7 @@ pub enum Error {
 
 /// `text` cut to its first `max` characters (with "…") when longer: long inputs are not
 /// echoed whole in messages.
-pub fn abbreviate(text: &str, max: usize) -> std::borrow::Cow<'_, str> {
+pub(crate) fn abbreviate(text: &str, max: usize) -> std::borrow::Cow<'_, str> {
     match text.char_indices().nth(max) {
         Some((cut, _)) => format!("{}… ({} characters)", &text[..cut], text.chars().count()).into(),
         None => text.into(),

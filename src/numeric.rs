@@ -6,7 +6,7 @@
 use crate::error::{Error, Result};
 
 /// Gauss–Legendre nodes and weights on [−1, 1], 4 points (exact to degree 7).
-pub const GAUSS_LEGENDRE_4: [(f64, f64); 4] = [
+pub(crate) const GAUSS_LEGENDRE_4: [(f64, f64); 4] = [
     (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
     (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
     (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
@@ -14,7 +14,7 @@ pub const GAUSS_LEGENDRE_4: [(f64, f64); 4] = [
 ];
 
 /// Gauss–Legendre nodes and weights on [−1, 1], 8 points (exact to degree 15).
-pub const GAUSS_LEGENDRE_8: [(f64, f64); 8] = [
+pub(crate) const GAUSS_LEGENDRE_8: [(f64, f64); 8] = [
     (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
     (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
     (-0.525_532_409_916_329, 0.313_706_645_877_887_3),
@@ -26,7 +26,7 @@ pub const GAUSS_LEGENDRE_8: [(f64, f64); 8] = [
 ];
 
 /// The polynomial through `points` (distinct abscissae) at `x`, in Lagrange form.
-pub fn lagrange(points: &[(f64, f64)], x: f64) -> f64 {
+pub(crate) fn lagrange(points: &[(f64, f64)], x: f64) -> f64 {
     (0..points.len())
         .map(|i| {
             let weight: f64 = (0..points.len())
@@ -40,7 +40,7 @@ pub fn lagrange(points: &[(f64, f64)], x: f64) -> f64 {
 
 /// Distance from `x` to the interval [lo, hi] (0 inside it).
 #[inline]
-pub fn distance_to_interval(x: f64, lo: f64, hi: f64) -> f64 {
+pub(crate) fn distance_to_interval(x: f64, lo: f64, hi: f64) -> f64 {
     (lo - x).max(x - hi).max(0.0)
 }
 
@@ -48,7 +48,7 @@ pub fn distance_to_interval(x: f64, lo: f64, hi: f64) -> f64 {
 /// by the Illinois variant of regula falsi: bracketing like bisection, superlinear
 /// like the secant method. Stops when the bracket is below `x_tol` (absolute) or
 /// `f` is exactly zero.
-pub fn bracketed_root(
+pub(crate) fn bracketed_root(
     what: &str,
     mut f: impl FnMut(f64) -> f64,
     mut lo: f64,
@@ -108,7 +108,7 @@ pub fn bracketed_root(
 /// safeguarded with bisection; `f` returns the value and its derivative. Quadratic once
 /// close, never leaves the bracket. Ends at a step below `x_tol` (absolute) or after 100
 /// iterations, returning the best estimate.
-pub fn newton_bracketed(
+pub(crate) fn newton_bracketed(
     f: impl Fn(f64) -> (f64, f64),
     mut lo: f64,
     mut hi: f64,

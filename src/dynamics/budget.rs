@@ -4,7 +4,7 @@
 //! of integrating for hours.
 //!
 //! Work is counted in integrator steps (and one per drive period, so that closed-form
-//! free flights count too) on the thread doing it. [`budgeted`] gives a computation its
+//! free flights count too) on the thread doing it. `budgeted` gives a computation its
 //! budget ([`STEPS`] unless a caller asks for more); computations nested inside it share
 //! that budget.
 
@@ -31,7 +31,7 @@ impl Drop for Reset {
 
 /// Run `f` with a budget of `steps`, unless it runs inside a budgeted computation
 /// already (then it spends from that one).
-pub fn budgeted<T>(steps: u64, f: impl FnOnce() -> Result<T>) -> Result<T> {
+pub(crate) fn budgeted<T>(steps: u64, f: impl FnOnce() -> Result<T>) -> Result<T> {
     if LEFT.get().is_some() {
         return f();
     }

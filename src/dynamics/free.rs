@@ -131,7 +131,7 @@ impl FreeFlight {
     /// f₀([x cos Ωτ] + Ω ∫ x sin Ωτ dτ), and damping takes the rest of the energy balance
     /// (the tip feels no force). The tip–sample integrals do not change. The variational
     /// matrix of a state with a tangent ([`super::model::has_tangent`]) is carried by [`FreeFlight::transition`].
-    pub fn advance<const N: usize>(&self, y: &mut State<N>, tau_a: f64, tau_b: f64) {
+    pub(crate) fn advance<const N: usize>(&self, y: &mut State<N>, tau_a: f64, tau_b: f64) {
         let (sc, ss) = self.fourier(tau_a, tau_b);
         let (x_a, v_a) = self.at(tau_a);
         let (x_b, v_b) = self.at(tau_b);
@@ -168,7 +168,7 @@ impl FreeFlight {
     /// (∫ x cos Ωτ dτ, ∫ x sin Ωτ dτ) over [a, b], exactly: with x = Re[P e^{iΩτ}] +
     /// Re[C e^{λ(τ−τ₀)}], P = a − ib, C = c₁ − ic₂, λ = −γ + iω_d, the integral of
     /// x e^{iΩτ} is a sum of integrals of complex exponentials.
-    pub fn fourier(&self, tau_a: f64, tau_b: f64) -> (f64, f64) {
+    pub(crate) fn fourier(&self, tau_a: f64, tau_b: f64) -> (f64, f64) {
         let w = self.omega;
         let p = Complex::new(self.a, -self.b);
         let e2 = |t: f64| Complex::from_polar(1.0, 2.0 * w * t);
@@ -189,7 +189,7 @@ impl FreeFlight {
     /// smallest deflection met on the way (at τ_b if there is no crossing).
     /// Sub-intervals of `max_dt` are checked at their ends and at their interior minimum
     /// (x' = 0), so a tip that only grazes the level is still caught.
-    pub fn first_fall_to(
+    pub(crate) fn first_fall_to(
         &self,
         level: f64,
         tau_a: f64,

@@ -161,12 +161,12 @@ pub fn phi<const N: usize>(y: &State<N>) -> Matrix2x3<f64> {
 
 /// Store `m` as Φ of a [`TANGENT`] state.
 #[inline]
-pub fn set_phi<const N: usize>(y: &mut State<N>, m: &Matrix2x3<f64>) {
+pub(crate) fn set_phi<const N: usize>(y: &mut State<N>, m: &Matrix2x3<f64>) {
     y.as_mut_slice()[PHI..PHI + 6].copy_from_slice(m.as_slice());
 }
 
 /// Φ at the start of a span: the identity in (x₀, x₀'), nothing yet from q.
-pub fn phi_start() -> Matrix2x3<f64> {
+pub(crate) fn phi_start() -> Matrix2x3<f64> {
     Matrix2x3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
 }
 
@@ -181,7 +181,7 @@ pub fn chain(first: &Matrix2x3<f64>, then: &Matrix2x3<f64>) -> Matrix2x3<f64> {
 
 /// Set the drive phasor of `y` to its exact value at τ.
 #[inline]
-pub fn set_phasor<const N: usize>(osc: &Oscillator, tau: f64, y: &mut State<N>) {
+pub(crate) fn set_phasor<const N: usize>(osc: &Oscillator, tau: f64, y: &mut State<N>) {
     let (s, c) = (osc.omega * tau).sin_cos();
     y[Part::DriveCos] = c;
     y[Part::DriveSin] = s;
@@ -220,7 +220,7 @@ impl Oscillator {
     }
 
     /// Whether free motion is underdamped enough for the closed form (Q > 0.55).
-    pub fn underdamped(&self) -> bool {
+    pub(crate) fn underdamped(&self) -> bool {
         self.gamma < 0.9
     }
 
@@ -267,7 +267,7 @@ impl Oscillator {
 
     /// Support displacement and velocity (x_b, x_b') from the phasor (sin Ωτ, cos Ωτ).
     #[inline]
-    pub fn base_from(&self, (s, c): (f64, f64)) -> (f64, f64) {
+    pub(crate) fn base_from(&self, (s, c): (f64, f64)) -> (f64, f64) {
         match self.drive {
             Drive::Force { .. } => (0.0, 0.0),
             Drive::Base { amplitude } => (amplitude * c, -amplitude * self.omega * s),
@@ -276,7 +276,7 @@ impl Oscillator {
 
     /// Drive force f_drive and support displacement x_b from cos Ωτ.
     #[inline]
-    pub fn drive_from(&self, c: f64) -> (f64, f64) {
+    pub(crate) fn drive_from(&self, c: f64) -> (f64, f64) {
         match self.drive {
             Drive::Force { amplitude } => (amplitude * c, 0.0),
             Drive::Base { amplitude } => (0.0, amplitude * c),
@@ -304,7 +304,7 @@ impl Coupling {
 
     /// Deflection at which α̂ equals `alpha_hat` (without base displacement).
     #[inline]
-    pub fn x_at(&self, alpha_hat: f64) -> f64 {
+    pub(crate) fn x_at(&self, alpha_hat: f64) -> f64 {
         (alpha_hat - self.a0) / self.a1
     }
 }
@@ -314,7 +314,7 @@ impl Coupling {
 /// (∂f_ts/∂x)δx + (∂f_ts/∂x')δx' (+ ∂f_ts/∂q for the q column), ∂f_ts/∂x = ∂f_ts/∂q =
 /// −f_scale·a₁·∂T̂/∂α̂, ∂f_ts/∂x' = −f_scale·a₁·∂T̂/∂(dα̂/dτ) (a rate-dependent law's).
 #[inline]
-pub fn rhs<L: ForceLaw, const N: usize>(
+pub(crate) fn rhs<L: ForceLaw, const N: usize>(
     law: &L,
     osc: &Oscillator,
     cpl: &Coupling,

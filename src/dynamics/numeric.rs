@@ -35,7 +35,7 @@ pub struct Tolerances {
 
 /// Which way the switching function must cross its level.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Crossing {
+pub(crate) enum Crossing {
     /// α̂ falls to the level (jump-in).
     Down,
     /// α̂ rises to the level (jump-out).
@@ -391,7 +391,7 @@ fn land<L: ForceLaw, O: StepObserver, const N: usize>(
 
 /// Where a numerical segment ended.
 #[derive(Debug, Clone, Copy)]
-pub struct SegmentEnd<const N: usize = BASE> {
+pub(crate) struct SegmentEnd<const N: usize = BASE> {
     /// τ at the end.
     pub tau: f64,
     /// State at the end.
@@ -513,7 +513,7 @@ fn run<S: System<f64, State<N>>, const N: usize>(
 /// crossing of `event` (level, direction) if given. `h0` is the first trial step (0 lets
 /// the solver choose).
 #[allow(clippy::too_many_arguments)]
-pub fn integrate<L: ForceLaw, O: StepObserver, const N: usize>(
+pub(crate) fn integrate<L: ForceLaw, O: StepObserver, const N: usize>(
     law: &L,
     osc: &Oscillator,
     cpl: &Coupling,

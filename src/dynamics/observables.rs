@@ -240,7 +240,7 @@ pub struct TrajectorySample {
 /// Records the trajectory (dimensionless samples, converted by [`Recorder::to_si`]):
 /// step ends plus points on each step's Hermite interpolant, and closed-form free flight
 /// sampled evenly.
-pub struct Recorder<'a, L: ForceLaw> {
+pub(crate) struct Recorder<'a, L: ForceLaw> {
     /// (τ, x, x', α̂, f_ts, branch).
     pub samples: Vec<(f64, f64, f64, f64, f64, Branch)>,
     /// Whether samples were dropped at [`MAX_TRAJECTORY_SAMPLES`].
@@ -314,7 +314,7 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
     }
 
     /// The samples in SI units for the prepared experiment `p`.
-    pub fn to_si(&self, p: &Prepared) -> Vec<TrajectorySample> {
+    pub(crate) fn to_si(&self, p: &Prepared) -> Vec<TrajectorySample> {
         let cant = &p.setup.cantilever;
         let w0 = 2.0 * PI * cant.resonance_hz;
         let a0 = cant.free_amplitude_m;

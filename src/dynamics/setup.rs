@@ -272,7 +272,7 @@ fn separation_in_range(separation_m: f64, a0_m: f64) -> Result<()> {
 impl TapSetup {
     /// Refuse values outside what an AFM can be (SI slips like `--radius 20`, meaning
     /// 20 m) and regimes tapsim cannot resolve within seconds; the message explains.
-    pub fn check_plausible(&self) -> Result<()> {
+    pub(crate) fn check_plausible(&self) -> Result<()> {
         let (c, k) = (&self.contact, &self.cantilever);
         let length = |what, lo, hi, why| Range {
             what,
@@ -460,7 +460,7 @@ impl Prepared {
     }
 
     /// The simulation with the rest separation moved to `separation_m` (a sweep step).
-    pub fn simulation_at(&self, separation_m: f64) -> Result<Simulation<'_, AnyLaw>> {
+    pub(crate) fn simulation_at(&self, separation_m: f64) -> Result<Simulation<'_, AnyLaw>> {
         separation_in_range(separation_m, self.setup.cantilever.free_amplitude_m)?;
         let mut sim = self.simulation();
         sim.cpl.a0 = separation_m / self.setup.contact.separation_scale_m();

@@ -325,7 +325,7 @@ struct Orbit {
 impl<L: ForceLaw> Simulation<'_, L> {
     /// The branch a state at rest separation α̂ starts on: in contact if the tip is already
     /// below the jump-in separation.
-    pub fn branch_at(&self, tau: f64, x: f64) -> Branch {
+    pub(crate) fn branch_at(&self, tau: f64, x: f64) -> Branch {
         let alpha = self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
         if alpha <= self.law.jump_in_alpha_hat() {
             Branch::Contact
@@ -983,7 +983,7 @@ const MAX_REJECTIONS: usize = 6;
 const STALL_STEPS: usize = 8;
 /// The fewest periods a steady-state search may be given: enough to classify the motion
 /// and average irregular motion over a window of its own.
-pub const MIN_CYCLES: usize = 32;
+pub(crate) const MIN_CYCLES: usize = 32;
 /// The averaging window of irregular motion: whole batches and the one being filled.
 struct Window {
     /// Periods per batch.

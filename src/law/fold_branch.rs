@@ -213,7 +213,7 @@ fn jkr_slope(alpha_hat: f64) -> f64 {
 
 /// Distance in u = √|α̂ − α̂₀| from the fold below which [`FoldBranch::slope_hat`] is
 /// held at its value there.
-pub const FOLD_SLOPE_FLOOR_U: f64 = 1e-8;
+pub(crate) const FOLD_SLOPE_FLOOR_U: f64 = 1e-8;
 
 /// JKR work function (6) along the stable contact branch at α̂.
 fn jkr_work(alpha_hat: f64) -> f64 {

@@ -83,7 +83,7 @@ fn log_integral(x: f64, a: f64, b: f64, g_a: f64, g_m: f64, g_b: f64) -> f64 {
 
 /// Integrals of G(x, y) against the two hat functions of element [a, b]:
 /// (∫ (b − y)/(b − a) G dy, ∫ (y − a)/(b − a) G dy).
-pub fn element_integrals(x: f64, a: f64, b: f64) -> (f64, f64) {
+pub(crate) fn element_integrals(x: f64, a: f64, b: f64) -> (f64, f64) {
     let h = b - a;
     if x == 0.0 {
         return (PI / 2.0 * h / 2.0, PI / 2.0 * h / 2.0);

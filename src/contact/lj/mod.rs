@@ -5,7 +5,8 @@ pub mod curve;
 pub mod kernel;
 pub mod moving;
 pub mod result;
-pub mod solver;
+pub(crate) mod solver;
 
 pub use moving::Reach;
-pub use result::{Estimate, LjSolution, obtain, solve};
+pub(crate) use result::obtain;
+pub use result::{Estimate, LjSolution, solve};

@@ -107,7 +107,7 @@ impl LjSolution {
     /// support separation α̂ + T̂/k̂ ([`Hysteresis::with_spring`]). A soft spring lets go
     /// near the pull-off and lands far out on the approach branch, beyond where it was
     /// traced: there the sphere is as good as rigid, and the branch continues as the
-    /// rigid sphere's force ([`rigid_sphere_t_hat`]), scaled to meet the traced branch.
+    /// rigid sphere's force (`rigid_sphere_t_hat`), scaled to meet the traced branch.
     /// Its landing on the contact branch lies where T̂ > 0, which a trace of
     /// [`Reach::Springs`] passes.
     pub fn spring_loop(&self, k_hat: f64) -> Result<Hysteresis> {
@@ -158,7 +158,7 @@ impl LjSolution {
     }
 
     /// The approach branch: the points before the fold A.
-    pub fn approach_branch(&self) -> &[CurvePoint] {
+    pub(crate) fn approach_branch(&self) -> &[CurvePoint] {
         let k = self.curve.partition_point(|p| p.s < self.s_a);
         &self.curve[..k]
     }
@@ -190,7 +190,7 @@ impl LjSolution {
 /// T̂ of a rigid sphere at separation α̂: the traction (10) over the parabolic gap
 /// h̄ = μα̂ + 1 + x²/2, ∫ f(h̄) x dx = h̄₀⁻²/2 − h̄₀⁻⁸/8, times 16π/3 (the solver's
 /// normalisation). The far approach branch, where the deformation no longer matters.
-pub fn rigid_sphere_t_hat(alpha_hat: f64, tabor_mu: f64) -> f64 {
+pub(crate) fn rigid_sphere_t_hat(alpha_hat: f64, tabor_mu: f64) -> f64 {
     let h0 = tabor_mu * alpha_hat + 1.0;
     16.0 * std::f64::consts::PI / 3.0 * (0.5 * h0.powi(-2) - 0.125 * h0.powi(-8))
 }
@@ -242,7 +242,7 @@ pub fn set_source(source: Source) {
 
 /// The solution for `tabor_mu` and `reach` from the installed source ([`set_source`]),
 /// else computed.
-pub fn obtain(tabor_mu: f64, reach: Reach) -> Result<LjSolution> {
+pub(crate) fn obtain(tabor_mu: f64, reach: Reach) -> Result<LjSolution> {
     SOURCE.get().copied().unwrap_or(solve)(tabor_mu, reach)
 }
 

@@ -21,9 +21,7 @@ pub fn traction(h: f64) -> (f64, f64) {
 
 /// The discretised problem for one μ and one mesh.
 #[derive(Debug)]
-pub struct Problem {
-    /// Tabor parameter μ.
-    pub tabor_mu: f64,
+pub(crate) struct Problem {
     /// Mesh nodes x_i (x = r/√(Rε)).
     pub nodes: Vec<f64>,
     /// Influence matrix, pre-multiplied by c = (32/(3π)) μ^{3/2}.
@@ -36,7 +34,7 @@ pub struct Problem {
 
 /// A solution: the gap at the nodes and the rigid approach ᾱ = μα̂.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Solution {
+pub(crate) struct Solution {
     /// h̄ at the nodes.
     pub gap: DVector<f64>,
     /// ᾱ = α/ε.
@@ -50,7 +48,6 @@ impl Problem {
         let cm = influence_matrix(&nodes) * c;
         let moments = moment_weights(&nodes);
         Self {
-            tabor_mu,
             nodes,
             cm,
             moments,
@@ -59,7 +56,7 @@ impl Problem {
     }
 
     /// LU factorisations done so far.
-    pub fn factorisations(&self) -> usize {
+    pub(crate) fn factorisations(&self) -> usize {
         self.factorisations
             .load(std::sync::atomic::Ordering::Relaxed)
     }
@@ -67,11 +64,6 @@ impl Problem {
     /// Number of nodes.
     pub fn len(&self) -> usize {
         self.nodes.len()
-    }
-
-    /// Whether the mesh is empty (never for a built problem).
-    pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
     }
 
     /// Tractions and their derivatives at the nodes.
@@ -99,7 +91,7 @@ impl Problem {
     /// stretched mesh is a times the original (the kernel G(x, y) dy is homogeneous of
     /// degree one; a reassembled matrix differs only by its element quadrature error), so
     /// a moving mesh needs no reassembly.
-    pub fn residual_scaled(&self, s: &Solution, a: f64) -> DVector<f64> {
+    pub(crate) fn residual_scaled(&self, s: &Solution, a: f64) -> DVector<f64> {
         let (f, _) = self.tractions(&s.gap);
         let mut r = &self.cm * f;
         r *= a;
@@ -112,7 +104,7 @@ impl Problem {
 
     /// Force T̂ and its gradient with respect to the nodal gaps, on the mesh stretched by `a` (moments scale as a²; the
     /// tail beyond the last node does not depend on where that node is).
-    pub fn force_scaled(&self, gap: &DVector<f64>, a: f64) -> (f64, DVector<f64>) {
+    pub(crate) fn force_scaled(&self, gap: &DVector<f64>, a: f64) -> (f64, DVector<f64>) {
         let (f, df) = self.tractions(gap);
         let k = 16.0 * PI / 3.0;
         let a2 = a * a;
@@ -148,7 +140,7 @@ impl Problem {
     /// `target` and ᾱ free (bordered system [[J, −1], [e_nodeᵀ, 0]]), by Newton from
     /// `guess`, reusing `lu` while it converges fast (refactorised otherwise). Returns
     /// the solution and the iterations taken.
-    pub fn solve_pinned(
+    pub(crate) fn solve_pinned(
         &self,
         guess: &Solution,
         a: f64,
