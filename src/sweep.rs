@@ -147,6 +147,41 @@ pub fn log_grid(name: &'static str, lo: f64, hi: f64, n: usize) -> Result<Vec<f6
         .collect())
 }
 
+/// One of `count` parts of a job whose items are numbered 0, 1, 2, …: the part numbered
+/// `index` takes every item whose number ≡ `index` (mod `count`), so neighbouring
+/// items, which cost about the same, are spread over the parts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// I, from 0.
+    pub index: usize,
+    /// N ≥ 1.
+    pub count: usize,
+}
+
+/// The most parts a job can be split into.
+pub const MAX_SHARDS: usize = 100_000;
+
+impl Shard {
+    /// The whole job as one part.
+    pub const WHOLE: Shard = Shard { index: 0, count: 1 };
+
+    /// Part `index` of `count`, checked.
+    pub fn new(index: usize, count: usize) -> Result<Self> {
+        if count == 0 || count > MAX_SHARDS || index >= count {
+            return Err(Error::NotApplicable(format!(
+                "shard {index} of {count}: the part number runs from 0 to the number of \
+                 parts less one, and there are from 1 to {MAX_SHARDS} parts"
+            )));
+        }
+        Ok(Self { index, count })
+    }
+
+    /// The numbers of this part's items among `total`.
+    pub fn items(&self, total: usize) -> Vec<usize> {
+        (self.index..total).step_by(self.count).collect()
+    }
+}
+
 /// E_ts and φ over a grid of (Δγ, E*) at the setup's setpoint, one independent steady
 /// state per cell (each from the free steady state), computed in parallel on `threads`
 /// threads (0: all cores). Cells are independent, so the result does not depend on the
@@ -160,6 +195,29 @@ pub fn adhesion_modulus_map(
     threads: usize,
     progress: impl Fn() + Sync,
 ) -> Result<Vec<MapCell>> {
+    let all: Vec<usize> = (0..works_j_m2.len() * moduli_pa.len()).collect();
+    map_cells(
+        setup,
+        numerics,
+        (works_j_m2, moduli_pa),
+        &all,
+        threads,
+        progress,
+    )
+}
+
+/// The cells numbered `cells` of the map [`adhesion_modulus_map`] computes (numbered in
+/// its order: cell k has modulus k / (number of works), work k mod (number of works)),
+/// in the order given: a part of a map split over machines ([`Shard`]). Each cell is
+/// exactly what the whole map gives for it.
+pub fn map_cells(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    (works_j_m2, moduli_pa): (&[f64], &[f64]),
+    cells: &[usize],
+    threads: usize,
+    progress: impl Fn() + Sync,
+) -> Result<Vec<MapCell>> {
     use rayon::prelude::*;
     if threads > MAX_THREADS {
         return Err(Error::InvalidParameter {
@@ -168,9 +226,22 @@ pub fn adhesion_modulus_map(
             reason: "must be at most 256 (0: one per core)",
         });
     }
-    let cells: Vec<(f64, f64)> = moduli_pa
+    let total = works_j_m2.len() * moduli_pa.len();
+    if let Some(&k) = cells.iter().find(|&&k| k >= total) {
+        return Err(Error::NotApplicable(format!(
+            "cell {k} is not on the {} × {} grid",
+            works_j_m2.len(),
+            moduli_pa.len()
+        )));
+    }
+    let cells: Vec<(f64, f64)> = cells
         .iter()
-        .flat_map(|&e| works_j_m2.iter().map(move |&w| (w, e)))
+        .map(|&k| {
+            (
+                works_j_m2[k % works_j_m2.len()],
+                moduli_pa[k / works_j_m2.len()],
+            )
+        })
         .collect();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

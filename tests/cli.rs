@@ -1036,3 +1036,136 @@ fn a_viscous_sample_is_a_law_parameter_checked_against_the_law() {
         assert!(help.contains(&format!("- {}:", law.name)), "{}", law.name);
     }
 }
+
+/// `tapsim` with the Slurm array variables removed (a test run inside a job array must
+/// not shard its maps).
+fn tapsim_here(args: &[&str], dir: &std::path::Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .args(args)
+        .current_dir(dir)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("SLURM_ARRAY_TASK_COUNT")
+        .env_remove("SLURM_ARRAY_TASK_MIN")
+        .output()
+        .expect("the binary runs")
+}
+
+#[test]
+fn sharded_maps_merge_to_the_whole_map_byte_for_byte() {
+    let dir = scratch("shards");
+    let ok = |args: &[&str]| {
+        let out = tapsim_here(args, &dir);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    };
+    // A 5 × 5 grid: 10 cells where the law does not apply, 4 that are not period-1.
+    let grid = ["map", "--steps", "5", "--quiet"];
+    fn with<'a>(grid: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        [grid, extra].concat()
+    }
+    ok(&with(&grid, &["--csv", "whole.csv", "--plot", "whole.png"]));
+    let whole_json = ok(&with(&grid, &["--json"])).stdout;
+    let whole_csv = std::fs::read(dir.join("whole.csv")).unwrap();
+    let csv_text = String::from_utf8_lossy(&whole_csv);
+    assert!(csv_text.lines().filter(|l| l.contains(",,")).count() >= 5);
+    assert!(csv_text.contains("irregular") || csv_text.contains("period-2"));
+    for n in [1usize, 2, 3, 7] {
+        let mut parts = Vec::new();
+        for i in 0..n {
+            let part = format!("part-{i}-of-{n}.json");
+            ok(&with(
+                &grid,
+                &["--shard", &format!("{i}/{n}"), "--part", &part],
+            ));
+            parts.push(part);
+        }
+        // Given in any order.
+        parts.reverse();
+        let mut merge: Vec<&str> = vec!["merge"];
+        merge.extend(parts.iter().map(String::as_str));
+        let outs = [
+            format!("m{n}.csv"),
+            format!("m{n}.png"),
+            format!("m{n}.json"),
+        ];
+        let mut args = merge.clone();
+        for o in &outs {
+            args.extend(["--out", o.as_str()]);
+        }
+        ok(&args);
+        assert_eq!(
+            std::fs::read(dir.join(&outs[0])).unwrap(),
+            whole_csv,
+            "N = {n}"
+        );
+        assert_eq!(
+            std::fs::read(dir.join(&outs[1])).unwrap(),
+            std::fs::read(dir.join("whole.png")).unwrap(),
+            "N = {n}"
+        );
+        assert_eq!(
+            std::fs::read(dir.join(&outs[2])).unwrap(),
+            whole_json,
+            "N = {n}"
+        );
+        let mut args = merge.clone();
+        args.push("--json");
+        assert_eq!(ok(&args).stdout, whole_json, "N = {n}");
+    }
+    // A part missing: named as sbatch --array= takes it.
+    let out = tapsim_here(
+        &[
+            "merge",
+            "part-0-of-7.json",
+            "part-1-of-7.json",
+            "part-2-of-7.json",
+            "part-5-of-7.json",
+        ],
+        &dir,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("3 of 7 parts missing: 3-4,6") && err.contains("--array=3-4,6"),
+        "{err}"
+    );
+    // A part of another map (another grid) is refused.
+    ok(&[
+        "map",
+        "--steps",
+        "6",
+        "--quiet",
+        "--shard",
+        "1/2",
+        "--part",
+        "other.json",
+    ]);
+    let out = tapsim_here(&["merge", "part-0-of-2.json", "other.json"], &dir);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("belongs to another map"),
+        "{err}"
+    );
+    // Slurm's array variables shard a run with no flag.
+    let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .args(with(&grid, &["--part", "slurm.json"]))
+        .current_dir(&dir)
+        .env("SLURM_ARRAY_TASK_ID", "12")
+        .env("SLURM_ARRAY_TASK_MIN", "10")
+        .env("SLURM_ARRAY_TASK_COUNT", "3")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(dir.join("slurm.json")).unwrap(),
+        std::fs::read(dir.join("part-2-of-3.json")).unwrap()
+    );
+}

@@ -25,6 +25,7 @@ mod figure;
 mod hysteresis;
 mod lj;
 mod map;
+mod merge;
 mod reproduce;
 mod tap;
 
@@ -53,6 +54,7 @@ enum Command {
     Bifurcation(bifurcation::BifurcationArgs),
     Contrast(contrast::ContrastArgs),
     Map(map::MapArgs),
+    Merge(merge::MergeArgs),
     Hysteresis(hysteresis::HysteresisArgs),
     Lj(lj::LjArgs),
     Figure(figure::FigureArgs),
@@ -222,6 +224,7 @@ pub fn main() -> ExitCode {
         Command::Bifurcation(args) => bifurcation::run(args),
         Command::Contrast(args) => contrast::run(args),
         Command::Map(args) => map::run(args),
+        Command::Merge(args) => merge::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),
         Command::Lj(args) => lj::run(args),
         Command::Figure(args) => figure::run(args),

@@ -1,16 +1,29 @@
 //! The `tapsim map` outputs: heat maps of E_ts, φ and A/A₀ over the (Δγ, E*) grid and
-//! the grid as JSON (the CSV is the cells as records).
+//! the grid as JSON (the CSV is the cells as records). Everything is drawn from the
+//! cells as records (JSON objects, fields in order), so a map merged from part files
+//! ([`super::part`]) gives the same bytes as one computed whole.
 
 use super::heatmap::{Cell, HeatMap};
 use super::records;
-use crate::dynamics::observables::TapObservables;
 use crate::error::Result;
 use crate::sweep::MapCell;
+use serde_json::{Map, Value};
 
-/// Heat maps of E_ts per cycle, phase and A/A₀ over the grid for `law`. The cells come
-/// row by row, one row per modulus (as [`map_json`] lays them out).
-pub fn heat_maps(law: &str, works: &[f64], moduli: &[f64], cells: &[MapCell]) -> Vec<HeatMap> {
-    let map = |title: &str, value_label: &str, value: fn(&TapObservables) -> f64| HeatMap {
+/// The cells as records.
+pub fn cell_records(cells: &[MapCell]) -> Result<Vec<Map<String, Value>>> {
+    cells.iter().map(records::object).collect()
+}
+
+/// Heat maps of E_ts per cycle, phase and A/A₀ over the grid for `law`. The records come
+/// row by row, one row per modulus (as [`map_json`] lays them out); a cell without the
+/// value (the law does not apply there) is grey.
+pub fn heat_maps(
+    law: &str,
+    works: &[f64],
+    moduli: &[f64],
+    cells: &[Map<String, Value>],
+) -> Vec<HeatMap> {
+    let map = |title: &str, value_label: &str, key: &str| HeatMap {
         title: format!("{law} law: {title}"),
         x_label: "work of adhesion Δγ (J/m²)".into(),
         y_label: "composite modulus E* (GPa)".into(),
@@ -21,24 +34,21 @@ pub fn heat_maps(law: &str, works: &[f64], moduli: &[f64], cells: &[MapCell]) ->
             .chunks(works.len())
             .map(|row| {
                 row.iter()
-                    .map(|c| {
-                        c.observables
-                            .as_ref()
-                            .map_or(Cell::NotApplicable, |o| Cell::Value {
-                                value: value(o),
-                                period_one: o.period == Some(1),
-                            })
+                    .map(|c| match c.get(key).and_then(Value::as_f64) {
+                        Some(value) => Cell::Value {
+                            value,
+                            period_one: c.get("period").and_then(Value::as_u64) == Some(1),
+                        },
+                        None => Cell::NotApplicable,
                     })
                     .collect()
             })
             .collect(),
     };
     vec![
-        map("dissipation per cycle", "E_ts per cycle (eV)", |o| {
-            o.e_ts_ev
-        }),
-        map("phase", "phase lag φ (deg)", |o| o.phase_deg),
-        map("amplitude", "A/A₀", |o| o.amplitude_ratio),
+        map("dissipation per cycle", "E_ts per cycle (eV)", "e_ts_ev"),
+        map("phase", "phase lag φ (deg)", "phase_deg"),
+        map("amplitude", "A/A₀", "amplitude_ratio"),
     ]
 }
 
@@ -48,8 +58,8 @@ pub fn map_json(
     law: &str,
     works: &[f64],
     moduli: &[f64],
-    cells: &[MapCell],
-) -> Result<serde_json::Value> {
+    cells: &[Map<String, Value>],
+) -> Result<Value> {
     Ok(serde_json::json!({
         "law": law,
         "work_of_adhesion_j_m2": works,

@@ -10,6 +10,7 @@ pub mod hysteresis;
 pub mod lj;
 pub mod map;
 pub mod output;
+pub mod part;
 pub mod plot;
 pub mod records;
 pub mod sweep;

@@ -5,8 +5,8 @@ use crate::error::{Error, Result};
 use serde::Serialize;
 use serde_json::{Map, Value};
 
-/// A record as a JSON object.
-fn object<T: Serialize>(record: &T) -> Result<Map<String, Value>> {
+/// A record as a JSON object (its fields in order).
+pub fn object<T: Serialize>(record: &T) -> Result<Map<String, Value>> {
     let fail = |reason: String| Error::Output {
         path: "records".into(),
         reason,

@@ -1,0 +1,82 @@
+//! `tapsim merge`: the parts of a sharded map, checked and joined into the outputs one
+//! whole run writes.
+
+use crate::error::{Error, Result};
+use crate::report::part::{self, MapPart};
+use clap::Args;
+use std::path::PathBuf;
+
+/// Join the part files of a sharded `tapsim map` (--shard I/N, or a Slurm job array)
+/// into exactly the outputs the whole map writes: the CSV, the heat maps and the JSON
+/// are byte for byte those of one unsharded run.
+///
+/// Every part must come from the same configuration (the hash in its header) and the
+/// same split, and every part 0 … N−1 must be there exactly once. A missing part is
+/// named in the form `sbatch --array=` takes, to resubmit it:
+///
+///   tapsim merge parts/*.json --out map.csv --out map.png
+///   error: 2 of 7 parts missing: 3,5 (rerun them with sbatch --array=3,5)
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct MergeArgs {
+    /// The part files.
+    #[arg(required = true)]
+    parts: Vec<PathBuf>,
+    /// Write an output, by its extension: .csv (the CSV), .json (the JSON --json
+    /// prints), .png or .svg (the heat maps). May be repeated.
+    #[arg(long)]
+    out: Vec<PathBuf>,
+    #[command(flatten)]
+    output: super::SweepOutput,
+}
+
+/// The largest part file read, in bytes (a 200 × 200 map is some 60 MB whole).
+const MAX_PART_BYTES: u64 = 1 << 30;
+
+fn read(path: &PathBuf) -> Result<MapPart> {
+    let fail = |reason: String| Error::Parse {
+        name: "part file",
+        text: path.display().to_string(),
+        reason,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(fail("not a regular file".into()));
+    }
+    if meta.len() > MAX_PART_BYTES {
+        return Err(fail(format!("larger than {MAX_PART_BYTES} bytes")));
+    }
+    let text = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
+    serde_json::from_slice(&text).map_err(|e| fail(format!("not a tapsim map part file: {e}")))
+}
+
+/// Run the subcommand.
+pub fn run(args: MergeArgs) -> Result<()> {
+    for path in &args.out {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or_default()
+            .to_ascii_lowercase();
+        if !["csv", "json", "png", "svg"].contains(&ext.as_str()) {
+            return Err(Error::NotApplicable(format!(
+                "--out {}: give a .csv, .json, .png or .svg file",
+                path.display()
+            )));
+        }
+    }
+    let parts = args
+        .parts
+        .iter()
+        .map(|p| Ok((p.display().to_string(), read(p)?)))
+        .collect::<Result<Vec<_>>>()?;
+    let merged = part::merge(parts)?;
+    super::map::emit(
+        &args.output,
+        &args.out,
+        &merged.law,
+        &merged.works,
+        &merged.moduli,
+        &merged.records,
+    )
+}
