@@ -1169,3 +1169,91 @@ fn sharded_maps_merge_to_the_whole_map_byte_for_byte() {
         std::fs::read(dir.join("part-2-of-3.json")).unwrap()
     );
 }
+
+#[test]
+fn a_sharded_batch_merges_to_the_whole_batch_and_a_toml_table_reads_as_the_csv() {
+    let dir = scratch("batch");
+    let ok = |args: &[&str]| {
+        let out = tapsim_here(args, &dir);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out.stdout
+    };
+    // Tap cases on several laws (one irregular, one where the law does not apply, one
+    // viscous) and an approach case, whose setpoints stay together.
+    std::fs::write(
+        dir.join("cases.csv"),
+        "name,law,separation,sample-modulus,work-of-adhesion,viscosity,command,points\n\
+         soft,hybrid,16nm,,,,,\n\
+         stiff,hybrid,16nm,2GPa,,,,\n\
+         irregular,jkr,16nm,,,,,\n\
+         viscous,hertz,12nm,,,50Pa·s,,\n\
+         ramp,hybrid,,,,,approach,4\n\
+         nothing,hybrid,,100GPa,0.02,,,\n\
+         lj,lj,14nm,,,,,\n\
+         dmt,dmt,,,,,,\n",
+    )
+    .unwrap();
+    let whole = ok(&["batch", "cases.csv", "--quiet"]);
+    let text = String::from_utf8_lossy(&whole).to_string();
+    assert_eq!(text.lines().count(), 1 + 7 + 8, "{text}");
+    assert!(text.contains("irregular,tap,jkr") && text.contains("does not apply"));
+    assert!(text.contains("hertz+kelvin-voigt"));
+    let whole_json = ok(&["batch", "cases.csv", "--quiet", "--json"]);
+    for n in [1usize, 2, 3, 7] {
+        let mut merge = vec!["merge".to_string()];
+        for i in 0..n {
+            let part = format!("b-{i}-of-{n}.json");
+            ok(&[
+                "batch",
+                "cases.csv",
+                "--quiet",
+                "--shard",
+                &format!("{i}/{n}"),
+                "--part",
+                &part,
+            ]);
+            merge.push(part);
+        }
+        let merge: Vec<&str> = merge.iter().map(String::as_str).collect();
+        assert_eq!(ok(&merge), whole, "N = {n}");
+        assert_eq!(
+            ok(&[&merge[..], &["--json"]].concat()),
+            whole_json,
+            "N = {n}"
+        );
+    }
+    // A missing part is named; a map's part does not merge with a batch's.
+    let out = tapsim_here(&["merge", "b-0-of-3.json", "b-2-of-3.json"], &dir);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--array=1"), "{err}");
+    // The same cases as TOML.
+    std::fs::write(
+        dir.join("cases.toml"),
+        "[[case]]\nname = \"viscous\"\nlaw = \"hertz\"\nseparation = \"12nm\"\n\
+         viscosity = \"50Pa·s\"\n\n[[case]]\nname = \"ramp\"\ncommand = \"approach\"\n\
+         points = 4\n",
+    )
+    .unwrap();
+    let toml = String::from_utf8_lossy(&ok(&["batch", "cases.toml", "--quiet"])).to_string();
+    let rows = |t: &str, name: &str| -> Vec<String> {
+        t.lines()
+            .filter(|l| l.starts_with(&format!("{name},")))
+            .map(|l| l.trim_end_matches(',').to_string())
+            .collect()
+    };
+    for name in ["viscous", "ramp"] {
+        assert_eq!(rows(&toml, name), rows(&text, name), "{name}");
+    }
+    // A column nobody knows is refused, naming the row.
+    std::fs::write(dir.join("bad.csv"), "name,colour\nx,blue\n").unwrap();
+    let out = tapsim_here(&["batch", "bad.csv"], &dir);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("row 1") && err.contains("unknown column"),
+        "{err}"
+    );
+}

@@ -2,7 +2,7 @@
 
 use crate::config::{TapInputs, pressure, surface_energy};
 use crate::error::{Error, Result};
-use crate::report::part::{self, MapPart};
+use crate::report::part::{Job, Part};
 use crate::report::{map as report, output, plot, records};
 use crate::sweep;
 use crate::sweep::Shard;
@@ -61,7 +61,7 @@ pub struct MapArgs {
 /// Which part of the map this run computes: `--shard I/N`, else inside a Slurm array
 /// task SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN of SLURM_ARRAY_TASK_COUNT, else the
 /// whole map (`None`).
-fn shard(flag: Option<&str>) -> Result<Option<Shard>> {
+pub(super) fn shard(flag: Option<&str>) -> Result<Option<Shard>> {
     let number = |what: &str, text: &str| {
         text.trim().parse::<usize>().map_err(|_| Error::Parse {
             name: "shard",
@@ -149,18 +149,19 @@ pub fn run(args: MapArgs) -> Result<()> {
             let path = args.part.clone().unwrap_or_else(|| {
                 format!("map-part-{}-of-{}.json", shard.index, shard.count).into()
             });
-            let part = MapPart {
-                format: part::FORMAT.into(),
-                tapsim_version: env!("CARGO_PKG_VERSION").into(),
-                config_hash: part::config_hash(&setup, &numerics, &works, &moduli),
-                shards: shard.count,
-                shard: shard.index,
+            let config = (&setup, &numerics, &works, &moduli);
+            let job = Job::Map {
                 law,
-                work_of_adhesion_j_m2: works,
-                modulus_pa: moduli,
-                cells,
-                records,
+                work_of_adhesion_j_m2: works.clone(),
+                modulus_pa: moduli.clone(),
             };
+            let part = Part::new(
+                shard,
+                job,
+                &config,
+                cells,
+                records.into_iter().map(|r| vec![r]).collect(),
+            );
             let text = serde_json::to_string(&part).expect("a part serialises");
             output::write_bytes(&path, text.as_bytes())?;
             if !args.out.quiet {
@@ -168,7 +169,7 @@ pub fn run(args: MapArgs) -> Result<()> {
                     "part {} of {}: {} of {total} cells written to {}",
                     shard.index,
                     shard.count,
-                    part.cells.len(),
+                    part.items.len(),
                     path.display()
                 );
             }

@@ -2,13 +2,13 @@
 //! whole run writes.
 
 use crate::error::{Error, Result};
-use crate::report::part::{self, MapPart};
+use crate::report::part::{self, Job, Part};
 use clap::Args;
 use std::path::PathBuf;
 
-/// Join the part files of a sharded `tapsim map` (--shard I/N, or a Slurm job array)
-/// into exactly the outputs the whole map writes: the CSV, the heat maps and the JSON
-/// are byte for byte those of one unsharded run.
+/// Join the part files of a sharded `tapsim map` or `tapsim batch` (--shard I/N, or a
+/// Slurm job array) into exactly the outputs the whole run writes: the CSV, the JSON and
+/// a map's heat maps are byte for byte those of one unsharded run.
 ///
 /// Every part must come from the same configuration (the hash in its header) and the
 /// same split, and every part 0 … N−1 must be there exactly once. A missing part is
@@ -23,7 +23,7 @@ pub struct MergeArgs {
     #[arg(required = true)]
     parts: Vec<PathBuf>,
     /// Write an output, by its extension: .csv (the CSV), .json (the JSON --json
-    /// prints), .png or .svg (the heat maps). May be repeated.
+    /// prints), .png or .svg (a map's heat maps). May be repeated.
     #[arg(long)]
     out: Vec<PathBuf>,
     #[command(flatten)]
@@ -33,7 +33,7 @@ pub struct MergeArgs {
 /// The largest part file read, in bytes (a 200 × 200 map is some 60 MB whole).
 const MAX_PART_BYTES: u64 = 1 << 30;
 
-fn read(path: &PathBuf) -> Result<MapPart> {
+fn read(path: &PathBuf) -> Result<Part> {
     let fail = |reason: String| Error::Parse {
         name: "part file",
         text: path.display().to_string(),
@@ -47,7 +47,7 @@ fn read(path: &PathBuf) -> Result<MapPart> {
         return Err(fail(format!("larger than {MAX_PART_BYTES} bytes")));
     }
     let text = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
-    serde_json::from_slice(&text).map_err(|e| fail(format!("not a tapsim map part file: {e}")))
+    serde_json::from_slice(&text).map_err(|e| fail(format!("not a tapsim part file: {e}")))
 }
 
 /// Run the subcommand.
@@ -71,12 +71,19 @@ pub fn run(args: MergeArgs) -> Result<()> {
         .map(|p| Ok((p.display().to_string(), read(p)?)))
         .collect::<Result<Vec<_>>>()?;
     let merged = part::merge(parts)?;
-    super::map::emit(
-        &args.output,
-        &args.out,
-        &merged.law,
-        &merged.works,
-        &merged.moduli,
-        &merged.records,
-    )
+    match &merged.job {
+        Job::Map {
+            law,
+            work_of_adhesion_j_m2,
+            modulus_pa,
+        } => super::map::emit(
+            &args.output,
+            &args.out,
+            law,
+            work_of_adhesion_j_m2,
+            modulus_pa,
+            &merged.records,
+        ),
+        Job::Batch { .. } => super::batch::emit(&args.output, &args.out, &merged.records),
+    }
 }

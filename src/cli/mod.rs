@@ -18,6 +18,7 @@ macro_rules! out {
 }
 
 mod approach;
+mod batch;
 mod bifurcation;
 mod branches;
 mod contrast;
@@ -54,6 +55,7 @@ enum Command {
     Bifurcation(bifurcation::BifurcationArgs),
     Contrast(contrast::ContrastArgs),
     Map(map::MapArgs),
+    Batch(batch::BatchArgs),
     Merge(merge::MergeArgs),
     Hysteresis(hysteresis::HysteresisArgs),
     Lj(lj::LjArgs),
@@ -224,6 +226,7 @@ pub fn main() -> ExitCode {
         Command::Bifurcation(args) => bifurcation::run(args),
         Command::Contrast(args) => contrast::run(args),
         Command::Map(args) => map::run(args),
+        Command::Batch(args) => batch::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),
         Command::Lj(args) => lj::run(args),

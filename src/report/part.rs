@@ -1,42 +1,96 @@
-//! Part files of a map split over machines (`tapsim map --shard I/N`) and their merge
-//! (`tapsim merge`). A part file is one JSON object: a header (format, tapsim version,
-//! a hash of the whole configuration, N, I, the part's cell numbers) and the part's
-//! cells as records, floats written so they read back bit for bit. Merging checks that
-//! the parts belong together and cover every cell exactly once, and gives the cells in
-//! the order one whole run gives them.
+//! Part files of a job split over machines (`tapsim map --shard I/N`, `tapsim batch
+//! --shard I/N`) and their merge (`tapsim merge`). A part file is one JSON object: a
+//! header (format, tapsim version, a hash of the whole configuration, N, I, what the job
+//! is, the numbers of the part's items: a map's cells, a batch's cases) and each item's
+//! records, floats written so they read back bit for bit. Merging checks that the parts
+//! belong together and cover every item exactly once, and gives the records in the
+//! order one whole run gives them.
 
-use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
 use crate::sweep::Shard;
 use serde::{Deserialize, Serialize};
+
 use serde_json::{Map, Value};
 
 /// What a part file says it is.
-pub const FORMAT: &str = "tapsim-map-part";
+pub const FORMAT: &str = "tapsim-part";
 
-/// One part of a map.
+/// The job a part belongs to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MapPart {
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Job {
+    /// `tapsim map`: one record per cell.
+    Map {
+        /// The law, as the map's outputs name it.
+        law: String,
+        /// The work-of-adhesion axis in J/m².
+        work_of_adhesion_j_m2: Vec<f64>,
+        /// The modulus axis in Pa.
+        modulus_pa: Vec<f64>,
+    },
+    /// `tapsim batch`: one record per tap case, one per setpoint of an approach case.
+    Batch {
+        /// The number of cases.
+        cases: usize,
+    },
+}
+
+impl Job {
+    /// How many items the whole job has.
+    pub fn items(&self) -> usize {
+        match self {
+            Job::Map {
+                work_of_adhesion_j_m2,
+                modulus_pa,
+                ..
+            } => work_of_adhesion_j_m2.len() * modulus_pa.len(),
+            Job::Batch { cases } => *cases,
+        }
+    }
+}
+
+/// One part of a job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Part {
     /// Always [`FORMAT`].
     pub format: String,
     /// The tapsim version that wrote it.
     pub tapsim_version: String,
-    /// Hash of everything that determines the map ([`config_hash`]).
+    /// Hash of everything that determines the job ([`config_hash`]).
     pub config_hash: String,
     /// N, the number of parts.
     pub shards: usize,
     /// I, this part's number (from 0).
     pub shard: usize,
-    /// The law, as the map's outputs name it.
-    pub law: String,
-    /// The work-of-adhesion axis in J/m².
-    pub work_of_adhesion_j_m2: Vec<f64>,
-    /// The modulus axis in Pa.
-    pub modulus_pa: Vec<f64>,
-    /// The cells this part computed, by number (row by row over the grid).
-    pub cells: Vec<usize>,
-    /// Those cells as records, in the same order.
-    pub records: Vec<Map<String, Value>>,
+    /// The job.
+    pub job: Job,
+    /// The items this part computed, by number.
+    pub items: Vec<usize>,
+    /// Each item's records, in the same order.
+    pub records: Vec<Vec<Map<String, Value>>>,
+}
+
+impl Part {
+    /// Part `shard` of `job` with these items and records, stamped with this build's
+    /// version and the hash of `config`.
+    pub fn new(
+        shard: Shard,
+        job: Job,
+        config: &impl Serialize,
+        items: Vec<usize>,
+        records: Vec<Vec<Map<String, Value>>>,
+    ) -> Self {
+        Self {
+            format: FORMAT.into(),
+            tapsim_version: env!("CARGO_PKG_VERSION").into(),
+            config_hash: config_hash(config),
+            shards: shard.count,
+            shard: shard.index,
+            job,
+            items,
+            records,
+        }
+    }
 }
 
 /// FNV-1a, 64 bits: a stable hash (the same on every machine and build).
@@ -46,15 +100,12 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
-/// A hash of the tapsim version, the setup, the numerics and both axes: parts with equal
-/// hashes were computed for the same map.
-pub fn config_hash(setup: &TapSetup, numerics: &Numerics, works: &[f64], moduli: &[f64]) -> String {
+/// A hash of the tapsim version and `config` (everything that determines a job's
+/// results): parts with equal hashes were computed for the same job.
+pub fn config_hash(config: &impl Serialize) -> String {
     let config = serde_json::json!({
         "tapsim_version": env!("CARGO_PKG_VERSION"),
-        "setup": setup,
-        "numerics": numerics,
-        "work_of_adhesion_j_m2": works,
-        "modulus_pa": moduli,
+        "config": config,
     });
     format!("{:016x}", fnv1a(config.to_string().as_bytes()))
 }
@@ -78,34 +129,33 @@ pub fn array_spec(numbers: &[usize]) -> String {
     out.join(",")
 }
 
-/// The merged map: law, axes and every cell's record in the order of a whole run.
+/// A merged job: what it is and every record in the order of a whole run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Merged {
-    /// The law.
-    pub law: String,
-    /// The work-of-adhesion axis.
-    pub works: Vec<f64>,
-    /// The modulus axis.
-    pub moduli: Vec<f64>,
-    /// Every cell's record.
+    /// The job.
+    pub job: Job,
+    /// Every record.
     pub records: Vec<Map<String, Value>>,
 }
 
-/// Merge `parts` (each with the name it was read from): refuse parts of different maps
+/// Merge `parts` (each with the name it was read from): refuse parts of different jobs
 /// or of a different split, a part given twice, and any missing part, naming the missing
 /// part numbers as `sbatch --array=` takes them.
-pub fn merge(parts: Vec<(String, MapPart)>) -> Result<Merged> {
+pub fn merge(parts: Vec<(String, Part)>) -> Result<Merged> {
     let refuse = |why: String| Error::NotApplicable(why);
     let Some((first_name, first)) = parts.first() else {
         return Err(refuse("no part files to merge".into()));
     };
     for (name, p) in &parts {
         if p.format != FORMAT {
-            return Err(refuse(format!("{name} is not a tapsim map part file")));
+            return Err(refuse(format!("{name} is not a tapsim part file")));
         }
-        if p.config_hash != first.config_hash || p.tapsim_version != first.tapsim_version {
+        if p.config_hash != first.config_hash
+            || p.tapsim_version != first.tapsim_version
+            || p.job != first.job
+        {
             return Err(refuse(format!(
-                "{name} belongs to another map than {first_name} (configuration {} of tapsim \
+                "{name} belongs to another job than {first_name} (configuration {} of tapsim \
                  {} against {} of tapsim {}): merge the parts of one run",
                 p.config_hash, p.tapsim_version, first.config_hash, first.tapsim_version
             )));
@@ -119,7 +169,7 @@ pub fn merge(parts: Vec<(String, MapPart)>) -> Result<Merged> {
         }
     }
     let n = first.shards;
-    let total = first.work_of_adhesion_j_m2.len() * first.modulus_pa.len();
+    let total = first.job.items();
     let mut seen: Vec<Option<&str>> = vec![None; n];
     for (name, p) in &parts {
         let shard = Shard::new(p.shard, p.shards)?;
@@ -130,9 +180,9 @@ pub fn merge(parts: Vec<(String, MapPart)>) -> Result<Merged> {
             )));
         }
         seen[p.shard] = Some(name);
-        if p.cells != shard.items(total) || p.records.len() != p.cells.len() {
+        if p.items != shard.items(total) || p.records.len() != p.items.len() {
             return Err(refuse(format!(
-                "{name} does not hold the cells of part {} of {n}: it was changed or cut short",
+                "{name} does not hold the items of part {} of {n}: it was changed or cut short",
                 p.shard
             )));
         }
@@ -146,20 +196,22 @@ pub fn merge(parts: Vec<(String, MapPart)>) -> Result<Merged> {
             array_spec(&missing)
         )));
     }
-    let mut records: Vec<Option<Map<String, Value>>> = vec![None; total];
-    for (_, p) in parts.iter() {
-        for (&k, r) in p.cells.iter().zip(&p.records) {
-            records[k] = Some(r.clone());
+    let mut by_item: Vec<Option<&Vec<Map<String, Value>>>> = vec![None; total];
+    for (_, p) in &parts {
+        for (&k, r) in p.items.iter().zip(&p.records) {
+            by_item[k] = Some(r);
         }
     }
+    let records = by_item
+        .into_iter()
+        .flat_map(|r| {
+            r.expect("every item was checked to be in exactly one part")
+                .clone()
+        })
+        .collect();
     Ok(Merged {
-        law: first.law.clone(),
-        works: first.work_of_adhesion_j_m2.clone(),
-        moduli: first.modulus_pa.clone(),
-        records: records
-            .into_iter()
-            .map(|r| r.expect("every cell was checked to be in exactly one part"))
-            .collect(),
+        job: first.job.clone(),
+        records,
     })
 }
 

@@ -1,0 +1,422 @@
+//! `tapsim batch`: independent tap and approach runs from a table, in parallel and
+//! shardable like a map.
+
+use crate::config::TapInputs;
+use crate::error::{Error, Result};
+use crate::report::part::{Job, Part};
+use crate::report::{output, records};
+use crate::sweep::{self, Shard};
+use clap::Args;
+use serde_json::{Map, Value};
+use std::path::{Path, PathBuf};
+
+/// Run one independent simulation per row of a table: a `tapsim tap` (the default) or a
+/// `tapsim approach` (column command = approach), in parallel, each on its own core.
+///
+/// The table is CSV (a header row of column names) or TOML (an array of tables
+/// [[case]]). Columns: any `tapsim tap` option by its flag's name (law, radius,
+/// sample-modulus, work-of-adhesion, separation, quality, viscosity, …, with units as on
+/// the command line; an empty cell keeps the default), and
+///   name      the case's name (default: its row number, from 1)
+///   command   tap or approach
+///   points, from, to, no-retract   an approach's setpoints (as `tapsim approach`)
+/// Options given on the command line apply to every row that does not set them.
+///
+/// Output: CSV on stdout (or --csv FILE), or --json (one object of equal-length
+/// columns): one row per tap case (case, command, and every observable of `tapsim tap
+/// --json`; a note where the law does not apply), one row per setpoint of an approach
+/// case (an approach is one sequential job: its setpoints are never split).
+///
+/// --shard I/N runs every N-th case (number ≡ I mod N) into a part file for `tapsim
+/// merge`, as `tapsim map` does (inside a Slurm array task, I and N come from it).
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct BatchArgs {
+    /// The table (.csv or .toml).
+    table: PathBuf,
+    #[command(flatten)]
+    inputs: TapInputs,
+    #[command(flatten)]
+    out: super::SweepOutput,
+    /// Worker threads (0: all cores).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
+    threads: usize,
+    /// Run only part I (from 0) of N, into a part file (--part) for `tapsim merge`.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<String>,
+    /// The part file of a sharded run [default: batch-part-I-of-N.json].
+    #[arg(long)]
+    part: Option<PathBuf>,
+}
+
+/// The largest table read, in bytes.
+const MAX_TABLE_BYTES: u64 = 16 * 1024 * 1024;
+
+/// The most cases a table may hold.
+const MAX_CASES: usize = 100_000;
+
+/// What a case runs.
+#[derive(Debug, Clone, serde::Serialize)]
+enum Run {
+    Tap,
+    Approach {
+        points: usize,
+        from: Option<f64>,
+        to: Option<f64>,
+        retract: bool,
+    },
+}
+
+/// One row of the table, resolved.
+#[derive(Debug, Clone, serde::Serialize)]
+struct Case {
+    name: String,
+    run: Run,
+    setup: crate::dynamics::setup::TapSetup,
+    numerics: crate::dynamics::setup::Numerics,
+}
+
+/// The cells of one row: (column, text), empty cells left out.
+type Row = Vec<(String, String)>;
+
+fn read_rows(path: &Path) -> Result<Vec<Row>> {
+    let fail = |reason: String| Error::Parse {
+        name: "table",
+        text: path.display().to_string(),
+        reason,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
+    if !meta.is_file() || meta.len() > MAX_TABLE_BYTES {
+        return Err(fail(format!(
+            "must be a regular file of at most {MAX_TABLE_BYTES} bytes"
+        )));
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+    let is_toml = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let rows: Vec<Row> = if is_toml {
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+            fail(format!("not valid TOML: {}", e.to_string().trim_end()))
+        })?;
+        let cases = match table.get("case") {
+            Some(toml::Value::Array(cases)) => cases,
+            _ => return Err(fail("expected an array of tables [[case]]".into())),
+        };
+        cases
+            .iter()
+            .map(|case| {
+                let toml::Value::Table(t) = case else {
+                    return Err(fail("every [[case]] must be a table".into()));
+                };
+                t.iter()
+                    .map(|(k, v)| {
+                        let text = match v {
+                            toml::Value::String(s) => s.clone(),
+                            toml::Value::Integer(i) => i.to_string(),
+                            toml::Value::Float(f) => f.to_string(),
+                            toml::Value::Boolean(b) => b.to_string(),
+                            other => {
+                                return Err(fail(format!(
+                                    "{k} = {other}: a number, a string or true/false"
+                                )));
+                            }
+                        };
+                        Ok((k.clone(), text))
+                    })
+                    .collect()
+            })
+            .collect::<Result<_>>()?
+    } else {
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let header: Vec<String> = reader
+            .headers()
+            .map_err(|e| fail(e.to_string()))?
+            .iter()
+            .map(str::to_string)
+            .collect();
+        reader
+            .records()
+            .map(|r| {
+                let r = r.map_err(|e| fail(e.to_string()))?;
+                Ok(header
+                    .iter()
+                    .zip(r.iter())
+                    .filter(|(_, v)| !v.is_empty())
+                    .map(|(k, v)| (k.clone(), v.to_string()))
+                    .collect())
+            })
+            .collect::<Result<_>>()?
+    };
+    if rows.is_empty() || rows.len() > MAX_CASES {
+        return Err(fail(format!("must hold from 1 to {MAX_CASES} cases")));
+    }
+    Ok(rows)
+}
+
+/// Resolve row `index` (from 0) over `base`.
+fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
+    let at = |e: Error| Error::NotApplicable(format!("row {}: {e}", index + 1));
+    let mut inputs = TapInputs::default();
+    let mut name = (index + 1).to_string();
+    let mut command = "tap".to_string();
+    let (mut points, mut from, mut to, mut retract) = (60usize, None, None, true);
+    for (key, text) in row {
+        match key.as_str() {
+            "name" => name = text.clone(),
+            "command" => command = text.to_ascii_lowercase(),
+            "points" => {
+                points = text.parse().map_err(|_| {
+                    at(Error::Parse {
+                        name: "points",
+                        text: text.clone(),
+                        reason: "a whole number".into(),
+                    })
+                })?
+            }
+            "from" => {
+                from = Some(crate::config::length(text).map_err(|e| at(Error::NotApplicable(e)))?)
+            }
+            "to" => {
+                to = Some(crate::config::length(text).map_err(|e| at(Error::NotApplicable(e)))?)
+            }
+            "no-retract" => retract = !matches!(text.as_str(), "true" | "yes" | "1"),
+            "law" => {
+                inputs.law = Some(crate::law::LawKind::from_name(text).ok_or_else(|| {
+                    at(Error::Parse {
+                        name: "law",
+                        text: text.clone(),
+                        reason: format!(
+                            "expected one of {}",
+                            crate::law::LawKind::names().join(", ")
+                        ),
+                    })
+                })?)
+            }
+            other => inputs.set(other, text).map_err(|e| match e {
+                Error::Parse { name: "key", .. } => at(Error::Parse {
+                    name: "column",
+                    text: other.to_string(),
+                    reason: format!(
+                        "unknown column; the columns are name, command, points, from, to, \
+                         no-retract, law and every tap option's name ({e})"
+                    ),
+                }),
+                e => at(e),
+            })?,
+        }
+    }
+    let inputs = inputs.or(base.clone());
+    let (setup, numerics) = inputs.resolve().map_err(at)?;
+    let (run, numerics) = match command.as_str() {
+        "tap" => (Run::Tap, numerics),
+        "approach" => (
+            Run::Approach {
+                points,
+                from,
+                to,
+                retract,
+            },
+            inputs.sweep_numerics(numerics),
+        ),
+        other => {
+            return Err(at(Error::Parse {
+                name: "command",
+                text: other.to_string(),
+                reason: "expected tap or approach".into(),
+            }));
+        }
+    };
+    Ok(Case {
+        name,
+        run,
+        setup,
+        numerics,
+    })
+}
+
+/// The records of one case: one for a tap, one per setpoint for an approach; a note
+/// where the law does not apply.
+fn run_case(c: &Case) -> Result<Vec<Map<String, Value>>> {
+    let head = |command: &str| {
+        let mut m = Map::new();
+        m.insert("case".into(), Value::String(c.name.clone()));
+        m.insert("command".into(), Value::String(command.into()));
+        m
+    };
+    let outcome = match &c.run {
+        Run::Tap => crate::dynamics::observables::tap(
+            &c.setup,
+            &c.numerics,
+            crate::dynamics::observables::Observe::default(),
+        )
+        .and_then(|run| Ok(vec![joined(head("tap"), &run.observables)?])),
+        Run::Approach {
+            points,
+            from,
+            to,
+            retract,
+        } => {
+            let a0 = c.setup.cantilever.free_amplitude_m;
+            sweep::ramp(
+                from.unwrap_or(1.2 * a0),
+                to.unwrap_or(0.4 * a0),
+                *points,
+                *retract,
+            )
+            .and_then(|ramp| sweep::approach_curve(&c.setup, &c.numerics, &ramp, |_, _| {}))
+            .and_then(|curve| curve.iter().map(|p| joined(head("approach"), p)).collect())
+        }
+    };
+    match outcome {
+        Ok(records) => Ok(records),
+        Err(Error::NotApplicable(why)) => {
+            let mut m = head(match c.run {
+                Run::Tap => "tap",
+                Run::Approach { .. } => "approach",
+            });
+            m.insert("note".into(), Value::String(why));
+            Ok(vec![m])
+        }
+        Err(e) => Err(Error::NotApplicable(format!("case {}: {e}", c.name))),
+    }
+}
+
+/// `head` followed by the fields of `record`.
+fn joined(
+    mut head: Map<String, Value>,
+    record: &impl serde::Serialize,
+) -> Result<Map<String, Value>> {
+    head.extend(records::object(record)?);
+    Ok(head)
+}
+
+/// Run the subcommand.
+pub fn run(args: BatchArgs) -> Result<()> {
+    use rayon::prelude::*;
+    if args.out.plot.is_some() {
+        return Err(Error::NotApplicable(
+            "batch writes tables (--csv, --json), not plots".into(),
+        ));
+    }
+    let base = args.inputs.clone().with_config()?;
+    let rows = read_rows(&args.table)?;
+    let cases = rows
+        .iter()
+        .enumerate()
+        .map(|(i, row)| case(i, row, &base))
+        .collect::<Result<Vec<_>>>()?;
+    let shard = super::map::shard(args.shard.as_deref())?;
+    if shard.is_some() && (args.out.csv.is_some() || args.out.json) {
+        return Err(Error::NotApplicable(
+            "a sharded batch writes only its part file (--part): merge the parts with \
+             `tapsim merge` for the CSV and JSON"
+                .into(),
+        ));
+    }
+    if shard.is_none() && args.part.is_some() {
+        return Err(Error::NotApplicable(
+            "--part writes one part of a sharded batch: give --shard I/N (or run in a Slurm \
+             array)"
+                .into(),
+        ));
+    }
+    let items = shard.unwrap_or(Shard::WHOLE).items(cases.len());
+    if args.threads > sweep::MAX_THREADS {
+        return Err(Error::InvalidParameter {
+            name: "threads",
+            value: args.threads as f64,
+            reason: "must be at most 256 (0: one per core)",
+        });
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads)
+        .build()
+        .map_err(|e| Error::NotApplicable(format!("cannot start the threads: {e}")))?;
+    let bar = args.out.progress_bar(items.len());
+    let records: Vec<Vec<Map<String, Value>>> = pool.install(|| {
+        items
+            .par_iter()
+            .map(|&k| {
+                let r = run_case(&cases[k]);
+                bar.inc(1);
+                r
+            })
+            .collect::<Result<_>>()
+    })?;
+    bar.finish_and_clear();
+    match shard {
+        Some(shard) => {
+            let path = args.part.clone().unwrap_or_else(|| {
+                format!("batch-part-{}-of-{}.json", shard.index, shard.count).into()
+            });
+            let part = Part::new(
+                shard,
+                Job::Batch { cases: cases.len() },
+                &cases,
+                items,
+                records,
+            );
+            let text = serde_json::to_string(&part).expect("a part serialises");
+            output::write_bytes(&path, text.as_bytes())?;
+            if !args.out.quiet {
+                eprintln!(
+                    "part {} of {}: {} of {} cases written to {}",
+                    shard.index,
+                    shard.count,
+                    part.items.len(),
+                    cases.len(),
+                    path.display()
+                );
+            }
+            Ok(())
+        }
+        None => emit(
+            &args.out,
+            &[],
+            &records.into_iter().flatten().collect::<Vec<_>>(),
+        ),
+    }
+}
+
+/// Write a whole batch's outputs: CSV (--csv or a .csv in `extra`), JSON (--json on
+/// stdout or a .json in `extra`); without either the CSV on stdout. `tapsim merge`
+/// writes through this too.
+pub(super) fn emit(
+    out: &super::SweepOutput,
+    extra: &[PathBuf],
+    records: &[Map<String, Value>],
+) -> Result<()> {
+    let has = |p: &PathBuf, ext: &str| p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext));
+    if out.plot.is_some() || extra.iter().any(|p| has(p, "png") || has(p, "svg")) {
+        return Err(Error::NotApplicable(
+            "a batch has no plot: write .csv or .json".into(),
+        ));
+    }
+    let csv: Vec<&PathBuf> = out
+        .csv
+        .iter()
+        .chain(extra.iter().filter(|p| has(p, "csv")))
+        .collect();
+    let json_files: Vec<&PathBuf> = extra.iter().filter(|p| has(p, "json")).collect();
+    for path in &csv {
+        output::write_bytes(path, &records::records_csv(records)?)?;
+    }
+    let json = || -> Result<String> {
+        Ok(serde_json::to_string_pretty(&records::columns_json(records)?).expect("serialises"))
+    };
+    for path in &json_files {
+        output::write_bytes(path, format!("{}\n", json()?).as_bytes())?;
+    }
+    if out.json {
+        outln!("{}", json()?);
+    } else if csv.is_empty() && json_files.is_empty() {
+        out!(
+            "{}",
+            String::from_utf8_lossy(&records::records_csv(records)?)
+        );
+    }
+    Ok(())
+}
