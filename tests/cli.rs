@@ -1147,7 +1147,7 @@ fn sharded_maps_merge_to_the_whole_map_byte_for_byte() {
     let out = tapsim_here(&["merge", "part-0-of-2.json", "other.json"], &dir);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        !out.status.success() && err.contains("belongs to another map"),
+        !out.status.success() && err.contains("belongs to another job"),
         "{err}"
     );
     // Slurm's array variables shard a run with no flag.
