@@ -1257,3 +1257,39 @@ fn a_sharded_batch_merges_to_the_whole_batch_and_a_toml_table_reads_as_the_csv()
         "{err}"
     );
 }
+
+#[test]
+fn merge_refuses_what_is_not_a_part_file_of_a_job_tapsim_can_run() {
+    let dir = scratch("hostile-parts");
+    let write = |name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
+    write("garbage.json", "{ not json");
+    write("other.json", "{\"format\": \"something-else\"}");
+    let header = |shards: &str, axes: &str| {
+        format!(
+            "{{\"format\":\"tapsim-part\",\"tapsim_version\":\"0.1.0\",\"config_hash\":\"0\",\
+             \"shards\":{shards},\"shard\":0,\"job\":{{\"kind\":\"map\",\"law\":\"hybrid\",\
+             \"work_of_adhesion_j_m2\":{axes},\"modulus_pa\":{axes}}},\"items\":[],\"records\":[]}}"
+        )
+    };
+    write("many-shards.json", &header("1000000000000000000", "[1,2]"));
+    let big_axis = format!("[{}]", vec!["1"; 5000].join(","));
+    write("huge-grid.json", &header("2", &big_axis));
+    write("cut-short.json", &header("1", "[1,2]"));
+    for (file, needle) in [
+        ("garbage.json", "not a tapsim part file"),
+        ("other.json", "not a tapsim part file"),
+        ("many-shards.json", "parts"),
+        ("huge-grid.json", "more than any tapsim job has"),
+        ("cut-short.json", "changed or cut short"),
+        ("missing.json", "No such file"),
+        (".", "not a regular file"),
+    ] {
+        let out = tapsim_here(&["merge", file], &dir);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            out.status.code() == Some(1) && err.contains(needle),
+            "{file}: {:?} {err}",
+            out.status
+        );
+    }
+}

@@ -12,6 +12,9 @@ use serde::{Deserialize, Serialize};
 
 use serde_json::{Map, Value};
 
+/// The most items a job can have: a 200 × 200 map's cells, a batch's 100 000 cases.
+pub const MAX_ITEMS: usize = 100_000;
+
 /// What a part file says it is.
 pub const FORMAT: &str = "tapsim-part";
 
@@ -43,7 +46,7 @@ impl Job {
                 work_of_adhesion_j_m2,
                 modulus_pa,
                 ..
-            } => work_of_adhesion_j_m2.len() * modulus_pa.len(),
+            } => work_of_adhesion_j_m2.len().saturating_mul(modulus_pa.len()),
             Job::Batch { cases } => *cases,
         }
     }
@@ -168,8 +171,15 @@ pub fn merge(parts: Vec<(String, Part)>) -> Result<Merged> {
             )));
         }
     }
+    // (Checked before anything is sized by them: a part file is input like any other.)
+    Shard::new(first.shard, first.shards)?;
     let n = first.shards;
     let total = first.job.items();
+    if total > MAX_ITEMS {
+        return Err(refuse(format!(
+            "{first_name} describes {total} items, more than any tapsim job has ({MAX_ITEMS})"
+        )));
+    }
     let mut seen: Vec<Option<&str>> = vec![None; n];
     for (name, p) in &parts {
         let shard = Shard::new(p.shard, p.shards)?;
