@@ -182,6 +182,22 @@ impl Shard {
     }
 }
 
+/// A pool of `threads` worker threads (0: one per core, at most [`MAX_THREADS`]) for
+/// independent runs.
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    if threads > MAX_THREADS {
+        return Err(Error::InvalidParameter {
+            name: "threads",
+            value: threads as f64,
+            reason: "must be at most 256 (0: one per core)",
+        });
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::NotApplicable(format!("cannot start {threads} threads: {e}")))
+}
+
 /// E_ts and φ over a grid of (Δγ, E*) at the setup's setpoint, one independent steady
 /// state per cell (each from the free steady state), computed in parallel on `threads`
 /// threads (0: all cores). Cells are independent, so the result does not depend on the
@@ -219,13 +235,7 @@ pub fn map_cells(
     progress: impl Fn() + Sync,
 ) -> Result<Vec<MapCell>> {
     use rayon::prelude::*;
-    if threads > MAX_THREADS {
-        return Err(Error::InvalidParameter {
-            name: "threads",
-            value: threads as f64,
-            reason: "must be at most 256 (0: one per core)",
-        });
-    }
+    let pool = thread_pool(threads)?;
     let total = works_j_m2.len() * moduli_pa.len();
     if let Some(&k) = cells.iter().find(|&&k| k >= total) {
         return Err(Error::NotApplicable(format!(
@@ -243,10 +253,6 @@ pub fn map_cells(
             )
         })
         .collect();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::NotApplicable(format!("cannot start {threads} threads: {e}")))?;
     pool.install(|| {
         cells
             .par_iter()

@@ -1050,25 +1050,28 @@ fn tapsim_here(args: &[&str], dir: &std::path::Path) -> Output {
         .expect("the binary runs")
 }
 
+/// [`tapsim_here`], asserting success; its standard output.
+fn succeeds_here(args: &[&str], dir: &std::path::Path) -> Vec<u8> {
+    let out = tapsim_here(args, dir);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
+}
+
 #[test]
 fn sharded_maps_merge_to_the_whole_map_byte_for_byte() {
     let dir = scratch("shards");
-    let ok = |args: &[&str]| {
-        let out = tapsim_here(args, &dir);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        out
-    };
+    let ok = |args: &[&str]| succeeds_here(args, &dir);
     // A 5 × 5 grid: 10 cells where the law does not apply, 4 that are not period-1.
     let grid = ["map", "--steps", "5", "--quiet"];
     fn with<'a>(grid: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
         [grid, extra].concat()
     }
     ok(&with(&grid, &["--csv", "whole.csv", "--plot", "whole.png"]));
-    let whole_json = ok(&with(&grid, &["--json"])).stdout;
+    let whole_json = ok(&with(&grid, &["--json"]));
     let whole_csv = std::fs::read(dir.join("whole.csv")).unwrap();
     let csv_text = String::from_utf8_lossy(&whole_csv);
     assert!(csv_text.lines().filter(|l| l.contains(",,")).count() >= 5);
@@ -1114,7 +1117,7 @@ fn sharded_maps_merge_to_the_whole_map_byte_for_byte() {
         );
         let mut args = merge.clone();
         args.push("--json");
-        assert_eq!(ok(&args).stdout, whole_json, "N = {n}");
+        assert_eq!(ok(&args), whole_json, "N = {n}");
     }
     // A part missing: named as sbatch --array= takes it.
     let out = tapsim_here(
@@ -1173,15 +1176,7 @@ fn sharded_maps_merge_to_the_whole_map_byte_for_byte() {
 #[test]
 fn a_sharded_batch_merges_to_the_whole_batch_and_a_toml_table_reads_as_the_csv() {
     let dir = scratch("batch");
-    let ok = |args: &[&str]| {
-        let out = tapsim_here(args, &dir);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        out.stdout
-    };
+    let ok = |args: &[&str]| succeeds_here(args, &dir);
     // Tap cases on several laws (one irregular, one where the law does not apply, one
     // viscous) and an approach case, whose setpoints stay together.
     std::fs::write(

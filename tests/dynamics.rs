@@ -437,14 +437,8 @@ fn deflection_harmonics_are_the_force_harmonics_through_the_transfer_function() 
 /// elastic law's own loss; and the viscous force does what it should, adding loss.
 #[test]
 fn a_viscous_sample_adds_loss_and_keeps_the_energy_balance_on_every_law() {
-    for kind in [
-        LawKind::Hybrid,
-        LawKind::HybridAttractive,
-        LawKind::Jkr,
-        LawKind::Dmt,
-        LawKind::Hertz,
-        LawKind::Lj,
-    ] {
+    // Every law with a contact (all but none).
+    for kind in LawKind::ALL.into_iter().filter(|k| *k != LawKind::None) {
         let at = |viscosity: Option<f64>| {
             let setup = TapSetup {
                 law: LawSpec {

@@ -3,7 +3,7 @@
 
 use crate::config::TapInputs;
 use crate::error::{Error, Result};
-use crate::report::part::{Job, Part};
+use crate::report::part::Job;
 use crate::report::{output, records};
 use crate::sweep::{self, Shard};
 use clap::Args;
@@ -41,12 +41,8 @@ pub struct BatchArgs {
     /// Worker threads (0: all cores).
     #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
     threads: usize,
-    /// Run only part I (from 0) of N, into a part file (--part) for `tapsim merge`.
-    #[arg(long, value_name = "I/N")]
-    shard: Option<String>,
-    /// The part file of a sharded run [default: batch-part-I-of-N.json].
-    #[arg(long)]
-    part: Option<PathBuf>,
+    #[command(flatten)]
+    split: super::shard::ShardArgs,
 }
 
 /// The largest table read, in bytes.
@@ -308,33 +304,11 @@ pub fn run(args: BatchArgs) -> Result<()> {
         .enumerate()
         .map(|(i, row)| case(i, row, &base))
         .collect::<Result<Vec<_>>>()?;
-    let shard = super::map::shard(args.shard.as_deref())?;
-    if shard.is_some() && (args.out.csv.is_some() || args.out.json) {
-        return Err(Error::NotApplicable(
-            "a sharded batch writes only its part file (--part): merge the parts with \
-             `tapsim merge` for the CSV and JSON"
-                .into(),
-        ));
-    }
-    if shard.is_none() && args.part.is_some() {
-        return Err(Error::NotApplicable(
-            "--part writes one part of a sharded batch: give --shard I/N (or run in a Slurm \
-             array)"
-                .into(),
-        ));
-    }
+    let shard = args
+        .split
+        .resolve("batch", args.out.csv.is_some() || args.out.json)?;
     let items = shard.unwrap_or(Shard::WHOLE).items(cases.len());
-    if args.threads > sweep::MAX_THREADS {
-        return Err(Error::InvalidParameter {
-            name: "threads",
-            value: args.threads as f64,
-            reason: "must be at most 256 (0: one per core)",
-        });
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .map_err(|e| Error::NotApplicable(format!("cannot start the threads: {e}")))?;
+    let pool = sweep::thread_pool(args.threads)?;
     let bar = args.out.progress_bar(items.len());
     let records: Vec<Vec<Map<String, Value>>> = pool.install(|| {
         items
@@ -348,31 +322,13 @@ pub fn run(args: BatchArgs) -> Result<()> {
     })?;
     bar.finish_and_clear();
     match shard {
-        Some(shard) => {
-            let path = args.part.clone().unwrap_or_else(|| {
-                format!("batch-part-{}-of-{}.json", shard.index, shard.count).into()
-            });
-            let part = Part::new(
-                shard,
-                Job::Batch { cases: cases.len() },
-                &cases,
-                items,
-                records,
-            );
-            let text = serde_json::to_string(&part).expect("a part serialises");
-            output::write_bytes(&path, text.as_bytes())?;
-            if !args.out.quiet {
-                eprintln!(
-                    "part {} of {}: {} of {} cases written to {}",
-                    shard.index,
-                    shard.count,
-                    part.items.len(),
-                    cases.len(),
-                    path.display()
-                );
-            }
-            Ok(())
-        }
+        Some(shard) => args.split.write(
+            ("batch", shard, args.out.quiet),
+            Job::Batch { cases: cases.len() },
+            &cases,
+            items,
+            records,
+        ),
         None => emit(
             &args.out,
             &[],

@@ -1,8 +1,8 @@
 //! `tapsim map`: dissipation and phase over a grid of work of adhesion and modulus.
 
 use crate::config::{TapInputs, pressure, surface_energy};
-use crate::error::{Error, Result};
-use crate::report::part::{Job, Part};
+use crate::error::Result;
+use crate::report::part::Job;
 use crate::report::{map as report, output, plot, records};
 use crate::sweep;
 use crate::sweep::Shard;
@@ -46,63 +46,8 @@ pub struct MapArgs {
     /// Worker threads (0: all cores).
     #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
     threads: usize,
-    /// Compute only part I (from 0) of N: the cells whose number (row by row over the
-    /// grid, as the CSV lists them) is I mod N, written to a part file (--part) for
-    /// `tapsim merge`. Inside a Slurm array task, I and N default to the task's
-    /// SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN and SLURM_ARRAY_TASK_COUNT.
-    #[arg(long, value_name = "I/N")]
-    shard: Option<String>,
-    /// The part file of a sharded run [default: map-part-I-of-N.json]; written whole or
-    /// not at all, with a header (tapsim version, configuration hash, N, I, the cells).
-    #[arg(long)]
-    part: Option<std::path::PathBuf>,
-}
-
-/// Which part of the map this run computes: `--shard I/N`, else inside a Slurm array
-/// task SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN of SLURM_ARRAY_TASK_COUNT, else the
-/// whole map (`None`).
-pub(super) fn shard(flag: Option<&str>) -> Result<Option<Shard>> {
-    let number = |what: &str, text: &str| {
-        text.trim().parse::<usize>().map_err(|_| Error::Parse {
-            name: "shard",
-            text: text.to_string(),
-            reason: format!("{what} must be a whole number"),
-        })
-    };
-    if let Some(text) = flag {
-        let (i, n) = text.split_once('/').ok_or_else(|| Error::Parse {
-            name: "shard",
-            text: text.to_string(),
-            reason: "expected I/N, part I (from 0) of N".into(),
-        })?;
-        return Ok(Some(Shard::new(number("I", i)?, number("N", n)?)?));
-    }
-    let var = |name: &str| std::env::var(name).ok();
-    match (var("SLURM_ARRAY_TASK_ID"), var("SLURM_ARRAY_TASK_COUNT")) {
-        (Some(id), Some(count)) => {
-            let min = var("SLURM_ARRAY_TASK_MIN").unwrap_or_else(|| "0".into());
-            let (id, min, count) = (
-                number("SLURM_ARRAY_TASK_ID", &id)?,
-                number("SLURM_ARRAY_TASK_MIN", &min)?,
-                number("SLURM_ARRAY_TASK_COUNT", &count)?,
-            );
-            let index = id.checked_sub(min).ok_or_else(|| {
-                Error::NotApplicable(format!(
-                    "Slurm array task {id} is below the array's first, {min}"
-                ))
-            })?;
-            Shard::new(index, count)
-                .map_err(|_| {
-                    Error::NotApplicable(format!(
-                        "Slurm array task {id} of {count} starting at {min}: the array's \
-                         task numbers must be consecutive (--array=0-{} or a range like it)",
-                        count.saturating_sub(1)
-                    ))
-                })
-                .map(Some)
-        }
-        _ => Ok(None),
-    }
+    #[command(flatten)]
+    split: super::shard::ShardArgs,
 }
 
 /// Run the subcommand.
@@ -117,21 +62,8 @@ pub fn run(args: MapArgs) -> Result<()> {
     let moduli = sweep::log_grid("modulus", args.modulus_from, args.modulus_to, args.steps)?;
     let law = setup.law.to_string();
     let total = works.len() * moduli.len();
-    let shard = shard(args.shard.as_deref())?;
-    if shard.is_some() && (args.out.csv.is_some() || args.out.plot.is_some() || args.out.json) {
-        return Err(Error::NotApplicable(
-            "a sharded map writes only its part file (--part): merge the parts with `tapsim \
-             merge` for the CSV, JSON and plot"
-                .into(),
-        ));
-    }
-    if shard.is_none() && args.part.is_some() {
-        return Err(Error::NotApplicable(
-            "--part writes one part of a sharded map: give --shard I/N (or run in a Slurm \
-             array)"
-                .into(),
-        ));
-    }
+    let whole_outputs = args.out.csv.is_some() || args.out.plot.is_some() || args.out.json;
+    let shard = args.split.resolve("map", whole_outputs)?;
     let cells = shard.unwrap_or(Shard::WHOLE).items(total);
     let bar = args.out.progress_bar(cells.len());
     let computed = sweep::map_cells(
@@ -145,36 +77,17 @@ pub fn run(args: MapArgs) -> Result<()> {
     bar.finish_and_clear();
     let records = report::cell_records(&computed)?;
     match shard {
-        Some(shard) => {
-            let path = args.part.clone().unwrap_or_else(|| {
-                format!("map-part-{}-of-{}.json", shard.index, shard.count).into()
-            });
-            let config = (&setup, &numerics, &works, &moduli);
-            let job = Job::Map {
+        Some(shard) => args.split.write(
+            ("map", shard, args.out.quiet),
+            Job::Map {
                 law,
                 work_of_adhesion_j_m2: works.clone(),
                 modulus_pa: moduli.clone(),
-            };
-            let part = Part::new(
-                shard,
-                job,
-                &config,
-                cells,
-                records.into_iter().map(|r| vec![r]).collect(),
-            );
-            let text = serde_json::to_string(&part).expect("a part serialises");
-            output::write_bytes(&path, text.as_bytes())?;
-            if !args.out.quiet {
-                eprintln!(
-                    "part {} of {}: {} of {total} cells written to {}",
-                    shard.index,
-                    shard.count,
-                    part.items.len(),
-                    path.display()
-                );
-            }
-            Ok(())
-        }
+            },
+            &(&setup, &numerics, &works, &moduli),
+            cells,
+            records.into_iter().map(|r| vec![r]).collect(),
+        ),
         None => emit(&args.out, &[], &law, &works, &moduli, &records),
     }
 }

@@ -28,6 +28,7 @@ mod lj;
 mod map;
 mod merge;
 mod reproduce;
+mod shard;
 mod tap;
 
 use clap::{Parser, Subcommand};
