@@ -2,7 +2,7 @@
 
 use crate::config::{TapInputs, pressure, surface_energy};
 use crate::error::Result;
-use crate::report::part::Job;
+use crate::report::part::{self, Job};
 use crate::report::{map as report, output, plot, records};
 use crate::sweep;
 use crate::sweep::Shard;
@@ -75,7 +75,6 @@ pub fn run(args: MapArgs) -> Result<()> {
         || bar.inc(1),
     )?;
     bar.finish_and_clear();
-    let records = report::cell_records(&computed)?;
     match shard {
         Some(shard) => args.split.write(
             ("map", shard, args.out.quiet),
@@ -86,22 +85,25 @@ pub fn run(args: MapArgs) -> Result<()> {
             },
             &(&setup, &numerics, &works, &moduli),
             cells,
-            records.into_iter().map(|r| vec![r]).collect(),
+            computed
+                .iter()
+                .map(|c| part::raw_records(std::slice::from_ref(c)))
+                .collect::<Result<_>>()?,
         ),
-        None => emit(&args.out, &[], &law, &works, &moduli, &records),
+        None => emit(&args.out, &[], &law, &works, &moduli, &computed),
     }
 }
 
 /// Write a whole map's outputs: CSV (--csv, or `csv_files`), the heat maps (--plot), the
 /// grid as JSON (--json on stdout, or `json_files`); without any of them the CSV on
 /// stdout. `tapsim merge` writes through this too, so its outputs are a whole run's.
-pub(super) fn emit(
+pub(super) fn emit<T: report::MapRecord>(
     out: &super::SweepOutput,
     extra: &[std::path::PathBuf],
     law: &str,
     works: &[f64],
     moduli: &[f64],
-    records: &[serde_json::Map<String, serde_json::Value>],
+    records: &[T],
 ) -> Result<()> {
     fn by_extension<'a>(
         extra: &'a [std::path::PathBuf],

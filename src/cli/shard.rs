@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::report::output;
 use crate::report::part::{Job, Part};
 use crate::sweep::Shard;
-use serde_json::{Map, Value};
+use serde_json::value::RawValue;
 use std::path::PathBuf;
 
 /// The flags that split a job.
@@ -94,7 +94,7 @@ impl ShardArgs {
         job: Job,
         config: &impl serde::Serialize,
         items: Vec<usize>,
-        records: Vec<Vec<Map<String, Value>>>,
+        records: Vec<Vec<Box<RawValue>>>,
     ) -> Result<()> {
         let path = self.part.clone().unwrap_or_else(|| {
             format!("{command}-part-{}-of-{}.json", shard.index, shard.count).into()

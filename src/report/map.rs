@@ -1,27 +1,51 @@
 //! The `tapsim map` outputs: heat maps of E_ts, φ and A/A₀ over the (Δγ, E*) grid and
-//! the grid as JSON (the CSV is the cells as records). Everything is drawn from the
-//! cells as records (JSON objects, fields in order), so a map merged from part files
-//! ([`super::part`]) gives the same bytes as one computed whole.
+//! the grid as JSON (the CSV is the cells as records). They are drawn from anything
+//! that serialises to a cell's record and answers for its values ([`MapRecord`]): the
+//! cells as computed, or their records read back from part files ([`super::part`]), so a
+//! merged map gives the same bytes as one computed whole.
 
 use super::heatmap::{Cell, HeatMap};
 use super::records;
 use crate::error::Result;
 use crate::sweep::MapCell;
-use serde_json::{Map, Value};
+use serde::Serialize;
+use serde_json::value::RawValue;
 
-/// The cells as records.
-pub fn cell_records(cells: &[MapCell]) -> Result<Vec<Map<String, Value>>> {
-    cells.iter().map(records::object).collect()
+/// A map cell's values by their record's key.
+pub trait MapRecord: Serialize {
+    /// The number under `key` (`None` where the law does not apply).
+    fn number(&self, key: &str) -> Option<f64>;
+}
+
+impl MapRecord for MapCell {
+    fn number(&self, key: &str) -> Option<f64> {
+        let o = self.observables.as_ref()?;
+        match key {
+            "e_ts_ev" => Some(o.e_ts_ev),
+            "phase_deg" => Some(o.phase_deg),
+            "amplitude_ratio" => Some(o.amplitude_ratio),
+            "period" => o.period.map(|p| p as f64),
+            _ => None,
+        }
+    }
+}
+
+impl MapRecord for Box<RawValue> {
+    fn number(&self, key: &str) -> Option<f64> {
+        let record: serde_json::Map<String, serde_json::Value> =
+            serde_json::from_str(self.get()).ok()?;
+        record.get(key)?.as_f64()
+    }
 }
 
 /// Heat maps of E_ts per cycle, phase and A/A₀ over the grid for `law`. The records come
 /// row by row, one row per modulus (as [`map_json`] lays them out); a cell without the
 /// value (the law does not apply there) is grey.
-pub fn heat_maps(
+pub fn heat_maps<T: MapRecord>(
     law: &str,
     works: &[f64],
     moduli: &[f64],
-    cells: &[Map<String, Value>],
+    cells: &[T],
 ) -> Vec<HeatMap> {
     let map = |title: &str, value_label: &str, key: &str| HeatMap {
         title: format!("{law} law: {title}"),
@@ -34,10 +58,10 @@ pub fn heat_maps(
             .chunks(works.len())
             .map(|row| {
                 row.iter()
-                    .map(|c| match c.get(key).and_then(Value::as_f64) {
+                    .map(|c| match c.number(key) {
                         Some(value) => Cell::Value {
                             value,
-                            period_one: c.get("period").and_then(Value::as_u64) == Some(1),
+                            period_one: c.number("period") == Some(1.0),
                         },
                         None => Cell::NotApplicable,
                     })
@@ -54,12 +78,12 @@ pub fn heat_maps(
 
 /// The grid as one JSON object: the law, both axes, and per observable an array of rows
 /// (one per modulus) of values (one per work of adhesion).
-pub fn map_json(
+pub fn map_json<T: Serialize>(
     law: &str,
     works: &[f64],
     moduli: &[f64],
-    cells: &[Map<String, Value>],
-) -> Result<Value> {
+    cells: &[T],
+) -> Result<serde_json::Value> {
     Ok(serde_json::json!({
         "law": law,
         "work_of_adhesion_j_m2": works,
