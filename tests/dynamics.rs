@@ -460,8 +460,23 @@ fn a_viscous_sample_adds_loss_and_keeps_the_energy_balance_on_every_law() {
             "{kind}: {:e}",
             viscous.energy_balance_rel
         );
-        // Per touch the elastic law loses its loop; the sample adds to it.
+        // Per touch the elastic law loses its loop; the sample adds to it. E_ts splits
+        // into the two channels, each from its own integral: the adhesion channel is the
+        // law's loop per touch, the viscous one the rest.
         let elastic_loss = viscous.loop_area_j * viscous.jumps_in;
+        assert_eq!(elastic.e_ts_viscous_j, 0.0, "{kind}");
+        let sum = viscous.e_ts_adhesion_j + viscous.e_ts_viscous_j;
+        assert!(
+            (sum - viscous.e_ts_j).abs() <= 1e-12 * viscous.e_ts_j,
+            "{kind}"
+        );
+        assert!(
+            (viscous.e_ts_adhesion_j - elastic_loss).abs() <= 1e-6 * viscous.e_ts_j,
+            "{kind}: adhesion channel {:e} vs loop per touch {:e}",
+            viscous.e_ts_adhesion_j,
+            elastic_loss
+        );
+        assert!(viscous.e_ts_viscous_j > 0.0, "{kind}");
         assert!(
             viscous.e_ts_j > elastic_loss + 1e-3 * viscous.e_ts_j,
             "{kind}: {:e} vs {:e}",

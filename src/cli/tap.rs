@@ -27,12 +27,13 @@ use std::path::PathBuf;
 /// (with standard errors), never one period of motion that is not period-1.
 ///
 /// JSON keys (--json): amplitude_m, amplitude_ratio, phase_deg, phase_from_energy_deg,
-/// e_ts_j, e_ts_ev, e_damp_j, e_drive_j, energy_balance_rel, virial_j, mean_force_n,
-/// peak_force_n, min_separation_m, contact_fraction, jumps_in, loop_area_j, tabor_mu,
-/// regime, period, periods_averaged, stable, floquet_multipliers, amplitude_std_err_m,
+/// e_ts_j, e_ts_ev, e_ts_adhesion_j and e_ts_viscous_j (E_ts by mechanism), e_damp_j,
+/// e_drive_j, energy_balance_rel, virial_j, mean_force_n, peak_force_n,
+/// min_separation_m, contact_fraction, jumps_in, loop_area_j, tabor_mu, regime, period,
+/// periods_averaged, stable, floquet_multipliers, amplitude_std_err_m,
 /// phase_std_err_deg, e_ts_std_err_j, cycles, converged, harmonics (harmonics 2…10 of
 /// the deflection and the force over a periodic orbit: order, deflection_amplitude_m,
-/// deflection_phase_deg, force_amplitude_n, force_phase_deg; absent for irregular
+/// deflection_phase_deg, force_amplitude_n, force_phase_deg; null for irregular
 /// motion), and more (see README).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]

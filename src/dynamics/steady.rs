@@ -72,6 +72,9 @@ pub struct CycleIntegrals {
     /// branch work functions between the located switches (exact for the computed path),
     /// a rate-dependent part from its carried integral.
     pub e_ts: f64,
+    /// The part of `e_ts` done against a rate-dependent force (a viscous sample's loss),
+    /// from its carried integral; zero for an elastic law.
+    pub e_viscous: f64,
     /// Energy dissipated by damping.
     pub e_damp: f64,
     /// Energy put in by the drive ([`Oscillator::drive_work`]).
@@ -127,6 +130,7 @@ impl CycleIntegrals {
             periods: self.periods + next.periods,
             period: self.period + next.period,
             e_ts: self.e_ts + next.e_ts,
+            e_viscous: self.e_viscous + next.e_viscous,
             e_damp: self.e_damp + next.e_damp,
             e_drive: self.e_drive + next.e_drive,
             delta_mechanical: self.delta_mechanical + next.delta_mechanical,
@@ -524,9 +528,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
             }
         }
         // A rate-dependent force's work, carried along (zero for every other law).
-        if let Some(i) = dissipative_work_index(N) {
-            e_ts += work_scale * y[i];
-        }
+        let e_viscous = dissipative_work_index(N).map_or(0.0, |i| work_scale * y[i]);
+        e_ts += e_viscous;
         phase.tau = tau_end;
         phase.x = y[X];
         phase.v = y[V];
@@ -534,6 +537,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             periods: 1,
             period,
             e_ts,
+            e_viscous,
             e_damp: y[Carried::Damping],
             e_drive: self.osc.drive_work(
                 start,

@@ -57,7 +57,7 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
         };
     let ratio = |p: &SweepPoint| p.observables.amplitude_ratio;
     // (file stem, caption, axis label, column, value); the first is A/A₀ itself.
-    let quantities: [(&str, &str, &str, &str, Pick); 5] = [
+    let quantities: [(&str, &str, &str, &str, Pick); 6] = [
         ("amplitude", "amplitude", "A/A₀", "amplitude_ratio", |p| {
             p.observables.amplitude_ratio
         }),
@@ -70,6 +70,13 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             "E_ts per cycle (eV)",
             "e_ts_ev",
             |p| p.observables.e_ts_ev,
+        ),
+        (
+            "e_ts_viscous",
+            "viscous dissipation",
+            "E_ts in the viscous sample per cycle (eV)",
+            "e_ts_viscous_ev",
+            |p| p.observables.e_ts_viscous_j / crate::params::ELECTRONVOLT_J,
         ),
         (
             "virial",
@@ -87,7 +94,8 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
         ),
     ];
     // A quantity that is zero throughout (a peak repulsive force where the tip never
-    // presses into the sample: the attractive regime) gets no panels.
+    // presses into the sample: the attractive regime; the viscous part of E_ts on an
+    // elastic sample) gets no panels.
     let shown = |q: &&(&str, &str, &str, &str, Pick)| !points.iter().all(|p| q.4(p) == 0.0);
     let against_separation =
         quantities
