@@ -27,12 +27,15 @@ pub struct ApproachArgs {
     #[command(flatten)]
     range: super::SeparationRange,
     /// Points on the approach (the retract has as many).
-    #[arg(long, allow_hyphen_values = true, default_value_t = 60)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = DEFAULT_POINTS)]
     points: usize,
     /// Approach only.
     #[arg(long)]
     no_retract: bool,
 }
+
+/// Setpoints of an approach unless told otherwise (`batch` rows too).
+pub(super) const DEFAULT_POINTS: usize = 60;
 
 /// Run the subcommand.
 pub fn run(args: ApproachArgs) -> Result<()> {

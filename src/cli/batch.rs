@@ -159,7 +159,8 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
     let mut inputs = TapInputs::default();
     let mut name = (index + 1).to_string();
     let mut command = "tap".to_string();
-    let (mut points, mut from, mut to, mut retract) = (60usize, None, None, true);
+    let (mut points, mut from, mut to, mut retract) =
+        (super::approach::DEFAULT_POINTS, None, None, true);
     for (key, text) in row {
         match key.as_str() {
             "name" => name = text.clone(),
@@ -256,15 +257,15 @@ fn run_case(c: &Case) -> Result<Vec<Map<String, Value>>> {
             to,
             retract,
         } => {
-            let a0 = c.setup.cantilever.free_amplitude_m;
-            sweep::ramp(
-                from.unwrap_or(1.2 * a0),
-                to.unwrap_or(0.4 * a0),
-                *points,
-                *retract,
-            )
-            .and_then(|ramp| sweep::approach_curve(&c.setup, &c.numerics, &ramp, |_, _| {}))
-            .and_then(|curve| curve.iter().map(|p| joined(head("approach"), p)).collect())
+            // The defaults of `tapsim approach`.
+            let range = super::SeparationRange {
+                from: *from,
+                to: *to,
+            };
+            let (from, to) = range.resolve(c.setup.cantilever.free_amplitude_m);
+            sweep::ramp(from, to, *points, *retract)
+                .and_then(|ramp| sweep::approach_curve(&c.setup, &c.numerics, &ramp, |_, _| {}))
+                .and_then(|curve| curve.iter().map(|p| joined(head("approach"), p)).collect())
         }
     };
     match outcome {
