@@ -88,10 +88,21 @@ fn settle(c: &mut Criterion) {
         separation_m: 9e-9,
         law: LawKind::Hertz.into(),
     };
+    // The defaults on a viscous sample (Kelvin–Voigt, 10 Pa·s: the repulsive orbit, away
+    // from the fold near 25 Pa·s where it ends and the motion drifts for hundreds of
+    // periods to the attractive one).
+    let viscous = TapSetup {
+        law: tapsim::law::LawSpec {
+            viscosity_pa_s: Some(10.0),
+            ..LawKind::Hybrid.into()
+        },
+        ..default_setup()
+    };
     let mut group = c.benchmark_group("settle");
     for (name, setup, most) in [
         ("hybrid defaults", default_setup(), 20),
         ("dforce hertz Q=1e5", hertz, 60),
+        ("hybrid + kelvin-voigt 10 Pa·s defaults", viscous, 20),
     ] {
         let o = tap(&setup, &Numerics::default(), Observe::default())
             .expect("tap")
