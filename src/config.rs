@@ -184,12 +184,13 @@ pub struct TapInputs {
     /// The contact.
     #[command(flatten)]
     pub contact: ContactInputs,
-    /// Hamaker constant for the dmt law [J or eV; default 12πε²Δγ].
-    #[arg(long, allow_hyphen_values = true, value_parser = energy, help_heading = "Contact (SI)")]
+    /// A law parameter ([`crate::law::HAMAKER`]; its help is the registry's).
+    #[arg(long, allow_hyphen_values = true, value_parser = energy, help_heading = "Contact (SI)",
+          help = crate::law::HAMAKER.help)]
     pub hamaker: Option<f64>,
-    /// Kelvin–Voigt viscosity η of the sample, a force η√(Rδ)·dδ/dt against the
-    /// indentation rate added to the law (e.g. 50Pa·s) [Pa·s; default: none, elastic].
-    #[arg(long, allow_hyphen_values = true, value_parser = viscosity, help_heading = "Contact (SI)")]
+    /// A law parameter ([`crate::law::VISCOSITY`]; its help is the registry's).
+    #[arg(long, allow_hyphen_values = true, value_parser = viscosity, help_heading = "Contact (SI)",
+          help = crate::law::VISCOSITY.help)]
     pub viscosity: Option<f64>,
     /// Cantilever spring constant k [N/m; default 40].
     #[arg(long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Cantilever")]
@@ -487,6 +488,17 @@ mod tests {
                 .map(|f| f.0)
                 .collect();
             assert_eq!(set, [*key]);
+        }
+    }
+
+    #[test]
+    fn every_law_parameter_of_the_registry_is_a_key() {
+        for param in crate::law::LAW_PARAMS {
+            assert!(
+                FIELDS.iter().any(|(key, _, _)| *key == param.key),
+                "{}",
+                param.key
+            );
         }
     }
 

@@ -17,7 +17,7 @@ mod viscous;
 pub use adhesive::AdhesiveLaw;
 pub use conservative::{DmtLaw, HertzLaw, NoForce};
 pub use fold_branch::{FarField, FoldBranch, Side};
-pub use registry::{LAW_PARAMS, LAWS, LawInfo, LawParam, LawSpec};
+pub use registry::{HAMAKER, LAW_PARAMS, LAWS, LawInfo, LawParam, LawSpec, VISCOSITY};
 pub use table::UniformTable;
 pub use viscous::KelvinVoigt;
 
@@ -124,16 +124,16 @@ pub enum LawKind {
 }
 
 impl LawKind {
-    /// Every law, in the order of the help.
-    pub const ALL: [LawKind; 7] = [
-        LawKind::Hybrid,
-        LawKind::HybridAttractive,
-        LawKind::Jkr,
-        LawKind::Dmt,
-        LawKind::Hertz,
-        LawKind::Lj,
-        LawKind::None,
-    ];
+    /// Every law, in the order of the help (the registry's).
+    pub const ALL: [LawKind; LAWS.len()] = {
+        let mut all = [LawKind::Hybrid; LAWS.len()];
+        let mut i = 0;
+        while i < LAWS.len() {
+            all[i] = LAWS[i].kind;
+            i += 1;
+        }
+        all
+    };
 
     /// What the registry says of this law.
     pub fn info(self) -> &'static LawInfo {

@@ -70,7 +70,7 @@ pub struct LawParam {
     pub name: &'static str,
     /// Its SI unit.
     pub unit: &'static str,
-    /// One line of help.
+    /// Its help (the flag's).
     pub help: &'static str,
     /// Whether `law` takes it.
     pub taken_by: fn(LawKind) -> bool,
@@ -78,30 +78,35 @@ pub struct LawParam {
     pub range: (f64, f64, &'static str),
 }
 
+/// DMT's Hamaker constant.
+pub const HAMAKER: LawParam = LawParam {
+    key: "hamaker",
+    name: "Hamaker constant",
+    unit: "J",
+    help: "Hamaker constant for the dmt law [J or eV; default 12πε²Δγ, whose pull-off is \
+           2πRΔγ]",
+    taken_by: |law| law == LawKind::Dmt,
+    range: (1e-22, 1e-17, "the range of real materials, about 1e-20 J"),
+};
+
+/// A Kelvin–Voigt sample's viscosity.
+pub const VISCOSITY: LawParam = LawParam {
+    key: "viscosity",
+    name: "sample viscosity",
+    unit: "Pa·s",
+    help: "Kelvin–Voigt viscosity η of the sample, a force η√(Rδ)·dδ/dt against the \
+           indentation rate added to the law (dForce's and pyDAMPF's form; e.g. 50Pa·s) \
+           [Pa·s; default: none, elastic]",
+    taken_by: |law| law != LawKind::None,
+    range: (
+        1e-6,
+        1e6,
+        "from water (1e-3 Pa·s) to polymer melts; 0 is no viscosity (leave it out)",
+    ),
+};
+
 /// Every law parameter.
-pub const LAW_PARAMS: [LawParam; 2] = [
-    LawParam {
-        key: "hamaker",
-        name: "Hamaker constant",
-        unit: "J",
-        help: "Hamaker constant H of the dmt law (default 12πε²Δγ, whose pull-off is 2πRΔγ)",
-        taken_by: |law| law == LawKind::Dmt,
-        range: (1e-22, 1e-17, "the range of real materials, about 1e-20 J"),
-    },
-    LawParam {
-        key: "viscosity",
-        name: "sample viscosity",
-        unit: "Pa·s",
-        help: "Kelvin–Voigt viscosity η of the sample: a force η√(Rδ)·dδ/dt opposing the \
-               indentation rate, added to any contact law (dForce's and pyDAMPF's form)",
-        taken_by: |law| law != LawKind::None,
-        range: (
-            1e-6,
-            1e6,
-            "from water (1e-3 Pa·s) to polymer melts; 0 is no viscosity (leave it out)",
-        ),
-    },
-];
+pub const LAW_PARAMS: [&LawParam; 2] = [&HAMAKER, &VISCOSITY];
 
 /// A force law with its own parameters: what a setup asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -127,19 +132,21 @@ impl LawSpec {
     /// Each law parameter with its value in this spec (`None`: not set).
     pub fn params(&self) -> [(&'static LawParam, Option<f64>); 2] {
         [
-            (&LAW_PARAMS[0], self.hamaker_j),
-            (&LAW_PARAMS[1], self.viscosity_pa_s),
+            (&HAMAKER, self.hamaker_j),
+            (&VISCOSITY, self.viscosity_pa_s),
         ]
     }
 
     /// The same parameters for law `kind`, leaving out those it does not take (a sweep
     /// over laws on one material).
     pub fn with_kind(&self, kind: LawKind) -> Self {
-        let keep = |i: usize, value: Option<f64>| value.filter(|_| (LAW_PARAMS[i].taken_by)(kind));
+        let [hamaker_j, viscosity_pa_s] = self
+            .params()
+            .map(|(param, value)| value.filter(|_| (param.taken_by)(kind)));
         Self {
             kind,
-            hamaker_j: keep(0, self.hamaker_j),
-            viscosity_pa_s: keep(1, self.viscosity_pa_s),
+            hamaker_j,
+            viscosity_pa_s,
         }
     }
 
