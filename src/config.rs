@@ -229,6 +229,37 @@ pub struct TapInputs {
 /// The largest parameter file read, in bytes.
 pub const MAX_CONFIG_BYTES: u64 = 64 * 1024;
 
+/// The input file `path` read whole. Only a regular file of at most `max_bytes` is read
+/// (a FIFO would block, a device never end); `refuse` makes the error for one that is
+/// not, failures to read are [`Error::Io`].
+pub fn read_input(
+    path: &Path,
+    max_bytes: u64,
+    refuse: impl Fn(String) -> Error,
+) -> Result<Vec<u8>> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(refuse("not a regular file".into()));
+    }
+    if meta.len() > max_bytes {
+        return Err(refuse(format!(
+            "{} bytes; at most {max_bytes} are read",
+            meta.len()
+        )));
+    }
+    std::fs::read(path).map_err(io)
+}
+
+/// [`read_input`] as UTF-8 text.
+pub fn read_text(path: &Path, max_bytes: u64, refuse: impl Fn(String) -> Error) -> Result<String> {
+    let bytes = read_input(path, max_bytes, &refuse)?;
+    String::from_utf8(bytes).map_err(|_| refuse("not UTF-8 text".into()))
+}
+
 /// A settable quantity: its key (a flag's name, also the TOML key), its dimension, and
 /// where it lives in [`TapInputs`].
 type Field = (
@@ -293,30 +324,15 @@ impl TapInputs {
         Ok(())
     }
 
-    /// Read a TOML parameter file (keys as the flags' names).
-    /// Only a regular file of at most [`MAX_CONFIG_BYTES`] is read (a FIFO would block,
-    /// a device never end).
+    /// Read a TOML parameter file (keys as the flags' names), at most
+    /// [`MAX_CONFIG_BYTES`] ([`read_input`]).
     pub fn from_toml_file(path: &Path) -> Result<Self> {
-        let io = |source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        };
         let refuse = |reason: String| Error::Parse {
             name: "config",
             text: path.display().to_string(),
             reason,
         };
-        let meta = std::fs::metadata(path).map_err(io)?;
-        if !meta.is_file() {
-            return Err(refuse("not a regular file".into()));
-        }
-        if meta.len() > MAX_CONFIG_BYTES {
-            return Err(refuse(format!(
-                "{} bytes; a parameter file is at most {MAX_CONFIG_BYTES}",
-                meta.len()
-            )));
-        }
-        let text = std::fs::read_to_string(path).map_err(io)?;
+        let text = read_text(path, MAX_CONFIG_BYTES, refuse)?;
         Self::from_toml(&text).map_err(|e| match e {
             Error::Parse {
                 name: "config",

@@ -82,13 +82,7 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
         text: path.display().to_string(),
         reason,
     };
-    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
-    if !meta.is_file() || meta.len() > MAX_TABLE_BYTES {
-        return Err(fail(format!(
-            "must be a regular file of at most {MAX_TABLE_BYTES} bytes"
-        )));
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+    let text = crate::config::read_text(path, MAX_TABLE_BYTES, fail)?;
     let is_toml = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"));

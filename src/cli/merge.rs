@@ -33,20 +33,13 @@ pub struct MergeArgs {
 /// The largest part file read, in bytes (a 200 × 200 map is some 60 MB whole).
 const MAX_PART_BYTES: u64 = 1 << 30;
 
-fn read(path: &PathBuf) -> Result<Part> {
+fn read(path: &std::path::Path) -> Result<Part> {
     let fail = |reason: String| Error::Parse {
         name: "part file",
         text: path.display().to_string(),
         reason,
     };
-    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
-    if !meta.is_file() {
-        return Err(fail("not a regular file".into()));
-    }
-    if meta.len() > MAX_PART_BYTES {
-        return Err(fail(format!("larger than {MAX_PART_BYTES} bytes")));
-    }
-    let text = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
+    let text = crate::config::read_input(path, MAX_PART_BYTES, fail)?;
     serde_json::from_slice(&text).map_err(|e| fail(format!("not a tapsim part file: {e}")))
 }
 
