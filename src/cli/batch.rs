@@ -4,7 +4,7 @@
 use crate::config::TapInputs;
 use crate::error::{Error, Result};
 use crate::report::part::{self, Job};
-use crate::report::{output, records};
+use crate::report::records;
 use crate::sweep::{self, Shard};
 use clap::Args;
 use serde_json::value::RawValue;
@@ -334,42 +334,17 @@ pub fn run(args: BatchArgs) -> Result<()> {
     }
 }
 
-/// Write a whole batch's outputs: CSV (--csv or a .csv in `extra`), JSON (--json on
-/// stdout or a .json in `extra`); without either the CSV on stdout. `tapsim merge`
-/// writes through this too.
+/// Write a whole batch's outputs ([`super::SweepOutput::emit`]): the CSV and the JSON
+/// columns; a batch has no plot. `tapsim merge` writes through this too.
 pub(super) fn emit(
     out: &super::SweepOutput,
     extra: &[PathBuf],
     records: &[Box<RawValue>],
 ) -> Result<()> {
-    let has = |p: &PathBuf, ext: &str| p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext));
-    if out.plot.is_some() || extra.iter().any(|p| has(p, "png") || has(p, "svg")) {
-        return Err(Error::NotApplicable(
-            "a batch has no plot: write .csv or .json".into(),
-        ));
-    }
-    let csv: Vec<&PathBuf> = out
-        .csv
-        .iter()
-        .chain(extra.iter().filter(|p| has(p, "csv")))
-        .collect();
-    let json_files: Vec<&PathBuf> = extra.iter().filter(|p| has(p, "json")).collect();
-    for path in &csv {
-        output::write_bytes(path, &records::records_csv(records)?)?;
-    }
-    let json = || -> Result<String> {
-        Ok(serde_json::to_string_pretty(&records::columns_json(records)?).expect("serialises"))
-    };
-    for path in &json_files {
-        output::write_bytes(path, format!("{}\n", json()?).as_bytes())?;
-    }
-    if out.json {
-        outln!("{}", json()?);
-    } else if csv.is_empty() && json_files.is_empty() {
-        out!(
-            "{}",
-            String::from_utf8_lossy(&records::records_csv(records)?)
-        );
-    }
-    Ok(())
+    out.emit(
+        ("batch", extra),
+        records,
+        || records::columns_json(records),
+        None,
+    )
 }

@@ -3,7 +3,7 @@
 use crate::config::{TapInputs, pressure, surface_energy};
 use crate::error::Result;
 use crate::report::part::{self, Job};
-use crate::report::{map as report, output, plot, records};
+use crate::report::{map as report, plot};
 use crate::sweep;
 use crate::sweep::Shard;
 use clap::Args;
@@ -94,9 +94,8 @@ pub fn run(args: MapArgs) -> Result<()> {
     }
 }
 
-/// Write a whole map's outputs: CSV (--csv, or `csv_files`), the heat maps (--plot), the
-/// grid as JSON (--json on stdout, or `json_files`); without any of them the CSV on
-/// stdout. `tapsim merge` writes through this too, so its outputs are a whole run's.
+/// Write a whole map's outputs ([`super::SweepOutput::emit`]): the CSV, the heat maps,
+/// the grid as JSON. `tapsim merge` writes through this too.
 pub(super) fn emit<T: report::MapRecord>(
     out: &super::SweepOutput,
     extra: &[std::path::PathBuf],
@@ -105,44 +104,10 @@ pub(super) fn emit<T: report::MapRecord>(
     moduli: &[f64],
     records: &[T],
 ) -> Result<()> {
-    fn by_extension<'a>(
-        extra: &'a [std::path::PathBuf],
-        ext: &'static str,
-    ) -> impl Iterator<Item = &'a std::path::PathBuf> {
-        extra
-            .iter()
-            .filter(move |p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext)))
-    }
-    let csv: Vec<_> = out.csv.iter().chain(by_extension(extra, "csv")).collect();
-    let plots: Vec<_> = out
-        .plot
-        .iter()
-        .chain(by_extension(extra, "png"))
-        .chain(by_extension(extra, "svg"))
-        .collect();
-    let json_files: Vec<_> = by_extension(extra, "json").collect();
-    for path in &csv {
-        output::write_bytes(path, &records::records_csv(records)?)?;
-    }
-    for path in &plots {
-        plot::render_heatmaps(&report::heat_maps(law, works, moduli, records), path)?;
-    }
-    let json = || -> Result<String> {
-        Ok(
-            serde_json::to_string_pretty(&report::map_json(law, works, moduli, records)?)
-                .expect("serialises"),
-        )
-    };
-    for path in &json_files {
-        output::write_bytes(path, format!("{}\n", json()?).as_bytes())?;
-    }
-    if out.json {
-        outln!("{}", json()?);
-    } else if csv.is_empty() && plots.is_empty() && json_files.is_empty() {
-        out!(
-            "{}",
-            String::from_utf8_lossy(&records::records_csv(records)?)
-        );
-    }
-    Ok(())
+    out.emit(
+        ("map", extra),
+        records,
+        || report::map_json(law, works, moduli, records),
+        Some(&|path| plot::render_heatmaps(&report::heat_maps(law, works, moduli, records), path)),
+    )
 }

@@ -119,6 +119,9 @@ impl SweepStart {
     }
 }
 
+/// Draws a run's plot into a file.
+pub type Draw<'a> = dyn Fn(&std::path::Path) -> crate::Result<()> + 'a;
+
 /// Output flags shared by the sweep commands (approach, contrast, map).
 #[derive(Debug, clap::Args)]
 pub struct SweepOutput {
@@ -165,6 +168,60 @@ impl SweepOutput {
         }
         if let Some(path) = &self.plot {
             plot::render_stack(&charts(), path)?;
+        }
+        Ok(())
+    }
+
+    /// Write a whole run's `records` where they were asked for: the CSV to --csv and to
+    /// the .csv files of `extra`; the plot `draw` makes to --plot and the .png/.svg files
+    /// of `extra` (refused, naming the `command`, where it has none); the JSON `json`
+    /// builds to --json (stdout) and the .json files of `extra`; with none of these the
+    /// CSV on stdout. `tapsim merge` writes through this too (with its --out files as
+    /// `extra`), so its outputs are those of one whole run.
+    pub fn emit<T: serde::Serialize>(
+        &self,
+        (command, extra): (&str, &[std::path::PathBuf]),
+        records: &[T],
+        json: impl Fn() -> crate::Result<serde_json::Value>,
+        draw: Option<&Draw>,
+    ) -> crate::Result<()> {
+        use crate::report::{output, records as csv};
+        let with = |ext: &'static str| {
+            extra
+                .iter()
+                .filter(move |p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext)))
+        };
+        let csv_files: Vec<_> = self.csv.iter().chain(with("csv")).collect();
+        let plots: Vec<_> = self
+            .plot
+            .iter()
+            .chain(with("png"))
+            .chain(with("svg"))
+            .collect();
+        let json_files: Vec<_> = with("json").collect();
+        if !plots.is_empty() && draw.is_none() {
+            return Err(crate::Error::NotApplicable(format!(
+                "a {command} has no plot: write .csv or .json"
+            )));
+        }
+        for path in &csv_files {
+            output::write_bytes(path, &csv::records_csv(records)?)?;
+        }
+        if let Some(draw) = draw {
+            for path in &plots {
+                draw(path)?;
+            }
+        }
+        let text = || -> crate::Result<String> {
+            Ok(serde_json::to_string_pretty(&json()?).expect("serialises"))
+        };
+        for path in &json_files {
+            output::write_bytes(path, format!("{}\n", text()?).as_bytes())?;
+        }
+        if self.json {
+            outln!("{}", text()?);
+        } else if csv_files.is_empty() && plots.is_empty() && json_files.is_empty() {
+            out!("{}", String::from_utf8_lossy(&csv::records_csv(records)?));
         }
         Ok(())
     }
