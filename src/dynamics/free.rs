@@ -130,7 +130,8 @@ impl FreeFlight {
     /// the drive's work follows from them by parts, ∫ f₀ cos Ωτ x' dτ =
     /// f₀([x cos Ωτ] + Ω ∫ x sin Ωτ dτ), and damping takes the rest of the energy balance
     /// (the tip feels no force). The tip–sample integrals do not change. The variational
-    /// matrix of a state with a tangent ([`super::model::has_tangent`]) is carried by [`FreeFlight::transition`].
+    /// matrix of a state with a tangent ([`super::model::has_tangent`]) is carried by
+    /// [`FreeFlight::transition`].
     pub(crate) fn advance<const N: usize>(&self, y: &mut State<N>, tau_a: f64, tau_b: f64) {
         let (sc, ss) = self.fourier(tau_a, tau_b);
         let (x_a, v_a) = self.at(tau_a);

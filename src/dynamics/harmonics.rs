@@ -13,7 +13,7 @@
 use super::free::FreeFlight;
 use super::model::{Coupling, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver};
-use crate::law::{Branch, ContactState, ForceLaw};
+use crate::law::{Branch, ForceLaw};
 use crate::numeric::GAUSS_LEGENDRE_8;
 use nalgebra::Complex;
 use serde::Serialize;
@@ -94,8 +94,6 @@ impl<'a, L: ForceLaw> HarmonicsObserver<'a, L> {
     pub fn finish(&self) -> HarmonicCoefficients {
         let scale = 2.0 / self.span;
         HarmonicCoefficients {
-            omega: self.osc.omega,
-            gamma: self.osc.gamma,
             deflection: self.deflection.map(|z| z * scale),
             force: self.force.map(|z| z * scale),
         }
@@ -115,12 +113,9 @@ impl<L: ForceLaw> StepObserver for HarmonicsObserver<'_, L> {
             let (t, w) = (0.5 * (1.0 + x), 0.5 * w);
             let tau = from.tau + t * h;
             let (x, dx_dt) = quintic_hermite(t, start, finish);
-            let (x_b, v_b) = self.osc.base_at(tau);
-            let state = ContactState {
-                alpha_hat: self.cpl.alpha_hat(x, x_b),
-                rate_hat: self.cpl.a1 * (dx_dt / h + v_b),
-                branch,
-            };
+            let state = self
+                .cpl
+                .contact_state((x, dx_dt / h), self.osc.base_at(tau), branch);
             let f = -self.cpl.f_scale * self.law.force_hat(&state);
             self.add(tau, w * h, x, f);
         }
@@ -146,26 +141,14 @@ impl<L: ForceLaw> StepObserver for HarmonicsObserver<'_, L> {
 }
 
 /// The Fourier coefficients of a periodic orbit's deflection and force, n = 1…10, in the
-/// model's units (L and kL): index n − 1.
+/// model's units (L and kL): index n − 1. For n ≥ 2 they obey X_n = F_n/(1 − n²Ω² +
+/// 2iγnΩ) (the module's check).
 #[derive(Debug, Clone, PartialEq)]
 pub struct HarmonicCoefficients {
-    /// Ω of the drive.
-    pub omega: f64,
-    /// γ = 1/(2Q).
-    pub gamma: f64,
     /// X_n.
     pub deflection: [Complex<f64>; HIGHEST_HARMONIC],
     /// F_n.
     pub force: [Complex<f64>; HIGHEST_HARMONIC],
-}
-
-impl HarmonicCoefficients {
-    /// The point-mass transfer function at nΩ: X_n = H(nΩ)·F_n for every harmonic the
-    /// drive does not act on, H(w) = 1/(1 − w² + 2iγw).
-    pub fn transfer(&self, n: usize) -> Complex<f64> {
-        let w = n as f64 * self.omega;
-        Complex::new(1.0 - w * w, 2.0 * self.gamma * w).inv()
-    }
 }
 
 /// One harmonic of the deflection and the force, in SI units.

@@ -302,6 +302,22 @@ impl Coupling {
         self.a0 + self.a1 * (x + x_b)
     }
 
+    /// What the law sees at deflection and velocity `(x, v)` with the support at
+    /// `(x_b, x_b')`: α̂ and its rate a₁(x' + x_b').
+    #[inline]
+    pub fn contact_state(
+        &self,
+        (x, v): (f64, f64),
+        (x_b, v_b): (f64, f64),
+        branch: Branch,
+    ) -> ContactState {
+        ContactState {
+            alpha_hat: self.alpha_hat(x, x_b),
+            rate_hat: self.a1 * (v + v_b),
+            branch,
+        }
+    }
+
     /// Deflection at which α̂ equals `alpha_hat` (without base displacement).
     #[inline]
     pub(crate) fn x_at(&self, alpha_hat: f64) -> f64 {

@@ -8,7 +8,7 @@ use super::numeric::{StepEnd, StepObserver, hermite};
 use super::setup::{Numerics, Prepared, TapSetup};
 use super::steady::{CycleIntegrals, Motion, SteadyState};
 use crate::error::{Error, Result};
-use crate::law::{Branch, ContactState, ForceLaw};
+use crate::law::{Branch, ForceLaw};
 use crate::params::ELECTRONVOLT_J;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -311,16 +311,12 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
             self.overflowed = true;
             return;
         }
-        let (x_b, v_b) = self.osc.base_at(tau);
-        let alpha = self.cpl.alpha_hat(x, x_b);
-        let state = ContactState {
-            alpha_hat: alpha,
-            rate_hat: self.cpl.a1 * (v + v_b),
-            branch,
-        };
+        let state = self
+            .cpl
+            .contact_state((x, v), self.osc.base_at(tau), branch);
         // (+ 0.0 turns the −0 of a force-free branch into 0.)
         let f = -self.cpl.f_scale * self.law.force_hat(&state) + 0.0;
-        self.samples.push((tau, x, v, alpha, f, branch));
+        self.samples.push((tau, x, v, state.alpha_hat, f, branch));
     }
 
     /// The samples in SI units for the prepared experiment `p`.

@@ -23,7 +23,7 @@ use super::model::{
 };
 use super::numeric::{self, Crossing, StepEnd, StepObserver, Tolerances, hermite};
 use crate::error::{Error, Result};
-use crate::law::{Branch, ContactState, ForceLaw};
+use crate::law::{Branch, ForceLaw};
 use nalgebra::{Complex, Matrix2, Matrix2x3, Vector2};
 
 /// Where the oscillator is: time, deflection, velocity and contact branch.
@@ -173,15 +173,12 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
         if a.y[V] < 0.0 && b.y[V] > 0.0 {
             let t = hermite_minimum(a, b);
             let tau = a.tau + t * (b.tau - a.tau);
-            let turn = alpha(tau, hermite(a, b, X, tau));
-            lowest = lowest.min(turn);
             // (The tip is at rest there; the support may not be.)
-            let state = ContactState {
-                alpha_hat: turn,
-                rate_hat: self.cpl.a1 * self.osc.base_at(tau).1,
-                branch,
-            };
-            let f = -self.cpl.f_scale * self.law.force_hat(&state);
+            let turn =
+                self.cpl
+                    .contact_state((hermite(a, b, X, tau), 0.0), self.osc.base_at(tau), branch);
+            lowest = lowest.min(turn.alpha_hat);
+            let f = -self.cpl.f_scale * self.law.force_hat(&turn);
             self.max_f = self.max_f.max(f);
             self.min_f = self.min_f.min(f);
         }
@@ -410,11 +407,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             return;
         }
         let (x_b, v_b) = self.osc.base_at(tau);
-        let at = |branch| ContactState {
-            alpha_hat: self.cpl.alpha_hat(y[X], x_b),
-            rate_hat: self.cpl.a1 * (y[V] + v_b),
-            branch,
-        };
+        let at = |branch| self.cpl.contact_state((y[X], y[V]), (x_b, v_b), branch);
         let jump =
             -self.cpl.f_scale * (self.law.force_hat(&at(to)) - self.law.force_hat(&at(from)));
         if jump == 0.0 {
