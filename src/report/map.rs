@@ -11,30 +11,43 @@ use crate::sweep::MapCell;
 use serde::Serialize;
 use serde_json::value::RawValue;
 
-/// A map cell's values by their record's key.
+/// What a heat map shows of one cell: E_ts per cycle (eV), the phase (deg) and A/A₀, and
+/// whether the motion is period-1; `None` where the law does not apply.
+pub type Plotted = Option<([f64; 3], bool)>;
+
+/// A map cell as its record serialises, and what its heat maps show.
 pub trait MapRecord: Serialize {
-    /// The number under `key` (`None` where the law does not apply).
-    fn number(&self, key: &str) -> Option<f64>;
+    /// The cell's plotted values.
+    fn plotted(&self) -> Plotted;
 }
 
 impl MapRecord for MapCell {
-    fn number(&self, key: &str) -> Option<f64> {
+    fn plotted(&self) -> Plotted {
         let o = self.observables.as_ref()?;
-        match key {
-            "e_ts_ev" => Some(o.e_ts_ev),
-            "phase_deg" => Some(o.phase_deg),
-            "amplitude_ratio" => Some(o.amplitude_ratio),
-            "period" => o.period.map(|p| p as f64),
-            _ => None,
-        }
+        Some((
+            [o.e_ts_ev, o.phase_deg, o.amplitude_ratio],
+            o.period == Some(1),
+        ))
     }
 }
 
+/// The fields of a cell's record that its heat maps show.
+#[derive(serde::Deserialize)]
+struct PlottedFields {
+    e_ts_ev: Option<f64>,
+    phase_deg: Option<f64>,
+    amplitude_ratio: Option<f64>,
+    period: Option<u64>,
+}
+
 impl MapRecord for Box<RawValue> {
-    fn number(&self, key: &str) -> Option<f64> {
-        let record: serde_json::Map<String, serde_json::Value> =
-            serde_json::from_str(self.get()).ok()?;
-        record.get(key)?.as_f64()
+    /// Read from the record's text once (the other fields are skipped).
+    fn plotted(&self) -> Plotted {
+        let f: PlottedFields = serde_json::from_str(self.get()).ok()?;
+        Some((
+            [f.e_ts_ev?, f.phase_deg?, f.amplitude_ratio?],
+            f.period == Some(1),
+        ))
     }
 }
 
@@ -47,21 +60,22 @@ pub fn heat_maps<T: MapRecord>(
     moduli: &[f64],
     cells: &[T],
 ) -> Vec<HeatMap> {
-    let map = |title: &str, value_label: &str, key: &str| HeatMap {
+    let plotted: Vec<Plotted> = cells.iter().map(MapRecord::plotted).collect();
+    let map = |title: &str, value_label: &str, which: usize| HeatMap {
         title: format!("{law} law: {title}"),
         x_label: "work of adhesion Δγ (J/m²)".into(),
         y_label: "composite modulus E* (GPa)".into(),
         value_label: value_label.into(),
         x: works.to_vec(),
         y: moduli.iter().map(|e| e * 1e-9).collect(),
-        cells: cells
+        cells: plotted
             .chunks(works.len())
             .map(|row| {
                 row.iter()
-                    .map(|c| match c.number(key) {
-                        Some(value) => Cell::Value {
-                            value,
-                            period_one: c.number("period") == Some(1.0),
+                    .map(|c| match c {
+                        Some((values, period_one)) => Cell::Value {
+                            value: values[which],
+                            period_one: *period_one,
                         },
                         None => Cell::NotApplicable,
                     })
@@ -70,9 +84,9 @@ pub fn heat_maps<T: MapRecord>(
             .collect(),
     };
     vec![
-        map("dissipation per cycle", "E_ts per cycle (eV)", "e_ts_ev"),
-        map("phase", "phase lag φ (deg)", "phase_deg"),
-        map("amplitude", "A/A₀", "amplitude_ratio"),
+        map("dissipation per cycle", "E_ts per cycle (eV)", 0),
+        map("phase", "phase lag φ (deg)", 1),
+        map("amplitude", "A/A₀", 2),
     ]
 }
 
