@@ -288,11 +288,8 @@ fn joined(
 /// Run the subcommand.
 pub fn run(args: BatchArgs) -> Result<()> {
     use rayon::prelude::*;
-    if args.out.plot.is_some() {
-        return Err(Error::NotApplicable(
-            "batch writes tables (--csv, --json), not plots".into(),
-        ));
-    }
+    // Before any case runs.
+    args.out.refuse_plots("batch", &[])?;
     let base = args.inputs.clone().with_config()?;
     let rows = read_rows(&args.table)?;
     let cases = rows

@@ -172,6 +172,20 @@ impl SweepOutput {
         Ok(())
     }
 
+    /// Refuse a plot (--plot, or a .png/.svg among `extra`) for `command`, which has none.
+    pub fn refuse_plots(&self, command: &str, extra: &[std::path::PathBuf]) -> crate::Result<()> {
+        let plot_file = |p: &std::path::PathBuf| {
+            p.extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("png") || e.eq_ignore_ascii_case("svg"))
+        };
+        if self.plot.is_some() || extra.iter().any(plot_file) {
+            return Err(crate::Error::NotApplicable(format!(
+                "a {command} has no plot: write .csv or .json"
+            )));
+        }
+        Ok(())
+    }
+
     /// Write a whole run's `records` where they were asked for: the CSV to --csv and to
     /// the .csv files of `extra`; the plot `draw` makes to --plot and the .png/.svg files
     /// of `extra` (refused, naming the `command`, where it has none); the JSON `json`
@@ -199,10 +213,8 @@ impl SweepOutput {
             .chain(with("svg"))
             .collect();
         let json_files: Vec<_> = with("json").collect();
-        if !plots.is_empty() && draw.is_none() {
-            return Err(crate::Error::NotApplicable(format!(
-                "a {command} has no plot: write .csv or .json"
-            )));
+        if draw.is_none() {
+            self.refuse_plots(command, extra)?;
         }
         for path in &csv_files {
             output::write_bytes(path, &csv::records_csv(records)?)?;
