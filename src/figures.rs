@@ -108,7 +108,7 @@ pub fn figure(number: u32, opts: &FigureOptions) -> Result<Chart> {
         1 => Ok(fig1()),
         2 => fig2(
             &lj_cache::solve(FIG2_MU, Reach::Rigid, true)?,
-            &lj_cache::solve(FIG2_MU, Reach::Springs, true)?,
+            &lj_cache::solve(FIG2_MU, Reach::Whole, true)?,
         ),
         3 => fig3(&lj_solutions()?),
         4 => fig4(opts.jump_in, &lj_solutions()?),
@@ -198,7 +198,7 @@ const FIG2_ALPHA_MAX: f64 = 4.0;
 /// Fig. 2: the Lennard-Jones force–separation curve for μ = 5 (numerical), with its
 /// folds A and C, the jumps, and the JKR curve (5) for comparison: the folds and Ŵ of
 /// `s` (the rigid-support solution `tapsim lj` reports), the curve of `traced` (the
-/// same μ traced for springs, deeper into contact).
+/// same μ traced whole, the unstable branch included).
 pub fn fig2(s: &LjSolution, traced: &LjSolution) -> Result<Chart> {
     let c = jkr::point_c();
     let jkr_curve: Vec<(f64, f64)> = grid(c.a_hat, 2.4, 300, false)

@@ -68,6 +68,7 @@ fn cache_path(tabor_mu: f64, reach: Reach) -> PathBuf {
         match reach {
             Reach::Rigid => "rigid",
             Reach::Springs => "springs",
+            Reach::Whole => "whole",
         },
         ELEMENTS_PER_ANNULUS.to_bits(),
         opts.tolerance.to_bits(),

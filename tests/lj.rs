@@ -391,3 +391,59 @@ fn spring_losses_reach_both_limits() {
     }
     assert!(last < 1e-5, "{last:e}");
 }
+
+/// The results need only the two stable branches, each traced in a leg of its own: the
+/// approach in the central gap through A, the contact branch in the contact radius from
+/// where it pushes back through the pull-off and C. The unstable branch between the
+/// folds is traced only for drawing (`Reach::Whole`) and changes no result; without it
+/// the curve has a gap there, with it none.
+#[test]
+fn the_unstable_branch_is_drawn_only_and_changes_no_result() {
+    use tapsim::contact::lj::curve::Curve;
+    for mu in [2.0, 20.0] {
+        let [drawn] = traces_reaching(mu, &[1.0], lj::Reach::Whole)
+            .try_into()
+            .unwrap();
+        let [bare] = traces_reaching(mu, &[1.0], lj::Reach::Springs)
+            .try_into()
+            .unwrap();
+        let values = |c: &Curve| {
+            [
+                c.w_hat,
+                c.fold_a.alpha_hat,
+                c.fold_a.t_hat,
+                c.fold_c.alpha_hat,
+                c.fold_c.t_hat,
+                c.pull_off_hat,
+            ]
+        };
+        for (x, y) in values(&drawn).into_iter().zip(values(&bare)) {
+            assert!((x - y).abs() <= 1e-12 * x.abs(), "mu {mu}: {x} vs {y}");
+        }
+        // The widest step between neighbouring points within the loop's range of α̂
+        // (chords there are at most 0.05; the legs' ends lie 0.5 and more apart).
+        let widest = |c: &Curve| {
+            c.points
+                .windows(2)
+                .filter(|w| w[0].alpha_hat < 3.0 && w[1].alpha_hat < 3.0)
+                .map(|w| (w[1].alpha_hat - w[0].alpha_hat).hypot(w[1].t_hat - w[0].t_hat))
+                .fold(0.0, f64::max)
+        };
+        println!(
+            "mu {mu}: {} steps drawn, {} without the unstable branch; widest gaps {:.3}, {:.3}",
+            drawn.steps,
+            bare.steps,
+            widest(&drawn),
+            widest(&bare)
+        );
+        assert!(widest(&drawn) <= 0.05 + 1e-12);
+        assert!(widest(&bare) > 0.5);
+        assert!(bare.steps < drawn.steps);
+        // The contact leg starts where the sample pushes, deeper than any landing.
+        let deepest = drawn.points.last().unwrap();
+        assert!(
+            deepest.t_hat < 0.0 && deepest.alpha_hat < 0.0,
+            "{deepest:?}"
+        );
+    }
+}

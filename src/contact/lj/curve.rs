@@ -36,7 +36,8 @@ pub struct Curve {
     pub tabor_mu: f64,
     /// Mesh nodes.
     pub nodes: usize,
-    /// The points in order: approach, A, unstable branch, C, contact branch.
+    /// The points in order: approach, A, unstable branch (traced for drawing only:
+    /// otherwise, or where it stopped short, a gap), C, contact branch.
     pub points: Vec<CurvePoint>,
     /// Jump-in fold A.
     pub fold_a: Fold,

@@ -7,13 +7,18 @@
 //! radius, defined by pinning the gap at ξ = 1 to [`EDGE_GAP`] (or the spec's own
 //! `edge_gap`; the results do not depend on it beyond their error). Stretching the mesh
 //! multiplies the influence matrix by a (no reassembly), the solution varies smoothly
-//! with a, and a grows monotonically from the first contact to deep contact, so plain
-//! natural-parameter continuation in a works.
+//! with a, and a changes monotonically along the curve from the first contact to deep
+//! contact, so plain natural-parameter continuation in a works.
 //!
-//! Before there is a contact the same mesh is frozen at a = a₀ and the curve is followed
-//! in the central gap h̄(0), which falls monotonically from far out through the jump-in
-//! fold A to the forming contact; once the gap at x = a₀ falls to the edge gap the
-//! continuation switches to a.
+//! The curve is traced in two legs, each holding one fold. The approach leg freezes the
+//! mesh at a = a₀ and follows the central gap h̄(0), which falls monotonically from far
+//! out through the jump-in fold A. The contact leg starts in deep contact, where the
+//! sample pushes (T̂ < 0), by Newton's method from the JKR solution, and follows a
+//! falling through the pull-off and the jump-out fold C. Neither leg needs the unstable
+//! branch between the folds, the part hardest to follow (at large μ the central gap
+//! levels off there and the continuation has to pin another node); it is traced only
+//! for drawing ([`Reach::Whole`]), by both legs going on until they meet where the
+//! contact's edge reaches x = a₀, and a failure there only leaves a gap in the curve.
 
 use super::curve::{Curve, CurvePoint, Fold, Hysteresis};
 use super::solver::{Problem, Solution};
@@ -152,9 +157,13 @@ pub enum Reach {
     /// branch past the jump-in's landing. What Ŵ_LJ, the folds and the pull-off need.
     Rigid,
     /// Also every support spring down to k̂ = [`SOFTEST_SPRING`]: the approach branch
-    /// from far enough out for the softest spring's jump-out, the contact branch deep
-    /// enough for its landing. What the tabulated law and the spring losses use.
+    /// from far enough out for the softest spring's jump-out (the contact branch, traced
+    /// from where it pushes, holds every landing). What the tabulated law and the
+    /// spring losses use.
     Springs,
+    /// The whole S-curve for drawing: [`Reach::Springs`] and the unstable branch between
+    /// the folds, which no result uses (it costs up to three times the rest at large μ).
+    Whole,
 }
 
 impl Reach {
@@ -162,8 +171,13 @@ impl Reach {
     pub fn softest_spring(self) -> f64 {
         match self {
             Reach::Rigid => f64::INFINITY,
-            Reach::Springs => SOFTEST_SPRING,
+            Reach::Springs | Reach::Whole => SOFTEST_SPRING,
         }
+    }
+
+    /// Whether the trace includes the unstable branch.
+    pub fn unstable_branch(self) -> bool {
+        self == Reach::Whole
     }
 }
 
@@ -183,6 +197,9 @@ pub struct MovingOptions {
     /// that a support spring down to k̂ = `softest_spring` still finds its landing (∞:
     /// a rigid support only).
     pub softest_spring: f64,
+    /// Whether to trace the unstable branch between the folds too (for drawing: no
+    /// result uses it).
+    pub unstable_branch: bool,
 }
 
 impl MovingOptions {
@@ -190,16 +207,18 @@ impl MovingOptions {
     pub fn reaching(reach: Reach) -> Self {
         Self {
             softest_spring: reach.softest_spring(),
+            unstable_branch: reach.unstable_branch(),
             ..Self::default()
         }
     }
 
-    /// What these settings trace.
+    /// What these settings trace (any trace with the unstable branch counts as
+    /// [`Reach::Whole`]).
     pub fn reach(&self) -> Reach {
-        if self.softest_spring.is_finite() {
-            Reach::Springs
-        } else {
-            Reach::Rigid
+        match (self.unstable_branch, self.softest_spring.is_finite()) {
+            (true, _) => Reach::Whole,
+            (false, true) => Reach::Springs,
+            (false, false) => Reach::Rigid,
         }
     }
 }
@@ -211,92 +230,326 @@ impl Default for MovingOptions {
             max_chord: 0.05,
             max_steps: 2000,
             softest_spring: SOFTEST_SPRING,
+            unstable_branch: true,
         }
     }
 }
 
-/// One continuation phase: the pinned node and how its parameter moves.
+/// One continuation phase: the pinned node and the parameter that falls along it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Phase {
-    /// Frozen mesh (a = a₀), central gap pinned and decreasing.
+    /// Frozen mesh (a = a₀), the central gap pinned (or, where it folds, the gap that
+    /// changes fastest).
     CentralGap,
-    /// Edge gap pinned, a increasing.
+    /// The edge gap pinned, the contact radius a the parameter.
     Radius,
 }
 
-/// Trace the S-curve of `spec`'s μ on the moving mesh (see the module docs): approach
-/// branch, fold A, unstable branch, fold C, contact branch past the landing point of
-/// the jump-in (and of a support spring as soft as `opts.softest_spring`).
+/// Newton iterations allowed on a continuation step (from a predictor).
+const STEP_ITERATIONS: usize = 30;
+
+/// Newton iterations allowed from the JKR guess that starts the contact branch (damped
+/// at first; 45–50 from μ = 3 to 50).
+const START_ITERATIONS: usize = 150;
+
+/// Where the contact branch starts: the JKR contact radius â with T̂ ≈ −1 (T̂ = 0 at
+/// â ≈ 2.42), deeper than any landing of a jump-in, with a rigid support or any spring
+/// (those land where the contact branch still pulls, T̂ > 0); deeper ones if the
+/// solution there does not yet push.
+const CONTACT_START_A_HAT: [f64; 3] = [2.5, 3.0, 3.5];
+
+/// An extremum located on converged solutions: the continuation parameter there, α̂, T̂.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Extremum {
+    parameter: f64,
+    alpha_hat: f64,
+    t_hat: f64,
+}
+
+/// One leg of the trace, in the order it was followed.
+#[derive(Debug)]
+struct Leg {
+    /// The points (arclength not yet set).
+    points: Vec<CurvePoint>,
+    /// Extrema of α̂ located on converged solutions: minima on the approach leg, maxima
+    /// on the contact leg.
+    alpha_extrema: Vec<Extremum>,
+    /// Maxima of T̂ located on converged solutions (contact leg).
+    force_maxima: Vec<Extremum>,
+    /// Whether the leg went all the way to its end (the contact at radius a₀); the
+    /// unstable branch beyond the fold is only drawn, so a leg may stop short there.
+    complete: bool,
+}
+
+impl Leg {
+    /// Whether the sampled α̂ has passed its first extremum (a minimum for `sign` = −1, a
+    /// maximum for 1) by at least three points, which the interpolation around the fold
+    /// needs.
+    fn past_fold(&self, sign: f64) -> bool {
+        let p = &self.points;
+        (1..p.len().saturating_sub(1))
+            .find(|&k| {
+                sign * (p[k].alpha_hat - p[k - 1].alpha_hat) > 0.0
+                    && sign * (p[k].alpha_hat - p[k + 1].alpha_hat) >= 0.0
+            })
+            .is_some_and(|k| p.len() - 1 - k >= 3)
+    }
+}
+
+type Lu = nalgebra::linalg::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
+
+/// The continuation on one mesh.
+struct Tracer<'a> {
+    spec: &'a MovingSpec,
+    opts: &'a MovingOptions,
+    problem: Problem,
+    /// Index of the node at ξ = 1.
+    edge: usize,
+    /// The factorised Jacobian, reused while Newton converges fast.
+    lu: Option<Lu>,
+    steps: usize,
+    iterations: usize,
+}
+
+/// Trace the S-curve of `spec`'s μ on the moving mesh (see the module docs) in two legs:
+/// the approach branch in the central gap from far out through the jump-in fold A, and
+/// the contact branch in the contact radius from deep contact (T̂ < 0, started from the
+/// JKR solution) back through the pull-off and the jump-out fold C. Each leg goes on
+/// along the unstable branch until the two meet (at contact radius a₀), for plots: that
+/// part may stop short without harm, and the curve then has a gap there.
 pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
     let mu = spec.tabor_mu;
     let (xi, edge) = spec.nodes();
-    let problem = Problem::new(mu, xi);
-    let a0 = spec.a_start;
-    let guess_a = JumpIn::SemiRigid.alpha_hat_a(mu)?.unwrap_or(2.0);
-    // Far enough out that the softest spring's jump-out (at α̂ + T̂/k̂ of the fold C,
-    // T̂ there below ~1.2 times the JKR pull-off 3π/2) lies on the traced approach.
-    let alpha_start = (2.0 * guess_a)
-        .max(RIGID_START)
-        .max(jkr::ALPHA_HAT_C + 1.2 * 1.5 * std::f64::consts::PI / opts.softest_spring + 1.0);
-    let tol = opts.tolerance;
-    let point = |sol: &Solution, a: f64, s: f64| CurvePoint {
-        s,
-        alpha_hat: sol.alpha_bar / mu,
-        t_hat: problem.force_scaled(&sol.gap, a).0,
-        central_gap: sol.gap[0],
+    let mut tracer = Tracer {
+        spec,
+        opts,
+        problem: Problem::new(mu, xi),
+        edge,
+        lu: None,
+        steps: 0,
+        iterations: 0,
     };
-    // Far out: the rigid gap, relaxed with the central gap pinned.
-    let rigid = Solution {
-        gap: DVector::from_iterator(
-            problem.len(),
-            problem
-                .nodes
-                .iter()
-                .map(|x| alpha_start * mu + 1.0 + 0.5 * (a0 * x).powi(2)),
-        ),
-        alpha_bar: alpha_start * mu,
+    let approach = tracer.approach()?;
+    if !approach.past_fold(-1.0) {
+        return Err(Error::NoHysteresis(
+            "the force-separation curve has no jump-in fold: approach and retraction \
+             follow one curve (the Lennard-Jones loop closes at mu ~ 0.70)"
+                .into(),
+        ));
+    }
+    let alpha_hat_a = approach
+        .points
+        .iter()
+        .map(|p| p.alpha_hat)
+        .fold(f64::INFINITY, f64::min);
+    let contact = tracer.contact(alpha_hat_a)?;
+    // Approach, then the contact leg backwards; where both legs reached a₀ they end on
+    // the same solution, drawn once.
+    let joined = approach.complete && contact.complete;
+    let mut points = approach.points.clone();
+    points.extend(contact.points.iter().rev().skip(usize::from(joined)));
+    let mut s = 0.0;
+    for k in 1..points.len() {
+        let (p, q) = (points[k - 1], points[k]);
+        s += (q.alpha_hat - p.alpha_hat).hypot(q.t_hat - p.t_hat);
+        points[k].s = s;
+    }
+    let hysteresis = Hysteresis::of(&points)?;
+    let k_c = points.partition_point(|p| p.s <= hysteresis.fold_c.s);
+    // The folds and the pull-off from converged solutions where they were located so
+    // (and agree with the traced curve), else interpolated on the curve.
+    let exact = |fold: Fold, found: Option<&Extremum>| match found {
+        Some(e) if (e.alpha_hat - fold.alpha_hat).abs() < 1e-2 => Fold {
+            alpha_hat: e.alpha_hat,
+            t_hat: e.t_hat,
+            ..fold
+        },
+        _ => fold,
     };
-    let mut lu = None;
-    let (first, mut iterations) =
-        problem.solve_pinned(&rigid, a0, (0, rigid.gap[0]), tol, &mut lu)?;
-    let mut points = vec![point(&first, a0, 0.0)];
-    // (parameter, solution) of the last few points of the current phase.
-    let mut history: VecDeque<(f64, Solution)> = VecDeque::from(vec![(first.gap[0], first)]);
-    let mut phase = Phase::CentralGap;
-    // Before contact the gap pinned is the central one, unless that one folds (stops
-    // falling): then the node whose gap changes fastest, in the direction it changes.
-    let (mut pin_node, mut direction) = (0usize, -1.0);
-    let mut step = 0.05 * history[0].0;
-    let mut seen_c = false;
-    let mut steps = 0;
-    let landing_alpha = guess_a - 0.5;
-    // Extremes located on converged solutions: (parameter, α̂, T̂) of the fold A (the
-    // first minimum of α̂ in the central gap), the fold C (the largest maximum of α̂ in
-    // the contact radius) and the pull-off (the largest maximum of T̂ after C).
-    let mut exact_a: Option<(f64, f64, f64)> = None;
-    let mut exact_c: Option<(f64, f64, f64)> = None;
-    let mut exact_pull_off: Option<(f64, f64, f64)> = None;
-    loop {
-        if steps >= opts.max_steps {
-            return Err(Error::Numerical(format!(
-                "LJ continuation took {steps} steps without passing the landing point"
-            )));
+    let fold_a = exact(hysteresis.fold_a, approach.alpha_extrema.first());
+    let exact_c = contact
+        .alpha_extrema
+        .iter()
+        .max_by(|x, y| x.alpha_hat.total_cmp(&y.alpha_hat));
+    let fold_c = exact(hysteresis.fold_c, exact_c);
+    let w_hat = Hysteresis::between(&points, fold_a, fold_c)?.w_hat;
+    let interpolated = super::curve::pull_off(&points, k_c)
+        .map_or(hysteresis.fold_c.t_hat, |t| t.max(hysteresis.fold_c.t_hat));
+    // The pull-off lies on the contact branch: at a larger radius than C.
+    let exact_pull_off = contact
+        .force_maxima
+        .iter()
+        .filter(|f| exact_c.is_none_or(|c| f.parameter > c.parameter))
+        .max_by(|x, y| x.t_hat.total_cmp(&y.t_hat));
+    let pull_off_hat = match exact_pull_off {
+        Some(f) if (f.t_hat - interpolated).abs() < 1e-2 => f.t_hat,
+        _ => interpolated,
+    };
+    Ok(Curve {
+        tabor_mu: mu,
+        nodes: tracer.problem.len(),
+        points,
+        fold_a,
+        fold_c,
+        pull_off_hat,
+        w_hat,
+        steps: tracer.steps,
+        factorisations: tracer.problem.factorisations(),
+        iterations: tracer.iterations,
+    })
+}
+
+impl Tracer<'_> {
+    /// A point of the curve (arclength unset) from a solution on the mesh stretched by a.
+    fn point(&self, sol: &Solution, a: f64) -> CurvePoint {
+        CurvePoint {
+            s: 0.0,
+            alpha_hat: sol.alpha_bar / self.spec.tabor_mu,
+            t_hat: self.problem.force_scaled(&sol.gap, a).0,
+            central_gap: sol.gap[0],
         }
-        let (p_last, last) = history.back().expect("never empty");
-        let p_next = match phase {
-            Phase::CentralGap => p_last + direction * step,
-            Phase::Radius => p_last + step,
+    }
+
+    /// The approach leg: from far out (far enough that the softest spring's jump-out,
+    /// at α̂ + T̂/k̂ of the fold C with T̂ there below ~1.2 times the JKR pull-off 3π/2,
+    /// lies on it) in the central gap on the frozen mesh, through the fold A, on until
+    /// the contact reaches a₀. Essential: the fold A.
+    fn approach(&mut self) -> Result<Leg> {
+        let mu = self.spec.tabor_mu;
+        let a0 = self.spec.a_start;
+        let guess_a = JumpIn::SemiRigid.alpha_hat_a(mu)?.unwrap_or(2.0);
+        let alpha_start = (2.0 * guess_a).max(RIGID_START).max(
+            jkr::ALPHA_HAT_C + 1.2 * 1.5 * std::f64::consts::PI / self.opts.softest_spring + 1.0,
+        );
+        // Far out: the rigid gap, relaxed with the central gap pinned.
+        let rigid = Solution {
+            gap: DVector::from_iterator(
+                self.problem.len(),
+                self.problem
+                    .nodes
+                    .iter()
+                    .map(|x| alpha_start * mu + 1.0 + 0.5 * (a0 * x).powi(2)),
+            ),
+            alpha_bar: alpha_start * mu,
         };
-        let guess = extrapolate(&history, p_next);
-        let (pin, a_next) = match phase {
-            Phase::CentralGap => ((pin_node, p_next), a0),
-            Phase::Radius => ((edge, spec.edge_gap), p_next),
+        let (first, its) = self.problem.solve_pinned(
+            &rigid,
+            a0,
+            (0, rigid.gap[0]),
+            self.opts.tolerance,
+            &mut self.lu,
+            STEP_ITERATIONS,
+        )?;
+        self.iterations += its;
+        let p = first.gap[0];
+        self.follow(Phase::CentralGap, first, p, |leg| leg.past_fold(-1.0))
+    }
+
+    /// The contact leg: from deep contact (the solution at a JKR contact radius where it
+    /// pushes, T̂ < 0, and α̂ is below the jump-in's landing α̂_A − 0.5), started by
+    /// Newton from the JKR gap, in the contact radius a falling, through the pull-off and
+    /// the fold C, on until a = a₀. Essential: the fold C.
+    fn contact(&mut self, alpha_hat_a: f64) -> Result<Leg> {
+        let mu = self.spec.tabor_mu;
+        // (A fresh factorisation: the contact leg does not depend on how the approach
+        // leg ended.)
+        self.lu = None;
+        for a_hat in CONTACT_START_A_HAT {
+            let (guess, a) = jkr_guess(&self.problem.nodes, a_hat, mu, self.spec.edge_gap);
+            let mut lu = None;
+            let Ok((start, its)) = self.problem.solve_pinned(
+                &guess,
+                a,
+                (self.edge, self.spec.edge_gap),
+                self.opts.tolerance,
+                &mut lu,
+                START_ITERATIONS,
+            ) else {
+                continue;
+            };
+            self.iterations += its;
+            let q = self.point(&start, a);
+            if q.t_hat < 0.0 && q.alpha_hat < alpha_hat_a - 0.5 {
+                return self.follow(Phase::Radius, start, a, |leg| leg.past_fold(1.0));
+            }
+        }
+        Err(Error::Numerical(format!(
+            "the Lennard-Jones contact branch could not be started from the JKR solution \
+             at mu = {mu}"
+        )))
+    }
+
+    /// Follow the curve from `start` (parameter `p_start`) in `phase`, the parameter
+    /// falling, to the leg's end: in the central gap, until the contact reaches x = a₀
+    /// (the leg ends on that solution, edge pinned, a = a₀); in the contact radius, at
+    /// a = a₀. A failure before `essential(leg)` holds is an error; after it, the leg
+    /// ends there, incomplete.
+    fn follow(
+        &mut self,
+        phase: Phase,
+        start: Solution,
+        p_start: f64,
+        essential: impl Fn(&Leg) -> bool,
+    ) -> Result<Leg> {
+        let spec = self.spec;
+        let (a0, edge, tol) = (spec.a_start, self.edge, self.opts.tolerance);
+        let mesh_a = |p: f64| if phase == Phase::Radius { p } else { a0 };
+        let mut leg = Leg {
+            points: vec![self.point(&start, mesh_a(p_start))],
+            alpha_extrema: Vec::new(),
+            force_maxima: Vec::new(),
+            complete: false,
         };
-        let prev = *points.last().expect("never empty");
-        let (sol, its) = match problem.solve_pinned(&guess, a_next, pin, tol, &mut lu) {
-            Ok(v) => v,
-            Err(_) => {
-                lu = None;
+        // (parameter, solution) of the last few points.
+        let mut history: VecDeque<(f64, Solution)> = VecDeque::from(vec![(p_start, start)]);
+        // In the central gap the pinned node is the axis, unless its gap folds (stops
+        // falling): then the node whose gap changes fastest, in the direction it changes.
+        let (mut pin_node, mut direction) = (0usize, -1.0);
+        let pin = |p: f64, pin_node: usize| match phase {
+            Phase::CentralGap => (pin_node, p),
+            Phase::Radius => (edge, spec.edge_gap),
+        };
+        let mut step = match phase {
+            Phase::CentralGap => 0.05 * p_start,
+            Phase::Radius => 0.01 * p_start,
+        };
+        let outcome: Result<()> = loop {
+            if !self.opts.unstable_branch && essential(&leg) {
+                break Err(Error::Numerical("the unstable branch is not traced".into()));
+            }
+            if self.steps >= self.opts.max_steps {
+                break Err(Error::Numerical(format!(
+                    "LJ continuation took {} steps without reaching the end of its trace",
+                    self.steps
+                )));
+            }
+            let (p_last, last) = history.back().expect("never empty");
+            let p_last = *p_last;
+            let prev = *leg.points.last().expect("never empty");
+            let stalled = |step: f64| {
+                (step < 1e-9 * p_last.abs().max(1.0)).then(|| {
+                    Error::Numerical(format!(
+                        "LJ continuation stalled at alpha_hat = {:.4}, T_hat = {:.4}",
+                        prev.alpha_hat, prev.t_hat
+                    ))
+                })
+            };
+            let mut p_next = p_last + direction * step;
+            let at_end = phase == Phase::Radius && p_next <= a0;
+            if at_end {
+                p_next = a0;
+            }
+            let guess = extrapolate(&history, p_next);
+            let solved = self.problem.solve_pinned(
+                &guess,
+                mesh_a(p_next),
+                pin(p_next, pin_node),
+                tol,
+                &mut self.lu,
+                STEP_ITERATIONS,
+            );
+            let Ok((sol, its)) = solved else {
+                self.lu = None;
                 step *= 0.5;
                 if phase == Phase::CentralGap
                     && history.len() >= 2
@@ -319,167 +572,167 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
                         continue;
                     }
                 }
-                if step < 1e-9 * p_last.abs().max(1.0) {
-                    return Err(Error::Numerical(format!(
-                        "LJ continuation stalled at alpha_hat = {:.4}, T_hat = {:.4}",
-                        prev.alpha_hat, prev.t_hat
-                    )));
+                if let Some(e) = stalled(step) {
+                    break Err(e);
                 }
                 continue;
-            }
-        };
-        let q = point(&sol, a_next, 0.0);
-        let chord = (q.alpha_hat - prev.alpha_hat).hypot(q.t_hat - prev.t_hat);
-        let max_chord = chord_cap(opts, prev.alpha_hat);
-        if chord > max_chord {
-            // Too far along the curve for its points to resolve it: shorten in proportion.
-            step *= 0.8 * max_chord / chord;
-            continue;
-        }
-        if phase == Phase::CentralGap && sol.gap[edge] <= spec.edge_gap {
-            // The contact has reached x = a₀: pin the edge there (from the two solutions
-            // around that point) and follow a from now on.
-            let before = &last.gap[edge];
-            let f = (before - spec.edge_gap) / (before - sol.gap[edge]);
-            let mut guess = last.clone();
-            guess.gap.axpy(f, &(&sol.gap - &last.gap), 1.0);
-            guess.alpha_bar += f * (sol.alpha_bar - last.alpha_bar);
-            match problem.solve_pinned(&guess, a0, (edge, spec.edge_gap), tol, &mut lu) {
-                Ok((sol, its)) => {
-                    iterations += its;
-                    steps += 1;
-                    let q = point(&sol, a0, 0.0);
-                    let chord = (q.alpha_hat - prev.alpha_hat).hypot(q.t_hat - prev.t_hat);
-                    points.push(CurvePoint {
-                        s: prev.s + chord,
-                        ..q
-                    });
-                    history.clear();
-                    history.push_back((a0, sol));
-                    phase = Phase::Radius;
-                    step = 0.02 * a0;
-                }
-                Err(_) => {
-                    lu = None;
-                    step *= 0.5;
-                }
-            }
-            continue;
-        }
-        iterations += its;
-        steps += 1;
-        points.push(CurvePoint {
-            s: prev.s + chord,
-            ..q
-        });
-        history.push_back((p_next, sol));
-        if history.len() > 3 {
-            history.pop_front();
-        }
-        if history.len() == 3 {
-            let alpha_of = |_: f64, s: &Solution| s.alpha_bar / mu;
-            let problem = &problem;
-            let at = |phase: Phase| {
-                move |p: f64, guess: &Solution| -> Result<Solution> {
-                    let (pin, a) = match phase {
-                        Phase::CentralGap => ((pin_node, p), a0),
-                        Phase::Radius => ((edge, spec.edge_gap), p),
-                    };
-                    let mut lu = None;
-                    Ok(problem.solve_pinned(guess, a, pin, tol, &mut lu)?.0)
-                }
             };
-            let found = |sign: f64, value: &dyn Fn(f64, &Solution) -> f64| {
-                refine_extremum(&history, &at(phase), value, sign).map(|(p, around)| {
-                    let at_p = |quantity: &dyn Fn(f64, &Solution) -> f64| {
-                        let q =
-                            [0, 1, 2].map(|i| (around[i].0, quantity(around[i].0, &around[i].1)));
-                        lagrange(&q, p)
-                    };
-                    let force = |q: f64, s: &Solution| {
-                        let a = if phase == Phase::Radius { q } else { a0 };
-                        problem.force_scaled(&s.gap, a).0
-                    };
-                    (p, at_p(&alpha_of), at_p(&force))
-                })
-            };
-            match phase {
-                Phase::CentralGap if exact_a.is_none() => exact_a = found(-1.0, &alpha_of),
-                Phase::CentralGap => {}
-                Phase::Radius => {
-                    if let Some(c) = found(1.0, &alpha_of) {
-                        if exact_c.is_none_or(|old| c.1 > old.1) {
-                            exact_c = Some(c);
-                            exact_pull_off = None;
-                        }
+            let q = self.point(&sol, mesh_a(p_next));
+            let chord = (q.alpha_hat - prev.alpha_hat).hypot(q.t_hat - prev.t_hat);
+            let max_chord = chord_cap(self.opts, prev.alpha_hat);
+            if chord > max_chord {
+                // Too far along the curve for its points to resolve it: shorten in proportion.
+                step *= 0.8 * max_chord / chord;
+                continue;
+            }
+            if phase == Phase::CentralGap && sol.gap[edge] <= spec.edge_gap {
+                // The contact has reached x = a₀: the solution with the edge pinned
+                // there (guessed between the two around that point) ends the leg.
+                let before = last.gap[edge];
+                let f = (before - spec.edge_gap) / (before - sol.gap[edge]);
+                let mut guess = last.clone();
+                guess.gap.axpy(f, &(&sol.gap - &last.gap), 1.0);
+                guess.alpha_bar += f * (sol.alpha_bar - last.alpha_bar);
+                let pinned = (edge, spec.edge_gap);
+                match self.problem.solve_pinned(
+                    &guess,
+                    a0,
+                    pinned,
+                    tol,
+                    &mut self.lu,
+                    STEP_ITERATIONS,
+                ) {
+                    Ok((sol, its)) => {
+                        self.iterations += its;
+                        self.steps += 1;
+                        leg.points.push(self.point(&sol, a0));
+                        break Ok(());
                     }
-                    let force_of = |p: f64, s: &Solution| problem.force_scaled(&s.gap, p).0;
-                    if let Some(c) = exact_c {
-                        if let Some(f) = found(1.0, &force_of).filter(|f| f.0 > c.0) {
-                            if exact_pull_off.is_none_or(|old| f.2 > old.2) {
-                                exact_pull_off = Some(f);
-                            }
+                    Err(_) => {
+                        self.lu = None;
+                        step *= 0.5;
+                        if let Some(e) = stalled(step) {
+                            break Err(e);
                         }
+                        continue;
                     }
                 }
             }
-        }
-        // Step control from the predictor's error (third order for the quadratic
-        // extrapolation once three points are known), aiming at PREDICTOR_ERROR.
-        let predicted = predictor_error(&guess, &history.back().expect("just pushed").1);
-        let factor = if history.len() < 3 {
-            1.5
-        } else {
-            (PREDICTOR_ERROR / predicted.max(1e-12))
-                .cbrt()
-                .clamp(0.5, 2.0)
+            self.iterations += its;
+            self.steps += 1;
+            leg.points.push(q);
+            history.push_back((p_next, sol));
+            if history.len() > 3 {
+                history.pop_front();
+            }
+            if history.len() == 3 {
+                self.locate_extrema(phase, pin(p_next, pin_node).0, &history, &mut leg);
+            }
+            if at_end {
+                break Ok(());
+            }
+            // Step control from the predictor's error (third order for the quadratic
+            // extrapolation once three points are known), aiming at PREDICTOR_ERROR…
+            let predicted = predictor_error(&guess, &history.back().expect("just pushed").1);
+            let factor = if history.len() < 3 {
+                1.5
+            } else {
+                (PREDICTOR_ERROR / predicted.max(1e-12))
+                    .cbrt()
+                    .clamp(0.5, 2.0)
+            };
+            // …and at a chord of 0.8 of the largest.
+            step *= factor.min(0.8 * max_chord / chord.max(1e-12));
         };
-        // …and at a chord of 0.8 of the largest.
-        step *= factor.min(0.8 * max_chord / chord.max(1e-12));
-        if q.alpha_hat > guess_a + 0.3 {
-            seen_c = true;
-        }
-        if seen_c
-            && phase == Phase::Radius
-            && past_landing(&points, landing_alpha, opts)
-            && past_pull_off(&points)
-        {
-            break;
+        match outcome {
+            Ok(()) => {
+                leg.complete = true;
+                Ok(leg)
+            }
+            Err(_) if essential(&leg) => Ok(leg),
+            Err(e) => Err(e),
         }
     }
-    let hysteresis = Hysteresis::of(&points)?;
-    let k_c = points.partition_point(|p| p.s <= hysteresis.fold_c.s);
-    // The folds and the pull-off from converged solutions where they were located so
-    // (and agree with the traced curve), else interpolated on the curve.
-    let exact = |fold: Fold, found: Option<(f64, f64, f64)>| match found {
-        Some((_, alpha_hat, t_hat)) if (alpha_hat - fold.alpha_hat).abs() < 1e-2 => Fold {
-            alpha_hat,
-            t_hat,
-            ..fold
-        },
-        _ => fold,
+
+    /// Look for extrema bracketed by the three solutions of `history` (the pinned node
+    /// `pin_node` in the central gap) and locate them on converged solutions: the first
+    /// minimum of α̂ in the central gap (A), and every maximum of α̂ (C) and of T̂ (the
+    /// pull-off) in the contact radius.
+    fn locate_extrema(
+        &self,
+        phase: Phase,
+        pin_node: usize,
+        history: &VecDeque<(f64, Solution)>,
+        leg: &mut Leg,
+    ) {
+        let (mu, a0, edge) = (self.spec.tabor_mu, self.spec.a_start, self.edge);
+        let mesh_a = |p: f64| if phase == Phase::Radius { p } else { a0 };
+        let solve = |p: f64, guess: &Solution| -> Result<Solution> {
+            let pin = match phase {
+                Phase::CentralGap => (pin_node, p),
+                Phase::Radius => (edge, self.spec.edge_gap),
+            };
+            let mut lu = None;
+            let tol = self.opts.tolerance;
+            let (sol, _) =
+                self.problem
+                    .solve_pinned(guess, mesh_a(p), pin, tol, &mut lu, STEP_ITERATIONS)?;
+            Ok(sol)
+        };
+        let alpha_of = |_: f64, s: &Solution| s.alpha_bar / mu;
+        let force_of = |p: f64, s: &Solution| self.problem.force_scaled(&s.gap, mesh_a(p)).0;
+        let found = |sign: f64, value: &dyn Fn(f64, &Solution) -> f64| {
+            refine_extremum(history, &solve, value, sign).map(|(p, around)| {
+                let at_p = |quantity: &dyn Fn(f64, &Solution) -> f64| {
+                    let q = [0, 1, 2].map(|i| (around[i].0, quantity(around[i].0, &around[i].1)));
+                    lagrange(&q, p)
+                };
+                Extremum {
+                    parameter: p,
+                    alpha_hat: at_p(&alpha_of),
+                    t_hat: at_p(&force_of),
+                }
+            })
+        };
+        match phase {
+            Phase::CentralGap => {
+                if leg.alpha_extrema.is_empty() {
+                    leg.alpha_extrema.extend(found(-1.0, &alpha_of));
+                }
+            }
+            Phase::Radius => {
+                leg.alpha_extrema.extend(found(1.0, &alpha_of));
+                leg.force_maxima.extend(found(1.0, &force_of));
+            }
+        }
+    }
+}
+
+/// The JKR solution at contact radius `a_hat` as a guess on the ξ `nodes`: the gap
+/// (eqs. (5) with the Hertz and flat-punch surface displacements, in units of ε and
+/// √(Rε)) plus the equilibrium spacing, and the stretch a of the mesh that puts the
+/// edge gap at ξ = 1.
+fn jkr_guess(nodes: &[f64], a_hat: f64, tabor_mu: f64, edge_gap: f64) -> (Solution, f64) {
+    use std::f64::consts::PI;
+    let a_jkr = a_hat * tabor_mu.sqrt();
+    // The flat punch's lift √(2πaΔγ/E*), in ε.
+    let lift = (2.0 * PI * a_jkr * tabor_mu.powf(1.5)).sqrt();
+    // Near the edge the gap opens as 1 + (2·lift/π)√(2(x − a)/a).
+    let a = a_jkr * (1.0 + 0.5 * (PI * (edge_gap - 1.0) / (2.0 * lift)).powi(2));
+    let gap = |x: f64| {
+        if x <= a_jkr {
+            return 1.0;
+        }
+        let opening = (a_jkr / x).acos();
+        let hertz =
+            (a_jkr * (x * x - a_jkr * a_jkr).sqrt() - (2.0 * a_jkr * a_jkr - x * x) * opening) / PI;
+        1.0 + hertz + 2.0 * lift / PI * opening
     };
-    let fold_a = exact(hysteresis.fold_a, exact_a);
-    let fold_c = exact(hysteresis.fold_c, exact_c);
-    let w_hat = Hysteresis::between(&points, fold_a, fold_c)?.w_hat;
-    let interpolated = super::curve::pull_off(&points, k_c)
-        .map_or(hysteresis.fold_c.t_hat, |t| t.max(hysteresis.fold_c.t_hat));
-    let pull_off_hat = match exact_pull_off {
-        Some((_, _, t_hat)) if (t_hat - interpolated).abs() < 1e-2 => t_hat,
-        _ => interpolated,
+    let guess = Solution {
+        gap: DVector::from_iterator(nodes.len(), nodes.iter().map(|xi| gap(a * xi))),
+        alpha_bar: tabor_mu * jkr::separation_hat(a_hat),
     };
-    Ok(Curve {
-        tabor_mu: mu,
-        nodes: problem.len(),
-        points,
-        fold_a,
-        fold_c,
-        pull_off_hat,
-        w_hat,
-        steps,
-        factorisations: problem.factorisations(),
-        iterations,
-    })
+    (guess, a)
 }
 
 /// The largest chord allowed from a point at α̂: `opts.max_chord` where the folds are
@@ -487,37 +740,6 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
 /// gentle tail T̂ ~ α̂⁻².
 fn chord_cap(opts: &MovingOptions, alpha_hat: f64) -> f64 {
     opts.max_chord * (alpha_hat - 2.0).max(1.0)
-}
-
-/// Whether the contact branch has gone below `landing_alpha` and, seen through the
-/// softest support spring, below the spring's own jump-in landing too (and, for springs,
-/// to where T̂ < 0, below the landing of any softer spring).
-fn past_landing(points: &[CurvePoint], landing_alpha: f64, opts: &MovingOptions) -> bool {
-    let q = points.last().expect("never empty");
-    if q.alpha_hat >= landing_alpha {
-        return false;
-    }
-    let k = opts.softest_spring;
-    // The spring's jump-in: the first minimum of α̂ + T̂/k̂ (on the approach branch).
-    let support = |p: &CurvePoint| p.alpha_hat + p.t_hat / k;
-    let first_min = points
-        .windows(2)
-        .find(|w| support(&w[1]) > support(&w[0]))
-        .map(|w| support(&w[0]));
-    // (A softer spring lands where the contact branch still pulls, T̂ > 0: a trace for
-    // springs goes on until it pushes.)
-    // (No minimum at all: no fold, no loop; the trace need only pass `landing_alpha`.)
-    first_min.is_none_or(|m| support(q) < m - 0.5) && (k.is_infinite() || q.t_hat < 0.0)
-}
-
-/// Whether the contact branch has passed its largest T̂ (the load-control pull-off):
-/// the last point lies 1e-3 below the largest T̂ traced.
-fn past_pull_off(points: &[CurvePoint]) -> bool {
-    let peak = points
-        .iter()
-        .map(|p| p.t_hat)
-        .fold(f64::NEG_INFINITY, f64::max);
-    points.last().is_some_and(|q| q.t_hat < peak - 1e-3)
 }
 
 /// The extremum of `value` (a maximum for `sign` = 1, a minimum for −1) over the

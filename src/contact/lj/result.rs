@@ -16,7 +16,7 @@ pub const ELEMENTS_PER_ANNULUS: f64 = 7.0;
 /// μ has none.
 pub const MIN_TABOR_MU: f64 = 0.5;
 
-/// Largest Tabor parameter accepted: a solve takes 3.5 s at μ = 50 (the thin tensile
+/// Largest Tabor parameter accepted: a solve takes 1.3 s at μ = 50 (the thin tensile
 /// annulus needs ~670 nodes); the hybrid law is within 0.2 % of Ŵ_LJ from μ = 10 on.
 pub const MAX_TABOR_MU: f64 = 50.0;
 
@@ -93,7 +93,8 @@ pub struct LjSolution {
     pub nodes_coarse: usize,
     /// Continuation steps on the production mesh.
     pub steps: usize,
-    /// The traced curve (production mesh).
+    /// The traced curve (production mesh): with the unstable branch for
+    /// [`Reach::Whole`], else with a gap between the folds.
     pub curve: Vec<CurvePoint>,
     /// Arclength of the fold A on `curve`.
     pub s_a: f64,

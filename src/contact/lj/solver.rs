@@ -138,8 +138,8 @@ impl Problem {
 
     /// Solve on the mesh stretched by `a` with the gap at node `node` pinned to
     /// `target` and ᾱ free (bordered system [[J, −1], [e_nodeᵀ, 0]]), by Newton from
-    /// `guess`, reusing `lu` while it converges fast (refactorised otherwise). Returns
-    /// the solution and the iterations taken.
+    /// `guess` in at most `max_iterations`, reusing `lu` while it converges fast
+    /// (refactorised otherwise). Returns the solution and the iterations taken.
     pub(crate) fn solve_pinned(
         &self,
         guess: &Solution,
@@ -147,13 +147,14 @@ impl Problem {
         (node, target): (usize, f64),
         tol: f64,
         lu: &mut Option<nalgebra::linalg::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+        max_iterations: usize,
     ) -> Result<(Solution, usize)> {
         let n = self.len();
         let mut s = guess.clone();
         s.gap[node] = target;
         let mut last_norm = f64::INFINITY;
         let mut fresh = false;
-        for it in 1..=30 {
+        for it in 1..=max_iterations {
             let r = self.residual_scaled(&s, a);
             let norm = Self::residual_norm(&r, &s.gap);
             if norm < tol {
