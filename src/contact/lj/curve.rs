@@ -95,8 +95,9 @@ fn interval(points: &[CurvePoint], s: f64) -> usize {
         .unwrap_or(points.len() - 2)
 }
 
-/// ∫ T̂ dα̂ along the curve between arclengths a < b.
-fn work_between(points: &[CurvePoint], a: f64, b: f64) -> f64 {
+/// ∫ T̂ dα̂ along the curve between arclengths a < b, on the cubic through the four
+/// points around each interval, by 4-point Gauss–Legendre on every interval.
+pub(super) fn work_between(points: &[CurvePoint], a: f64, b: f64) -> f64 {
     let mut total = 0.0;
     let (ka, kb) = (interval(points, a), interval(points, b));
     for k in ka..=kb {
@@ -154,8 +155,8 @@ pub fn pull_off(points: &[CurvePoint], from: usize) -> Option<f64> {
     Some(locate_extremum(points, k, |p| p.t_hat).map_or(sampled, |f| f.t_hat.max(sampled)))
 }
 
-/// First arclength after `from` (within the sampled range) where α̂ = `level`.
-fn crossing(points: &[CurvePoint], from: usize, to: usize, level: f64) -> Result<f64> {
+/// First arclength after index `from` (before index `to`) where α̂ = `level`.
+pub(super) fn crossing(points: &[CurvePoint], from: usize, to: usize, level: f64) -> Result<f64> {
     for k in from..to {
         let (a, b) = (points[k].alpha_hat - level, points[k + 1].alpha_hat - level);
         if a == 0.0 {

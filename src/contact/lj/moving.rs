@@ -20,7 +20,7 @@
 //! for drawing ([`Reach::Whole`]), by both legs going on until they meet where the
 //! contact's edge reaches x = a₀, and a failure there only leaves a gap in the curve.
 
-use super::curve::{Curve, CurvePoint, Fold, Hysteresis};
+use super::curve::{Curve, CurvePoint, Fold, Hysteresis, crossing, work_between};
 use super::solver::{Problem, Solution};
 use crate::contact::hybrid::JumpIn;
 use crate::contact::jkr;
@@ -258,10 +258,12 @@ const START_ITERATIONS: usize = 150;
 /// solution there does not yet push.
 const CONTACT_START_A_HAT: [f64; 3] = [2.5, 3.0, 3.5];
 
-/// An extremum located on converged solutions: the continuation parameter there, α̂, T̂.
+/// An extremum located on converged solutions: the continuation parameter there, the
+/// leg's own parameter there (see [`Leg::along`]), α̂, T̂.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Extremum {
     parameter: f64,
+    along: f64,
     alpha_hat: f64,
     t_hat: f64,
 }
@@ -271,6 +273,13 @@ struct Extremum {
 struct Leg {
     /// The points (arclength not yet set).
     points: Vec<CurvePoint>,
+    /// The leg's own parameter at each point, increasing along it: −h̄(0) on the
+    /// approach leg, −a on the contact leg.
+    along: Vec<f64>,
+    /// How many leading points `along` parametrises (on the approach leg, the points
+    /// before the continuation first pins another node than the axis, where h̄(0)
+    /// folds).
+    monotone: usize,
     /// Extrema of α̂ located on converged solutions: minima on the approach leg, maxima
     /// on the contact leg.
     alpha_extrema: Vec<Extremum>,
@@ -282,6 +291,23 @@ struct Leg {
 }
 
 impl Leg {
+    /// Append a point, at continuation parameter `p` of `phase`.
+    fn push(&mut self, point: CurvePoint, phase: Phase, p: f64) {
+        self.along.push(match phase {
+            Phase::CentralGap => -point.central_gap,
+            Phase::Radius => -p,
+        });
+        self.points.push(point);
+    }
+
+    /// The leading points `along` parametrises, with their arclength set to it.
+    fn in_own_parameter(&self) -> Vec<CurvePoint> {
+        let n = self.monotone.min(self.points.len());
+        (self.points[..n].iter().zip(&self.along))
+            .map(|(p, &along)| CurvePoint { s: along, ..*p })
+            .collect()
+    }
+
     /// Whether the sampled α̂ has passed its first extremum (a minimum for `sign` = −1, a
     /// maximum for 1) by at least three points, which the interpolation around the fold
     /// needs.
@@ -372,7 +398,20 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
         .iter()
         .max_by(|x, y| x.alpha_hat.total_cmp(&y.alpha_hat));
     let fold_c = exact(hysteresis.fold_c, exact_c);
-    let w_hat = Hysteresis::between(&points, fold_a, fold_c)?.w_hat;
+    // Ŵ in the legs' own parameters where both folds were located on converged
+    // solutions (and were used), else along the drawn curve.
+    let w_hat = match (approach.alpha_extrema.first(), exact_c) {
+        (Some(a), Some(c))
+            if fold_a.alpha_hat == a.alpha_hat && fold_c.alpha_hat == c.alpha_hat =>
+        {
+            loop_work(&approach, &contact, a, c)
+        }
+        _ => None,
+    };
+    let w_hat = match w_hat {
+        Some(w) => w,
+        None => Hysteresis::between(&points, fold_a, fold_c)?.w_hat,
+    };
     let interpolated = super::curve::pull_off(&points, k_c)
         .map_or(hysteresis.fold_c.t_hat, |t| t.max(hysteresis.fold_c.t_hat));
     // The pull-off lies on the contact branch: at a larger radius than C.
@@ -495,11 +534,14 @@ impl Tracer<'_> {
         let (a0, edge, tol) = (spec.a_start, self.edge, self.opts.tolerance);
         let mesh_a = |p: f64| if phase == Phase::Radius { p } else { a0 };
         let mut leg = Leg {
-            points: vec![self.point(&start, mesh_a(p_start))],
+            points: Vec::new(),
+            along: Vec::new(),
+            monotone: usize::MAX,
             alpha_extrema: Vec::new(),
             force_maxima: Vec::new(),
             complete: false,
         };
+        leg.push(self.point(&start, mesh_a(p_start)), phase, p_start);
         // (parameter, solution) of the last few points.
         let mut history: VecDeque<(f64, Solution)> = VecDeque::from(vec![(p_start, start)]);
         // In the central gap the pinned node is the axis, unless its gap folds (stops
@@ -563,6 +605,7 @@ impl Tracer<'_> {
                         .max_by(|&i, &j| change(i).abs().total_cmp(&change(j).abs()))
                         .expect("nodes");
                     if fastest != pin_node {
+                        leg.monotone = leg.monotone.min(leg.points.len());
                         pin_node = fastest;
                         direction = change(fastest).signum();
                         step = (newer.gap[fastest] - older.gap[fastest]).abs();
@@ -605,7 +648,7 @@ impl Tracer<'_> {
                     Ok((sol, its)) => {
                         self.iterations += its;
                         self.steps += 1;
-                        leg.points.push(self.point(&sol, a0));
+                        leg.push(self.point(&sol, a0), phase, a0);
                         break Ok(());
                     }
                     Err(_) => {
@@ -620,7 +663,7 @@ impl Tracer<'_> {
             }
             self.iterations += its;
             self.steps += 1;
-            leg.points.push(q);
+            leg.push(q, phase, p_next);
             history.push_back((p_next, sol));
             if history.len() > 3 {
                 history.pop_front();
@@ -689,6 +732,10 @@ impl Tracer<'_> {
                 };
                 Extremum {
                     parameter: p,
+                    along: match phase {
+                        Phase::CentralGap => -at_p(&|_, s: &Solution| s.gap[0]),
+                        Phase::Radius => -p,
+                    },
                     alpha_hat: at_p(&alpha_of),
                     t_hat: at_p(&force_of),
                 }
@@ -706,6 +753,29 @@ impl Tracer<'_> {
             }
         }
     }
+}
+
+/// Ŵ = ∫_{α̂_A}^{α̂_C} (T̂_contact − T̂_approach) dα̂ in each leg's own parameter
+/// ([`Leg::along`]): ∫ T̂ (dα̂/dp) dp by 4-point Gauss–Legendre on every continuation
+/// step, on the cubic through the four solutions around it, from the approach branch's
+/// crossing of α̂_C to the fold A and from the contact branch's crossing of α̂_A (the
+/// jump-in's landing) to the fold C. The solution varies smoothly in those parameters
+/// across the folds, so the steps the predictor sets, not the drawing's chord, decide
+/// the accuracy. `None` if a crossing lies outside what the legs parametrise.
+fn loop_work(approach: &Leg, contact: &Leg, a: &Extremum, c: &Extremum) -> Option<f64> {
+    let (app, con) = (approach.in_own_parameter(), contact.in_own_parameter());
+    // The first point past the fold, which must lie inside the parametrised points with
+    // two beyond it for the cubic.
+    let past = |points: &[CurvePoint], along: f64| {
+        let k = points.partition_point(|p| p.s < along);
+        (k >= 1 && k + 2 <= points.len()).then_some(k)
+    };
+    let (k_a, k_c) = (past(&app, a.along)?, past(&con, c.along)?);
+    let from_c = crossing(&app, 0, k_a, c.alpha_hat).ok()?;
+    let landing = crossing(&con, 0, k_c, a.alpha_hat).ok()?;
+    // Along each leg: the approach from α̂_C to A, the contact branch from the landing
+    // (α̂_A) to C; the loop runs the contact branch the other way.
+    Some(work_between(&app, from_c, a.along) + work_between(&con, landing, c.along))
 }
 
 /// The JKR solution at contact radius `a_hat` as a guess on the ξ `nodes`: the gap
