@@ -3,7 +3,8 @@
 //! The physics follows Ciavarella, Greenwood & Barber, "Effect of Tabor parameter on
 //! hysteresis losses during adhesive contact"; equation numbers in the documentation
 //! are that paper's. Data flows one way: [`params`] → [`contact`] (force laws) →
-//! [`law`] → [`dynamics`] / [`quasistatic`] → [`sweep`] → [`figures`] → [`report`].
+//! [`law`] → [`dynamics`] / [`quasistatic`] → [`sweep`] → [`identification`] →
+//! [`figures`] → [`report`].
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -13,6 +14,7 @@ pub mod contact;
 pub mod contrast;
 pub mod dynamics;
 pub mod error;
+pub mod identification;
 pub mod law;
 pub mod numeric;
 pub mod params;

@@ -9,7 +9,8 @@ use crate::dynamics::observables::{Observe, tap};
 use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
 use crate::error::{Error, Result};
 use crate::figures::{self, FigureOptions};
-use crate::law::LawKind;
+use crate::identification::{self, Normalized};
+use crate::law::{LawKind, LawSpec};
 use crate::params::{Contact, ELECTRONVOLT_J, composite_modulus};
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::report::{output, plot, records, sweep as sweep_report, tap as tap_report};
@@ -19,6 +20,10 @@ use std::path::{Path, PathBuf};
 
 /// The laws compared in the tapping figures.
 const LAWS: [LawKind; 3] = [LawKind::Jkr, LawKind::Hybrid, LawKind::Lj];
+
+/// The viscous sample of the identification figure (Pa·s): one that settles on the
+/// repulsive orbit at the defaults (from about 25 Pa·s it does not).
+const IDENTIFICATION_VISCOSITY_PA_S: f64 = 10.0;
 
 /// A second, stiffer and less adhesive polymer for the phase-contrast figure
 /// (E = 1 GPa, ν = 0.4, Δγ = 0.08 J/m²: μ ≈ 1.5).
@@ -53,7 +58,7 @@ pub struct Manifest {
     pub default_tap: crate::dynamics::observables::TapObservables,
 }
 
-fn approach(setup: &TapSetup, law: LawKind, points: usize) -> Result<Vec<SweepPoint>> {
+fn approach(setup: &TapSetup, law: impl Into<LawSpec>, points: usize) -> Result<Vec<SweepPoint>> {
     let setup = TapSetup {
         law: law.into(),
         ..setup.clone()
@@ -285,6 +290,73 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
             &mut entries,
         );
     }
+
+    // Identification curves: adhesion hysteresis (hybrid) against a viscous sample
+    // (Hertz + Kelvin–Voigt), polymer A.
+    progress("identification curves");
+    let viscous = LawSpec {
+        viscosity_pa_s: Some(IDENTIFICATION_VISCOSITY_PA_S),
+        ..LawKind::Hertz.into()
+    };
+    let mechanisms = [
+        (
+            "hybrid: adhesion hysteresis",
+            approach(&setup, LawKind::Hybrid, 40)?,
+        ),
+        (
+            "hertz + kelvin-voigt 10 Pa·s: viscous",
+            approach(&setup, viscous, 40)?,
+        ),
+    ];
+    let normalized: Vec<Vec<Normalized>> = mechanisms
+        .iter()
+        .map(|(_, points)| identification::normalize(points))
+        .collect();
+    let curves: Vec<(&str, &[SweepPoint], &[Normalized])> = mechanisms
+        .iter()
+        .zip(&normalized)
+        .map(|((name, points), n)| (*name, points.as_slice(), n.as_slice()))
+        .collect();
+    // (The CSV's law column: the legend's name before its colon.)
+    let law_of = |name: &str| name.split(':').next().unwrap_or(name).to_string();
+    let chart = sweep_report::identification_chart(
+        "tap_identification",
+        "Identification curves (approach, polymer A)",
+        &curves,
+    );
+    for ext in ["png", "svg"] {
+        let path = out.join(format!("tap_identification.{ext}"));
+        plot::render_stack(std::slice::from_ref(&chart), &path)?;
+        add(
+            vec![path],
+            "E_ts/E_max vs A/A0 on approach: adhesion hysteresis (hybrid) steps to a plateau, a \
+             viscous sample (hertz + kelvin-voigt) peaks inside",
+            &mut entries,
+        );
+    }
+    let mut records = Vec::new();
+    for ((law, points), n) in mechanisms.iter().zip(&normalized) {
+        for (p, n) in points.iter().zip(n) {
+            records.push(serde_json::json!({
+                "law": law_of(law),
+                "separation_m": p.separation_m,
+                "direction": p.direction,
+                "amplitude_ratio": p.observables.amplitude_ratio,
+                "e_ts_j": p.observables.e_ts_j,
+                "e_ts_adhesion_j": p.observables.e_ts_adhesion_j,
+                "e_ts_viscous_j": p.observables.e_ts_viscous_j,
+                "e_ts_norm": n.e_ts_norm,
+                "regime": p.observables.regime,
+            }));
+        }
+    }
+    let path = out.join("tap_identification.csv");
+    output::write_bytes(&path, &records::records_csv(&records)?)?;
+    add(
+        vec![path],
+        "identification curves: each setpoint's dissipation by mechanism, normalized",
+        &mut entries,
+    );
 
     // Headline numbers and the README.
     progress("README.md");

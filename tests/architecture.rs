@@ -6,12 +6,13 @@
 use std::path::{Path, PathBuf};
 
 /// The library's modules (everything outside the `app` feature).
-const LIBRARY: [&str; 11] = [
+const LIBRARY: [&str; 12] = [
     "src/lib.rs",
     "src/contact",
     "src/contrast.rs",
     "src/dynamics",
     "src/error.rs",
+    "src/identification.rs",
     "src/law",
     "src/numeric.rs",
     "src/params.rs",

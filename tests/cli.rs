@@ -565,6 +565,86 @@ fn approach_json_is_one_object_of_equal_length_arrays() {
     assert_eq!(obj["direction"][11], "retract");
 }
 
+/// `approach --normalize` adds each mechanism's E/E_max (null for one that dissipates
+/// nothing in the sweep) and draws the identification curves first.
+#[test]
+fn approach_normalize_adds_each_mechanisms_share_of_its_largest() {
+    let args = [
+        "approach",
+        "--points",
+        "6",
+        "--from",
+        "22nm",
+        "--to",
+        "12nm",
+        "--json",
+        "--quiet",
+        "--normalize",
+    ];
+    let v = json(&args);
+    let (norm, e_ts) = (
+        v["e_ts_norm"].as_array().unwrap(),
+        v["e_ts_j"].as_array().unwrap(),
+    );
+    assert_eq!(norm.len(), 12);
+    let e_max = e_ts.iter().map(|e| e.as_f64().unwrap()).fold(0.0, f64::max);
+    assert!(e_max > 0.0);
+    for (n, e) in norm.iter().zip(e_ts) {
+        let expected = e.as_f64().unwrap() / e_max;
+        assert!((n.as_f64().unwrap() - expected).abs() <= 1e-12 * expected.max(1.0));
+    }
+    assert_eq!(
+        v["e_ts_adhesion_norm"], v["e_ts_norm"],
+        "the hybrid's one mechanism"
+    );
+    assert!(
+        v["e_ts_viscous_norm"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|x| x.is_null())
+    );
+    // The table gains a column; the plot its identification panel.
+    let table = tapsim(&[
+        "approach",
+        "--points",
+        "6",
+        "--from",
+        "22nm",
+        "--to",
+        "12nm",
+        "--quiet",
+        "--normalize",
+    ]);
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(
+        text.lines().next().unwrap().ends_with("E_ts/E_max"),
+        "{text}"
+    );
+    let dir = scratch("normalize");
+    let csv = dir.join("id.csv");
+    let out = tapsim(&[
+        "approach",
+        "--points",
+        "4",
+        "--quiet",
+        "--normalize",
+        "--plot",
+        dir.join("id.svg").to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let svg = std::fs::read_to_string(dir.join("id.svg")).unwrap();
+    assert!(svg.contains("identification curves"));
+    let header = std::fs::read_to_string(&csv).unwrap();
+    assert!(header.lines().next().unwrap().contains("e_ts_viscous_norm"));
+}
+
 #[test]
 fn reproduce_regenerates_every_file_its_readme_lists() {
     let dir = scratch("reproduce");

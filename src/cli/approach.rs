@@ -2,8 +2,9 @@
 
 use crate::config::TapInputs;
 use crate::error::Result;
+use crate::identification::{self, Normalized};
 use crate::report::sweep as report;
-use crate::sweep::{self, Direction};
+use crate::sweep::{self, Direction, SweepPoint};
 use clap::Args;
 
 /// Sweep the rest separation z_c down (approach) and back up (retract), carrying the
@@ -32,6 +33,22 @@ pub struct ApproachArgs {
     /// Approach only.
     #[arg(long)]
     no_retract: bool,
+    /// Identification curves (García et al., PRL 97, 016103, 2006): add each
+    /// mechanism's dissipation over its largest in the sweep (columns e_ts_norm,
+    /// e_ts_adhesion_norm, e_ts_viscous_norm; null for a mechanism that dissipates
+    /// nothing) and plot them against A/A₀ on the approach, first. Adhesion hysteresis
+    /// steps up to a plateau once the loop is traversed; a viscous sample peaks inside.
+    #[arg(long)]
+    normalize: bool,
+}
+
+/// A setpoint with its identification values (`--normalize`).
+#[derive(serde::Serialize)]
+struct Identified<'a> {
+    #[serde(flatten)]
+    point: &'a SweepPoint,
+    #[serde(flatten)]
+    normalized: Normalized,
 }
 
 /// Setpoints of an approach unless told otherwise (`batch` rows too).
@@ -47,40 +64,72 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         bar.set_position(done as u64)
     })?;
     bar.finish_and_clear();
-    args.out.write_files(&points, || {
-        report::approach_charts(&points, &format!("{} law", setup.law))
-    })?;
-    if args.out.json {
-        args.out.print_json(&points)?;
-    } else {
-        outln!(
-            "{:>9} {:>9} {:>10} {:>9} {:>10} {:>11} {:>10} {:>5}",
-            "z_c (nm)",
-            "dir",
-            "motion",
-            "A/A0",
-            "phi (deg)",
-            "E_ts (eV)",
-            "F_pk (nN)",
-            "conv"
-        );
-        for p in &points {
-            let o = &p.observables;
-            outln!(
-                "{:>9.3} {:>9} {:>10} {:>9.5} {:>10.4} {:>11.4} {:>10.4} {:>5}",
-                p.separation_m * 1e9,
-                match p.direction {
-                    Direction::Approach => "approach",
-                    Direction::Retract => "retract",
-                },
-                o.regime,
-                o.amplitude_ratio,
-                o.phase_deg,
-                o.e_ts_ev,
-                o.peak_force_n * 1e9,
-                if o.converged { "yes" } else { "NO" }
-            );
+    let title = format!("{} law", setup.law);
+    let normalized = args.normalize.then(|| identification::normalize(&points));
+    if let Some(normalized) = &normalized {
+        let rows: Vec<Identified> = points
+            .iter()
+            .zip(normalized)
+            .map(|(point, &normalized)| Identified { point, normalized })
+            .collect();
+        args.out.write_files(&rows, || {
+            let mut charts = vec![report::identification_chart(
+                "identification",
+                &format!("{title}: identification curves (approach)"),
+                &[("", &points, normalized)],
+            )];
+            charts.extend(report::approach_charts(&points, &title));
+            charts
+        })?;
+        if args.out.json {
+            return args.out.print_json(&rows);
         }
+    } else {
+        args.out
+            .write_files(&points, || report::approach_charts(&points, &title))?;
+        if args.out.json {
+            return args.out.print_json(&points);
+        }
+    }
+    outln!(
+        "{:>9} {:>9} {:>10} {:>9} {:>10} {:>11} {:>10} {:>5}{}",
+        "z_c (nm)",
+        "dir",
+        "motion",
+        "A/A0",
+        "phi (deg)",
+        "E_ts (eV)",
+        "F_pk (nN)",
+        "conv",
+        if normalized.is_some() {
+            "  E_ts/E_max"
+        } else {
+            ""
+        }
+    );
+    for (i, p) in points.iter().enumerate() {
+        let o = &p.observables;
+        let share = normalized
+            .as_ref()
+            .map(|n| {
+                n[i].e_ts_norm
+                    .map_or("        -".into(), |e| format!("{e:>11.5}"))
+            })
+            .unwrap_or_default();
+        outln!(
+            "{:>9.3} {:>9} {:>10} {:>9.5} {:>10.4} {:>11.4} {:>10.4} {:>5}{share}",
+            p.separation_m * 1e9,
+            match p.direction {
+                Direction::Approach => "approach",
+                Direction::Retract => "retract",
+            },
+            o.regime,
+            o.amplitude_ratio,
+            o.phase_deg,
+            o.e_ts_ev,
+            o.peak_force_n * 1e9,
+            if o.converged { "yes" } else { "NO" }
+        );
     }
     Ok(())
 }

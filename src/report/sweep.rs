@@ -2,6 +2,7 @@
 //! through [`super::records`].)
 
 use super::chart::{Axis, Chart, Corner, Series, Style};
+use crate::identification::{Mechanism, Normalized};
 use crate::sweep::{Direction, SweepPoint};
 
 /// The x axis of every chart against the rest separation: z_c in nm.
@@ -127,6 +128,63 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
                 )
             });
     against_separation.chain(against_amplitude).collect()
+}
+
+/// The identification curves of a sweep ([`crate::identification`]): each mechanism's
+/// E/E_max against A/A₀ on the approach (`normalized` holds the points' values), one
+/// curve per mechanism that dissipates anything (the total only where it is a single
+/// mechanism's); the free points (A/A₀ ≥ 0.999) left out.
+pub fn identification_chart(
+    name: &str,
+    title: &str,
+    curves: &[(&str, &[SweepPoint], &[Normalized])],
+) -> Chart {
+    let mut series = Vec::new();
+    let mut all = Vec::new();
+    let mut color = 0;
+    for (label, points, normalized) in curves {
+        let present: Vec<Mechanism> = Mechanism::ALL
+            .into_iter()
+            .filter(|&m| normalized.iter().any(|n| n.of(m).is_some()))
+            .collect();
+        // With one mechanism the total is that mechanism's curve: drawn once, as the
+        // mechanism's.
+        let shown = present
+            .iter()
+            .copied()
+            .filter(|&m| m != Mechanism::All || present.len() > 2);
+        for mechanism in shown {
+            color += 1;
+            let on: Vec<Located> = points
+                .iter()
+                .zip(normalized.iter())
+                .filter(|(p, _)| {
+                    p.direction == Direction::Approach && p.observables.amplitude_ratio < 0.999
+                })
+                .filter_map(|(p, n)| {
+                    let e = n.of(mechanism)?;
+                    Some(locate(p, &|p| (p.observables.amplitude_ratio, e)))
+                })
+                .collect();
+            let name = match (curves.len(), present.len()) {
+                (1, _) => mechanism.label().to_string(),
+                (_, 2) => label.to_string(),
+                _ => format!("{label}: {}", mechanism.label()),
+            };
+            series.extend(period_one_lines(&on, &name, Style::Line, color));
+            all.extend(on);
+        }
+    }
+    series.extend(not_period_one(&all));
+    Chart {
+        name: name.into(),
+        title: title.into(),
+        x: Axis::linear("A/A₀", "amplitude_ratio"),
+        y: Axis::linear("E/E_max per mechanism", "e_ts_norm"),
+        legend: Corner::quietest(&series),
+        series,
+        labels: vec![],
+    }
 }
 
 /// φ against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999 left out), one series
