@@ -2,8 +2,10 @@
 //! or more samples, for several force laws side by side — how much contrast the classic
 //! JKR law overstates against the hybrid and the exact Lennard-Jones law.
 
+use crate::dynamics::observables::TapObservables;
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
+use crate::identification::Mechanism;
 use crate::law::LawKind;
 use crate::sweep::{self, Direction, SweepPoint};
 use serde::Serialize;
@@ -54,6 +56,12 @@ pub struct ContrastRow {
     pub converged: Vec<Option<bool>>,
     /// φ(last material) − φ(first material), degrees, where both are on this branch.
     pub delta_phase_deg: Option<f64>,
+    /// E_ts per cycle of each material (J), interpolated as φ is; null where φ is.
+    pub e_ts_j: Vec<Option<f64>>,
+    /// Its adhesion-hysteresis share (J).
+    pub e_ts_adhesion_j: Vec<Option<f64>>,
+    /// Its viscous share (J).
+    pub e_ts_viscous_j: Vec<Option<f64>>,
 }
 
 /// One steady state at an amplitude setpoint.
@@ -61,14 +69,24 @@ pub struct ContrastRow {
 struct AtSetpoint {
     branch: PhaseBranch,
     phase_deg: f64,
+    /// E_ts per mechanism ([`Mechanism::ALL`]), J.
+    e_ts_j: [f64; 3],
     regime: String,
     converged: bool,
 }
 
-/// Linear interpolation of (A/A₀, φ) pairs at A/A₀ = `r`, if `a` and `b` bracket it.
-fn crossing(a: (f64, f64), b: (f64, f64), r: f64) -> Option<f64> {
-    ((a.0 - r) * (b.0 - r) <= 0.0 && a.0 != b.0)
-        .then(|| a.1 + (r - a.0) / (b.0 - a.0) * (b.1 - a.1))
+/// φ and E_ts per mechanism interpolated linearly in A/A₀ at A/A₀ = `r` between two
+/// steady states, if they bracket it.
+fn crossing(a: &TapObservables, b: &TapObservables, r: f64) -> Option<(f64, [f64; 3])> {
+    let (ra, rb) = (a.amplitude_ratio, b.amplitude_ratio);
+    ((ra - r) * (rb - r) <= 0.0 && ra != rb).then(|| {
+        let t = (r - ra) / (rb - ra);
+        let at = |va: f64, vb: f64| va + t * (vb - va);
+        (
+            at(a.phase_deg, b.phase_deg),
+            Mechanism::ALL.map(|m| at(m.energy_j(a), m.energy_j(b))),
+        )
+    })
 }
 
 /// The steady states of one material and law at amplitude setpoint `r`: every stable
@@ -87,7 +105,6 @@ fn states_at(
             PhaseBranch::Repulsive
         }
     };
-    let pair = |o: &crate::dynamics::observables::TapObservables| (o.amplitude_ratio, o.phase_deg);
     let mut out: Vec<AtSetpoint> = family
         .windows(2)
         .filter(|w| {
@@ -96,18 +113,14 @@ fn states_at(
                 && w[1].observables.stable == Some(true)
         })
         .filter_map(|w| {
-            crossing(pair(&w[0].observables), pair(&w[1].observables), r).map(|phase| {
-                (
-                    phase,
-                    w[0].observables.converged && w[1].observables.converged,
-                )
+            let (a, b) = (&w[0].observables, &w[1].observables);
+            crossing(a, b, r).map(|(phase_deg, e_ts_j)| AtSetpoint {
+                branch: branch_of(phase_deg),
+                phase_deg,
+                e_ts_j,
+                regime: "period-1".into(),
+                converged: a.converged && b.converged,
             })
-        })
-        .map(|(phase_deg, converged)| AtSetpoint {
-            branch: branch_of(phase_deg),
-            phase_deg,
-            regime: "period-1".into(),
-            converged,
         })
         .collect();
     let approach: Vec<&SweepPoint> = ramp
@@ -119,7 +132,7 @@ fn states_at(
         if a.period == Some(1) && b.period == Some(1) {
             continue;
         }
-        if let Some(phase_deg) = crossing(pair(a), pair(b), r) {
+        if let Some((phase_deg, e_ts_j)) = crossing(a, b, r) {
             let branch = branch_of(phase_deg);
             if !out.iter().any(|s| s.branch == branch) {
                 let nearer = if (a.amplitude_ratio - r).abs() < (b.amplitude_ratio - r).abs() {
@@ -130,6 +143,7 @@ fn states_at(
                 out.push(AtSetpoint {
                     branch,
                     phase_deg,
+                    e_ts_j,
                     regime: nearer.regime.clone(),
                     converged: a.converged && b.converged,
                 });
@@ -228,6 +242,9 @@ pub fn contrast(
                 }
                 let phase_deg: Vec<Option<f64>> =
                     on.iter().map(|s| s.map(|a| a.phase_deg)).collect();
+                let share = |i: usize| -> Vec<Option<f64>> {
+                    on.iter().map(|s| s.map(|a| a.e_ts_j[i])).collect()
+                };
                 rows.push(ContrastRow {
                     law: law.to_string(),
                     materials: of_law.iter().map(|c| c.material.clone()).collect(),
@@ -238,6 +255,9 @@ pub fn contrast(
                         _ => None,
                     },
                     regime: on.iter().map(|s| s.map(|a| a.regime.clone())).collect(),
+                    e_ts_j: share(0),
+                    e_ts_adhesion_j: share(1),
+                    e_ts_viscous_j: share(2),
                     converged: on.iter().map(|s| s.map(|a| a.converged)).collect(),
                     phase_deg,
                 });

@@ -767,6 +767,77 @@ fn map_is_bit_identical_whatever_the_thread_count() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// A viscous sample's E_ts in the contrast table is its viscous share plus its adhesion
+/// share, each interpolated at the setpoint as φ is; its CSV has a column per material.
+#[test]
+fn contrast_splits_the_dissipation_of_a_viscous_sample() {
+    let v = json(&[
+        "contrast",
+        "--laws",
+        "hertz,jkr",
+        "--setpoints",
+        "0.8",
+        "--points",
+        "12",
+        "--quiet",
+        "--json",
+        "--viscosity",
+        "10",
+    ]);
+    let mut viscous_seen = 0;
+    for r in v.as_array().unwrap() {
+        let pick = |key: &str| r[key].as_array().unwrap().clone();
+        let (all, adhesion, viscous) = (
+            pick("e_ts_j"),
+            pick("e_ts_adhesion_j"),
+            pick("e_ts_viscous_j"),
+        );
+        for i in 0..all.len() {
+            let Some(e) = all[i].as_f64() else { continue };
+            let (a, w) = (adhesion[i].as_f64().unwrap(), viscous[i].as_f64().unwrap());
+            assert!((a + w - e).abs() <= 1e-12 * e, "{r}");
+            if r["law"] == "hertz" {
+                // Hertz has no hysteresis: the sample's viscosity is all of it.
+                assert_eq!(a, 0.0);
+                assert!(w > 0.0);
+                viscous_seen += 1;
+            }
+        }
+    }
+    assert_eq!(viscous_seen, 2, "{v}");
+    let dir = scratch("contrast-split");
+    let csv = dir.join("c.csv");
+    let out = tapsim(&[
+        "contrast",
+        "--laws",
+        "hertz",
+        "--setpoints",
+        "0.8",
+        "--points",
+        "8",
+        "--quiet",
+        "--viscosity",
+        "10",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    for column in ["e_ts_j_", "e_ts_adhesion_j_", "e_ts_viscous_j_"] {
+        assert_eq!(
+            header.iter().filter(|h| h.starts_with(column)).count(),
+            2,
+            "{header:?}"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn contrast_reports_a_row_per_law_and_setpoint() {
     let v = json(&[
@@ -814,6 +885,24 @@ fn contrast_reports_a_row_per_law_and_setpoint() {
                 assert!((r["delta_phase_deg"].as_f64().unwrap() - (b - a)).abs() < 1e-9)
             }
             _ => assert!(r["delta_phase_deg"].is_null()),
+        }
+    }
+    // E_ts of each material, split by mechanism, null exactly where φ is.
+    for r in rows {
+        let pick = |key: &str| r[key].as_array().unwrap().clone();
+        let (all, adhesion, viscous) = (
+            pick("e_ts_j"),
+            pick("e_ts_adhesion_j"),
+            pick("e_ts_viscous_j"),
+        );
+        for (i, phase) in r["phase_deg"].as_array().unwrap().iter().enumerate() {
+            assert_eq!(all[i].is_null(), phase.is_null(), "{r}");
+            if let Some(e) = all[i].as_f64() {
+                assert!(e >= 0.0 && e.is_finite());
+                // Elastic samples: all of it is adhesion hysteresis.
+                assert_eq!(viscous[i].as_f64(), Some(0.0));
+                assert_eq!(adhesion[i].as_f64(), Some(e));
+            }
         }
     }
     // Under the hybrid law both polymers stay attractive at A/A0 = 0.9, on period-1 orbits.

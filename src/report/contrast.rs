@@ -2,7 +2,7 @@
 //! (phase against amplitude per law, Δφ per law and branch).
 
 use super::chart::{Axis, Chart, Corner, Series, Style};
-use super::sweep::phase_vs_amplitude;
+use super::sweep::{phase_vs_amplitude, vs_amplitude};
 use crate::contrast::{ContrastRow, LawCurve, Material, PhaseBranch};
 use crate::law::LawKind;
 use std::fmt::Write as _;
@@ -15,8 +15,9 @@ pub fn branch_name(b: PhaseBranch) -> &'static str {
     }
 }
 
-/// The rows as CSV: law, setpoint, branch, each material's phase and regime, Δφ. An
-/// error is the CSV writer's reason.
+/// The rows as CSV: law, setpoint, branch, each material's phase and regime, Δφ, then
+/// each material's E_ts and its adhesion and viscous shares (J). An error is the CSV
+/// writer's reason.
 pub fn contrast_csv(
     rows: &[ContrastRow],
     materials: &[Material],
@@ -26,9 +27,14 @@ pub fn contrast_csv(
     header.extend(materials.iter().map(|m| format!("phase_deg_{}", m.name)));
     header.extend(materials.iter().map(|m| format!("regime_{}", m.name)));
     header.push("delta_phase_deg".into());
+    for column in ["e_ts_j", "e_ts_adhesion_j", "e_ts_viscous_j"] {
+        header.extend(materials.iter().map(|m| format!("{column}_{}", m.name)));
+    }
     w.write_record(&header).map_err(|e| e.to_string())?;
     for r in rows {
-        let cell = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
+        // (Debug: the shortest text that reads back the same float, with an exponent for
+        // energies of order 1e-19 J.)
+        let cell = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:?}"));
         let mut rec = vec![
             r.law.clone(),
             r.amplitude_ratio.to_string(),
@@ -37,12 +43,16 @@ pub fn contrast_csv(
         rec.extend(r.phase_deg.iter().map(|&p| cell(p)));
         rec.extend(r.regime.iter().map(|g| g.clone().unwrap_or_default()));
         rec.push(cell(r.delta_phase_deg));
+        for shares in [&r.e_ts_j, &r.e_ts_adhesion_j, &r.e_ts_viscous_j] {
+            rec.extend(shares.iter().map(|&e| cell(e)));
+        }
         w.write_record(&rec).map_err(|e| e.to_string())?;
     }
     w.into_inner().map_err(|e| e.to_string())
 }
 
-/// Phase against amplitude for each law (a curve per material), then Δφ against the
+/// Phase against amplitude for each law (a curve per material), E_ts against amplitude
+/// for each law (and its viscous share, where a sample is viscous), then Δφ against the
 /// setpoint for every law and branch.
 pub fn contrast_charts(
     laws: &[LawKind],
@@ -50,21 +60,52 @@ pub fn contrast_charts(
     rows: &[ContrastRow],
     curves: &[LawCurve],
 ) -> Vec<Chart> {
+    let per_material = |law: LawKind| -> Vec<(&str, &[crate::sweep::SweepPoint])> {
+        curves
+            .iter()
+            .filter(|c| c.law == law)
+            .map(|c| (c.material.as_str(), c.points.as_slice()))
+            .collect()
+    };
     let mut charts: Vec<Chart> = laws
         .iter()
-        .map(|law| {
-            let per_material: Vec<(&str, &[crate::sweep::SweepPoint])> = curves
-                .iter()
-                .filter(|c| c.law == *law)
-                .map(|c| (c.material.as_str(), c.points.as_slice()))
-                .collect();
+        .map(|&law| {
             phase_vs_amplitude(
                 &format!("phase_{law}"),
                 &format!("{law} law: phase vs amplitude"),
-                &per_material,
+                &per_material(law),
             )
         })
         .collect();
+    for &law in laws {
+        let of_law = per_material(law);
+        charts.push(vs_amplitude(
+            (
+                &format!("e_ts_{law}"),
+                &format!("{law} law: dissipation vs amplitude"),
+            ),
+            Axis::linear("E_ts per cycle (eV)", "e_ts_ev"),
+            |o| o.e_ts_ev,
+            &of_law,
+        ));
+        let viscous = of_law
+            .iter()
+            .any(|(_, points)| points.iter().any(|p| p.observables.e_ts_viscous_j > 0.0));
+        if viscous {
+            charts.push(vs_amplitude(
+                (
+                    &format!("e_ts_viscous_{law}"),
+                    &format!("{law} law: viscous share of the dissipation"),
+                ),
+                Axis::linear(
+                    "E_ts in the viscous sample per cycle (eV)",
+                    "e_ts_viscous_ev",
+                ),
+                |o| o.e_ts_viscous_j / crate::params::ELECTRONVOLT_J,
+                &of_law,
+            ));
+        }
+    }
     charts.push(Chart {
         name: "contrast".into(),
         title: format!(

@@ -190,56 +190,52 @@ pub fn identification_chart(
 /// φ against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999 left out), one series
 /// per labelled curve: the phase-contrast view.
 pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint])]) -> Chart {
-    let mut chart = Chart {
+    vs_amplitude(
+        (name, title),
+        Axis::linear("phase lag φ (deg)", "phase_deg"),
+        |o| o.phase_deg,
+        curves,
+    )
+}
+
+/// `pick` of each setpoint against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999
+/// left out), one series per labelled curve, broken where φ jumps between the
+/// attractive and the repulsive branch (a jump is no part of either).
+pub fn vs_amplitude(
+    (name, title): (&str, &str),
+    y: Axis,
+    pick: fn(&crate::dynamics::observables::TapObservables) -> f64,
+    curves: &[(&str, &[SweepPoint])],
+) -> Chart {
+    let xy = |p: &SweepPoint| (p.observables.amplitude_ratio, pick(&p.observables));
+    let mut series = Vec::new();
+    let mut others = Vec::new();
+    for (i, (label, points)) in curves.iter().enumerate() {
+        let kept: Vec<&SweepPoint> = points
+            .iter()
+            .filter(|p| p.direction == Direction::Approach && p.observables.amplitude_ratio < 0.999)
+            .collect();
+        for (k, part) in split_at_jumps(&kept).into_iter().enumerate() {
+            let on: Vec<Located> = part.iter().map(|p| locate(p, &xy)).collect();
+            series.extend(period_one_lines(
+                &on,
+                if k == 0 { label } else { "" },
+                Style::Line,
+                i + 1,
+            ));
+            others.extend(on);
+        }
+    }
+    series.extend(not_period_one(&others));
+    Chart {
         name: name.into(),
         title: title.into(),
         x: Axis::linear("A/A₀", "amplitude_ratio"),
-        y: Axis::linear("phase lag φ (deg)", "phase_deg"),
-        series: {
-            let xy = |p: &SweepPoint| (p.observables.amplitude_ratio, p.observables.phase_deg);
-            let kept: Vec<Vec<Located>> = curves
-                .iter()
-                .map(|(_, points)| {
-                    points
-                        .iter()
-                        .filter(|p| {
-                            p.direction == Direction::Approach
-                                && p.observables.amplitude_ratio < 0.999
-                        })
-                        .map(|p| locate(p, &xy))
-                        .collect()
-                })
-                .collect();
-            // A jump between the attractive and the repulsive branch is no part of
-            // either: the line breaks where φ changes by more than JUMP_DEG between
-            // neighbouring setpoints.
-            let mut series: Vec<Series> = curves
-                .iter()
-                .zip(&kept)
-                .enumerate()
-                .flat_map(|(i, ((label, _), on))| {
-                    split_at_jumps(on)
-                        .into_iter()
-                        .enumerate()
-                        .flat_map(move |(k, part)| {
-                            period_one_lines(
-                                &part,
-                                if k == 0 { label } else { "" },
-                                Style::Line,
-                                i + 1,
-                            )
-                        })
-                })
-                .collect();
-            let others: Vec<Located> = kept.concat();
-            series.extend(not_period_one(&others));
-            series
-        },
+        y,
+        legend: Corner::quietest(&series),
+        series,
         labels: vec![],
-        legend: Corner::UpperRight,
-    };
-    chart.legend = Corner::quietest(&chart.series);
-    chart
+    }
 }
 
 /// A value to plot and the period of the motion behind it (`None`: irregular).
@@ -249,12 +245,13 @@ pub type Located = (Option<usize>, (f64, f64));
 /// branches, not a slope.
 const JUMP_DEG: f64 = 20.0;
 
-/// `points` in pieces, cut between neighbours whose values differ by more than
+/// `points` in pieces, cut between neighbours whose phases differ by more than
 /// [`JUMP_DEG`].
-fn split_at_jumps(points: &[Located]) -> Vec<Vec<Located>> {
-    let mut parts: Vec<Vec<Located>> = vec![Vec::new()];
+fn split_at_jumps<'a>(points: &[&'a SweepPoint]) -> Vec<Vec<&'a SweepPoint>> {
+    let mut parts: Vec<Vec<&SweepPoint>> = vec![Vec::new()];
     for (k, &p) in points.iter().enumerate() {
-        if k > 0 && (p.1.1 - points[k - 1].1.1).abs() > JUMP_DEG {
+        if k > 0 && (p.observables.phase_deg - points[k - 1].observables.phase_deg).abs() > JUMP_DEG
+        {
             parts.push(Vec::new());
         }
         parts.last_mut().expect("a part").push(p);
