@@ -10,6 +10,17 @@ fn tapsim(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// Run `args`, asserting success.
+fn succeeds(args: &[&str]) -> Output {
+    let out = tapsim(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// Run `args` with the Lennard-Jones cache in `cache` (a test's own), asserting success.
 fn succeeds_with_cache(args: &[&str], cache: &std::path::Path) -> Output {
     let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
@@ -623,7 +634,7 @@ fn approach_normalize_adds_each_mechanisms_share_of_its_largest() {
     );
     let dir = scratch("normalize");
     let csv = dir.join("id.csv");
-    let out = tapsim(&[
+    succeeds(&[
         "approach",
         "--points",
         "4",
@@ -634,11 +645,6 @@ fn approach_normalize_adds_each_mechanisms_share_of_its_largest() {
         "--csv",
         csv.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let svg = std::fs::read_to_string(dir.join("id.svg")).unwrap();
     assert!(svg.contains("identification curves"));
     let header = std::fs::read_to_string(&csv).unwrap();
@@ -807,7 +813,7 @@ fn contrast_splits_the_dissipation_of_a_viscous_sample() {
     assert_eq!(viscous_seen, 2, "{v}");
     let dir = scratch("contrast-split");
     let csv = dir.join("c.csv");
-    let out = tapsim(&[
+    succeeds(&[
         "contrast",
         "--laws",
         "hertz",
@@ -821,11 +827,6 @@ fn contrast_splits_the_dissipation_of_a_viscous_sample() {
         "--csv",
         csv.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let text = std::fs::read_to_string(&csv).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
     for column in ["e_ts_j_", "e_ts_adhesion_j_", "e_ts_viscous_j_"] {

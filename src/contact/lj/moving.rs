@@ -153,8 +153,9 @@ impl MovingSpec {
 #[serde(rename_all = "kebab-case")]
 pub enum Reach {
     /// The loop under a rigid support: the approach branch from α̂ = [`RIGID_START`] (or
-    /// twice the jump-in separation) through A, C and the pull-off, down the contact
-    /// branch past the jump-in's landing. What Ŵ_LJ, the folds and the pull-off need.
+    /// twice the jump-in separation) through A, and the contact branch from where it
+    /// pushes (past every landing) through the pull-off and C. What Ŵ_LJ, the folds and
+    /// the pull-off need.
     Rigid,
     /// Also every support spring down to k̂ = [`SOFTEST_SPRING`]: the approach branch
     /// from far enough out for the softest spring's jump-out (the contact branch, traced
