@@ -1231,6 +1231,50 @@ fn succeeds_here(args: &[&str], dir: &std::path::Path) -> Vec<u8> {
     out.stdout
 }
 
+/// A map over a viscous sample adds the heat map of E_ts's viscous share, the same
+/// whether computed whole or merged from parts; an elastic sample's map has none.
+#[test]
+fn a_viscous_maps_plot_shows_the_viscous_share_merged_or_whole() {
+    let dir = scratch("viscous-map");
+    let ok = |args: &[&str]| succeeds_here(args, &dir);
+    let grid = [
+        "map",
+        "--steps",
+        "3",
+        "--quiet",
+        "--law",
+        "hertz",
+        "--viscosity",
+        "10",
+    ];
+    ok(&[&grid[..], &["--plot", "whole.svg"]].concat());
+    for i in 0..2 {
+        let shard = format!("{i}/2");
+        let part = format!("p{i}.json");
+        ok(&[&grid[..], &["--shard", &shard, "--part", &part]].concat());
+    }
+    ok(&["merge", "p1.json", "p0.json", "--out", "merged.svg"]);
+    let whole = std::fs::read_to_string(dir.join("whole.svg")).unwrap();
+    assert!(whole.contains("viscous share of the dissipation"));
+    assert_eq!(
+        std::fs::read_to_string(dir.join("merged.svg")).unwrap(),
+        whole
+    );
+    ok(&[
+        "map",
+        "--steps",
+        "3",
+        "--quiet",
+        "--law",
+        "hertz",
+        "--plot",
+        "elastic.svg",
+    ]);
+    let elastic = std::fs::read_to_string(dir.join("elastic.svg")).unwrap();
+    assert!(!elastic.contains("viscous share"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn sharded_maps_merge_to_the_whole_map_byte_for_byte() {
     let dir = scratch("shards");

@@ -18,9 +18,10 @@ use clap::Args;
 /// per cell (empty where the law does not apply, with a note). JSON (--json): law, the
 /// two axes work_of_adhesion_j_m2 and modulus_pa, and grid: per column of the CSV an
 /// array of rows, one per modulus, each with one value per work of adhesion (null
-/// where the law does not apply); --plot draws heat maps of E_ts, φ and A/A₀ over the
-/// grid (log axes, a viridis colour bar each; grey where the law does not apply, cells
-/// that are not period-1 marked with a circle).
+/// where the law does not apply); --plot draws heat maps of E_ts, φ and A/A₀ (and, for
+/// a viscous sample, of E_ts's viscous share) over the grid (log axes, a viridis colour
+/// bar each; grey where the law does not apply, cells that are not period-1 marked with
+/// a circle).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct MapArgs {

@@ -7,13 +7,15 @@
 use super::heatmap::{Cell, HeatMap};
 use super::records;
 use crate::error::Result;
+use crate::params::ELECTRONVOLT_J;
 use crate::sweep::MapCell;
 use serde::Serialize;
 use serde_json::value::RawValue;
 
-/// What a heat map shows of one cell: E_ts per cycle (eV), the phase (deg) and A/A₀, and
-/// whether the motion is period-1; `None` where the law does not apply.
-pub type Plotted = Option<([f64; 3], bool)>;
+/// What a heat map shows of one cell: E_ts per cycle (eV), the phase (deg), A/A₀ and the
+/// viscous share of E_ts (eV), and whether the motion is period-1; `None` where the law
+/// does not apply.
+pub type Plotted = Option<([f64; 4], bool)>;
 
 /// A map cell as its record serialises, and what its heat maps show.
 pub trait MapRecord: Serialize {
@@ -25,7 +27,12 @@ impl MapRecord for MapCell {
     fn plotted(&self) -> Plotted {
         let o = self.observables.as_ref()?;
         Some((
-            [o.e_ts_ev, o.phase_deg, o.amplitude_ratio],
+            [
+                o.e_ts_ev,
+                o.phase_deg,
+                o.amplitude_ratio,
+                o.e_ts_viscous_j / ELECTRONVOLT_J,
+            ],
             o.period == Some(1),
         ))
     }
@@ -37,6 +44,7 @@ struct PlottedFields {
     e_ts_ev: Option<f64>,
     phase_deg: Option<f64>,
     amplitude_ratio: Option<f64>,
+    e_ts_viscous_j: Option<f64>,
     period: Option<u64>,
 }
 
@@ -45,13 +53,19 @@ impl MapRecord for Box<RawValue> {
     fn plotted(&self) -> Plotted {
         let f: PlottedFields = serde_json::from_str(self.get()).ok()?;
         Some((
-            [f.e_ts_ev?, f.phase_deg?, f.amplitude_ratio?],
+            [
+                f.e_ts_ev?,
+                f.phase_deg?,
+                f.amplitude_ratio?,
+                f.e_ts_viscous_j? / ELECTRONVOLT_J,
+            ],
             f.period == Some(1),
         ))
     }
 }
 
-/// Heat maps of E_ts per cycle, phase and A/A₀ over the grid for `law`. The records come
+/// Heat maps of E_ts per cycle, phase and A/A₀ over the grid for `law` (and of E_ts's
+/// viscous share, where a sample is viscous). The records come
 /// row by row, one row per modulus (as [`map_json`] lays them out); a cell without the
 /// value (the law does not apply there) is grey.
 pub fn heat_maps<T: MapRecord>(
@@ -83,11 +97,19 @@ pub fn heat_maps<T: MapRecord>(
             })
             .collect(),
     };
-    vec![
+    let mut maps = vec![
         map("dissipation per cycle", "E_ts per cycle (eV)", 0),
         map("phase", "phase lag φ (deg)", 1),
         map("amplitude", "A/A₀", 2),
-    ]
+    ];
+    if plotted.iter().flatten().any(|(values, _)| values[3] > 0.0) {
+        maps.push(map(
+            "viscous share of the dissipation",
+            "E_ts in the viscous sample per cycle (eV)",
+            3,
+        ));
+    }
+    maps
 }
 
 /// The grid as one JSON object: the law, both axes, and per observable an array of rows
