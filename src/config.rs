@@ -192,6 +192,18 @@ pub struct TapInputs {
     #[arg(long, allow_hyphen_values = true, value_parser = viscosity, help_heading = "Contact (SI)",
           help = crate::law::VISCOSITY.help)]
     pub viscosity: Option<f64>,
+    /// A law parameter ([`crate::law::RUPTURE_DISTANCE`]; its help is the registry's).
+    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Contact (SI)",
+          help = crate::law::RUPTURE_DISTANCE.help)]
+    pub rupture_distance: Option<f64>,
+    /// A law parameter ([`crate::law::SURFACE_TENSION`]; its help is the registry's).
+    #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, help_heading = "Contact (SI)",
+          help = crate::law::SURFACE_TENSION.help)]
+    pub surface_tension: Option<f64>,
+    /// A law parameter ([`crate::law::CONTACT_ANGLE`]; its help is the registry's).
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)",
+          help = crate::law::CONTACT_ANGLE.help)]
+    pub contact_angle: Option<f64>,
     /// Cantilever spring constant k [N/m; default 40].
     #[arg(long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Cantilever")]
     pub stiffness: Option<f64>,
@@ -296,6 +308,9 @@ const FIELDS: &[Field] = fields![
     "range" => Length => |i| i.contact.range,
     "hamaker" => Energy => |i| i.hamaker,
     "viscosity" => Viscosity => |i| i.viscosity,
+    "rupture-distance" => Length => |i| i.rupture_distance,
+    "surface-tension" => SurfaceEnergy => |i| i.surface_tension,
+    "contact-angle" => Dimensionless => |i| i.contact_angle,
     "stiffness" => Stiffness => |i| i.stiffness,
     "resonance" => Frequency => |i| i.resonance,
     "quality" => Dimensionless => |i| i.quality,
@@ -391,6 +406,9 @@ impl TapInputs {
             contact: self.contact.or(base.contact),
             hamaker: self.hamaker.or(base.hamaker),
             viscosity: self.viscosity.or(base.viscosity),
+            rupture_distance: self.rupture_distance.or(base.rupture_distance),
+            surface_tension: self.surface_tension.or(base.surface_tension),
+            contact_angle: self.contact_angle.or(base.contact_angle),
             stiffness: self.stiffness.or(base.stiffness),
             resonance: self.resonance.or(base.resonance),
             quality: self.quality.or(base.quality),
@@ -449,6 +467,9 @@ impl TapInputs {
                 kind: self.law.unwrap_or(d.law.kind),
                 hamaker_j: self.hamaker.or(d.law.hamaker_j),
                 viscosity_pa_s: self.viscosity.or(d.law.viscosity_pa_s),
+                rupture_distance_m: self.rupture_distance.or(d.law.rupture_distance_m),
+                surface_tension_j_m2: self.surface_tension.or(d.law.surface_tension_j_m2),
+                contact_angle_deg: self.contact_angle.or(d.law.contact_angle_deg),
             },
         };
         let mut numerics = Numerics::default();

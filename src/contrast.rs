@@ -62,6 +62,8 @@ pub struct ContrastRow {
     pub e_ts_adhesion_j: Vec<Option<f64>>,
     /// Its viscous share (J).
     pub e_ts_viscous_j: Vec<Option<f64>>,
+    /// Its capillary share (J).
+    pub e_ts_capillary_j: Vec<Option<f64>>,
 }
 
 /// One steady state at an amplitude setpoint.
@@ -70,14 +72,14 @@ struct AtSetpoint {
     branch: PhaseBranch,
     phase_deg: f64,
     /// E_ts per mechanism ([`Mechanism::ALL`]), J.
-    e_ts_j: [f64; 3],
+    e_ts_j: [f64; 4],
     regime: String,
     converged: bool,
 }
 
 /// φ and E_ts per mechanism interpolated linearly in A/A₀ at A/A₀ = `r` between two
 /// steady states, if they bracket it.
-fn crossing(a: &TapObservables, b: &TapObservables, r: f64) -> Option<(f64, [f64; 3])> {
+fn crossing(a: &TapObservables, b: &TapObservables, r: f64) -> Option<(f64, [f64; 4])> {
     let (ra, rb) = (a.amplitude_ratio, b.amplitude_ratio);
     ((ra - r) * (rb - r) <= 0.0 && ra != rb).then(|| {
         let t = (r - ra) / (rb - ra);
@@ -258,6 +260,7 @@ pub fn contrast(
                     e_ts_j: share(0),
                     e_ts_adhesion_j: share(1),
                     e_ts_viscous_j: share(2),
+                    e_ts_capillary_j: share(3),
                     converged: on.iter().map(|s| s.map(|a| a.converged)).collect(),
                     phase_deg,
                 });

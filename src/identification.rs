@@ -21,11 +21,18 @@ pub enum Mechanism {
     Adhesion,
     /// A viscous sample (Kelvin–Voigt).
     Viscous,
+    /// A capillary neck.
+    Capillary,
 }
 
 impl Mechanism {
     /// Every mechanism, E_ts first.
-    pub const ALL: [Mechanism; 3] = [Mechanism::All, Mechanism::Adhesion, Mechanism::Viscous];
+    pub const ALL: [Mechanism; 4] = [
+        Mechanism::All,
+        Mechanism::Adhesion,
+        Mechanism::Viscous,
+        Mechanism::Capillary,
+    ];
 
     /// What a legend calls it.
     pub fn label(self) -> &'static str {
@@ -33,6 +40,7 @@ impl Mechanism {
             Mechanism::All => "E_ts, all mechanisms",
             Mechanism::Adhesion => "adhesion hysteresis",
             Mechanism::Viscous => "viscous sample",
+            Mechanism::Capillary => "capillary neck",
         }
     }
 
@@ -42,6 +50,7 @@ impl Mechanism {
             Mechanism::All => o.e_ts_j,
             Mechanism::Adhesion => o.e_ts_adhesion_j,
             Mechanism::Viscous => o.e_ts_viscous_j,
+            Mechanism::Capillary => o.e_ts_capillary_j,
         }
     }
 }
@@ -56,6 +65,8 @@ pub struct Normalized {
     pub e_ts_adhesion_norm: Option<f64>,
     /// The viscous sample's share over its largest.
     pub e_ts_viscous_norm: Option<f64>,
+    /// The capillary neck's share over its largest.
+    pub e_ts_capillary_norm: Option<f64>,
 }
 
 impl Normalized {
@@ -65,6 +76,7 @@ impl Normalized {
             Mechanism::All => self.e_ts_norm,
             Mechanism::Adhesion => self.e_ts_adhesion_norm,
             Mechanism::Viscous => self.e_ts_viscous_norm,
+            Mechanism::Capillary => self.e_ts_capillary_norm,
         }
     }
 }
@@ -83,13 +95,14 @@ pub fn normalize(points: &[SweepPoint]) -> Vec<Normalized> {
     points
         .iter()
         .map(|p| {
-            let [all, adhesion, viscous] = [0, 1, 2].map(|i| {
+            let [all, adhesion, viscous, capillary] = [0, 1, 2, 3].map(|i| {
                 largest[i].map(|e_max| Mechanism::ALL[i].energy_j(&p.observables) / e_max)
             });
             Normalized {
                 e_ts_norm: all,
                 e_ts_adhesion_norm: adhesion,
                 e_ts_viscous_norm: viscous,
+                e_ts_capillary_norm: capillary,
             }
         })
         .collect()

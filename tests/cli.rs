@@ -1166,6 +1166,70 @@ fn figure_json_is_a_manifest_of_the_files_written() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// A capillary neck is put on by its rupture distance, from a flag or a parameter file,
+/// on the laws without hysteresis of their own; the rest is refused with the reason.
+#[test]
+fn a_capillary_neck_is_a_law_parameter_checked_against_the_law() {
+    let v = json(&[
+        "tap",
+        "--law",
+        "dmt",
+        "--rupture-distance",
+        "2nm",
+        "--contact-angle",
+        "30",
+        "--separation",
+        "9nm",
+        "--json",
+    ]);
+    assert_eq!(v["law"], "dmt+capillary");
+    let (e, cap) = (num(&v, "e_ts_j"), num(&v, "e_ts_capillary_j"));
+    assert!(cap > 0.0 && (e - cap).abs() <= 1e-9 * e, "{v}");
+    let dir = scratch("capillary-config");
+    let cfg = dir.join("neck.toml");
+    std::fs::write(
+        &cfg,
+        "law = \"dmt\"\nrupture-distance = \"2nm\"\ncontact-angle = 30\nseparation = \"9nm\"\n",
+    )
+    .unwrap();
+    let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
+    assert_eq!(w["e_ts_j"], v["e_ts_j"]);
+    for (args, needle) in [
+        (
+            vec!["tap", "--law", "jkr", "--rupture-distance", "2nm"],
+            "the jkr law takes no rupture-distance parameter (the laws that do: dmt, hertz)",
+        ),
+        (
+            vec!["tap", "--law", "hertz", "--surface-tension", "72mN/m"],
+            "give its rupture-distance too",
+        ),
+        (
+            vec![
+                "tap",
+                "--law",
+                "hertz",
+                "--rupture-distance",
+                "2nm",
+                "--contact-angle",
+                "95",
+            ],
+            "contact angle = 95 deg is outside",
+        ),
+        (
+            vec!["tap", "--law", "dmt", "--rupture-distance", "0.2nm"],
+            "the neck breaks beyond contact",
+        ),
+    ] {
+        let out = tapsim(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(needle),
+            "{args:?}: {err}"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn a_viscous_sample_is_a_law_parameter_checked_against_the_law() {
     // Flag and parameter file alike; the law's name says the sample is viscous.

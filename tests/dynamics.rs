@@ -534,3 +534,64 @@ fn a_small_viscosity_loses_eta_times_the_elastic_orbits_rate_integral() {
     let decade = (ratios[0] - ratios[1]) / (ratios[1] - ratios[2]);
     assert!((decade - 10.0).abs() < 1.0, "{decade}: {ratios:?}");
 }
+
+/// A capillary neck (VEDA's model) on Hertz and DMT, alone and with a viscous sample:
+/// every cycle in which the neck forms and breaks loses exactly its closed-form loop
+/// 2πRγ cos θ (D₀ − a₀), the channels add up to E_ts, and the energy balance holds.
+#[test]
+fn a_capillary_neck_loses_its_closed_form_loop_per_touch_on_every_combination() {
+    let contact = default_setup().contact;
+    for (kind, a0) in [(LawKind::Hertz, 0.0), (LawKind::Dmt, contact.range_m)] {
+        for viscosity in [None, Some(10.0)] {
+            for (rupture, angle, separation) in [(2e-9, 0.0, 12e-9), (3e-9, 40.0, 9e-9)] {
+                let setup = TapSetup {
+                    law: LawSpec {
+                        rupture_distance_m: Some(rupture),
+                        contact_angle_deg: Some(angle),
+                        viscosity_pa_s: viscosity,
+                        ..kind.into()
+                    },
+                    separation_m: separation,
+                    ..default_setup()
+                };
+                let o = tap(&setup, &Numerics::default(), Observe::default())
+                    .unwrap()
+                    .observables;
+                let name = format!("{} D0 {rupture:e} θ {angle} z_c {separation:e}", o.law);
+                assert!(o.converged, "{name}");
+                assert!(
+                    o.energy_balance_rel < 1e-6,
+                    "{name}: {:e}",
+                    o.energy_balance_rel
+                );
+                // The neck's loop, from the parameters alone.
+                let loop_j =
+                    2.0 * PI * contact.radius_m * 0.072 * angle.to_radians().cos() * (rupture - a0);
+                assert!(
+                    (o.loop_area_j - loop_j).abs() <= 1e-12 * loop_j,
+                    "{name}: {:e} vs {loop_j:e}",
+                    o.loop_area_j
+                );
+                assert!(o.jumps_in > 0.0, "{name}: the tip must touch");
+                // Each touch forms the neck, each retreat breaks it: the loop per touch.
+                let per_touch = o.e_ts_capillary_j / o.jumps_in;
+                assert!(
+                    (per_touch - loop_j).abs() <= 1e-9 * loop_j,
+                    "{name}: {per_touch:e} per touch vs {loop_j:e}"
+                );
+                let sum = o.e_ts_adhesion_j + o.e_ts_viscous_j + o.e_ts_capillary_j;
+                assert!((sum - o.e_ts_j).abs() <= 1e-12 * o.e_ts_j, "{name}");
+                // Hertz and DMT have no hysteresis of their own.
+                assert!(o.e_ts_adhesion_j.abs() <= 1e-9 * o.e_ts_j, "{name}");
+                assert_eq!(o.e_ts_viscous_j > 0.0, viscosity.is_some(), "{name}");
+                eprintln!(
+                    "{name}: {} , {:.3} touches/period, E_cap {:.4} eV, E_visc {:.4} eV",
+                    o.regime,
+                    o.jumps_in,
+                    o.e_ts_capillary_j / 1.602176634e-19,
+                    o.e_ts_viscous_j / 1.602176634e-19
+                );
+            }
+        }
+    }
+}

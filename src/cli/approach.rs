@@ -35,7 +35,8 @@ pub struct ApproachArgs {
     no_retract: bool,
     /// Identification curves (García et al., PRL 97, 016103, 2006): add each
     /// mechanism's dissipation over its largest in the sweep (columns e_ts_norm,
-    /// e_ts_adhesion_norm, e_ts_viscous_norm; null for a mechanism that dissipates
+    /// e_ts_adhesion_norm, e_ts_viscous_norm, e_ts_capillary_norm; null for a mechanism
+    /// that dissipates
     /// nothing) and plot them against A/A₀ on the approach, first. Adhesion hysteresis
     /// steps up to a plateau once the loop is traversed; a viscous sample peaks inside.
     #[arg(long)]

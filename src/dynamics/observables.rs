@@ -46,6 +46,9 @@ pub struct TapObservables {
     /// The part of E_ts lost in a viscous sample (Kelvin–Voigt), from its carried
     /// integral ∮ T_d dα, in J; 0 for an elastic sample.
     pub e_ts_viscous_j: f64,
+    /// The part of E_ts lost to a capillary neck (formed and broken), from its share of
+    /// the branch work functions, in J; 0 without a neck.
+    pub e_ts_capillary_j: f64,
     /// Energy dissipated by the cantilever's damping per cycle in J.
     pub e_damp_j: f64,
     /// Energy put in by the drive per cycle in J.
@@ -121,6 +124,7 @@ impl TapObservables {
             ("e_ts_ev", self.e_ts_ev),
             ("e_ts_adhesion_j", self.e_ts_adhesion_j),
             ("e_ts_viscous_j", self.e_ts_viscous_j),
+            ("e_ts_capillary_j", self.e_ts_capillary_j),
             ("e_damp_j", self.e_damp_j),
             ("e_drive_j", self.e_drive_j),
             ("energy_balance_rel", self.energy_balance_rel),
@@ -190,8 +194,9 @@ impl TapObservables {
             phase_from_energy_deg,
             e_ts_j: c.e_ts_per_period() * energy,
             e_ts_ev: c.e_ts_per_period() * energy / ELECTRONVOLT_J,
-            e_ts_adhesion_j: (c.e_ts - c.e_viscous) / periods * energy,
+            e_ts_adhesion_j: (c.e_ts - c.e_viscous - c.e_capillary) / periods * energy,
             e_ts_viscous_j: c.e_viscous / periods * energy,
+            e_ts_capillary_j: c.e_capillary / periods * energy,
             e_damp_j: c.e_damp / periods * energy,
             e_drive_j: c.e_drive_per_period() * energy,
             energy_balance_rel: balance,

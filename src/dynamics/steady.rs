@@ -75,6 +75,9 @@ pub struct CycleIntegrals {
     /// The part of `e_ts` done against a rate-dependent force (a viscous sample's loss),
     /// from its carried integral; zero for an elastic law.
     pub e_viscous: f64,
+    /// The part of `e_ts` a capillary neck lost, from its share of the branch work
+    /// functions ([`ForceLaw::capillary_work_hat`]); zero without a neck.
+    pub e_capillary: f64,
     /// Energy dissipated by damping.
     pub e_damp: f64,
     /// Energy put in by the drive ([`Oscillator::drive_work`]).
@@ -131,6 +134,7 @@ impl CycleIntegrals {
             period: self.period + next.period,
             e_ts: self.e_ts + next.e_ts,
             e_viscous: self.e_viscous + next.e_viscous,
+            e_capillary: self.e_capillary + next.e_capillary,
             e_damp: self.e_damp + next.e_damp,
             e_drive: self.e_drive + next.e_drive,
             delta_mechanical: self.delta_mechanical + next.delta_mechanical,
@@ -451,7 +455,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let (mut contact_time, mut jumps_in, mut jumps_out) = (0.0, 0, 0);
         // E_ts = (RΔγ/(kL))/(L/(με)) ∫ T̂ dα̂ in units of kL².
         let work_scale = self.cpl.f_scale / self.cpl.a1;
-        let mut e_ts = 0.0;
+        let (mut e_ts, mut e_capillary) = (0.0, 0.0);
         let mut tau = phase.tau;
         let closed_form = self.law.free_branch_is_force_free();
         // Stop when the remaining time is round-off.
@@ -481,7 +485,9 @@ impl<L: ForceLaw> Simulation<'_, L> {
             let event = level.is_finite().then_some((level, crossing));
             let alpha_at =
                 |tau: f64, y: &State<N>| self.cpl.alpha_hat(y[X], self.osc.base_at(tau).0);
-            let work_start = self.law.work_hat(alpha_at(tau, &y), phase.branch);
+            let alpha_start = alpha_at(tau, &y);
+            let work_start = self.law.work_hat(alpha_start, phase.branch);
+            let capillary_start = self.law.capillary_work_hat(alpha_start, phase.branch);
             let end = numeric::integrate(
                 self.law,
                 &self.osc,
@@ -495,8 +501,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 &self.tol,
                 &mut tracker,
             )?;
-            e_ts += work_scale
-                * (self.law.work_hat(alpha_at(end.tau, &end.y), phase.branch) - work_start);
+            let alpha_end = alpha_at(end.tau, &end.y);
+            e_ts += work_scale * (self.law.work_hat(alpha_end, phase.branch) - work_start);
+            e_capillary += work_scale
+                * (self.law.capillary_work_hat(alpha_end, phase.branch) - capillary_start);
             if phase.branch == Branch::Contact {
                 contact_time += end.tau - tau;
             }
@@ -531,6 +539,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             period,
             e_ts,
             e_viscous,
+            e_capillary,
             e_damp: y[Carried::Damping],
             e_drive: self.osc.drive_work(
                 start,

@@ -8,6 +8,7 @@
 //! ways at the same separation; hysteretic laws enclose [`ForceLaw::loop_area_hat`].
 
 mod adhesive;
+mod capillary;
 mod conservative;
 mod fold_branch;
 mod registry;
@@ -15,9 +16,13 @@ mod table;
 mod viscous;
 
 pub use adhesive::AdhesiveLaw;
+pub use capillary::{Capillary, Neck};
 pub use conservative::{DmtLaw, HertzLaw, NoForce};
 pub use fold_branch::{FarField, FoldBranch, Side};
-pub use registry::{HAMAKER, LAW_PARAMS, LAWS, LawInfo, LawParam, LawSpec, VISCOSITY};
+pub use registry::{
+    CONTACT_ANGLE, HAMAKER, LAW_PARAMS, LAWS, LawInfo, LawParam, LawSpec, RUPTURE_DISTANCE,
+    SURFACE_TENSION, VISCOSITY,
+};
 pub use table::UniformTable;
 pub use viscous::KelvinVoigt;
 
@@ -75,6 +80,11 @@ pub trait ForceLaw: Send + Sync {
     fn free_branch_is_force_free(&self) -> bool;
     /// Area of the force loop, ∮ T̂ dα̂ over one full traversal (Ŵ; 0 if conservative).
     fn loop_area_hat(&self) -> f64;
+    /// The part of [`ForceLaw::work_hat`] that a capillary neck contributes (0 by
+    /// default), so its loss is told apart from the contact law's own hysteresis.
+    fn capillary_work_hat(&self, _alpha_hat: f64, _branch: Branch) -> f64 {
+        0.0
+    }
     /// Whether the force has a rate-dependent part (if not, the integrator never asks
     /// for it).
     fn is_rate_dependent(&self) -> bool {
@@ -177,6 +187,8 @@ pub enum AnyLaw {
     Hertz(HertzLaw),
     /// none.
     None(NoForce),
+    /// Any of the above with a capillary neck.
+    Capillary(Box<Capillary<AnyLaw>>),
     /// Any of the above with a Kelvin–Voigt viscous sample.
     Viscous(Box<KelvinVoigt<AnyLaw>>),
 }
@@ -218,6 +230,23 @@ impl AnyLaw {
             ),
             LawKind::None => AnyLaw::None(NoForce),
         };
+        let elastic = match spec.neck() {
+            Some(neck) => {
+                // The gap at contact: DMT's d = α + ε, Hertz's d = α.
+                let contact_gap_m = if kind == LawKind::Dmt {
+                    contact.range_m
+                } else {
+                    0.0
+                };
+                AnyLaw::Capillary(Box::new(Capillary::new(
+                    elastic,
+                    &neck,
+                    contact,
+                    contact_gap_m,
+                )?))
+            }
+            None => elastic,
+        };
         Ok(match spec.viscosity_pa_s {
             Some(eta) => AnyLaw::Viscous(Box::new(KelvinVoigt::new(
                 elastic,
@@ -238,6 +267,7 @@ macro_rules! dispatch {
             AnyLaw::Dmt($l) => $e,
             AnyLaw::Hertz($l) => $e,
             AnyLaw::None($l) => $e,
+            AnyLaw::Capillary($l) => $e,
             AnyLaw::Viscous($l) => $e,
         }
     };
@@ -266,6 +296,9 @@ impl ForceLaw for AnyLaw {
     }
     fn loop_area_hat(&self) -> f64 {
         dispatch!(self, l => l.loop_area_hat())
+    }
+    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        dispatch!(self, l => l.capillary_work_hat(alpha_hat, branch))
     }
     #[inline]
     fn is_rate_dependent(&self) -> bool {

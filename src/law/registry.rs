@@ -24,13 +24,15 @@ pub const LAWS: [LawInfo; 7] = [
         kind: LawKind::Hybrid,
         name: "hybrid",
         help: "the paper's hybrid law: force-free approach, jump-in at α̂_A of eq. (17), \
-               JKR contact branch (5), jump-out at α̂_C (8); loop area Ŵ_hybrid (18)",
+ \
+           JKR contact branch (5), jump-out at α̂_C (8); loop area Ŵ_hybrid (18)",
     },
     LawInfo {
         kind: LawKind::HybridAttractive,
         name: "hybrid-attractive",
         help: "the hybrid law with Greenwood's semi-rigid attraction (12), (14) on the \
-               approach branch, jumping in at that curve's own fold (15)",
+ \
+           approach branch, jumping in at that curve's own fold (15)",
     },
     LawInfo {
         kind: LawKind::Jkr,
@@ -41,7 +43,8 @@ pub const LAWS: [LawInfo; 7] = [
         kind: LawKind::Dmt,
         name: "dmt",
         help: "DMT as VEDA and dForce define it: −HR/(6d²) outside, Hertz plus constant \
-               adhesion inside, d = α + ε; conservative",
+ \
+           adhesion inside, d = α + ε; conservative",
     },
     LawInfo {
         kind: LawKind::Hertz,
@@ -52,7 +55,8 @@ pub const LAWS: [LawInfo; 7] = [
         kind: LawKind::Lj,
         name: "lj",
         help: "the Lennard-Jones law (10) tabulated from the full numerical solution: both \
-               branches, jumps at its folds A and C (first use per μ solves it)",
+ \
+           branches, jumps at its folds A and C (first use per μ solves it)",
     },
     LawInfo {
         kind: LawKind::None,
@@ -84,6 +88,7 @@ pub const HAMAKER: LawParam = LawParam {
     name: "Hamaker constant",
     unit: "J",
     help: "Hamaker constant for the dmt law [J or eV; default 12πε²Δγ, whose pull-off is \
+ \
            2πRΔγ]",
     taken_by: |law| law == LawKind::Dmt,
     range: (1e-22, 1e-17, "the range of real materials, about 1e-20 J"),
@@ -95,7 +100,9 @@ pub const VISCOSITY: LawParam = LawParam {
     name: "sample viscosity",
     unit: "Pa·s",
     help: "Kelvin–Voigt viscosity η of the sample, a force η√(Rδ)·dδ/dt against the \
+ \
            indentation rate added to the law (dForce's and pyDAMPF's form; e.g. 50Pa·s) \
+ \
            [Pa·s; default: none, elastic]",
     taken_by: |law| law != LawKind::None,
     range: (
@@ -105,8 +112,69 @@ pub const VISCOSITY: LawParam = LawParam {
     ),
 };
 
+/// Whether a law takes a capillary neck: one without hysteresis of its own.
+fn takes_a_neck(law: LawKind) -> bool {
+    matches!(law, LawKind::Hertz | LawKind::Dmt)
+}
+
+/// A capillary neck's rupture distance: giving it puts the neck on.
+pub const RUPTURE_DISTANCE: LawParam = LawParam {
+    key: "rupture-distance",
+    name: "capillary rupture distance",
+    unit: "m",
+    help: "capillary neck (VEDA's model, after Kober et al. 2008) on the hertz or dmt law: \
+           a meniscus forms at contact, pulls with 4πRγ cos θ, falling linearly to zero at \
+           this gap D₀ where it breaks, losing 2πRγ cos θ (D₀ − a₀) per cycle (e.g. 2nm) \
+           [m; default: none, no neck]",
+    taken_by: takes_a_neck,
+    range: (
+        1e-11,
+        1e-6,
+        "a water neck breaks within a few nm to tens of nm",
+    ),
+};
+
+/// A capillary neck's surface tension.
+pub const SURFACE_TENSION: LawParam = LawParam {
+    key: "surface-tension",
+    name: "surface tension",
+    unit: "J/m²",
+    help: "surface tension γ of the capillary neck's liquid [J/m² or N/m; default 0.072, \
+           water at 25 °C; only with a rupture distance]",
+    taken_by: takes_a_neck,
+    range: (
+        1e-3,
+        1.0,
+        "liquids from about 0.02 (alkanes) to 0.072 J/m² (water)",
+    ),
+};
+
+/// A capillary neck's contact angle.
+pub const CONTACT_ANGLE: LawParam = LawParam {
+    key: "contact-angle",
+    name: "contact angle",
+    unit: "deg",
+    help: "contact angle θ of the capillary neck's liquid on tip and sample [degrees, \
+           0 <= θ < 90; default 0, complete wetting; only with a rupture distance]",
+    taken_by: takes_a_neck,
+    range: (
+        0.0,
+        90.0,
+        "a meniscus pulls only for a wetting liquid, θ < 90°",
+    ),
+};
+
+/// Surface tension of water at 25 °C, J/m², the neck's default liquid.
+pub const WATER_SURFACE_TENSION_J_M2: f64 = 0.072;
+
 /// Every law parameter.
-pub const LAW_PARAMS: [&LawParam; 2] = [&HAMAKER, &VISCOSITY];
+pub const LAW_PARAMS: [&LawParam; 5] = [
+    &HAMAKER,
+    &VISCOSITY,
+    &RUPTURE_DISTANCE,
+    &SURFACE_TENSION,
+    &CONTACT_ANGLE,
+];
 
 /// A force law with its own parameters: what a setup asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -117,6 +185,15 @@ pub struct LawSpec {
     pub hamaker_j: Option<f64>,
     /// Kelvin–Voigt viscosity η of the sample in Pa·s (none: elastic).
     pub viscosity_pa_s: Option<f64>,
+    /// A capillary neck's rupture distance D₀ in m (none: no neck).
+    #[serde(default)]
+    pub rupture_distance_m: Option<f64>,
+    /// The neck's surface tension γ in J/m² (default water's).
+    #[serde(default)]
+    pub surface_tension_j_m2: Option<f64>,
+    /// The neck's contact angle θ in degrees (default 0).
+    #[serde(default)]
+    pub contact_angle_deg: Option<f64>,
 }
 
 impl From<LawKind> for LawSpec {
@@ -130,23 +207,47 @@ impl From<LawKind> for LawSpec {
 
 impl LawSpec {
     /// Each law parameter with its value in this spec (`None`: not set).
-    pub fn params(&self) -> [(&'static LawParam, Option<f64>); 2] {
+    pub fn params(&self) -> [(&'static LawParam, Option<f64>); 5] {
         [
             (&HAMAKER, self.hamaker_j),
             (&VISCOSITY, self.viscosity_pa_s),
+            (&RUPTURE_DISTANCE, self.rupture_distance_m),
+            (&SURFACE_TENSION, self.surface_tension_j_m2),
+            (&CONTACT_ANGLE, self.contact_angle_deg),
         ]
+    }
+
+    /// The capillary neck asked for, with the defaults filled in (none without a
+    /// rupture distance).
+    pub fn neck(&self) -> Option<super::Neck> {
+        Some(super::Neck {
+            rupture_distance_m: self.rupture_distance_m?,
+            surface_tension_j_m2: self
+                .surface_tension_j_m2
+                .unwrap_or(WATER_SURFACE_TENSION_J_M2),
+            contact_angle_deg: self.contact_angle_deg.unwrap_or(0.0),
+        })
     }
 
     /// The same parameters for law `kind`, leaving out those it does not take (a sweep
     /// over laws on one material).
     pub fn with_kind(&self, kind: LawKind) -> Self {
-        let [hamaker_j, viscosity_pa_s] = self
+        let [
+            hamaker_j,
+            viscosity_pa_s,
+            rupture_distance_m,
+            surface_tension_j_m2,
+            contact_angle_deg,
+        ] = self
             .params()
             .map(|(param, value)| value.filter(|_| (param.taken_by)(kind)));
         Self {
             kind,
             hamaker_j,
             viscosity_pa_s,
+            rupture_distance_m,
+            surface_tension_j_m2,
+            contact_angle_deg,
         }
     }
 
@@ -167,6 +268,15 @@ impl LawSpec {
                 )));
             }
         }
+        if self.rupture_distance_m.is_none()
+            && (self.surface_tension_j_m2.is_some() || self.contact_angle_deg.is_some())
+        {
+            return Err(Error::NotApplicable(
+                "a surface tension or contact angle describes a capillary neck: give its \
+                 rupture-distance too (which puts the neck on)"
+                    .into(),
+            ));
+        }
         Ok(())
     }
 }
@@ -175,6 +285,9 @@ impl fmt::Display for LawSpec {
     /// The law's name, with "+kelvin-voigt" for a viscous sample.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", self.kind)?;
+        if self.rupture_distance_m.is_some() {
+            f.write_str("+capillary")?;
+        }
         if self.viscosity_pa_s.is_some() {
             f.write_str("+kelvin-voigt")?;
         }

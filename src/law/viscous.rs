@@ -72,6 +72,9 @@ impl<L: ForceLaw> ForceLaw for KelvinVoigt<L> {
     fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         self.elastic.work_hat(alpha_hat, branch)
     }
+    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.elastic.capillary_work_hat(alpha_hat, branch)
+    }
     fn jump_in_alpha_hat(&self) -> f64 {
         self.elastic.jump_in_alpha_hat()
     }

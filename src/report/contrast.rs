@@ -27,7 +27,12 @@ pub fn contrast_csv(
     header.extend(materials.iter().map(|m| format!("phase_deg_{}", m.name)));
     header.extend(materials.iter().map(|m| format!("regime_{}", m.name)));
     header.push("delta_phase_deg".into());
-    for column in ["e_ts_j", "e_ts_adhesion_j", "e_ts_viscous_j"] {
+    for column in [
+        "e_ts_j",
+        "e_ts_adhesion_j",
+        "e_ts_viscous_j",
+        "e_ts_capillary_j",
+    ] {
         header.extend(materials.iter().map(|m| format!("{column}_{}", m.name)));
     }
     w.write_record(&header).map_err(|e| e.to_string())?;
@@ -43,7 +48,12 @@ pub fn contrast_csv(
         rec.extend(r.phase_deg.iter().map(|&p| cell(p)));
         rec.extend(r.regime.iter().map(|g| g.clone().unwrap_or_default()));
         rec.push(cell(r.delta_phase_deg));
-        for shares in [&r.e_ts_j, &r.e_ts_adhesion_j, &r.e_ts_viscous_j] {
+        for shares in [
+            &r.e_ts_j,
+            &r.e_ts_adhesion_j,
+            &r.e_ts_viscous_j,
+            &r.e_ts_capillary_j,
+        ] {
             rec.extend(shares.iter().map(|&e| cell(e)));
         }
         w.write_record(&rec).map_err(|e| e.to_string())?;

@@ -58,7 +58,7 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
         };
     let ratio = |p: &SweepPoint| p.observables.amplitude_ratio;
     // (file stem, caption, axis label, column, value); the first is A/A₀ itself.
-    let quantities: [(&str, &str, &str, &str, Pick); 6] = [
+    let quantities: [(&str, &str, &str, &str, Pick); 7] = [
         ("amplitude", "amplitude", "A/A₀", "amplitude_ratio", |p| {
             p.observables.amplitude_ratio
         }),
@@ -78,6 +78,13 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             "E_ts in the viscous sample per cycle (eV)",
             "e_ts_viscous_ev",
             |p| p.observables.e_ts_viscous_j / crate::params::ELECTRONVOLT_J,
+        ),
+        (
+            "e_ts_capillary",
+            "capillary dissipation",
+            "E_ts in the capillary neck per cycle (eV)",
+            "e_ts_capillary_ev",
+            |p| p.observables.e_ts_capillary_j / crate::params::ELECTRONVOLT_J,
         ),
         (
             "virial",

@@ -1,0 +1,249 @@
+//! A capillary neck on top of a contact law, as VEDA defines it (after Kober et al.,
+//! 2008): a meniscus forms when the tip touches the sample (gap d < a₀, the contact
+//! law's own contact separation: α = 0) and pulls with a force that falls linearly from
+//! its adhesion F_ad at contact to zero at the rupture distance D₀, where the neck
+//! breaks:
+//!
+//!   F_cap = F_ad for d < a₀,  F_ad (D₀ − d)/(D₀ − a₀) for a₀ ≤ d < D₀,  0 without a neck.
+//!
+//! VEDA parametrises the neck by the energy it loses per cycle, ΔE, with
+//! F_ad = 2ΔE(D₀ − a₀)/D₀²; tapsim by what sets that adhesion, the Laplace pressure of a
+//! water meniscus between a sphere and a flat: F_ad = 4πRγ cos θ (surface tension γ,
+//! contact angle θ). Not in the paper.
+//!
+//! In the contact's scales the neck pulls with T̂_cap = T̂_ad (1 − α̂/α̂_r) on
+//! 0 ≤ α̂ < α̂_r, T̂_ad below, with T̂_ad = 4πγ cos θ/Δγ and α̂_r = (D₀ − a₀)/(με). The
+//! neck is the law's contact branch: it forms at α̂ = 0 on the way down and breaks at
+//! α̂_r on the way up, so each cycle in which it forms and breaks loses the area
+//! ∫₀^{α̂_r} T̂_cap dα̂ = T̂_ad α̂_r / 2 in closed form. The contact law inside must itself
+//! be free of hysteresis (Hertz, DMT): a law with its own jump-in and jump-out and a neck
+//! that outlives the contact need a state each, which the two branches cannot hold.
+
+use super::{Branch, ContactState, ForceLaw};
+use crate::error::{Error, Result, positive};
+use crate::params::Contact;
+
+/// A contact law with a capillary neck.
+#[derive(Debug, Clone)]
+pub struct Capillary<L> {
+    elastic: L,
+    /// The neck's pull at contact, T̂_ad = 4πγ cos θ/Δγ.
+    adhesion_t_hat: f64,
+    /// Where the neck breaks, α̂_r = (D₀ − a₀)/(με).
+    rupture_alpha_hat: f64,
+}
+
+/// A capillary neck's parameters, in SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Neck {
+    /// Surface tension γ of the liquid, J/m².
+    pub surface_tension_j_m2: f64,
+    /// Contact angle θ of the liquid on tip and sample, degrees.
+    pub contact_angle_deg: f64,
+    /// Gap at which the neck breaks, D₀, in m (measured as the gap d; the contact law's
+    /// contact gap a₀ is subtracted).
+    pub rupture_distance_m: f64,
+}
+
+impl<L: ForceLaw> Capillary<L> {
+    /// `elastic` with the capillary `neck`, on `contact`, whose contact separation (gap)
+    /// is `contact_gap_m` (a₀: ε for DMT, 0 for Hertz).
+    pub fn new(elastic: L, neck: &Neck, contact: &Contact, contact_gap_m: f64) -> Result<Self> {
+        if elastic.loop_area_hat() != 0.0
+            || elastic.jump_in_alpha_hat() != 0.0
+            || elastic.jump_out_alpha_hat() != 0.0
+        {
+            return Err(Error::NotApplicable(
+                "a capillary neck goes on a contact law without hysteresis (hertz, dmt): \
+                 a law's own jump-in and jump-out and a neck that outlives the contact \
+                 would need a state each"
+                    .into(),
+            ));
+        }
+        positive("surface tension", neck.surface_tension_j_m2)?;
+        positive("rupture distance", neck.rupture_distance_m)?;
+        let theta = neck.contact_angle_deg;
+        if !(0.0..90.0).contains(&theta) {
+            return Err(Error::InvalidParameter {
+                name: "contact angle",
+                value: theta,
+                reason: "a meniscus pulls for 0 <= theta < 90 degrees (a wetting liquid)",
+            });
+        }
+        let open = neck.rupture_distance_m - contact_gap_m;
+        if open.is_nan() || open <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "rupture distance",
+                value: neck.rupture_distance_m,
+                reason: "the neck breaks beyond contact: the rupture distance exceeds the \
+                         contact gap a0 (the range for dmt, 0 for hertz)",
+            });
+        }
+        Ok(Self {
+            elastic,
+            adhesion_t_hat: 4.0
+                * std::f64::consts::PI
+                * neck.surface_tension_j_m2
+                * theta.to_radians().cos()
+                / contact.work_of_adhesion_j_m2,
+            rupture_alpha_hat: open / contact.separation_scale_m(),
+        })
+    }
+
+    /// T̂_ad, the neck's pull at contact.
+    pub fn adhesion_t_hat(&self) -> f64 {
+        self.adhesion_t_hat
+    }
+
+    /// α̂_r, where the neck breaks.
+    pub fn rupture_alpha_hat(&self) -> f64 {
+        self.rupture_alpha_hat
+    }
+
+    /// The neck's pull T̂_cap at α̂ while it holds.
+    #[inline]
+    fn neck_t_hat(&self, alpha_hat: f64) -> f64 {
+        self.adhesion_t_hat * (1.0 - alpha_hat.max(0.0) / self.rupture_alpha_hat)
+    }
+}
+
+impl<L: ForceLaw> ForceLaw for Capillary<L> {
+    #[inline]
+    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        let elastic = self.elastic.t_hat(alpha_hat, branch);
+        match branch {
+            Branch::Free => elastic,
+            Branch::Contact => elastic + self.neck_t_hat(alpha_hat),
+        }
+    }
+    #[inline]
+    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        let elastic = self.elastic.slope_hat(alpha_hat, branch);
+        match branch {
+            Branch::Contact if alpha_hat >= 0.0 => {
+                elastic - self.adhesion_t_hat / self.rupture_alpha_hat
+            }
+            _ => elastic,
+        }
+    }
+    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.elastic.work_hat(alpha_hat, branch) + self.capillary_work_hat(alpha_hat, branch)
+    }
+    fn jump_in_alpha_hat(&self) -> f64 {
+        0.0
+    }
+    fn jump_out_alpha_hat(&self) -> f64 {
+        self.rupture_alpha_hat
+    }
+    fn free_branch_is_force_free(&self) -> bool {
+        self.elastic.free_branch_is_force_free()
+    }
+    /// The neck's loop, T̂_ad α̂_r / 2.
+    fn loop_area_hat(&self) -> f64 {
+        0.5 * self.adhesion_t_hat * self.rupture_alpha_hat
+    }
+    /// ∫ T̂_cap dα̂ while the neck holds: T̂_ad α̂ below contact, T̂_ad (α̂ − α̂²/(2α̂_r))
+    /// above; nothing without a neck.
+    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        match branch {
+            Branch::Free => 0.0,
+            Branch::Contact if alpha_hat < 0.0 => self.adhesion_t_hat * alpha_hat,
+            Branch::Contact => {
+                self.adhesion_t_hat
+                    * (alpha_hat - 0.5 * alpha_hat * alpha_hat / self.rupture_alpha_hat)
+            }
+        }
+    }
+    fn is_rate_dependent(&self) -> bool {
+        self.elastic.is_rate_dependent()
+    }
+    fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
+        self.elastic.dissipative_t_hat(state)
+    }
+    fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
+        self.elastic.dissipative_slopes_hat(state)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::law::HertzLaw;
+
+    fn neck() -> Capillary<HertzLaw> {
+        let contact = crate::dynamics::setup::default_setup().contact;
+        let neck = Neck {
+            surface_tension_j_m2: 0.072,
+            contact_angle_deg: 30.0,
+            rupture_distance_m: 2e-9,
+        };
+        Capillary::new(HertzLaw, &neck, &contact, 0.0).unwrap()
+    }
+
+    #[test]
+    fn the_work_function_is_the_antiderivative_of_the_neck_and_gives_its_loop() {
+        let law = neck();
+        let h = 1e-6;
+        for alpha in [
+            -0.7,
+            -0.1,
+            0.2,
+            0.5 * law.rupture_alpha_hat(),
+            0.99 * law.rupture_alpha_hat(),
+        ] {
+            let dw = (law.work_hat(alpha + h, Branch::Contact)
+                - law.work_hat(alpha - h, Branch::Contact))
+                / (2.0 * h);
+            let t = law.t_hat(alpha, Branch::Contact);
+            assert!(
+                (dw - t).abs() < 1e-6 * t.abs().max(1.0),
+                "{alpha}: {dw} vs {t}"
+            );
+            let ds = (law.t_hat(alpha + h, Branch::Contact)
+                - law.t_hat(alpha - h, Branch::Contact))
+                / (2.0 * h);
+            let s = law.slope_hat(alpha, Branch::Contact);
+            assert!(
+                (ds - s).abs() < 1e-5 * s.abs().max(1.0),
+                "{alpha}: {ds} vs {s}"
+            );
+        }
+        // Formed at α̂ = 0, broken at α̂_r, nothing on the way down: the loop.
+        let r = law.rupture_alpha_hat();
+        let lost = law.work_hat(r, Branch::Contact) - law.work_hat(0.0, Branch::Contact);
+        assert!((lost - law.loop_area_hat()).abs() < 1e-14 * lost);
+        // And the neck lets go at zero force.
+        assert!(law.t_hat(r, Branch::Contact).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_neck_refuses_a_hysteretic_law_and_bad_parameters() {
+        let contact = crate::dynamics::setup::default_setup().contact;
+        let good = Neck {
+            surface_tension_j_m2: 0.072,
+            contact_angle_deg: 0.0,
+            rupture_distance_m: 2e-9,
+        };
+        let jkr = crate::law::AdhesiveLaw::jkr();
+        assert!(Capillary::new(jkr, &good, &contact, 0.0).is_err());
+        for bad in [
+            Neck {
+                contact_angle_deg: 95.0,
+                ..good
+            },
+            Neck {
+                surface_tension_j_m2: -1.0,
+                ..good
+            },
+            Neck {
+                rupture_distance_m: 0.1e-9,
+                ..good
+            },
+        ] {
+            assert!(
+                Capillary::new(HertzLaw, &bad, &contact, 0.3e-9).is_err(),
+                "{bad:?}"
+            );
+        }
+    }
+}
