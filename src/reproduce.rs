@@ -292,10 +292,15 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
     }
 
     // Identification curves: adhesion hysteresis (hybrid) against a viscous sample
-    // (Hertz + Kelvin–Voigt), polymer A.
+    // (Hertz + Kelvin–Voigt) and a capillary water neck (on Hertz), polymer A.
     progress("identification curves");
     let viscous = LawSpec {
         viscosity_pa_s: Some(IDENTIFICATION_VISCOSITY_PA_S),
+        ..LawKind::Hertz.into()
+    };
+    let neck = LawSpec {
+        rupture_distance_m: Some(1e-9),
+        contact_angle_deg: Some(60.0),
         ..LawKind::Hertz.into()
     };
     let mechanisms = [
@@ -306,6 +311,10 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         (
             "hertz + kelvin-voigt 10 Pa·s: viscous",
             approach(&setup, viscous, 40)?,
+        ),
+        (
+            "hertz + water neck (1 nm, 60°): capillary",
+            approach(&setup, neck, 40)?,
         ),
     ];
     let normalized: Vec<Vec<Normalized>> = mechanisms
@@ -329,8 +338,8 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         plot::render_stack(std::slice::from_ref(&chart), &path)?;
         add(
             vec![path],
-            "E_ts/E_max vs A/A0 on approach: adhesion hysteresis (hybrid) steps to a plateau, a \
-             viscous sample (hertz + kelvin-voigt) peaks inside",
+            "E_ts/E_max vs A/A0 on approach: adhesion hysteresis (hybrid) and a capillary \
+             neck step to a plateau, a viscous sample (hertz + kelvin-voigt) peaks inside",
             &mut entries,
         );
     }
@@ -345,6 +354,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
                 "e_ts_j": p.observables.e_ts_j,
                 "e_ts_adhesion_j": p.observables.e_ts_adhesion_j,
                 "e_ts_viscous_j": p.observables.e_ts_viscous_j,
+                "e_ts_capillary_j": p.observables.e_ts_capillary_j,
                 "e_ts_norm": n.e_ts_norm,
                 "regime": p.observables.regime,
             }));

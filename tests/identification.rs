@@ -133,3 +133,34 @@ fn a_viscous_sample_dissipates_most_at_an_intermediate_amplitude() {
     assert!(at > 0.5 && at < 0.9, "maximum at A/A0 {at}");
     assert!(first.1 < 0.5 && last.1 < 0.95, "{first:?} {last:?}");
 }
+
+/// A capillary neck, like adhesion hysteresis, loses a fixed loop per touch: its curve
+/// is the touches per period — a step to a plateau at 1 on every period-1 setpoint.
+#[test]
+fn a_capillary_neck_steps_to_a_plateau_too() {
+    let setup = TapSetup {
+        law: LawSpec {
+            rupture_distance_m: Some(1e-9),
+            contact_angle_deg: Some(60.0),
+            ..LawKind::Hertz.into()
+        },
+        ..default_setup()
+    };
+    let curve = approach(&setup, 0.4, 24);
+    let mut plateau = 0;
+    for (p, n) in &curve {
+        let o = &p.observables;
+        let e = n.of(Mechanism::Capillary).expect("the neck dissipates");
+        assert_eq!(n.of(Mechanism::All), Some(e), "one mechanism");
+        assert!(
+            (e - o.jumps_in).abs() < 1e-6,
+            "A/A0 {}: {e} vs {}",
+            o.amplitude_ratio,
+            o.jumps_in
+        );
+        if o.period == Some(1) && o.jumps_in > 0.0 {
+            plateau += 1;
+        }
+    }
+    assert!(plateau >= 10, "{plateau} period-1 touching setpoints");
+}

@@ -178,7 +178,10 @@ pub fn identification_chart(
                 (_, 2) => label.to_string(),
                 _ => format!("{label}: {}", mechanism.label()),
             };
-            series.extend(period_one_lines(&on, &name, Style::Line, color));
+            // Plateaus of different mechanisms coincide at 1: solid, dashed and dotted
+            // by turns, so none hides another.
+            let style = [Style::Line, Style::Dashed, Style::Dotted][(color - 1) % 3];
+            series.extend(period_one_lines(&on, &name, style, color));
             all.extend(on);
         }
     }
