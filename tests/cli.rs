@@ -21,6 +21,18 @@ fn succeeds(args: &[&str]) -> Output {
     out
 }
 
+/// Each command fails, and says what its needle says.
+fn refused(cases: &[(Vec<&str>, &str)]) {
+    for (args, needle) in cases {
+        let out = tapsim(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(needle),
+            "{args:?}: {err}"
+        );
+    }
+}
+
 /// Run `args` with the Lennard-Jones cache in `cache` (a test's own), asserting success.
 fn succeeds_with_cache(args: &[&str], cache: &std::path::Path) -> Output {
     let out = Command::new(env!("CARGO_BIN_EXE_tapsim"))
@@ -1194,7 +1206,7 @@ fn a_capillary_neck_is_a_law_parameter_checked_against_the_law() {
     .unwrap();
     let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
     assert_eq!(w["e_ts_j"], v["e_ts_j"]);
-    for (args, needle) in [
+    refused(&[
         (
             vec!["tap", "--law", "jkr", "--rupture-distance", "2nm"],
             "the jkr law takes no rupture-distance parameter (the laws that do: dmt, hertz)",
@@ -1219,14 +1231,7 @@ fn a_capillary_neck_is_a_law_parameter_checked_against_the_law() {
             vec!["tap", "--law", "dmt", "--rupture-distance", "0.2nm"],
             "the neck breaks beyond contact",
         ),
-    ] {
-        let out = tapsim(&args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            !out.status.success() && err.contains(needle),
-            "{args:?}: {err}"
-        );
-    }
+    ]);
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -1242,7 +1247,7 @@ fn a_viscous_sample_is_a_law_parameter_checked_against_the_law() {
     let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
     assert_eq!(w["e_ts_j"], v["e_ts_j"]);
     // A parameter the law does not take is refused, naming the laws that take it.
-    for (args, needle) in [
+    refused(&[
         (
             vec!["tap", "--law", "none", "--viscosity", "5"],
             "the none law takes no viscosity parameter",
@@ -1256,14 +1261,7 @@ fn a_viscous_sample_is_a_law_parameter_checked_against_the_law() {
             "sample viscosity = 1 GPa·s is outside",
         ),
         (vec!["tap", "--viscosity", "5kg"], "unknown unit"),
-    ] {
-        let out = tapsim(&args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            !out.status.success() && err.contains(needle),
-            "{args:?}: {err}"
-        );
-    }
+    ]);
     // `--law` lists every registered law with its help.
     let help = String::from_utf8_lossy(&tapsim(&["tap", "--help"]).stdout).to_string();
     for law in tapsim::law::LAWS {

@@ -191,22 +191,23 @@ mod tests {
             0.5 * law.rupture_alpha_hat(),
             0.99 * law.rupture_alpha_hat(),
         ] {
-            let dw = (law.work_hat(alpha + h, Branch::Contact)
-                - law.work_hat(alpha - h, Branch::Contact))
-                / (2.0 * h);
-            let t = law.t_hat(alpha, Branch::Contact);
-            assert!(
-                (dw - t).abs() < 1e-6 * t.abs().max(1.0),
-                "{alpha}: {dw} vs {t}"
-            );
-            let ds = (law.t_hat(alpha + h, Branch::Contact)
-                - law.t_hat(alpha - h, Branch::Contact))
-                / (2.0 * h);
-            let s = law.slope_hat(alpha, Branch::Contact);
-            assert!(
-                (ds - s).abs() < 1e-5 * s.abs().max(1.0),
-                "{alpha}: {ds} vs {s}"
-            );
+            // Each of work → force → slope is the derivative of the one before.
+            let derivative = |f: &dyn Fn(f64) -> f64| (f(alpha + h) - f(alpha - h)) / (2.0 * h);
+            let work = |a: f64| law.work_hat(a, Branch::Contact);
+            let force = |a: f64| law.t_hat(a, Branch::Contact);
+            for (numeric, exact, tolerance) in [
+                (derivative(&work), force(alpha), 1e-6),
+                (
+                    derivative(&force),
+                    law.slope_hat(alpha, Branch::Contact),
+                    1e-5,
+                ),
+            ] {
+                assert!(
+                    (numeric - exact).abs() < tolerance * exact.abs().max(1.0),
+                    "{alpha}: {numeric} vs {exact}"
+                );
+            }
         }
         // Formed at α̂ = 0, broken at α̂_r, nothing on the way down: the loop.
         let r = law.rupture_alpha_hat();
