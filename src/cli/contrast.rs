@@ -29,8 +29,9 @@ use clap::Args;
 ///
 /// JSON (--json): one object per law, setpoint and branch with law, materials,
 /// amplitude_ratio, branch, phase_deg, regime, converged, e_ts_j, e_ts_adhesion_j,
-/// e_ts_viscous_j and e_ts_capillary_j (one entry per material, null where it has no steady state on that
-/// branch; E_ts and its shares by mechanism interpolated at the setpoint as φ is) and
+/// e_ts_viscous_j and e_ts_capillary_j (one entry per material, null where it has no
+/// steady state on that branch; E_ts and its shares by mechanism interpolated at the
+/// setpoint as φ is) and
 /// delta_phase_deg. --csv has the same, a column per material. --plot: φ and E_ts (and
 /// a viscous sample's share) against A/A₀ per law, and Δφ against the setpoint.
 #[derive(Debug, Args)]

@@ -27,8 +27,9 @@ use std::path::PathBuf;
 /// (with standard errors), never one period of motion that is not period-1.
 ///
 /// JSON keys (--json): amplitude_m, amplitude_ratio, phase_deg, phase_from_energy_deg,
-/// e_ts_j, e_ts_ev, e_ts_adhesion_j and e_ts_viscous_j (E_ts by mechanism), e_damp_j,
-/// e_drive_j, energy_balance_rel, virial_j, mean_force_n, peak_force_n,
+/// e_ts_j, e_ts_ev, e_ts_adhesion_j, e_ts_viscous_j and e_ts_capillary_j (E_ts by
+/// mechanism), e_damp_j, e_drive_j, energy_balance_rel, virial_j, mean_force_n,
+/// peak_force_n,
 /// min_separation_m, contact_fraction, jumps_in, loop_area_j, tabor_mu, regime, period,
 /// periods_averaged, stable, floquet_multipliers, amplitude_std_err_m,
 /// phase_std_err_deg, e_ts_std_err_j, cycles, converged, harmonics (harmonics 2…10 of

@@ -91,10 +91,13 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
             o.e_ts_ev
         ),
     );
-    if o.e_ts_viscous_j != 0.0 {
+    if o.e_ts_viscous_j != 0.0 || o.e_ts_capillary_j != 0.0 {
         line(
-            "  of which adhesion, viscous",
-            format!("{:.4e} J, {:.4e} J", o.e_ts_adhesion_j, o.e_ts_viscous_j),
+            "  adhesion/viscous/capillary",
+            format!(
+                "{:.4e} J, {:.4e} J, {:.4e} J",
+                o.e_ts_adhesion_j, o.e_ts_viscous_j, o.e_ts_capillary_j
+            ),
         );
     }
     line("law's loop area", format!("{:.4e} J", o.loop_area_j));
