@@ -440,6 +440,24 @@ pub fn trace(spec: &MovingSpec, opts: &MovingOptions) -> Result<Curve> {
 }
 
 impl Tracer<'_> {
+    /// The stretch a of the mesh at continuation parameter `p` of `phase` (frozen at a₀
+    /// in the central gap).
+    fn mesh_a(&self, phase: Phase, p: f64) -> f64 {
+        match phase {
+            Phase::CentralGap => self.spec.a_start,
+            Phase::Radius => p,
+        }
+    }
+
+    /// The pinned (node, gap) at continuation parameter `p` of `phase`: node `pin_node`
+    /// at gap p in the central gap, the edge at the edge gap in the contact radius.
+    fn pin(&self, phase: Phase, p: f64, pin_node: usize) -> (usize, f64) {
+        match phase {
+            Phase::CentralGap => (pin_node, p),
+            Phase::Radius => (self.edge, self.spec.edge_gap),
+        }
+    }
+
     /// A point of the curve (arclength unset) from a solution on the mesh stretched by a.
     fn point(&self, sol: &Solution, a: f64) -> CurvePoint {
         CurvePoint {
@@ -533,7 +551,6 @@ impl Tracer<'_> {
     ) -> Result<Leg> {
         let spec = self.spec;
         let (a0, edge, tol) = (spec.a_start, self.edge, self.opts.tolerance);
-        let mesh_a = |p: f64| if phase == Phase::Radius { p } else { a0 };
         let mut leg = Leg {
             points: Vec::new(),
             along: Vec::new(),
@@ -542,16 +559,16 @@ impl Tracer<'_> {
             force_maxima: Vec::new(),
             complete: false,
         };
-        leg.push(self.point(&start, mesh_a(p_start)), phase, p_start);
+        leg.push(
+            self.point(&start, self.mesh_a(phase, p_start)),
+            phase,
+            p_start,
+        );
         // (parameter, solution) of the last few points.
         let mut history: VecDeque<(f64, Solution)> = VecDeque::from(vec![(p_start, start)]);
         // In the central gap the pinned node is the axis, unless its gap folds (stops
         // falling): then the node whose gap changes fastest, in the direction it changes.
         let (mut pin_node, mut direction) = (0usize, -1.0);
-        let pin = |p: f64, pin_node: usize| match phase {
-            Phase::CentralGap => (pin_node, p),
-            Phase::Radius => (edge, spec.edge_gap),
-        };
         let mut step = match phase {
             Phase::CentralGap => 0.05 * p_start,
             Phase::Radius => 0.01 * p_start,
@@ -585,8 +602,8 @@ impl Tracer<'_> {
             let guess = extrapolate(&history, p_next);
             let solved = self.problem.solve_pinned(
                 &guess,
-                mesh_a(p_next),
-                pin(p_next, pin_node),
+                self.mesh_a(phase, p_next),
+                self.pin(phase, p_next, pin_node),
                 tol,
                 &mut self.lu,
                 STEP_ITERATIONS,
@@ -621,7 +638,7 @@ impl Tracer<'_> {
                 }
                 continue;
             };
-            let q = self.point(&sol, mesh_a(p_next));
+            let q = self.point(&sol, self.mesh_a(phase, p_next));
             let chord = (q.alpha_hat - prev.alpha_hat).hypot(q.t_hat - prev.t_hat);
             let max_chord = chord_cap(self.opts, prev.alpha_hat);
             if chord > max_chord {
@@ -670,7 +687,7 @@ impl Tracer<'_> {
                 history.pop_front();
             }
             if history.len() == 3 {
-                self.locate_extrema(phase, pin(p_next, pin_node).0, &history, &mut leg);
+                self.locate_extrema(phase, pin_node, &history, &mut leg);
             }
             if at_end {
                 break Ok(());
@@ -709,15 +726,11 @@ impl Tracer<'_> {
         history: &VecDeque<(f64, Solution)>,
         leg: &mut Leg,
     ) {
-        let (mu, a0, edge) = (self.spec.tabor_mu, self.spec.a_start, self.edge);
-        let mesh_a = |p: f64| if phase == Phase::Radius { p } else { a0 };
+        let mu = self.spec.tabor_mu;
+        let mesh_a = |p: f64| self.mesh_a(phase, p);
         let solve = |p: f64, guess: &Solution| -> Result<Solution> {
-            let pin = match phase {
-                Phase::CentralGap => (pin_node, p),
-                Phase::Radius => (edge, self.spec.edge_gap),
-            };
+            let (pin, tol) = (self.pin(phase, p, pin_node), self.opts.tolerance);
             let mut lu = None;
-            let tol = self.opts.tolerance;
             let (sol, _) =
                 self.problem
                     .solve_pinned(guess, mesh_a(p), pin, tol, &mut lu, STEP_ITERATIONS)?;
