@@ -165,9 +165,7 @@ pub fn identification_chart(
             let on: Vec<Located> = points
                 .iter()
                 .zip(normalized.iter())
-                .filter(|(p, _)| {
-                    p.direction == Direction::Approach && p.observables.amplitude_ratio < 0.999
-                })
+                .filter(|(p, _)| touching_on_approach(p))
                 .filter_map(|(p, n)| {
                     let e = n.of(mechanism)?;
                     Some(locate(p, &|p| (p.observables.amplitude_ratio, e)))
@@ -221,10 +219,7 @@ pub fn vs_amplitude(
     let mut series = Vec::new();
     let mut others = Vec::new();
     for (i, (label, points)) in curves.iter().enumerate() {
-        let kept: Vec<&SweepPoint> = points
-            .iter()
-            .filter(|p| p.direction == Direction::Approach && p.observables.amplitude_ratio < 0.999)
-            .collect();
+        let kept: Vec<&SweepPoint> = points.iter().filter(|p| touching_on_approach(p)).collect();
         for (k, part) in split_at_jumps(&kept).into_iter().enumerate() {
             let on: Vec<Located> = part.iter().map(|p| locate(p, &xy)).collect();
             series.extend(period_one_lines(
@@ -246,6 +241,12 @@ pub fn vs_amplitude(
         series,
         labels: vec![],
     }
+}
+
+/// Whether a setpoint is on the approach and not free (A/A₀ < 0.999): what the views
+/// against A/A₀ show.
+fn touching_on_approach(p: &SweepPoint) -> bool {
+    p.direction == Direction::Approach && p.observables.amplitude_ratio < 0.999
 }
 
 /// A value to plot and the period of the motion behind it (`None`: irregular).
