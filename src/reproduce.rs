@@ -69,6 +69,25 @@ fn approach(setup: &TapSetup, law: impl Into<LawSpec>, points: usize) -> Result<
     sweep::approach_curve(&setup, &numerics, &ramp, |_, _| {})
 }
 
+/// `charts` stacked into `stem`.png and `stem`.svg in `out`; the two paths.
+fn render_stack(out: &Path, stem: &str, charts: &[Chart]) -> Result<Vec<PathBuf>> {
+    ["png", "svg"]
+        .into_iter()
+        .map(|ext| {
+            let path = out.join(format!("{stem}.{ext}"));
+            plot::render_stack(charts, &path)?;
+            Ok(path)
+        })
+        .collect()
+}
+
+/// `records` as CSV into `stem`.csv in `out`; its path.
+fn write_records<T: serde::Serialize>(out: &Path, stem: &str, records: &[T]) -> Result<PathBuf> {
+    let path = out.join(format!("{stem}.csv"));
+    output::write_bytes(&path, &records::records_csv(records)?)?;
+    Ok(path)
+}
+
 /// The first line of the generated README.md, which marks a directory as ours.
 const README_TITLE: &str = "# tapsim results";
 
@@ -140,15 +159,11 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
     let setup = default_setup();
     let run = tap(&setup, &Numerics::default(), Observe::recording(3))?;
     let charts = tap_report::trajectory_charts(&run, "hybrid law, defaults");
-    for ext in ["png", "svg"] {
-        let path = out.join(format!("tap_trajectory.{ext}"));
-        plot::render_stack(&charts, &path)?;
-        add(
-            vec![path],
-            "default tap (hybrid law): deflection, force, force-separation loop",
-            &mut entries,
-        );
-    }
+    add(
+        render_stack(out, "tap_trajectory", &charts)?,
+        "default tap (hybrid law): deflection, force, force-separation loop",
+        &mut entries,
+    );
     let path = out.join("tap_trajectory.csv");
     output::write_bytes(&path, &tap_report::trajectory_csv(&run.trajectory)?)?;
     add(vec![path], "default tap: trajectory samples", &mut entries);
@@ -233,15 +248,11 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
     for chart in &mut approach_charts {
         chart.legend = Corner::quietest(&chart.series);
     }
-    for ext in ["png", "svg"] {
-        let path = out.join(format!("tap_approach_laws.{ext}"));
-        plot::render_stack(&approach_charts, &path)?;
-        add(
-            vec![path],
-            "approach-retract curves for the jkr, hybrid and lj laws (polymer A)",
-            &mut entries,
-        );
-    }
+    add(
+        render_stack(out, "tap_approach_laws", &approach_charts)?,
+        "approach-retract curves for the jkr, hybrid and lj laws (polymer A)",
+        &mut entries,
+    );
     let mut records = Vec::new();
     for (material, law, pts) in &curves {
         for p in pts {
@@ -258,10 +269,8 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
             }));
         }
     }
-    let path = out.join("tap_approach_laws.csv");
-    output::write_bytes(&path, &records::records_csv(&records)?)?;
     add(
-        vec![path],
+        vec![write_records(out, "tap_approach_laws", &records)?],
         "approach-retract curves, both polymers, all three laws",
         &mut entries,
     );
@@ -281,15 +290,11 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
             )
         })
         .collect();
-    for ext in ["png", "svg"] {
-        let path = out.join(format!("tap_phase_contrast.{ext}"));
-        plot::render_stack(&contrast, &path)?;
-        add(
-            vec![path],
-            "phase vs A/A0 for polymers A and B under the jkr, hybrid and lj laws",
-            &mut entries,
-        );
-    }
+    add(
+        render_stack(out, "tap_phase_contrast", &contrast)?,
+        "phase vs A/A0 for polymers A and B under the jkr, hybrid and lj laws",
+        &mut entries,
+    );
 
     // Identification curves: adhesion hysteresis (hybrid) against a viscous sample
     // (Hertz + Kelvin–Voigt) and a capillary water neck (on Hertz), polymer A.
@@ -333,16 +338,12 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         "Identification curves (approach, polymer A)",
         &curves,
     );
-    for ext in ["png", "svg"] {
-        let path = out.join(format!("tap_identification.{ext}"));
-        plot::render_stack(std::slice::from_ref(&chart), &path)?;
-        add(
-            vec![path],
-            "E_ts/E_max vs A/A0 on approach: adhesion hysteresis (hybrid) and a capillary \
+    add(
+        render_stack(out, "tap_identification", std::slice::from_ref(&chart))?,
+        "E_ts/E_max vs A/A0 on approach: adhesion hysteresis (hybrid) and a capillary \
              neck step to a plateau, a viscous sample (hertz + kelvin-voigt) peaks inside",
-            &mut entries,
-        );
-    }
+        &mut entries,
+    );
     let mut records = Vec::new();
     for ((law, points), n) in mechanisms.iter().zip(&normalized) {
         for (p, n) in points.iter().zip(n) {
@@ -360,10 +361,8 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
             }));
         }
     }
-    let path = out.join("tap_identification.csv");
-    output::write_bytes(&path, &records::records_csv(&records)?)?;
     add(
-        vec![path],
+        vec![write_records(out, "tap_identification", &records)?],
         "identification curves: each setpoint's dissipation by mechanism, normalized",
         &mut entries,
     );
