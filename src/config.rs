@@ -43,6 +43,8 @@ unit_parser!(/// An energy (J or eV).
     energy, "energy", Dimension::Energy);
 unit_parser!(/// A viscosity (Pa·s).
     viscosity, "viscosity", Dimension::Viscosity);
+unit_parser!(/// A time (s).
+    time, "time", Dimension::Time);
 unit_parser!(/// A plain number.
     number, "value", Dimension::Dimensionless);
 
@@ -204,6 +206,14 @@ pub struct TapInputs {
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)",
           help = crate::law::CONTACT_ANGLE.help)]
     pub contact_angle: Option<f64>,
+    /// A law parameter ([`crate::law::UNRELAXED_MODULUS`]; its help is the registry's).
+    #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)",
+          help = crate::law::UNRELAXED_MODULUS.help)]
+    pub unrelaxed_modulus: Option<f64>,
+    /// A law parameter ([`crate::law::RELAXATION_TIME`]; its help is the registry's).
+    #[arg(long, allow_hyphen_values = true, value_parser = time, help_heading = "Contact (SI)",
+          help = crate::law::RELAXATION_TIME.help)]
+    pub relaxation_time: Option<f64>,
     /// Cantilever spring constant k [N/m; default 40].
     #[arg(long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Cantilever")]
     pub stiffness: Option<f64>,
@@ -311,6 +321,8 @@ const FIELDS: &[Field] = fields![
     "rupture-distance" => Length => |i| i.rupture_distance,
     "surface-tension" => SurfaceEnergy => |i| i.surface_tension,
     "contact-angle" => Dimensionless => |i| i.contact_angle,
+    "unrelaxed-modulus" => Pressure => |i| i.unrelaxed_modulus,
+    "relaxation-time" => Time => |i| i.relaxation_time,
     "stiffness" => Stiffness => |i| i.stiffness,
     "resonance" => Frequency => |i| i.resonance,
     "quality" => Dimensionless => |i| i.quality,
@@ -409,6 +421,8 @@ impl TapInputs {
             rupture_distance: self.rupture_distance.or(base.rupture_distance),
             surface_tension: self.surface_tension.or(base.surface_tension),
             contact_angle: self.contact_angle.or(base.contact_angle),
+            unrelaxed_modulus: self.unrelaxed_modulus.or(base.unrelaxed_modulus),
+            relaxation_time: self.relaxation_time.or(base.relaxation_time),
             stiffness: self.stiffness.or(base.stiffness),
             resonance: self.resonance.or(base.resonance),
             quality: self.quality.or(base.quality),
@@ -470,6 +484,8 @@ impl TapInputs {
                 rupture_distance_m: self.rupture_distance.or(d.law.rupture_distance_m),
                 surface_tension_j_m2: self.surface_tension.or(d.law.surface_tension_j_m2),
                 contact_angle_deg: self.contact_angle.or(d.law.contact_angle_deg),
+                unrelaxed_modulus_pa: self.unrelaxed_modulus.or(d.law.unrelaxed_modulus_pa),
+                relaxation_time_s: self.relaxation_time.or(d.law.relaxation_time_s),
             },
         };
         let mut numerics = Numerics::default();

@@ -21,6 +21,8 @@ pub enum Dimension {
     Energy,
     /// Pascal seconds (written Pa·s, Pa*s, Pa s or Pas).
     Viscosity,
+    /// Seconds.
+    Time,
     /// A plain number.
     Dimensionless,
 }
@@ -35,6 +37,7 @@ impl Dimension {
             Dimension::Frequency => &[("Hz", 1.0)],
             Dimension::Energy => &[("J", 1.0), ("eV", crate::params::ELECTRONVOLT_J)],
             Dimension::Viscosity => &[("Pa·s", 1.0), ("Pa*s", 1.0), ("Pa s", 1.0), ("Pas", 1.0)],
+            Dimension::Time => &[("s", 1.0)],
             Dimension::Dimensionless => &[],
         }
     }
@@ -138,6 +141,17 @@ mod tests {
             parse("w", "1.5eV", Dimension::Energy).unwrap(),
             1.5 * crate::params::ELECTRONVOLT_J
         ));
+        for (text, seconds) in [
+            ("1us", 1e-6),
+            ("2.5 ns", 2.5e-9),
+            ("3ms", 3e-3),
+            ("1e-7", 1e-7),
+        ] {
+            assert!(
+                close(parse("t", text, Dimension::Time).unwrap(), seconds),
+                "{text}"
+            );
+        }
         for text in ["50Pa·s", "50 Pa*s", "0.05 kPa s", "50000mPas"] {
             assert!(
                 close(parse("eta", text, Dimension::Viscosity).unwrap(), 50.0),

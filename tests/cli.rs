@@ -1236,6 +1236,96 @@ fn a_capillary_neck_is_a_law_parameter_checked_against_the_law() {
 }
 
 #[test]
+fn a_relaxing_sample_is_a_law_parameter_checked_against_the_law() {
+    // Flag and parameter file alike; the law's name says the sample relaxes.
+    let args = [
+        "tap",
+        "--law",
+        "hertz",
+        "--unrelaxed-modulus",
+        "1.8GPa",
+        "--relaxation-time",
+        "100ns",
+        "--json",
+    ];
+    let v = json(&args);
+    assert_eq!(v["law"], "hertz+sls");
+    assert_eq!(v["e_ts_viscous_j"], v["e_ts_j"]);
+    assert!(num(&v, "e_ts_j") > 0.0 && num(&v, "energy_balance_rel") < 1e-6);
+    // Its Floquet multipliers: one per dimension of the section state (x, x', memory).
+    assert_eq!(
+        v["floquet_multipliers"].as_array().map(Vec::len),
+        Some(3),
+        "{v}"
+    );
+    let dir = scratch("relaxing-config");
+    let cfg = dir.join("sample.toml");
+    std::fs::write(
+        &cfg,
+        "law = \"hertz\"\nunrelaxed-modulus = \"1.8GPa\"\nrelaxation-time = \"100ns\"\n",
+    )
+    .unwrap();
+    let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
+    assert_eq!(w["e_ts_j"], v["e_ts_j"]);
+    std::fs::remove_dir_all(dir).unwrap();
+    let sls = |extra: &[&'static str]| {
+        let mut a = vec!["tap", "--law", "hertz"];
+        a.extend_from_slice(extra);
+        a
+    };
+    refused(&[
+        (
+            vec![
+                "tap",
+                "--law",
+                "jkr",
+                "--unrelaxed-modulus",
+                "3GPa",
+                "--relaxation-time",
+                "1us",
+            ],
+            "the jkr law takes no unrelaxed-modulus parameter (the laws that do: dmt, hertz)",
+        ),
+        (sls(&["--relaxation-time", "1us"]), "needs both"),
+        (sls(&["--unrelaxed-modulus", "3GPa"]), "needs both"),
+        (
+            sls(&[
+                "--unrelaxed-modulus",
+                "3GPa",
+                "--relaxation-time",
+                "1us",
+                "--viscosity",
+                "5",
+            ]),
+            "takes no viscosity",
+        ),
+        (
+            sls(&[
+                "--unrelaxed-modulus",
+                "3GPa",
+                "--relaxation-time",
+                "1us",
+                "--rupture-distance",
+                "2nm",
+            ]),
+            "takes no capillary neck",
+        ),
+        (
+            sls(&["--unrelaxed-modulus", "0.3GPa", "--relaxation-time", "1us"]),
+            "must exceed the relaxed one",
+        ),
+        (
+            sls(&["--unrelaxed-modulus", "3GPa", "--relaxation-time", "10s"]),
+            "relaxation time = 10 s is outside",
+        ),
+        (
+            sls(&["--unrelaxed-modulus", "3GPa", "--relaxation-time", "1kg"]),
+            "unknown unit",
+        ),
+    ]);
+}
+
+#[test]
 fn a_viscous_sample_is_a_law_parameter_checked_against_the_law() {
     // Flag and parameter file alike; the law's name says the sample is viscous.
     let v = json(&["tap", "--law", "hertz", "--viscosity", "50 Pa·s", "--json"]);

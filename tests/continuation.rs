@@ -5,6 +5,7 @@ use nalgebra::Complex;
 use tapsim::dynamics::continuation::{Branch, ContinuationOptions, PointKind, follow_period_one};
 use tapsim::dynamics::numeric::Ignore;
 use tapsim::dynamics::setup::{Numerics, Prepared, TapSetup, default_setup};
+use tapsim::dynamics::steady::Multipliers;
 use tapsim::law::LawKind;
 use tapsim::sweep::{self, Direction};
 
@@ -39,7 +40,7 @@ fn bistable_dmt() -> TapSetup {
     setup
 }
 
-fn near(m: &[Complex<f64>; 2], target: f64) -> f64 {
+fn near(m: &Multipliers, target: f64) -> f64 {
     m.iter()
         .map(|l| (l - Complex::new(target, 0.0)).norm())
         .fold(f64::INFINITY, f64::min)

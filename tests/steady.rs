@@ -260,12 +260,17 @@ fn no_value_is_one_period_of_motion_that_is_not_period_one() {
 fn the_period_map_derivative_matches_finite_differences_across_switches() {
     use tapsim::dynamics::numeric::Ignore;
     use tapsim::dynamics::setup::Prepared;
-    use tapsim::dynamics::steady::Phase;
     // In contact for part of the period, with the force jumping at both switches
     // (hybrid, jkr), continuous (dmt, hertz), or tabulated with an attractive approach.
     // And with a viscous sample: a force that depends on the velocity too.
     let viscous = |kind: LawKind| tapsim::law::LawSpec {
         viscosity_pa_s: Some(20.0),
+        ..kind.into()
+    };
+    // And a relaxing sample, whose internal state is part of the section state.
+    let relaxing = |kind: LawKind| tapsim::law::LawSpec {
+        unrelaxed_modulus_pa: Some(2e9),
+        relaxation_time_s: Some(0.3e-6),
         ..kind.into()
     };
     for (law, z_nm) in [
@@ -276,6 +281,8 @@ fn the_period_map_derivative_matches_finite_differences_across_switches() {
         (LawKind::Hertz.into(), 14.0),
         (viscous(LawKind::Hertz), 14.0),
         (viscous(LawKind::Hybrid), 14.0),
+        (relaxing(LawKind::Hertz), 14.0),
+        (relaxing(LawKind::Dmt), 14.0),
     ] {
         let setup = TapSetup {
             law,
@@ -293,31 +300,41 @@ fn the_period_map_derivative_matches_finite_differences_across_switches() {
         sim.steady_state(&mut start, &p.steady).unwrap();
         let (c, d) = sim.cycle_with_derivative(&mut start.clone()).unwrap();
         assert!(c.jumps_in >= 1, "{law}: the period must touch");
-        let map = |dx: f64, dv: f64, dq: f64| {
+        let dim = sim.section_dim();
+        assert_eq!(d.shape(), (dim, dim + 1), "{law}");
+        // The map in the section's own units (Simulation::z), q last.
+        let z0 = sim.z(&start);
+        let map = |dz: &[f64]| {
             let mut s = sim;
-            s.cpl.a0 += dq * s.cpl.a1;
-            let mut ph = Phase {
-                x: start.x + dx,
-                v: start.v + dv,
-                ..start
-            };
+            s.cpl.a0 += dz[dim] * s.cpl.a1;
+            let z = z0.clone() + nalgebra::DVector::from_column_slice(&dz[..dim]);
+            let mut ph = sim.at_z(&start, &z);
             s.cycle(&mut ph, &mut Ignore).unwrap();
-            (ph.x, ph.v)
+            sim.z(&ph)
         };
+        // The derivative in the section's units: the internal rows and columns scaled.
+        let mut exact = d.clone();
+        for row in 2..dim {
+            for col in 0..=dim {
+                exact[(row, col)] *= sim.cpl.f_scale;
+                if col < dim {
+                    exact[(col, row)] /= sim.cpl.f_scale;
+                }
+            }
+        }
         let h = 1e-6;
-        for (col, (dx, dv, dq)) in [(h, 0.0, 0.0), (0.0, h, 0.0), (0.0, 0.0, h)]
-            .into_iter()
-            .enumerate()
-        {
-            let (xp, vp) = map(dx, dv, dq);
-            let (xm, vm) = map(-dx, -dv, -dq);
-            let fd = [(xp - xm) / (2.0 * h), (vp - vm) / (2.0 * h)];
-            for row in 0..2 {
-                let exact = d[(row, col)];
+        for col in 0..=dim {
+            let mut dz = vec![0.0; dim + 1];
+            dz[col] = h;
+            let plus = map(&dz);
+            dz[col] = -h;
+            let minus = map(&dz);
+            for row in 0..dim {
+                let fd = (plus[row] - minus[row]) / (2.0 * h);
                 assert!(
-                    (exact - fd[row]).abs() < 1e-5 * (1.0 + fd[row].abs()),
-                    "{law}: d[{row}, {col}] = {exact} vs finite differences {}",
-                    fd[row]
+                    (exact[(row, col)] - fd).abs() < 1e-5 * (1.0 + fd.abs()),
+                    "{law}: d[{row}, {col}] = {} vs finite differences {fd}",
+                    exact[(row, col)]
                 );
             }
         }

@@ -1,8 +1,9 @@
 //! The period-1 orbit family followed through the rest separation by pseudo-arclength
 //! continuation of the shooting equations.
 //!
-//! Unknowns u = (x, x', q): the state at the drive phase and the rest separation
-//! q = z_c/L. The equations P(x, x'; q) − (x, x') = 0 have the Jacobian [M − I | ∂P/∂q],
+//! Unknowns u = (z, q): the section state at the drive phase (x, x' and a law's
+//! internal state, [`Simulation::z`]) and the rest separation q = z_c/L. The equations
+//! P(z; q) − z = 0 have the Jacobian [M − I | ∂P/∂q],
 //! exact from the variational equations ([`Simulation::cycle_with_derivative`]); its null
 //! vector is the branch's tangent, so the family is followed through its folds, stable
 //! and unstable parts alike. Each new point is predicted along the tangent and corrected
@@ -15,10 +16,10 @@
 //! an orbit grazes a switch (it just starts to touch, or a hysteretic law's tip stalls at
 //! a fold) it is not, and the continuation may stop there; [`Stop`] says why.
 
-use super::steady::{CycleIntegrals, Phase, Simulation, eigenvalues};
+use super::steady::{CycleIntegrals, Multipliers, Phase, Simulation, eigenvalues};
 use crate::error::{Error, Result};
 use crate::law::ForceLaw;
-use nalgebra::{Complex, Matrix2, Matrix3, Vector2, Vector3};
+use nalgebra::{Complex, DMatrix, DVector, Vector3};
 
 /// Settings of a continuation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,13 +69,13 @@ pub struct BranchPoint {
     /// The integrals over the orbit's period.
     pub integrals: CycleIntegrals,
     /// Floquet multipliers.
-    pub multipliers: [Complex<f64>; 2],
+    pub multipliers: Multipliers,
     /// What the point is.
     pub kind: PointKind,
 }
 
 impl BranchPoint {
-    /// Whether the orbit is stable (both multipliers inside the unit circle).
+    /// Whether the orbit is stable (every multiplier inside the unit circle).
     pub fn stable(&self) -> bool {
         self.multipliers.iter().all(|m| m.norm() < 1.0)
     }
@@ -104,41 +105,71 @@ pub struct Branch {
 }
 
 /// A point of the unknowns with its evaluation.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 struct Solved {
-    u: Vector3<f64>,
+    /// (z, q).
+    u: DVector<f64>,
     phase: Phase,
     integrals: CycleIntegrals,
     /// [M − I | ∂P/∂q] at u.
-    jacobian: nalgebra::Matrix2x3<f64>,
+    jacobian: DMatrix<f64>,
 }
 
 impl Solved {
-    fn monodromy(&self) -> Matrix2<f64> {
-        self.jacobian.fixed_columns::<2>(0) + Matrix2::identity()
+    /// Dimension of the section state.
+    fn dim(&self) -> usize {
+        self.jacobian.nrows()
     }
 
-    /// The unit null vector of the Jacobian: the cross product of its rows.
-    fn tangent(&self, along: &Vector3<f64>) -> Vector3<f64> {
-        let r0 = self.jacobian.row(0).transpose();
-        let r1 = self.jacobian.row(1).transpose();
-        let t = r0.cross(&r1);
-        let t = t / t.norm();
-        if t.dot(along) < 0.0 { -t } else { t }
+    /// q.
+    fn q(&self) -> f64 {
+        self.u[self.dim()]
+    }
+
+    fn monodromy(&self) -> DMatrix<f64> {
+        let d = self.dim();
+        self.jacobian.columns(0, d) + DMatrix::identity(d, d)
+    }
+
+    /// The unit null vector of the Jacobian, pointing the way of `along`: for a section
+    /// of (x, x') the cross product of its two rows, otherwise the solution of the
+    /// Jacobian bordered by `along`.
+    fn tangent(&self, along: &DVector<f64>) -> Option<DVector<f64>> {
+        let t = if self.dim() == 2 {
+            let row = |i: usize| {
+                Vector3::new(
+                    self.jacobian[(i, 0)],
+                    self.jacobian[(i, 1)],
+                    self.jacobian[(i, 2)],
+                )
+            };
+            let t = row(0).cross(&row(1));
+            DVector::from_column_slice((t / t.norm()).as_slice())
+        } else {
+            let d = self.dim();
+            let mut bordered = self.jacobian.clone().insert_row(d, 0.0);
+            bordered.row_mut(d).copy_from(&along.transpose());
+            let mut e = DVector::zeros(d + 1);
+            e[d] = 1.0;
+            let t = bordered.lu().solve(&e)?;
+            &t / t.norm()
+        };
+        if !t.iter().all(|c| c.is_finite()) {
+            return None;
+        }
+        Some(if t.dot(along) < 0.0 { -t } else { t })
     }
 
     /// det(M − I) and det(M + I).
     fn tests(&self) -> [f64; 2] {
         let m = self.monodromy();
-        [
-            (m - Matrix2::identity()).determinant(),
-            (m + Matrix2::identity()).determinant(),
-        ]
+        let one = DMatrix::identity(self.dim(), self.dim());
+        [(&m - &one).determinant(), (&m + &one).determinant()]
     }
 
     fn point(&self, kind: PointKind) -> BranchPoint {
         BranchPoint {
-            q: self.u[2],
+            q: self.q(),
             phase: self.phase,
             integrals: self.integrals,
             multipliers: eigenvalues(&self.monodromy()),
@@ -157,26 +188,26 @@ impl<L: ForceLaw> Follower<'_, '_, L> {
     /// The period map at u from the section `at` (its drive phase and branch): its
     /// residual P − z and Jacobian. `None` where it cannot be evaluated (the orbit comes
     /// back on another branch, or stalls at a fold).
-    fn evaluate(&self, at: &Phase, u: &Vector3<f64>) -> Result<Option<(Vector2<f64>, Solved)>> {
+    fn evaluate(&self, at: &Phase, u: &DVector<f64>) -> Result<Option<(DVector<f64>, Solved)>> {
+        let d = u.len() - 1;
         let mut sim = *self.sim;
-        sim.cpl.a0 = u[2] * sim.cpl.a1;
-        let z = Vector2::new(u[0], u[1]);
+        sim.cpl.a0 = u[d] * sim.cpl.a1;
+        let z = u.rows(0, d).into_owned();
         let mut spent = 0;
-        let Some(value) = sim.period_map(at, z, 1, &mut spent)? else {
+        let Some(value) = sim.period_map(at, &z, 1, &mut spent)? else {
             return Ok(None);
         };
         let mut jacobian = value.derivative;
-        jacobian[(0, 0)] -= 1.0;
-        jacobian[(1, 1)] -= 1.0;
-        let residual = Vector2::new(value.end.x - u[0], value.end.v - u[1]);
+        for i in 0..d {
+            jacobian[(i, i)] -= 1.0;
+        }
+        let residual = sim.z(&value.end) - &z;
         let phase = Phase {
             tau: at.tau,
-            x: u[0],
-            v: u[1],
-            ..value.end
+            ..sim.at_z(&value.end, &z)
         };
         let solved = Solved {
-            u: *u,
+            u: u.clone(),
             phase,
             integrals: value.integrals,
             jacobian,
@@ -189,8 +220,8 @@ impl<L: ForceLaw> Follower<'_, '_, L> {
     fn correct(
         &self,
         from: &Phase,
-        anchor: Vector3<f64>,
-        t: &Vector3<f64>,
+        anchor: DVector<f64>,
+        t: &DVector<f64>,
     ) -> Result<Option<Solved>> {
         super::budget::budgeted(super::budget::STEPS, || {
             self.correct_within_budget(from, anchor, t)
@@ -200,10 +231,10 @@ impl<L: ForceLaw> Follower<'_, '_, L> {
     fn correct_within_budget(
         &self,
         from: &Phase,
-        anchor: Vector3<f64>,
-        t: &Vector3<f64>,
+        anchor: DVector<f64>,
+        t: &DVector<f64>,
     ) -> Result<Option<Solved>> {
-        let mut u = anchor;
+        let mut u = anchor.clone();
         for _ in 0..8 {
             let Some((r, solved)) = self.evaluate(from, &u)? else {
                 return Ok(None);
@@ -211,19 +242,16 @@ impl<L: ForceLaw> Follower<'_, '_, L> {
             if r.amax() <= self.tolerance {
                 return Ok(Some(solved));
             }
-            let j = solved.jacobian;
-            let system = Matrix3::new(
-                j[(0, 0)],
-                j[(0, 1)],
-                j[(0, 2)],
-                j[(1, 0)],
-                j[(1, 1)],
-                j[(1, 2)],
-                t[0],
-                t[1],
-                t[2],
-            );
-            let rhs = Vector3::new(-r[0], -r[1], -t.dot(&(u - anchor)));
+            let d = r.len();
+            let mut system = solved.jacobian.insert_row(d, 0.0);
+            system.row_mut(d).copy_from(&t.transpose());
+            let rhs = DVector::from_fn(d + 1, |i, _| {
+                if i < d {
+                    -r[i]
+                } else {
+                    -t.dot(&(&u - &anchor))
+                }
+            });
             let Some(du) = system.lu().solve(&rhs) else {
                 return Ok(None);
             };
@@ -237,9 +265,9 @@ impl<L: ForceLaw> Follower<'_, '_, L> {
 
     /// The point where test function `which` vanishes between `from` (tangent `t`) and
     /// the point a step `h` along it, by the secant method on the step length.
-    fn locate(&self, from: &Solved, t: &Vector3<f64>, h: f64, which: usize) -> Result<Solved> {
+    fn locate(&self, from: &Solved, t: &DVector<f64>, h: f64, which: usize) -> Result<Solved> {
         let at =
-            |s: f64| -> Result<Option<Solved>> { self.correct(&from.phase, from.u + t * s, t) };
+            |s: f64| -> Result<Option<Solved>> { self.correct(&from.phase, &from.u + t * s, t) };
         let (mut a, mut fa) = (0.0, from.tests()[which]);
         let Some(end) = at(h)? else {
             return Err(Error::Numerical(
@@ -247,7 +275,11 @@ impl<L: ForceLaw> Follower<'_, '_, L> {
             ));
         };
         let (mut b, mut fb) = (h, end.tests()[which]);
-        let mut best = if fa.abs() < fb.abs() { *from } else { end };
+        let mut best = if fa.abs() < fb.abs() {
+            from.clone()
+        } else {
+            end
+        };
         // Illinois-modified regula falsi: bracketing, superlinear.
         let mut side = 0;
         for _ in 0..60 {
@@ -301,15 +333,19 @@ pub fn follow_period_one<L: ForceLaw>(
     };
     let q0 = sim.cpl.a0 / sim.cpl.a1;
     let toward = (opts.q_end - q0).signum();
-    let u0 = Vector3::new(start.x, start.v, q0);
+    let z0 = sim.z(start);
+    let d = z0.len();
+    let u0 = z0.insert_row(d, q0);
     // The first point: corrected at fixed q (the tangent condition along q).
-    let along_q = Vector3::new(0.0, 0.0, toward);
+    let mut along_q = DVector::zeros(d + 1);
+    along_q[d] = toward;
+    let no_tangent = || Error::Numerical("the branch has no tangent at its first point".into());
     let Some(mut here) = follower.correct(start, u0, &along_q)? else {
         return Err(Error::Numerical(
             "no period-1 orbit through the starting state to continue".into(),
         ));
     };
-    let mut t = here.tangent(&along_q);
+    let mut t = here.tangent(&along_q).ok_or_else(no_tangent)?;
     let mut points = vec![here.point(PointKind::Regular)];
     let mut h = opts
         .max_step
@@ -319,22 +355,22 @@ pub fn follow_period_one<L: ForceLaw>(
         if points.len() >= opts.max_points {
             break Stop::PointCap;
         }
-        let Some(next) = follower.correct(&here.phase, here.u + t * h, &t)? else {
+        let Some(next) = follower.correct(&here.phase, &here.u + &t * h, &t)? else {
             h *= 0.5;
             if h < opts.min_step {
-                break Stop::NotSmooth(here.u[2]);
+                break Stop::NotSmooth(here.q());
             }
             continue;
         };
         // A tangent that reverses more than a right angle: the step jumped branches.
-        let t_next = next.tangent(&t);
-        if t_next.dot(&t) < 0.5 {
+        let t_next = next.tangent(&t).filter(|t_next| t_next.dot(&t) >= 0.5);
+        let Some(t_next) = t_next else {
             h *= 0.5;
             if h < opts.min_step {
-                break Stop::NotSmooth(here.u[2]);
+                break Stop::NotSmooth(here.q());
             }
             continue;
-        }
+        };
         let (before, after) = (here.tests(), next.tests());
         for (which, kind) in [(0, PointKind::Fold), (1, PointKind::PeriodDoubling)] {
             if before[which] != 0.0 && before[which].signum() != after[which].signum() {
@@ -343,7 +379,7 @@ pub fn follow_period_one<L: ForceLaw>(
             }
         }
         points.push(next.point(PointKind::Regular));
-        let q = next.u[2];
+        let q = next.q();
         here = next;
         t = t_next;
         if (q - opts.q_end) * toward >= 0.0 {

@@ -146,7 +146,12 @@ impl FreeFlight {
         y[Carried::CosProjection] += sc;
         y[Carried::SinProjection] += ss;
         if has_tangent(N) {
-            set_phi(y, &(self.transition(tau_b - tau_a) * phi(y)));
+            // The rows of x and x' (a law's internal rows are the caller's:
+            // `relax_internal`).
+            let mut phi = phi(y);
+            let moved = self.transition(tau_b - tau_a) * phi.rows(0, 2);
+            phi.rows_mut(0, 2).copy_from(&moved);
+            set_phi(y, &phi);
         }
     }
 

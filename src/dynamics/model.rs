@@ -8,27 +8,31 @@
 //! with f_ts = −T̂·RΔγ/(kL) and the tip–sample separation α̂ = a₀ + a₁(x + x_b(τ)),
 //! where x_b is the support displacement of a base drive (zero for a force drive).
 
-use crate::law::{Branch, ContactState, ForceLaw};
-use nalgebra::{Matrix2x3, SVector};
+use crate::law::{Branch, ContactState, ForceLaw, Internal, MAX_INTERNAL};
+use nalgebra::{DMatrix, SVector};
 use std::ops::{Index, IndexMut};
 
 /// ODE state: each cantilever mode's deflection and velocity, the per-cycle integrals
 /// carried along, and the drive phasor (cos Ωτ, sin Ωτ), integrated as a rotation so the
 /// right-hand side needs no trigonometric calls (it is reset to the exact values at every
-/// segment start). Four layouts, by `N`:
+/// segment start). Six layouts, by `N`:
 ///
 /// - [`BASE`]: just that, for a law whose force depends on the separation alone;
-/// - [`TANGENT`]: also the variational matrix Φ = ∂(x, x')/∂(x₀, x₀', q) after the base
-///   parts (q = z_c/L the rest separation, α̂ = a₁(q + x + x_b)), for the derivative of
-///   the period map;
+/// - [`TANGENT`]: also the variational matrix Φ = ∂z/∂(z₀, q) after the base parts,
+///   z the section state (x, x') and q = z_c/L the rest separation
+///   (α̂ = a₁(q + x + x_b)), for the derivative of the period map;
 /// - [`RATE`] and [`RATE_TANGENT`]: the same with, last, the work done against a
-///   rate-dependent force ([`dissipative_work_index`]).
+///   rate-dependent force ([`dissipative_work_index`]);
+/// - [`MEMORY`] and [`MEMORY_TANGENT`]: a rate-dependent law with internal state (a
+///   relaxing sample): its variables right after the base parts ([`Part::Internal`]),
+///   part of the section state z = (x, x', s) and so of Φ, and the work last.
 ///
 /// The hot path of a law pays only for what it needs (the integrator's error norm, and
 /// so every number, of an elastic law is that of its nine components). Parts are
 /// addressed by name: `y[Part::Deflection(0)]` (or [`X`]), `y[Carried::Damping]`. One
 /// mode today ([`MODES`]); the layout places further modes' deflections and velocities
-/// before the carried integrals.
+/// before the carried integrals, and the section state grows with them
+/// ([`section_dim`]).
 ///
 /// The contact's elastic E_ts is not carried: it is exact from the branch work functions
 /// at the segment ends. The drive's work follows from the Fourier projections by parts
@@ -71,6 +75,8 @@ pub enum Part {
     DriveCos,
     /// sin Ωτ.
     DriveSin,
+    /// Internal state variable k of the law ([`MEMORY`] layouts only).
+    Internal(usize),
 }
 
 impl Part {
@@ -83,6 +89,7 @@ impl Part {
             Part::Carried(c) => 2 * MODES + c as usize,
             Part::DriveCos => 2 * MODES + Carried::COUNT,
             Part::DriveSin => 2 * MODES + Carried::COUNT + 1,
+            Part::Internal(k) => BASE + k,
         }
     }
 }
@@ -125,57 +132,133 @@ pub const V: Part = Part::Velocity(0);
 /// Components of the plain state.
 pub const BASE: usize = 2 * MODES + Carried::COUNT + 2;
 /// Components of the state with the variational matrix.
-pub const TANGENT: usize = BASE + 6;
+pub const TANGENT: usize = BASE + phi_len(2 * MODES);
 /// Components of the plain state of a rate-dependent law.
 pub const RATE: usize = BASE + 1;
 /// Components of the state of a rate-dependent law with the variational matrix.
 pub const RATE_TANGENT: usize = TANGENT + 1;
+/// Components of the plain state of a law with internal state.
+pub const MEMORY: usize = BASE + MAX_INTERNAL + 1;
+/// Components of the state of a law with internal state, with the variational matrix.
+pub const MEMORY_TANGENT: usize = BASE + MAX_INTERNAL + phi_len(2 * MODES + MAX_INTERNAL) + 1;
+
+/// Entries of Φ for a section state of dimension `d`: d × (d + 1).
+const fn phi_len(d: usize) -> usize {
+    d * (d + 1)
+}
 
 /// Whether layout `N` carries the variational matrix Φ.
 #[inline]
 pub const fn has_tangent(n: usize) -> bool {
-    n == TANGENT || n == RATE_TANGENT
+    n == TANGENT || n == RATE_TANGENT || n == MEMORY_TANGENT
+}
+
+/// How many internal state variables layout `N` carries.
+#[inline]
+pub const fn internal_count(n: usize) -> usize {
+    if n == MEMORY || n == MEMORY_TANGENT {
+        MAX_INTERNAL
+    } else {
+        0
+    }
+}
+
+/// Dimension of the section state z of layout `N` (each mode's x and x', then the
+/// internal state): what the period map maps.
+#[inline]
+pub const fn section_dim(n: usize) -> usize {
+    2 * MODES + internal_count(n)
 }
 
 /// Where layout `N` carries the work done against a rate-dependent force,
-/// ∫ T̂_d dα̂ (dimensionless, the contact's units; what a viscous sample dissipates): the
-/// last component of [`RATE`] and [`RATE_TANGENT`], nowhere in the others.
+/// ∫ T̂_d dα̂ (dimensionless, the contact's units; what a viscous or relaxing sample
+/// dissipates): the last component of the rate and memory layouts, nowhere in the
+/// others.
 #[inline]
 pub const fn dissipative_work_index(n: usize) -> Option<usize> {
-    if n == RATE || n == RATE_TANGENT {
+    if n == RATE || n == RATE_TANGENT || n == MEMORY || n == MEMORY_TANGENT {
         Some(n - 1)
     } else {
         None
     }
 }
 
-/// First of the six entries of Φ, column by column: ∂(x, x')/∂x₀, ∂(x, x')/∂x₀',
-/// ∂(x, x')/∂q.
-const PHI: usize = BASE;
+/// First entry of Φ in layout `N`, stored column by column: ∂z/∂z₀ column by column,
+/// then ∂z/∂q.
+const fn phi_index(n: usize) -> usize {
+    BASE + internal_count(n)
+}
 
-/// Φ of a state with a tangent ([`has_tangent`]) as a matrix.
+/// The internal state carried in `y` (zeros where the layout carries none).
 #[inline]
-pub fn phi<const N: usize>(y: &State<N>) -> Matrix2x3<f64> {
-    Matrix2x3::from_column_slice(&y.as_slice()[PHI..PHI + 6])
+pub fn internal<const N: usize>(y: &State<N>) -> Internal {
+    let mut s = Internal::default();
+    for (k, s) in s.iter_mut().enumerate().take(internal_count(N)) {
+        *s = y[Part::Internal(k)];
+    }
+    s
 }
 
-/// Store `m` as Φ of a [`TANGENT`] state.
+/// Set the internal state carried in `y` (nothing where the layout carries none).
 #[inline]
-pub(crate) fn set_phi<const N: usize>(y: &mut State<N>, m: &Matrix2x3<f64>) {
-    y.as_mut_slice()[PHI..PHI + 6].copy_from_slice(m.as_slice());
+pub(crate) fn set_internal<const N: usize>(y: &mut State<N>, s: &Internal) {
+    for (k, s) in s.iter().enumerate().take(internal_count(N)) {
+        y[Part::Internal(k)] = *s;
+    }
 }
 
-/// Φ at the start of a span: the identity in (x₀, x₀'), nothing yet from q.
-pub(crate) fn phi_start() -> Matrix2x3<f64> {
-    Matrix2x3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+/// Relax the internal state of `y` over a force-free flight of length `span`, each
+/// variable at its rate λ_k ([`ForceLaw::free_relaxation_rates`]): s_k ← s_k e^{−λ_k span},
+/// and its row of Φ alike (in free flight nothing else feeds it).
+pub(crate) fn relax_internal<const N: usize>(
+    y: &mut State<N>,
+    rates: &[f64; MAX_INTERNAL],
+    span: f64,
+) {
+    if internal_count(N) == 0 {
+        return;
+    }
+    let mut phi = has_tangent(N).then(|| phi(y));
+    for (k, rate) in rates.iter().enumerate().take(internal_count(N)) {
+        let factor = (-rate * span).exp();
+        y[Part::Internal(k)] *= factor;
+        if let Some(phi) = phi.as_mut() {
+            phi.row_mut(2 * MODES + k).scale_mut(factor);
+        }
+    }
+    if let Some(phi) = phi {
+        set_phi(y, &phi);
+    }
 }
 
-/// The derivative over two spans, `first` then `then` (each ∂(x, x')/∂(x₀, x₀', q)):
-/// the chain rule, with q entering both.
-pub fn chain(first: &Matrix2x3<f64>, then: &Matrix2x3<f64>) -> Matrix2x3<f64> {
-    let mut out = then.fixed_columns::<2>(0) * first;
-    out[(0, 2)] += then[(0, 2)];
-    out[(1, 2)] += then[(1, 2)];
+/// Φ of a state with a tangent ([`has_tangent`]) as a d × (d + 1) matrix.
+pub fn phi<const N: usize>(y: &State<N>) -> DMatrix<f64> {
+    let d = section_dim(N);
+    let at = phi_index(N);
+    DMatrix::from_column_slice(d, d + 1, &y.as_slice()[at..at + phi_len(d)])
+}
+
+/// Store `m` as Φ of a state with a tangent.
+#[inline]
+pub(crate) fn set_phi<const N: usize>(y: &mut State<N>, m: &DMatrix<f64>) {
+    let at = phi_index(N);
+    y.as_mut_slice()[at..at + m.len()].copy_from_slice(m.as_slice());
+}
+
+/// Φ at the start of a span in a section of dimension `d`: the identity in z₀, nothing
+/// yet from q.
+pub(crate) fn phi_start(d: usize) -> DMatrix<f64> {
+    DMatrix::identity(d, d + 1)
+}
+
+/// The derivative over two spans, `first` then `then` (each ∂z/∂(z₀, q)): the chain
+/// rule, with q entering both.
+pub fn chain(first: &DMatrix<f64>, then: &DMatrix<f64>) -> DMatrix<f64> {
+    let d = then.nrows();
+    let mut out = then.columns(0, d) * first;
+    for row in 0..d {
+        out[(row, d)] += then[(row, d)];
+    }
     out
 }
 
@@ -303,18 +386,21 @@ impl Coupling {
     }
 
     /// What the law sees at deflection and velocity `(x, v)` with the support at
-    /// `(x_b, x_b')`: α̂ and its rate a₁(x' + x_b').
+    /// `(x_b, x_b')` and the law's internal state `internal`: α̂ and its rate
+    /// a₁(x' + x_b').
     #[inline]
     pub fn contact_state(
         &self,
         (x, v): (f64, f64),
         (x_b, v_b): (f64, f64),
         branch: Branch,
+        internal: Internal,
     ) -> ContactState {
         ContactState {
             alpha_hat: self.alpha_hat(x, x_b),
             rate_hat: self.a1 * (v + v_b),
             branch,
+            internal,
         }
     }
 
@@ -326,9 +412,11 @@ impl Coupling {
 }
 
 /// The right-hand side of the equation of motion and of the carried integrals; for a
-/// [`TANGENT`] state also of the variational equations δx'' + 2γδx' + δx =
-/// (∂f_ts/∂x)δx + (∂f_ts/∂x')δx' (+ ∂f_ts/∂q for the q column), ∂f_ts/∂x = ∂f_ts/∂q =
-/// −f_scale·a₁·∂T̂/∂α̂, ∂f_ts/∂x' = −f_scale·a₁·∂T̂/∂(dα̂/dτ) (a rate-dependent law's).
+/// state with a tangent also of the variational equations δx'' + 2γδx' + δx =
+/// (∂f_ts/∂x)δx + (∂f_ts/∂x')δx' + Σ (∂f_ts/∂s_k)δs_k (+ ∂f_ts/∂q for the q column),
+/// ∂f_ts/∂x = ∂f_ts/∂q = −f_scale·a₁·∂T̂/∂α̂, ∂f_ts/∂x' = −f_scale·a₁·∂T̂/∂(dα̂/dτ) (a
+/// rate-dependent law's), and for a law with internal state s also δs_k' = a₁(∂ṡ_k/∂α̂)
+/// (δx + δq) + a₁(∂ṡ_k/∂α̂')δx' + Σ (∂ṡ_k/∂s_j)δs_j.
 #[inline]
 pub(crate) fn rhs<L: ForceLaw, const N: usize>(
     law: &L,
@@ -351,6 +439,7 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
             alpha_hat: alpha,
             rate_hat: cpl.a1 * (v + osc.base_from((s, c)).1),
             branch,
+            internal: internal(y),
         };
         state = Some(at);
         law.dissipative_t_hat(&at)
@@ -363,12 +452,46 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
         let k = -cpl.f_scale * cpl.a1;
         let stiffness = k * (law.slope_hat(alpha, branch) + d_alpha);
         let damping = k * d_rate;
-        for col in [PHI, PHI + 2, PHI + 4] {
-            let (dx, dv) = (y[col], y[col + 1]);
-            dy[col] = dv;
-            dy[col + 1] = -2.0 * osc.gamma * dv - dx + stiffness * dx + damping * dv;
+        let d = section_dim(N);
+        let first = phi_index(N);
+        // The q column's δx' row.
+        let q_row = first + d * d + 1;
+        if internal_count(N) == 0 {
+            // Section (x, x'): the columns ∂/∂x₀, ∂/∂x₀', ∂/∂q (a fixed list, unrolled).
+            const _: () = assert!(MODES == 1, "the variational equations are one mode's");
+            for col in [first, first + d, first + 2 * d] {
+                let (dx, dv) = (y[col], y[col + 1]);
+                dy[col] = dv;
+                dy[col + 1] = -2.0 * osc.gamma * dv - dx + stiffness * dx + damping * dv;
+            }
+            dy[q_row] += stiffness;
+        } else if let Some(at) = state {
+            let slopes = law.internal_slopes_hat(&at);
+            let kinds = internal_count(N);
+            for j in 0..=d {
+                let col = first + d * j;
+                let (dx, dv) = (y[col], y[col + 1]);
+                let ds = |j: usize| y[col + 2 + j];
+                let mut accel = -2.0 * osc.gamma * dv - dx + stiffness * dx + damping * dv;
+                for j in 0..kinds {
+                    accel += -cpl.f_scale * slopes.force_d_internal[j] * ds(j);
+                }
+                dy[col] = dv;
+                dy[col + 1] = accel;
+                for i in 0..kinds {
+                    let mut rate =
+                        cpl.a1 * (slopes.rate_d_alpha[i] * dx + slopes.rate_d_rate[i] * dv);
+                    for j in 0..kinds {
+                        rate += slopes.rate_d_internal[i][j] * ds(j);
+                    }
+                    dy[col + 2 + i] = rate;
+                }
+            }
+            dy[q_row] += stiffness;
+            for i in 0..kinds {
+                dy[q_row + 1 + i] += cpl.a1 * slopes.rate_d_alpha[i];
+            }
         }
-        dy[PHI + 5] += stiffness;
     }
     dy[X] = v;
     dy[V] = -2.0 * osc.gamma * v - x + f + drive;
@@ -379,6 +502,12 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
     dy[Carried::Virial] = f * x;
     if let (Some(i), Some(at)) = (dissipative_work_index(N), state) {
         dy[i] = dissipative * at.rate_hat;
+        if internal_count(N) > 0 {
+            let rates = law.internal_rates_hat(&at);
+            for (k, rate) in rates.iter().enumerate().take(internal_count(N)) {
+                dy[Part::Internal(k)] = *rate;
+            }
+        }
     }
     dy[Part::DriveCos] = -osc.omega * s;
     dy[Part::DriveSin] = osc.omega * c;

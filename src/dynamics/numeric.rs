@@ -13,9 +13,11 @@
 //! three smooth steps instead of a cascade of shrinking ones onto the cusp.
 
 use super::budget;
-use super::model::{BASE, Coupling, Oscillator, Part, State, V, X, has_tangent, rhs, set_phasor};
+use super::model::{
+    BASE, Coupling, Oscillator, Part, State, V, X, has_tangent, internal_count, rhs, set_phasor,
+};
 use crate::error::{Error, Result};
-use crate::law::{Branch, ForceLaw};
+use crate::law::{Branch, ForceLaw, Internal};
 use crate::numeric::bracketed_root;
 use ode_solvers::dop_shared::{OutputType, System};
 use ode_solvers::dopri5::Dopri5;
@@ -103,6 +105,16 @@ where
         + (t3 - 2.0 * t2 + t) * h * a.dy[i]
         + (-2.0 * t3 + 3.0 * t2) * b.y[i]
         + (t3 - t2) * h * b.dy[i]
+}
+
+/// The law's internal state on the step [a, b] at τ, by cubic Hermite interpolation
+/// (zeros where the layout carries none).
+pub fn internal_at<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, tau: f64) -> Internal {
+    let mut s = Internal::default();
+    for (k, s) in s.iter_mut().enumerate().take(internal_count(N)) {
+        *s = hermite(a, b, Part::Internal(k), tau);
+    }
+    s
 }
 
 /// What a segment learns while the solver owns it.
@@ -475,7 +487,9 @@ fn run<S: System<f64, State<N>>, const N: usize>(
         Branch::Free => "out-of-contact",
         Branch::Contact => "contact",
     };
-    let segment_cap = if has_tangent(N) {
+    // (A law with internal state — a relaxing sample on Hertz or DMT — has no fold to
+    // stall at; its variational equations take steps of its relaxation time for good.)
+    let segment_cap = if has_tangent(N) && internal_count(N) == 0 {
         MAX_TANGENT_STEPS
     } else {
         MAX_SEGMENT_STEPS

@@ -4,11 +4,11 @@ use super::budget;
 use super::free::FreeFlight;
 use super::harmonics::{Harmonic, HarmonicsObserver};
 use super::model::{Coupling, Oscillator, V, X};
-use super::numeric::{StepEnd, StepObserver, hermite};
+use super::numeric::{StepEnd, StepObserver, hermite, internal_at};
 use super::setup::{Numerics, Prepared, TapSetup};
 use super::steady::{CycleIntegrals, Motion, SteadyState};
 use crate::error::{Error, Result};
-use crate::law::{Branch, ForceLaw};
+use crate::law::{Branch, ForceLaw, Internal};
 use crate::params::ELECTRONVOLT_J;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -283,7 +283,7 @@ impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
             let tau = from.tau + (to.tau - from.tau) * i as f64 / POINTS_PER_STEP as f64;
             let x = hermite(from, to, X, tau);
             let v = hermite(from, to, V, tau);
-            self.push(tau, x, v, branch);
+            self.push(tau, (x, v), internal_at(from, to, tau), branch);
         }
     }
 
@@ -293,8 +293,8 @@ impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
             .max(1.0) as usize;
         for i in 0..=n {
             let tau = from + (to - from) * i as f64 / n as f64;
-            let (x, v) = flight.at(tau);
-            self.push(tau, x, v, Branch::Free);
+            // (Closed-form free flight is only taken for laws without internal state.)
+            self.push(tau, flight.at(tau), Internal::default(), Branch::Free);
         }
     }
 }
@@ -311,14 +311,14 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
         }
     }
 
-    fn push(&mut self, tau: f64, x: f64, v: f64, branch: Branch) {
+    fn push(&mut self, tau: f64, (x, v): (f64, f64), internal: Internal, branch: Branch) {
         if self.samples.len() >= MAX_TRAJECTORY_SAMPLES {
             self.overflowed = true;
             return;
         }
         let state = self
             .cpl
-            .contact_state((x, v), self.osc.base_at(tau), branch);
+            .contact_state((x, v), self.osc.base_at(tau), branch, internal);
         // (+ 0.0 turns the −0 of a force-free branch into 0.)
         let f = -self.cpl.f_scale * self.law.force_hat(&state) + 0.0;
         self.samples.push((tau, x, v, state.alpha_hat, f, branch));

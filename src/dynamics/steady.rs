@@ -18,15 +18,17 @@
 use super::budget;
 use super::free::FreeFlight;
 use super::model::{
-    BASE, Carried, Coupling, Oscillator, RATE, RATE_TANGENT, State, TANGENT, V, X, chain,
-    dissipative_work_index, has_tangent, phi, phi_start, set_phi,
+    BASE, Carried, Coupling, MEMORY, MEMORY_TANGENT, MODES, Oscillator, RATE, RATE_TANGENT, State,
+    TANGENT, V, X, chain, dissipative_work_index, has_tangent, internal, internal_count, phi,
+    phi_start, relax_internal, section_dim, set_internal, set_phi,
 };
-use super::numeric::{self, Crossing, StepEnd, StepObserver, Tolerances, hermite};
+use super::numeric::{self, Crossing, StepEnd, StepObserver, Tolerances, hermite, internal_at};
 use crate::error::{Error, Result};
-use crate::law::{Branch, ForceLaw};
-use nalgebra::{Complex, Matrix2, Matrix2x3, Vector2};
+use crate::law::{Branch, ForceLaw, Internal, MAX_INTERNAL};
+use nalgebra::{Complex, DMatrix, DVector};
 
-/// Where the oscillator is: time, deflection, velocity and contact branch.
+/// Where the oscillator is: time, deflection, velocity, the law's internal state and
+/// the contact branch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Phase {
     /// τ.
@@ -35,6 +37,8 @@ pub struct Phase {
     pub x: f64,
     /// Velocity x'.
     pub v: f64,
+    /// The law's internal state ([`ForceLaw::internal_states`]; zeros for a law without).
+    pub internal: Internal,
     /// Contact branch.
     pub branch: Branch,
     /// First trial step for the next numerical segment on each branch (free, contact;
@@ -49,14 +53,34 @@ impl Phase {
             tau: 0.0,
             x: 0.0,
             v: 0.0,
+            internal: Internal::default(),
             branch: Branch::Free,
             h_next: [0.0; 2],
         }
     }
 
-    /// (x, x') as a vector.
-    fn z(&self) -> Vector2<f64> {
-        Vector2::new(self.x, self.v)
+    /// The section state z of dimension `d`: (x, x'), then the first d − 2 internal
+    /// variables times `scale`.
+    fn section(&self, d: usize, scale: f64) -> DVector<f64> {
+        DVector::from_fn(d, |i, _| match i {
+            0 => self.x,
+            1 => self.v,
+            k => scale * self.internal[k - 2 * MODES],
+        })
+    }
+
+    /// This phase moved to the section state `z` ([`Phase::section`]).
+    fn with_section(&self, z: &DVector<f64>, scale: f64) -> Self {
+        let mut internal = self.internal;
+        for (k, s) in internal.iter_mut().enumerate().take(z.len() - 2 * MODES) {
+            *s = z[2 * MODES + k] / scale;
+        }
+        Self {
+            x: z[0],
+            v: z[1],
+            internal,
+            ..*self
+        }
     }
 }
 
@@ -178,9 +202,12 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
             let t = hermite_minimum(a, b);
             let tau = a.tau + t * (b.tau - a.tau);
             // (The tip is at rest there; the support may not be.)
-            let turn =
-                self.cpl
-                    .contact_state((hermite(a, b, X, tau), 0.0), self.osc.base_at(tau), branch);
+            let turn = self.cpl.contact_state(
+                (hermite(a, b, X, tau), 0.0),
+                self.osc.base_at(tau),
+                branch,
+                internal_at(a, b, tau),
+            );
             lowest = lowest.min(turn.alpha_hat);
             let f = -self.cpl.f_scale * self.law.force_hat(&turn);
             self.max_f = self.max_f.max(f);
@@ -255,7 +282,7 @@ pub enum Motion {
         period: usize,
         /// Eigenvalues of the orbit's monodromy matrix (the derivative of the n-period
         /// map).
-        multipliers: [Complex<f64>; 2],
+        multipliers: Multipliers,
     },
     /// Quasi-periodic, chaotic or intermittent motion, or a period above [`MAX_PERIOD`].
     Irregular,
@@ -289,6 +316,30 @@ impl Motion {
     }
 }
 
+/// The most dimensions a section state has: each mode's x and x', and the law's
+/// internal state.
+pub const MAX_SECTION: usize = 2 * MODES + MAX_INTERNAL;
+
+/// Floquet multipliers of a periodic orbit: the eigenvalues of its monodromy matrix, one
+/// per dimension of the section state (two for a law without internal state).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Multipliers {
+    values: [Complex<f64>; MAX_SECTION],
+    len: usize,
+}
+
+impl Multipliers {
+    /// The multipliers.
+    pub fn as_slice(&self) -> &[Complex<f64>] {
+        &self.values[..self.len]
+    }
+
+    /// Iterate over them.
+    pub fn iter(&self) -> std::slice::Iter<'_, Complex<f64>> {
+        self.as_slice().iter()
+    }
+}
+
 /// Standard errors of window averages (batch means); zero for a periodic orbit.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StdErr {
@@ -304,8 +355,8 @@ pub struct StdErr {
 pub(crate) struct MapValue {
     /// The state n periods later.
     pub end: Phase,
-    /// ∂(x, x')(end)/∂(x, x', q)(start).
-    pub derivative: Matrix2x3<f64>,
+    /// ∂z(end)/∂(z, q)(start), z the section state.
+    pub derivative: DMatrix<f64>,
     /// The integrals over the n periods.
     pub integrals: CycleIntegrals,
     /// |state after k + 1 periods − start|∞ for k < min(n, [`MAX_PERIOD`]).
@@ -314,8 +365,9 @@ pub(crate) struct MapValue {
 
 impl MapValue {
     /// The derivative in the state alone (the monodromy matrix on an orbit).
-    pub fn monodromy(&self) -> Matrix2<f64> {
-        self.derivative.fixed_columns::<2>(0).into_owned()
+    pub fn monodromy(&self) -> DMatrix<f64> {
+        let d = self.derivative.nrows();
+        self.derivative.columns(0, d).into_owned()
     }
 }
 
@@ -328,6 +380,24 @@ struct Orbit {
 }
 
 impl<L: ForceLaw> Simulation<'_, L> {
+    /// Dimension of the section state: x, x' and the law's internal state.
+    pub fn section_dim(&self) -> usize {
+        2 * MODES + self.law.internal_states().min(MAX_INTERNAL)
+    }
+
+    /// The section state of `phase`: (x, x') and the law's internal variables (forces
+    /// in the contact's units, [`ForceLaw::internal_states`]) as forces in units of kL,
+    /// so that every component is a length in units of L and one norm and tolerance
+    /// serve them all.
+    pub fn z(&self, phase: &Phase) -> DVector<f64> {
+        phase.section(self.section_dim(), self.cpl.f_scale)
+    }
+
+    /// `phase` moved to the section state `z` ([`Simulation::z`]).
+    pub fn at_z(&self, phase: &Phase, z: &DVector<f64>) -> Phase {
+        phase.with_section(z, self.cpl.f_scale)
+    }
+
     /// The branch a state at rest separation α̂ starts on: in contact if the tip is already
     /// below the jump-in separation.
     pub(crate) fn branch_at(&self, tau: f64, x: f64) -> Branch {
@@ -348,6 +418,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             tau: 0.0,
             x,
             v,
+            internal: Internal::default(),
             branch: self.branch_at(0.0, x),
             h_next: [0.0; 2],
         }
@@ -359,7 +430,9 @@ impl<L: ForceLaw> Simulation<'_, L> {
         phase: &mut Phase,
         observer: &mut O,
     ) -> Result<CycleIntegrals> {
-        Ok(if self.law.is_rate_dependent() {
+        Ok(if self.law.internal_states() > 0 {
+            self.cycle_in::<MEMORY, O>(phase, observer)?.0
+        } else if self.law.is_rate_dependent() {
             self.cycle_in::<RATE, O>(phase, observer)?.0
         } else {
             self.cycle_in::<BASE, O>(phase, observer)?.0
@@ -367,19 +440,24 @@ impl<L: ForceLaw> Simulation<'_, L> {
     }
 
     /// Integrate one drive period from `phase`, updating it, with the derivative of the
-    /// period map, ∂(x, x')(τ + T)/∂(x, x', q)(τ), q = z_c/L: the variational equations
-    /// along every segment, the free flight's transition matrix in closed form, and at
-    /// every branch switch the saltation matrix: where the force jumps by Δf_ts as α̂
-    /// crosses its level, δx' gains Δf_ts(δx + δq)/(x' + x_b').
+    /// period map, ∂z(τ + T)/∂(z, q)(τ), z = (x, x') and the law's internal state
+    /// ([`Simulation::z`]), q = z_c/L: the variational equations along every segment, the
+    /// free flight's transition matrix in closed form, and at every branch switch the
+    /// saltation matrix: where the force jumps by Δf_ts as α̂ crosses its level, δx'
+    /// gains Δf_ts(δx + δq)/(x' + x_b') (and an internal variable whose rate jumps, its
+    /// jump times the same).
     pub fn cycle_with_derivative(
         &self,
         phase: &mut Phase,
-    ) -> Result<(CycleIntegrals, Matrix2x3<f64>)> {
-        if self.law.is_rate_dependent() {
+    ) -> Result<(CycleIntegrals, DMatrix<f64>)> {
+        let (integrals, derivative) = if self.law.internal_states() > 0 {
+            self.cycle_in::<MEMORY_TANGENT, _>(phase, &mut numeric::Ignore)
+        } else if self.law.is_rate_dependent() {
             self.cycle_in::<RATE_TANGENT, _>(phase, &mut numeric::Ignore)
         } else {
             self.cycle_in::<TANGENT, _>(phase, &mut numeric::Ignore)
-        }
+        }?;
+        Ok((integrals, derivative.expect("a tangent layout carries Φ")))
     }
 
     /// Move `phase` back by whole drive periods to τ in [0, T): the drive is periodic,
@@ -411,16 +489,36 @@ impl<L: ForceLaw> Simulation<'_, L> {
             return;
         }
         let (x_b, v_b) = self.osc.base_at(tau);
-        let at = |branch| self.cpl.contact_state((y[X], y[V]), (x_b, v_b), branch);
+        let at = |branch| {
+            self.cpl
+                .contact_state((y[X], y[V]), (x_b, v_b), branch, internal(y))
+        };
         let jump =
             -self.cpl.f_scale * (self.law.force_hat(&at(to)) - self.law.force_hat(&at(from)));
-        if jump == 0.0 {
+        let kinds = internal_count(N);
+        let (rates_to, rates_from) = if kinds > 0 {
+            (
+                self.law.internal_rates_hat(&at(to)),
+                self.law.internal_rates_hat(&at(from)),
+            )
+        } else {
+            ([0.0; MAX_INTERNAL], [0.0; MAX_INTERNAL])
+        };
+        let rate_jumps = (0..kinds).any(|k| rates_to[k] != rates_from[k]);
+        if jump == 0.0 && !rate_jumps {
             return;
         }
         let mut d = phi(y);
-        let k = jump / (y[V] + v_b);
-        for col in 0..3 {
-            d[(1, col)] += k * (d[(0, col)] + if col == 2 { 1.0 } else { 0.0 });
+        let dim = d.nrows();
+        let speed = y[V] + v_b;
+        let k = jump / speed;
+        for col in 0..=dim {
+            // δx + δq of this column: how far the switch moves.
+            let shift = d[(0, col)] + if col == dim { 1.0 } else { 0.0 };
+            d[(1, col)] += k * shift;
+            for i in 0..kinds {
+                d[(2 * MODES + i, col)] += (rates_to[i] - rates_from[i]) / speed * shift;
+            }
         }
         set_phi(y, &d);
     }
@@ -429,7 +527,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         &self,
         phase: &mut Phase,
         observer: &mut O,
-    ) -> Result<(CycleIntegrals, Matrix2x3<f64>)> {
+    ) -> Result<(CycleIntegrals, Option<DMatrix<f64>>)> {
         budget::spend(1)?;
         let period = self.osc.period();
         let tau_end = phase.tau + period;
@@ -437,8 +535,9 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let mut y = State::<N>::zeros();
         y[X] = phase.x;
         y[V] = phase.v;
+        set_internal(&mut y, &phase.internal);
         if has_tangent(N) {
-            set_phi(&mut y, &phi_start());
+            set_phi(&mut y, &phi_start(section_dim(N)));
         }
         let mechanical = |y: &State<N>| 0.5 * (y[X] * y[X] + y[V] * y[V]);
         let e0 = mechanical(&y);
@@ -457,7 +556,11 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let work_scale = self.cpl.f_scale / self.cpl.a1;
         let (mut e_ts, mut e_capillary) = (0.0, 0.0);
         let mut tau = phase.tau;
-        let closed_form = self.law.free_branch_is_force_free();
+        // An internal state evolves in free flight too: in closed form if the law says
+        // how it relaxes there, else integrated with the motion.
+        let relaxation = self.law.free_relaxation_rates();
+        let closed_form = self.law.free_branch_is_force_free()
+            && (internal_count(N) == 0 || relaxation.is_some());
         // Stop when the remaining time is round-off.
         while tau_end - tau > 1e-12 * period {
             let flight = (phase.branch == Branch::Free && closed_form)
@@ -468,6 +571,9 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 let (hit, min_x) = flight.first_fall_to(level, tau, tau_end, period / 8.0);
                 let stop = hit.unwrap_or(tau_end);
                 flight.advance(&mut y, tau, stop);
+                if let Some(rates) = &relaxation {
+                    relax_internal(&mut y, rates, stop - tau);
+                }
                 tracker.free_flight(&flight, tau, stop);
                 tracker.min_alpha = tracker.min_alpha.min(self.cpl.alpha_hat(min_x, 0.0));
                 tau = stop;
@@ -534,6 +640,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         phase.tau = tau_end;
         phase.x = y[X];
         phase.v = y[V];
+        phase.internal = internal(&y);
         let integrals = CycleIntegrals {
             periods: 1,
             period,
@@ -559,8 +666,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             jumps_in,
             jumps_out,
         };
-        let derivative = if has_tangent(N) { phi(&y) } else { phi_start() };
-        Ok((integrals, derivative))
+        Ok((integrals, has_tangent(N).then(|| phi(&y))))
     }
 
     /// The n-period map from `start` moved to `z`: the state n periods later and the
@@ -571,17 +677,13 @@ impl<L: ForceLaw> Simulation<'_, L> {
     pub(crate) fn period_map(
         &self,
         start: &Phase,
-        z: Vector2<f64>,
+        z: &DVector<f64>,
         n: usize,
         spent: &mut usize,
     ) -> Result<Option<MapValue>> {
-        let mut p = Phase {
-            x: z[0],
-            v: z[1],
-            ..*start
-        };
+        let mut p = self.at_z(start, z);
         let branch = self.consistent_branch(&p);
-        let mut derivative = phi_start();
+        let mut derivative = phi_start(z.len());
         let mut integrals: Option<CycleIntegrals> = None;
         let mut returns = [f64::INFINITY; MAX_PERIOD];
         for k in 0..n {
@@ -591,14 +693,25 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     derivative = chain(&derivative, &d);
                     integrals = Some(integrals.map_or(c, |s| s.then(&c)));
                     if let Some(r) = returns.get_mut(k) {
-                        *r = (p.z() - z).amax();
+                        *r = (self.z(&p) - z).amax();
                     }
                 }
                 Err(Error::Numerical(_)) => return Ok(None),
                 Err(e) => return Err(e),
             }
         }
-        let back = p.branch == branch && p.x.is_finite() && p.v.is_finite();
+        let back = p.branch == branch && self.z(&p).iter().all(|c| c.is_finite());
+        // The derivative in the section's units: internal rows times f_scale, internal
+        // columns divided by it.
+        let d = z.len();
+        for row in 2 * MODES..d {
+            for col in 0..=d {
+                derivative[(row, col)] *= self.cpl.f_scale;
+                if col < d {
+                    derivative[(col, row)] /= self.cpl.f_scale;
+                }
+            }
+        }
         Ok(back.then(|| MapValue {
             end: p,
             derivative,
@@ -625,12 +738,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
         budget: usize,
         spent: &mut usize,
     ) -> Result<Option<Orbit>> {
-        let mut z = start.z();
-        let Some(value) = self.period_map(start, z, n, spent)? else {
+        let mut z = self.z(start);
+        let Some(value) = self.period_map(start, &z, n, spent)? else {
             return Ok(None);
         };
         let (mut end, mut m) = (value.end, value.monodromy());
-        let mut r = end.z() - z;
+        let mut r = self.z(&end) - &z;
         let mut norm = r.amax();
         let mut radius: f64 = 0.2;
         let mut rejected = 0;
@@ -643,27 +756,29 @@ impl<L: ForceLaw> Simulation<'_, L> {
             if *spent + n > budget {
                 return Ok(None);
             }
-            let Some(inverse) = (m - Matrix2::identity()).try_inverse() else {
+            let Some(inverse) = (&m - DMatrix::identity(z.len(), z.len())).try_inverse() else {
                 return Ok(None);
             };
-            let step = -(inverse * r);
+            let step = -(inverse * &r);
             let length = step.amax();
             if !length.is_finite() {
                 return Ok(None);
             }
             let scale = (radius / length).min(1.0);
-            let trial = z + step * scale;
+            let trial = &z + step * scale;
             // Inexact Newton: far from the orbit the map need not be exact to the
             // integrator's tolerance, only well below the residual.
             match self
                 .loosened(NEWTON_TOLERANCE * norm)
-                .period_map(start, trial, n, spent)?
+                .period_map(start, &trial, n, spent)?
             {
-                Some(value) if (value.end.z() - trial).amax() <= (1.0 - 0.1 * scale) * norm => {
+                Some(value)
+                    if (self.z(&value.end) - &trial).amax() <= (1.0 - 0.1 * scale) * norm =>
+                {
                     z = trial;
                     m = value.monodromy();
                     end = value.end;
-                    r = end.z() - z;
+                    r = self.z(&end) - &z;
                     norm = r.amax();
                     radius = radius.max(2.0 * scale * length);
                     rejected = 0;
@@ -685,11 +800,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             }
         }
         Ok(Some(Orbit {
-            phase: Phase {
-                x: z[0],
-                v: z[1],
-                ..end
-            },
+            phase: self.at_z(&end, &z),
             residual: norm,
         }))
     }
@@ -739,14 +850,15 @@ impl<L: ForceLaw> Simulation<'_, L> {
         spent: &mut usize,
     ) -> Result<Option<SteadyState>> {
         let start = *phase;
-        let Some(mut pass) = self.period_map(&start, start.z(), n, spent)? else {
+        let z = self.z(&start);
+        let Some(mut pass) = self.period_map(&start, &z, n, spent)? else {
             return Ok(None);
         };
         let least = (1..=n)
             .find(|&m| n % m == 0 && (m == n || pass.returns[m - 1] <= 1e3 * residual.max(1e-12)))
             .unwrap_or(n);
         if least < n {
-            let Some(shorter) = self.period_map(&start, start.z(), least, spent)? else {
+            let Some(shorter) = self.period_map(&start, &z, least, spent)? else {
                 return Ok(None);
             };
             pass = shorter;
@@ -818,7 +930,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             *self
         };
         let mut ring = Recurrence::default();
-        ring.push(phase);
+        ring.push(self.z(phase), phase.branch);
         // The periods marched while searching are the averaging window's first batches,
         // should the motion prove irregular (a transient at their head is cut there).
         let mut window = Window::new(self.memory_periods(), budget - spent);
@@ -828,7 +940,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 self.rewind(phase);
                 let c = marching.cycle(phase, &mut numeric::Ignore)?;
                 spent += 1;
-                ring.push(phase);
+                ring.push(self.z(phase), phase.branch);
                 window.add(&c);
                 if !opts.shooting {
                     // A state contracting onto the orbit by a factor ρ per n periods
@@ -922,7 +1034,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             self.rewind(phase);
             let c = marching.cycle(phase, &mut numeric::Ignore)?;
             spent += 1;
-            ring.push(phase);
+            ring.push(self.z(phase), phase.branch);
             window.add(&c);
             let count = window.batches.len();
             let full = count >= BATCHES;
@@ -1135,29 +1247,40 @@ fn wrap_angle(d: f64) -> f64 {
     PI - (PI - d).rem_euclid(2.0 * PI)
 }
 
-/// Eigenvalues of a 2×2 matrix.
-pub(crate) fn eigenvalues(m: &Matrix2<f64>) -> [Complex<f64>; 2] {
-    let half_trace = 0.5 * m.trace();
-    let disc = Complex::new(half_trace * half_trace - m.determinant(), 0.0).sqrt();
-    let h = Complex::new(half_trace, 0.0);
-    [h + disc, h - disc]
+/// Eigenvalues of a monodromy matrix (at most [`MAX_SECTION`] × [`MAX_SECTION`]): in
+/// closed form for 2×2, from the real Schur form otherwise.
+pub(crate) fn eigenvalues(m: &DMatrix<f64>) -> Multipliers {
+    let mut values = [Complex::new(0.0, 0.0); MAX_SECTION];
+    let len = m.nrows().min(MAX_SECTION);
+    if len == 2 {
+        let half_trace = 0.5 * m.trace();
+        let disc = Complex::new(half_trace * half_trace - m.determinant(), 0.0).sqrt();
+        let h = Complex::new(half_trace, 0.0);
+        values[0] = h + disc;
+        values[1] = h - disc;
+    } else {
+        for (v, e) in values.iter_mut().zip(m.complex_eigenvalues().iter()) {
+            *v = *e;
+        }
+    }
+    Multipliers { values, len }
 }
 
 /// The last states at the drive phase, to see after how many periods they repeat.
 #[derive(Default)]
 struct Recurrence {
-    /// (x, x', branch), newest last; at most 3 + [`MAX_PERIOD`].
-    states: Vec<(Vector2<f64>, Branch)>,
+    /// (section state, branch), newest last; at most 3 + [`MAX_PERIOD`].
+    states: Vec<(DVector<f64>, Branch)>,
 }
 
 impl Recurrence {
     const KEEP: usize = MAX_PERIOD + 3;
 
-    fn push(&mut self, phase: &Phase) {
+    fn push(&mut self, z: DVector<f64>, branch: Branch) {
         if self.states.len() == Self::KEEP {
             self.states.remove(0);
         }
-        self.states.push((phase.z(), phase.branch));
+        self.states.push((z, branch));
     }
 
     /// Distance between the state `back` places from the newest and the one n before it.
@@ -1167,7 +1290,7 @@ impl Recurrence {
             self.states.get(len.checked_sub(1 + back)?)?,
             self.states.get(len.checked_sub(1 + back + n)?)?,
         );
-        (a.1 == b.1).then(|| (a.0 - b.0).amax())
+        (a.1 == b.1).then(|| (&a.0 - &b.0).amax())
     }
 
     /// The least n whose return distance has been within `within(n)` for the last three

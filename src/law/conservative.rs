@@ -11,7 +11,7 @@ use std::f64::consts::PI;
 pub struct HertzLaw;
 
 #[inline]
-fn hertz_t_hat(alpha_hat: f64) -> f64 {
+pub(super) fn hertz_t_hat(alpha_hat: f64) -> f64 {
     if alpha_hat < 0.0 {
         let d = -alpha_hat;
         -4.0 / 3.0 * d * d.sqrt()
@@ -22,7 +22,7 @@ fn hertz_t_hat(alpha_hat: f64) -> f64 {
 
 /// dT̂/dα̂ of the Hertz law: 2√(−α̂) for α̂ < 0.
 #[inline]
-fn hertz_slope_hat(alpha_hat: f64) -> f64 {
+pub(super) fn hertz_slope_hat(alpha_hat: f64) -> f64 {
     if alpha_hat < 0.0 {
         2.0 * (-alpha_hat).sqrt()
     } else {

@@ -164,16 +164,51 @@ pub const CONTACT_ANGLE: LawParam = LawParam {
     ),
 };
 
+/// Whether a law takes a standard-linear-solid sample: one whose contact is Hertzian.
+fn takes_a_relaxing_sample(law: LawKind) -> bool {
+    matches!(law, LawKind::Hertz | LawKind::Dmt)
+}
+
+/// A standard-linear-solid sample's unrelaxed modulus.
+pub const UNRELAXED_MODULUS: LawParam = LawParam {
+    key: "unrelaxed-modulus",
+    name: "unrelaxed modulus",
+    unit: "Pa",
+    help: "standard-linear-solid sample on the hertz or dmt law (Lee–Radok's hereditary \
+           Hertz integral with E(t) = E∞ + (E0 − E∞)exp(−t/τ)): its unrelaxed composite \
+           modulus E0, above the contact's modulus E*, which is the relaxed E∞ (e.g. 3GPa; \
+           give the relaxation time too) [Pa; default: none, elastic]",
+    taken_by: takes_a_relaxing_sample,
+    range: (1e5, 1e12, "from soft gels to stiff solids"),
+};
+
+/// A standard-linear-solid sample's relaxation time.
+pub const RELAXATION_TIME: LawParam = LawParam {
+    key: "relaxation-time",
+    name: "relaxation time",
+    unit: "s",
+    help: "relaxation time τ of the standard-linear-solid sample (e.g. 1us; give the \
+           unrelaxed modulus too) [s; default: none, elastic]",
+    taken_by: takes_a_relaxing_sample,
+    range: (
+        1e-12,
+        1.0,
+        "a relaxation time far outside the drive period (~µs) leaves the sample elastic",
+    ),
+};
+
 /// Surface tension of water at 25 °C, J/m², the neck's default liquid.
 pub const WATER_SURFACE_TENSION_J_M2: f64 = 0.072;
 
 /// Every law parameter.
-pub const LAW_PARAMS: [&LawParam; 5] = [
+pub const LAW_PARAMS: [&LawParam; 7] = [
     &HAMAKER,
     &VISCOSITY,
     &RUPTURE_DISTANCE,
     &SURFACE_TENSION,
     &CONTACT_ANGLE,
+    &UNRELAXED_MODULUS,
+    &RELAXATION_TIME,
 ];
 
 /// A force law with its own parameters: what a setup asks for.
@@ -194,6 +229,13 @@ pub struct LawSpec {
     /// The neck's contact angle θ in degrees (default 0).
     #[serde(default)]
     pub contact_angle_deg: Option<f64>,
+    /// A standard-linear-solid sample's unrelaxed composite modulus E₀ in Pa (none:
+    /// elastic).
+    #[serde(default)]
+    pub unrelaxed_modulus_pa: Option<f64>,
+    /// Its relaxation time τ_r in s.
+    #[serde(default)]
+    pub relaxation_time_s: Option<f64>,
 }
 
 impl From<LawKind> for LawSpec {
@@ -207,14 +249,22 @@ impl From<LawKind> for LawSpec {
 
 impl LawSpec {
     /// Each law parameter with its value in this spec (`None`: not set).
-    pub fn params(&self) -> [(&'static LawParam, Option<f64>); 5] {
+    pub fn params(&self) -> [(&'static LawParam, Option<f64>); LAW_PARAMS.len()] {
         [
             (&HAMAKER, self.hamaker_j),
             (&VISCOSITY, self.viscosity_pa_s),
             (&RUPTURE_DISTANCE, self.rupture_distance_m),
             (&SURFACE_TENSION, self.surface_tension_j_m2),
             (&CONTACT_ANGLE, self.contact_angle_deg),
+            (&UNRELAXED_MODULUS, self.unrelaxed_modulus_pa),
+            (&RELAXATION_TIME, self.relaxation_time_s),
         ]
+    }
+
+    /// The standard-linear-solid sample asked for: (unrelaxed modulus in Pa,
+    /// relaxation time in s), none unless both are given.
+    pub fn relaxing(&self) -> Option<(f64, f64)> {
+        Some((self.unrelaxed_modulus_pa?, self.relaxation_time_s?))
     }
 
     /// The capillary neck asked for, with the defaults filled in (none without a
@@ -238,6 +288,8 @@ impl LawSpec {
             rupture_distance_m,
             surface_tension_j_m2,
             contact_angle_deg,
+            unrelaxed_modulus_pa,
+            relaxation_time_s,
         ] = self
             .params()
             .map(|(param, value)| value.filter(|_| (param.taken_by)(kind)));
@@ -248,6 +300,8 @@ impl LawSpec {
             rupture_distance_m,
             surface_tension_j_m2,
             contact_angle_deg,
+            unrelaxed_modulus_pa,
+            relaxation_time_s,
         }
     }
 
@@ -277,6 +331,27 @@ impl LawSpec {
                     .into(),
             ));
         }
+        if self.unrelaxed_modulus_pa.is_some() != self.relaxation_time_s.is_some() {
+            return Err(Error::NotApplicable(
+                "a standard-linear-solid sample needs both its unrelaxed-modulus and its \
+                 relaxation-time"
+                    .into(),
+            ));
+        }
+        if self.relaxing().is_some() && self.viscosity_pa_s.is_some() {
+            return Err(Error::NotApplicable(
+                "a standard-linear-solid sample takes no viscosity: it is itself the \
+                 sample's rheology (Kelvin–Voigt is its limit of a short relaxation time)"
+                    .into(),
+            ));
+        }
+        if self.relaxing().is_some() && self.rupture_distance_m.is_some() {
+            return Err(Error::NotApplicable(
+                "a standard-linear-solid sample takes no capillary neck: its Maxwell force \
+                 would act on the neck's part of the contact branch, beyond contact"
+                    .into(),
+            ));
+        }
         Ok(())
     }
 }
@@ -290,6 +365,9 @@ impl fmt::Display for LawSpec {
         }
         if self.viscosity_pa_s.is_some() {
             f.write_str("+kelvin-voigt")?;
+        }
+        if self.relaxing().is_some() {
+            f.write_str("+sls")?;
         }
         Ok(())
     }
