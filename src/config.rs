@@ -14,7 +14,7 @@
 
 use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
 use crate::error::{Error, Result};
-use crate::law::{LawKind, LawSpec};
+use crate::law::{LAW_PARAMS, LawKind, LawParam, LawSpec};
 use crate::params::{self, Contact};
 use crate::units::{self, Dimension};
 use clap::Args;
@@ -173,6 +173,84 @@ impl clap::ValueEnum for LawKind {
     }
 }
 
+/// The law parameters of the registry ([`LAW_PARAMS`]), in its order: each one a flag
+/// and a parameter-file key named by its registry key, read in its registry unit, with
+/// its registry help. A new law parameter needs nothing here.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LawParamInputs(pub [Option<f64>; LAW_PARAMS.len()]);
+
+impl LawParamInputs {
+    /// The parameters `spec` sets.
+    pub fn of(spec: &LawSpec) -> Self {
+        Self(spec.params().map(|(_, value)| value))
+    }
+
+    /// Parameter-wise: `self` where given, else `base`.
+    pub fn or(self, base: Self) -> Self {
+        let mut out = self;
+        for (value, base) in out.0.iter_mut().zip(base.0) {
+            *value = value.or(base);
+        }
+        out
+    }
+}
+
+/// The dimension a law parameter is read in, from its registry unit.
+fn dimension(param: &LawParam) -> Dimension {
+    match param.unit {
+        "m" => Dimension::Length,
+        "Pa" => Dimension::Pressure,
+        "J" => Dimension::Energy,
+        "J/m²" => Dimension::SurfaceEnergy,
+        "Pa·s" => Dimension::Viscosity,
+        "s" => Dimension::Time,
+        _ => Dimension::Dimensionless,
+    }
+}
+
+impl clap::FromArgMatches for LawParamInputs {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> std::result::Result<Self, clap::Error> {
+        let mut inputs = Self::default();
+        inputs.update_from_arg_matches(matches)?;
+        Ok(inputs)
+    }
+
+    fn update_from_arg_matches(
+        &mut self,
+        matches: &clap::ArgMatches,
+    ) -> std::result::Result<(), clap::Error> {
+        for (value, param) in self.0.iter_mut().zip(LAW_PARAMS) {
+            if let Some(v) = matches.get_one::<f64>(param.key) {
+                *value = Some(*v);
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Args for LawParamInputs {
+    fn augment_args(command: clap::Command) -> clap::Command {
+        LAW_PARAMS.iter().fold(command, |command, &param| {
+            let dim = dimension(param);
+            command.arg(
+                clap::Arg::new(param.key)
+                    .long(param.key)
+                    .value_name(param.unit)
+                    .allow_hyphen_values(true)
+                    .value_parser(move |text: &str| {
+                        units::parse(param.name, text, dim).map_err(|e| e.to_string())
+                    })
+                    .help(param.help)
+                    .help_heading("Contact (SI)"),
+            )
+        })
+    }
+
+    fn augment_args_for_update(command: clap::Command) -> clap::Command {
+        Self::augment_args(command)
+    }
+}
+
 /// Everything a tapping simulation takes, every field optional (defaults fill in).
 #[derive(Debug, Clone, Default, Args)]
 pub struct TapInputs {
@@ -186,34 +264,9 @@ pub struct TapInputs {
     /// The contact.
     #[command(flatten)]
     pub contact: ContactInputs,
-    /// A law parameter ([`crate::law::HAMAKER`]; its help is the registry's).
-    #[arg(long, allow_hyphen_values = true, value_parser = energy, help_heading = "Contact (SI)",
-          help = crate::law::HAMAKER.help)]
-    pub hamaker: Option<f64>,
-    /// A law parameter ([`crate::law::VISCOSITY`]; its help is the registry's).
-    #[arg(long, allow_hyphen_values = true, value_parser = viscosity, help_heading = "Contact (SI)",
-          help = crate::law::VISCOSITY.help)]
-    pub viscosity: Option<f64>,
-    /// A law parameter ([`crate::law::RUPTURE_DISTANCE`]; its help is the registry's).
-    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Contact (SI)",
-          help = crate::law::RUPTURE_DISTANCE.help)]
-    pub rupture_distance: Option<f64>,
-    /// A law parameter ([`crate::law::SURFACE_TENSION`]; its help is the registry's).
-    #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, help_heading = "Contact (SI)",
-          help = crate::law::SURFACE_TENSION.help)]
-    pub surface_tension: Option<f64>,
-    /// A law parameter ([`crate::law::CONTACT_ANGLE`]; its help is the registry's).
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)",
-          help = crate::law::CONTACT_ANGLE.help)]
-    pub contact_angle: Option<f64>,
-    /// A law parameter ([`crate::law::UNRELAXED_MODULUS`]; its help is the registry's).
-    #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)",
-          help = crate::law::UNRELAXED_MODULUS.help)]
-    pub unrelaxed_modulus: Option<f64>,
-    /// A law parameter ([`crate::law::RELAXATION_TIME`]; its help is the registry's).
-    #[arg(long, allow_hyphen_values = true, value_parser = time, help_heading = "Contact (SI)",
-          help = crate::law::RELAXATION_TIME.help)]
-    pub relaxation_time: Option<f64>,
+    /// The law parameters of the registry, one flag each.
+    #[command(flatten)]
+    pub law_params: LawParamInputs,
     /// Cantilever spring constant k [N/m; default 40].
     #[arg(long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Cantilever")]
     pub stiffness: Option<f64>,
@@ -316,13 +369,6 @@ const FIELDS: &[Field] = fields![
     "sample-poisson" => Dimensionless => |i| i.contact.sample_poisson,
     "work-of-adhesion" => SurfaceEnergy => |i| i.contact.work_of_adhesion,
     "range" => Length => |i| i.contact.range,
-    "hamaker" => Energy => |i| i.hamaker,
-    "viscosity" => Viscosity => |i| i.viscosity,
-    "rupture-distance" => Length => |i| i.rupture_distance,
-    "surface-tension" => SurfaceEnergy => |i| i.surface_tension,
-    "contact-angle" => Dimensionless => |i| i.contact_angle,
-    "unrelaxed-modulus" => Pressure => |i| i.unrelaxed_modulus,
-    "relaxation-time" => Time => |i| i.relaxation_time,
     "stiffness" => Stiffness => |i| i.stiffness,
     "resonance" => Frequency => |i| i.resonance,
     "quality" => Dimensionless => |i| i.quality,
@@ -339,16 +385,25 @@ impl TapInputs {
     /// Set the quantity named `key` (a flag's name) from `text` (a number with an
     /// optional unit).
     pub fn set(&mut self, key: &str, text: &str) -> Result<()> {
-        let Some(&(name, dim, slot)) = FIELDS.iter().find(|(k, _, _)| *k == key) else {
-            let known: Vec<&str> = FIELDS.iter().map(|(k, _, _)| *k).collect();
-            return Err(Error::Parse {
-                name: "key",
-                text: key.to_string(),
-                reason: format!("unknown key; known keys: law, {}", known.join(", ")),
-            });
-        };
-        *slot(self) = Some(units::parse(name, text, dim)?);
-        Ok(())
+        if let Some(&(name, dim, slot)) = FIELDS.iter().find(|(k, _, _)| *k == key) {
+            *slot(self) = Some(units::parse(name, text, dim)?);
+            return Ok(());
+        }
+        if let Some(i) = LAW_PARAMS.iter().position(|p| p.key == key) {
+            let param = LAW_PARAMS[i];
+            self.law_params.0[i] = Some(units::parse(param.name, text, dimension(param))?);
+            return Ok(());
+        }
+        let known: Vec<&str> = FIELDS
+            .iter()
+            .map(|(k, _, _)| *k)
+            .chain(LAW_PARAMS.iter().map(|p| p.key))
+            .collect();
+        Err(Error::Parse {
+            name: "key",
+            text: key.to_string(),
+            reason: format!("unknown key; known keys: law, {}", known.join(", ")),
+        })
     }
 
     /// Read a TOML parameter file (keys as the flags' names), at most
@@ -416,13 +471,7 @@ impl TapInputs {
             config: self.config.or(base.config),
             law: self.law.or(base.law),
             contact: self.contact.or(base.contact),
-            hamaker: self.hamaker.or(base.hamaker),
-            viscosity: self.viscosity.or(base.viscosity),
-            rupture_distance: self.rupture_distance.or(base.rupture_distance),
-            surface_tension: self.surface_tension.or(base.surface_tension),
-            contact_angle: self.contact_angle.or(base.contact_angle),
-            unrelaxed_modulus: self.unrelaxed_modulus.or(base.unrelaxed_modulus),
-            relaxation_time: self.relaxation_time.or(base.relaxation_time),
+            law_params: self.law_params.or(base.law_params),
             stiffness: self.stiffness.or(base.stiffness),
             resonance: self.resonance.or(base.resonance),
             quality: self.quality.or(base.quality),
@@ -477,16 +526,10 @@ impl TapInputs {
             contact,
             cantilever,
             separation_m: self.separation.unwrap_or(d.separation_m),
-            law: LawSpec {
-                kind: self.law.unwrap_or(d.law.kind),
-                hamaker_j: self.hamaker.or(d.law.hamaker_j),
-                viscosity_pa_s: self.viscosity.or(d.law.viscosity_pa_s),
-                rupture_distance_m: self.rupture_distance.or(d.law.rupture_distance_m),
-                surface_tension_j_m2: self.surface_tension.or(d.law.surface_tension_j_m2),
-                contact_angle_deg: self.contact_angle.or(d.law.contact_angle_deg),
-                unrelaxed_modulus_pa: self.unrelaxed_modulus.or(d.law.unrelaxed_modulus_pa),
-                relaxation_time_s: self.relaxation_time.or(d.law.relaxation_time_s),
-            },
+            law: LawSpec::from_values(
+                self.law.unwrap_or(d.law.kind),
+                self.law_params.or(LawParamInputs::of(&d.law)).0,
+            ),
         };
         let mut numerics = Numerics::default();
         if let Some(rtol) = self.rtol {
@@ -527,7 +570,11 @@ mod tests {
             .filter_map(|a| a.get_long().map(str::to_string))
             .filter(|long| !["config", "law"].contains(&long.as_str()))
             .collect();
-        let mut keys: Vec<String> = FIELDS.iter().map(|f| f.0.to_string()).collect();
+        let mut keys: Vec<String> = FIELDS
+            .iter()
+            .map(|f| f.0.to_string())
+            .chain(LAW_PARAMS.iter().map(|p| p.key.to_string()))
+            .collect();
         flags.sort();
         keys.sort();
         assert_eq!(flags, keys);
@@ -545,13 +592,30 @@ mod tests {
     }
 
     #[test]
-    fn every_law_parameter_of_the_registry_is_a_key() {
-        for param in crate::law::LAW_PARAMS {
+    fn every_law_parameter_of_the_registry_reaches_the_law_spec() {
+        for (i, param) in LAW_PARAMS.iter().enumerate() {
+            // Read in its own unit, through a key as through its flag.
             assert!(
-                FIELDS.iter().any(|(key, _, _)| *key == param.key),
-                "{}",
-                param.key
+                param.unit == "deg" || dimension(param) != Dimension::Dimensionless,
+                "{}: unit {} has no dimension",
+                param.key,
+                param.unit
             );
+            let mut by_key = TapInputs::default();
+            by_key.set(param.key, "7").unwrap();
+            let flag = format!("--{}", param.key);
+            let by_flag = <TapInputs as clap::FromArgMatches>::from_arg_matches(
+                &TapInputs::augment_args(clap::Command::new("tap"))
+                    .try_get_matches_from(["tap", flag.as_str(), "7"])
+                    .unwrap(),
+            )
+            .unwrap();
+            for inputs in [by_key, by_flag] {
+                let spec = LawSpec::from_values(LawKind::Hertz, inputs.law_params.0);
+                let set: Vec<_> = spec.params().iter().map(|(_, v)| v.is_some()).collect();
+                assert_eq!(set.iter().filter(|s| **s).count(), 1, "{}", param.key);
+                assert_eq!(spec.params()[i].1, Some(7.0), "{}", param.key);
+            }
         }
     }
 

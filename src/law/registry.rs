@@ -122,7 +122,7 @@ pub const RUPTURE_DISTANCE: LawParam = LawParam {
     key: "rupture-distance",
     name: "capillary rupture distance",
     unit: "m",
-    help: "capillary neck (VEDA's model, after Kober et al. 2008) on the hertz or dmt law: \
+    help: "Capillary neck (VEDA's model, after Kober et al. 2008) on the hertz or dmt law: \
            a meniscus forms at contact, pulls with 4πRγ cos θ, falling linearly to zero at \
            this gap D₀ where it breaks, losing 2πRγ cos θ (D₀ − a₀) per cycle (e.g. 2nm) \
            [m; default: none, no neck]",
@@ -139,7 +139,7 @@ pub const SURFACE_TENSION: LawParam = LawParam {
     key: "surface-tension",
     name: "surface tension",
     unit: "J/m²",
-    help: "surface tension γ of the capillary neck's liquid [J/m² or N/m; default 0.072, \
+    help: "Surface tension γ of the capillary neck's liquid [J/m² or N/m; default 0.072, \
            water at 25 °C; only with a rupture distance]",
     taken_by: takes_a_neck,
     range: (
@@ -154,7 +154,7 @@ pub const CONTACT_ANGLE: LawParam = LawParam {
     key: "contact-angle",
     name: "contact angle",
     unit: "deg",
-    help: "contact angle θ of the capillary neck's liquid on tip and sample [degrees, \
+    help: "Contact angle θ of the capillary neck's liquid on tip and sample [degrees, \
            0 <= θ < 90; default 0, complete wetting; only with a rupture distance]",
     taken_by: takes_a_neck,
     range: (
@@ -174,7 +174,7 @@ pub const UNRELAXED_MODULUS: LawParam = LawParam {
     key: "unrelaxed-modulus",
     name: "unrelaxed modulus",
     unit: "Pa",
-    help: "standard-linear-solid sample on the hertz or dmt law (Lee–Radok's hereditary \
+    help: "Standard-linear-solid sample on the hertz or dmt law (Lee–Radok's hereditary \
            Hertz integral with E(t) = E∞ + (E0 − E∞)exp(−t/τ)): its unrelaxed composite \
            modulus E0, above the contact's modulus E*, which is the relaxed E∞ (e.g. 3GPa; \
            give the relaxation time too) [Pa; default: none, elastic]",
@@ -187,7 +187,7 @@ pub const RELAXATION_TIME: LawParam = LawParam {
     key: "relaxation-time",
     name: "relaxation time",
     unit: "s",
-    help: "relaxation time τ of the standard-linear-solid sample (e.g. 1us; give the \
+    help: "Relaxation time τ of the standard-linear-solid sample (e.g. 1us; give the \
            unrelaxed modulus too) [s; default: none, elastic]",
     taken_by: takes_a_relaxing_sample,
     range: (
@@ -279,9 +279,9 @@ impl LawSpec {
         })
     }
 
-    /// The same parameters for law `kind`, leaving out those it does not take (a sweep
-    /// over laws on one material).
-    pub fn with_kind(&self, kind: LawKind) -> Self {
+    /// The spec of law `kind` with the parameters `values`, in the order of
+    /// [`LAW_PARAMS`] (the inverse of [`LawSpec::params`]).
+    pub fn from_values(kind: LawKind, values: [Option<f64>; LAW_PARAMS.len()]) -> Self {
         let [
             hamaker_j,
             viscosity_pa_s,
@@ -290,9 +290,7 @@ impl LawSpec {
             contact_angle_deg,
             unrelaxed_modulus_pa,
             relaxation_time_s,
-        ] = self
-            .params()
-            .map(|(param, value)| value.filter(|_| (param.taken_by)(kind)));
+        ] = values;
         Self {
             kind,
             hamaker_j,
@@ -303,6 +301,16 @@ impl LawSpec {
             unrelaxed_modulus_pa,
             relaxation_time_s,
         }
+    }
+
+    /// The same parameters for law `kind`, leaving out those it does not take (a sweep
+    /// over laws on one material).
+    pub fn with_kind(&self, kind: LawKind) -> Self {
+        Self::from_values(
+            kind,
+            self.params()
+                .map(|(param, value)| value.filter(|_| (param.taken_by)(kind))),
+        )
     }
 
     /// Refuse a parameter the law does not take, naming the laws that do.
