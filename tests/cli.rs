@@ -1208,8 +1208,12 @@ fn a_capillary_neck_is_a_law_parameter_checked_against_the_law() {
     assert_eq!(w["e_ts_j"], v["e_ts_j"]);
     refused(&[
         (
-            vec!["tap", "--law", "jkr", "--rupture-distance", "2nm"],
-            "the jkr law takes no rupture-distance parameter (the laws that do: dmt, hertz)",
+            vec!["tap", "--law", "none", "--rupture-distance", "2nm"],
+            "the none law takes no rupture-distance parameter",
+        ),
+        (
+            vec!["tap", "--law", "jkr", "--rupture-distance", "0.1nm"],
+            "must break beyond the separation where the contact lets go",
         ),
         (
             vec!["tap", "--law", "hertz", "--surface-tension", "72mN/m"],

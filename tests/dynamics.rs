@@ -712,3 +712,89 @@ fn a_relaxing_sample_tends_to_kelvin_voigt_as_its_arm_becomes_a_dashpot() {
     );
     assert!(errors[2] < 1e-5, "{errors:?}");
 }
+
+/// On a hysteretic law (JKR, hybrid, LJ) the neck outlives the contact: it forms at the
+/// law's jump-in α_A, holds through the contact and past its let-go, and breaks at D₀.
+/// Each touch then loses the law's own loop (the adhesion channel) plus the neck's
+/// ∫_{α_A}^{D₀} F_cap dα (the capillary channel), each to 1e-9, alone and with a viscous
+/// sample; the energy balance holds.
+#[test]
+fn a_neck_on_a_hysteretic_law_loses_both_loops_per_touch() {
+    let contact = default_setup().contact;
+    let (rupture, angle) = (2e-9, 20.0);
+    let pull = 4.0 * PI * contact.radius_m * 0.072 * f64::cos(angle * PI / 180.0);
+    // ∫ F_cap dα from α_A to D₀: F_ad below contact, falling linearly to 0 at D₀.
+    let neck_work = |alpha: f64| {
+        if alpha < 0.0 {
+            pull * alpha
+        } else {
+            pull * (alpha - 0.5 * alpha * alpha / rupture)
+        }
+    };
+    for (kind, separation) in [
+        (LawKind::Jkr, 10e-9),
+        (LawKind::Hybrid, 10e-9),
+        (LawKind::Lj, 10e-9),
+    ] {
+        for viscosity in [None, Some(10.0)] {
+            let spec = LawSpec {
+                viscosity_pa_s: viscosity,
+                ..kind.into()
+            };
+            let setup = TapSetup {
+                law: spec,
+                separation_m: separation,
+                ..default_setup()
+            };
+            let plain_run = tap(&setup, &Numerics::default(), Observe::default()).unwrap();
+            let plain = plain_run.observables;
+            let necked = TapSetup {
+                law: LawSpec {
+                    rupture_distance_m: Some(rupture),
+                    contact_angle_deg: Some(angle),
+                    ..spec
+                },
+                ..setup.clone()
+            };
+            let o = tap(&necked, &Numerics::default(), Observe::default())
+                .unwrap()
+                .observables;
+            let name = format!("{} ({})", o.law, o.regime);
+            assert!(o.converged, "{name}");
+            assert!(
+                o.energy_balance_rel < 1e-6,
+                "{name}: {:e}",
+                o.energy_balance_rel
+            );
+            assert!(o.jumps_in > 0.0, "{name}: the tip must touch");
+            // The neck forms where the law jumps in (its own switch separations).
+            let alpha_a = plain_run.switch_separations_m.0;
+            let neck_loop = neck_work(rupture) - neck_work(alpha_a);
+            let per_touch = o.e_ts_capillary_j / o.jumps_in;
+            assert!(
+                (per_touch - neck_loop).abs() <= 1e-9 * neck_loop,
+                "{name}: {per_touch:e} per touch vs {neck_loop:e}"
+            );
+            // The law's own loop, as without the neck.
+            let adhesion = o.e_ts_adhesion_j / o.jumps_in;
+            assert!(
+                (adhesion - plain.loop_area_j).abs() <= 1e-9 * plain.loop_area_j,
+                "{name}: {adhesion:e} vs {:e}",
+                plain.loop_area_j
+            );
+            assert!(
+                (o.loop_area_j - plain.loop_area_j - neck_loop).abs() <= 1e-9 * o.loop_area_j,
+                "{name}"
+            );
+            let sum = o.e_ts_adhesion_j + o.e_ts_viscous_j + o.e_ts_capillary_j;
+            assert!((sum - o.e_ts_j).abs() <= 1e-12 * o.e_ts_j, "{name}");
+            assert_eq!(o.e_ts_viscous_j > 0.0, viscosity.is_some(), "{name}");
+            eprintln!(
+                "{name}: {:.3} touches/period, E_cap {:.4} eV, E_adh {:.4} eV per touch",
+                o.jumps_in,
+                per_touch / 1.602176634e-19,
+                adhesion / 1.602176634e-19
+            );
+        }
+    }
+}

@@ -44,6 +44,30 @@ pub(crate) enum Crossing {
     Up,
 }
 
+/// A switching level and the way α̂ must cross it.
+pub(crate) type Event = (f64, Crossing);
+
+/// Where a branch ends: α̂ falling to `below`, or rising to `above` (none: it runs on).
+/// A branch bounded on both sides (a capillary neck that outlives a hysteretic contact:
+/// it breaks above, the tip touches again below) ends at whichever it meets first.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Events {
+    /// The level α̂ falls to.
+    pub below: Option<f64>,
+    /// The level α̂ rises to.
+    pub above: Option<f64>,
+}
+
+impl Events {
+    /// Each event, the falling one first.
+    fn each(self) -> impl Iterator<Item = Event> {
+        self.below
+            .map(|level| (level, Crossing::Down))
+            .into_iter()
+            .chain(self.above.map(|level| (level, Crossing::Up)))
+    }
+}
+
 /// A sample of the trajectory at the end of an accepted step.
 #[derive(Debug, Clone, Copy)]
 pub struct StepEnd<const N: usize = BASE> {
@@ -121,13 +145,14 @@ pub fn internal_at<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, tau: f64) -> 
 struct Progress<const N: usize> {
     /// The last accepted step end.
     last: StepEnd<N>,
-    /// The step in which the switch happened (its start and end) and the located time.
-    hit: Option<(StepEnd<N>, StepEnd<N>, f64)>,
+    /// The step in which the switch happened (its start and end), the located time and
+    /// the event.
+    hit: Option<(StepEnd<N>, StepEnd<N>, f64, Event)>,
     /// Length of the first accepted step (0 until there is one).
     h: f64,
-    /// The step end from which the switch is close enough to land on (Hénon), and the
-    /// length of the step that ended there.
-    approach: Option<(StepEnd<N>, f64)>,
+    /// The step end from which the switch is close enough to land on (Hénon), the
+    /// length of the step that ended there, and the event.
+    approach: Option<(StepEnd<N>, f64, Event)>,
 }
 
 struct Segment<'a, L: ForceLaw, O: StepObserver, const N: usize> {
@@ -135,8 +160,8 @@ struct Segment<'a, L: ForceLaw, O: StepObserver, const N: usize> {
     osc: &'a Oscillator,
     cpl: &'a Coupling,
     branch: Branch,
-    /// Switching level and direction; `None` to run to the end.
-    event: Option<(f64, Crossing)>,
+    /// Where the branch ends (none: run to the end of the span).
+    events: Events,
     /// Whether to stop short of the switch to land on it ([`land`]).
     land: bool,
     /// End of the span.
@@ -249,21 +274,28 @@ impl<L: ForceLaw, O: StepObserver, const N: usize> System<f64, State<N>> for Seg
             dy: *dy,
         };
         let start = self.progress.last;
-        if let Some((level, crossing)) = self.event {
-            if let Some(t) = self.locate(&start, &end, level, crossing) {
-                self.progress.hit = Some((start, end, t));
-                return true;
-            }
+        let first = self
+            .events
+            .each()
+            .filter_map(|event| Some((self.locate(&start, &end, event.0, event.1)?, event)))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((t, event)) = first {
+            self.progress.hit = Some((start, end, t, event));
+            return true;
         }
         self.observer.step(&start, &end, self.branch);
         if self.progress.h == 0.0 {
             self.progress.h = end.tau - start.tau;
         }
         self.progress.last = end;
-        if let (true, Some((level, crossing))) = (self.land, self.event) {
+        if self.land {
             let h = end.tau - start.tau;
-            if self.within_reach(&end, h, level, crossing) {
-                self.progress.approach = Some((end, h));
+            let near = self
+                .events
+                .each()
+                .find(|&(level, crossing)| self.within_reach(&end, h, level, crossing));
+            if let Some(event) = near {
+                self.progress.approach = Some((end, h, event));
                 return true;
             }
         }
@@ -408,8 +440,8 @@ pub(crate) struct SegmentEnd<const N: usize = BASE> {
     pub tau: f64,
     /// State at the end.
     pub y: State<N>,
-    /// Whether it ended at a branch switch (else at `tau_end`).
-    pub switched: bool,
+    /// The event it ended at, a branch switch (none: it ended at `tau_end`).
+    pub switched: Option<Crossing>,
     /// Length of the first accepted step (a good first step for the next segment on
     /// the same branch, which starts in the same state of the motion).
     pub h_first: f64,
@@ -486,6 +518,7 @@ fn run<S: System<f64, State<N>>, const N: usize>(
     let branch = match branch {
         Branch::Free => "out-of-contact",
         Branch::Contact => "contact",
+        Branch::Necked => "capillary-neck",
     };
     // (A law with internal state — a relaxing sample on Hertz or DMT — has no fold to
     // stall at; its variational equations take steps of its relaxation time for good.)
@@ -523,16 +556,15 @@ fn run<S: System<f64, State<N>>, const N: usize>(
     }
 }
 
-/// Integrate branch `branch` from (`tau0`, `y0`) to `tau_end`, stopping at the first
-/// crossing of `event` (level, direction) if given. `h0` is the first trial step (0 lets
-/// the solver choose).
+/// Integrate branch `branch` from (`tau0`, `y0`) to `tau_end`, stopping at the first of
+/// its `events` met. `h0` is the first trial step (0 lets the solver choose).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn integrate<L: ForceLaw, O: StepObserver, const N: usize>(
     law: &L,
     osc: &Oscillator,
     cpl: &Coupling,
     branch: Branch,
-    event: Option<(f64, Crossing)>,
+    events: Events,
     tau0: f64,
     y0: State<N>,
     tau_end: f64,
@@ -545,7 +577,7 @@ pub(crate) fn integrate<L: ForceLaw, O: StepObserver, const N: usize>(
         osc,
         cpl,
         branch,
-        event,
+        events,
         tau_end,
         tol,
     };
@@ -558,7 +590,7 @@ struct Span<'a, L: ForceLaw> {
     osc: &'a Oscillator,
     cpl: &'a Coupling,
     branch: Branch,
-    event: Option<(f64, Crossing)>,
+    events: Events,
     tau_end: f64,
     tol: &'a Tolerances,
 }
@@ -579,7 +611,7 @@ impl<L: ForceLaw> Span<'_, L> {
             osc,
             cpl,
             branch,
-            event,
+            events,
             tau_end,
             tol,
         } = *self;
@@ -592,7 +624,7 @@ impl<L: ForceLaw> Span<'_, L> {
             return Ok(SegmentEnd {
                 tau: tau_end,
                 y: y0 + dy0 * (tau_end - tau0),
-                switched: false,
+                switched: None,
                 h_first: 0.0,
             });
         }
@@ -611,20 +643,20 @@ impl<L: ForceLaw> Span<'_, L> {
             osc,
             cpl,
             branch,
-            event,
+            events,
             land: land_on_switch,
             tau_end,
             progress: &mut progress,
             observer: &mut *observer,
         };
         run(segment, tau0, tau_end, y0, h0, tol, branch)?;
-        if let (Some((entry, h)), Some(event)) = (progress.approach, event) {
+        if let Some((entry, h, event)) = progress.approach {
             let landed = land(law, osc, cpl, branch, event, entry, tau_end, tol, observer)?;
             let end = match landed {
                 Some(end) => SegmentEnd {
                     tau: end.tau,
                     y: end.y,
-                    switched: true,
+                    switched: Some(event.1),
                     h_first: progress.h,
                 },
                 // Carry on from where the landing started, locating the crossing.
@@ -635,23 +667,23 @@ impl<L: ForceLaw> Span<'_, L> {
             };
             return Ok(end);
         }
-        let Some((start, hit_end, t_hit)) = progress.hit else {
+        let Some((start, hit_end, t_hit, event)) = progress.hit else {
             let last = progress.last;
             return Ok(SegmentEnd {
                 tau: last.tau,
                 y: last.y,
-                switched: false,
+                switched: None,
                 h_first: progress.h,
             });
         };
-        let (tau, y) = self.polish(start, hit_end, t_hit)?;
+        let (tau, y) = self.polish(start, hit_end, t_hit, event)?;
         let mut dy = State::<N>::zeros();
         rhs(law, osc, cpl, branch, tau, &y, &mut dy);
         observer.step(&start, &StepEnd { tau, y, dy }, branch);
         Ok(SegmentEnd {
             tau,
             y,
-            switched: true,
+            switched: Some(event.1),
             h_first: progress.h,
         })
     }
@@ -666,8 +698,8 @@ impl<L: ForceLaw> Span<'_, L> {
         start: StepEnd<N>,
         hit_end: StepEnd<N>,
         t_hit: f64,
+        (level, crossing): Event,
     ) -> Result<(f64, State<N>)> {
-        let (level, crossing) = self.event.expect("a hit implies an event");
         let mut t = t_hit;
         let mut y = start.y;
         for attempt in 0..4 {
@@ -687,7 +719,7 @@ impl<L: ForceLaw> Span<'_, L> {
                     osc: self.osc,
                     cpl: self.cpl,
                     branch: self.branch,
-                    event: None,
+                    events: Events::default(),
                     land: false,
                     tau_end: t,
                     progress: &mut refine,
@@ -733,7 +765,7 @@ mod tests {
     impl ForceLaw for Cusp {
         fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
             match branch {
-                Branch::Free => 0.0,
+                Branch::Free | Branch::Necked => 0.0,
                 Branch::Contact => {
                     let d = LEVEL - alpha_hat;
                     1.0 - d.signum() * d.abs().sqrt()
@@ -742,7 +774,7 @@ mod tests {
         }
         fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
             match branch {
-                Branch::Free => 0.0,
+                Branch::Free | Branch::Necked => 0.0,
                 Branch::Contact => 0.5 / (LEVEL - alpha_hat).abs().sqrt().max(1e-8),
             }
         }
@@ -789,7 +821,10 @@ mod tests {
             osc: &osc,
             cpl: &cpl,
             branch: Branch::Contact,
-            event: Some((LEVEL, Crossing::Up)),
+            events: Events {
+                below: None,
+                above: Some(LEVEL),
+            },
             tau_end: 4.0,
             tol: &tol,
         };
@@ -806,7 +841,8 @@ mod tests {
         for v0 in [0.5435, 0.6, 0.8] {
             let landed = to_switch(v0, true);
             let located = to_switch(v0, false);
-            assert!(landed.switched && located.switched);
+            assert_eq!(landed.switched, Some(Crossing::Up));
+            assert_eq!(located.switched, Some(Crossing::Up));
             // Landing ends exactly on the level; locating polishes to 1e-8 in α̂.
             assert!((landed.y[X] - LEVEL).abs() < 1e-14, "{}", landed.y[X]);
             assert!((located.y[X] - LEVEL).abs() < 2e-8, "{}", located.y[X]);
@@ -851,7 +887,7 @@ mod tests {
         // Held back by f = −0.1·T̂, the tip turns a hair below the fold for v₀ = 0.542.
         for land_on_switch in [true, false] {
             let end = to_switch(0.542, land_on_switch);
-            assert!(!end.switched);
+            assert_eq!(end.switched, None);
             assert_eq!(end.tau, 4.0);
             assert!(end.y[X] < LEVEL);
         }

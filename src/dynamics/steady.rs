@@ -22,9 +22,11 @@ use super::model::{
     TANGENT, V, X, chain, dissipative_work_index, has_tangent, internal, internal_count, phi,
     phi_start, relax_internal, section_dim, set_internal, set_phi,
 };
-use super::numeric::{self, Crossing, StepEnd, StepObserver, Tolerances, hermite, internal_at};
+use super::numeric::{
+    self, Crossing, Events, StepEnd, StepObserver, Tolerances, hermite, internal_at,
+};
 use crate::error::{Error, Result};
-use crate::law::{Branch, ForceLaw, Internal, MAX_INTERNAL};
+use crate::law::{Branch, Exits, ForceLaw, Internal, MAX_INTERNAL};
 use nalgebra::{Complex, DMatrix, DVector};
 
 /// Where the oscillator is: time, deflection, velocity, the law's internal state and
@@ -41,9 +43,9 @@ pub struct Phase {
     pub internal: Internal,
     /// Contact branch.
     pub branch: Branch,
-    /// First trial step for the next numerical segment on each branch (free, contact;
-    /// 0: the solver's choice).
-    pub h_next: [f64; 2],
+    /// First trial step for the next numerical segment on each branch (free, contact,
+    /// necked; 0: the solver's choice).
+    pub h_next: [f64; Branch::COUNT],
 }
 
 impl Phase {
@@ -55,7 +57,7 @@ impl Phase {
             v: 0.0,
             internal: Internal::default(),
             branch: Branch::Free,
-            h_next: [0.0; 2],
+            h_next: [0.0; Branch::COUNT],
         }
     }
 
@@ -420,7 +422,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             v,
             internal: Internal::default(),
             branch: self.branch_at(0.0, x),
-            h_next: [0.0; 2],
+            h_next: [0.0; Branch::COUNT],
         }
     }
 
@@ -440,8 +442,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
     }
 
     /// Integrate one drive period from `phase`, updating it, with the derivative of the
-    /// period map, ∂z(τ + T)/∂(z, q)(τ), z = (x, x') and the law's internal state
-    /// ([`Simulation::z`]), q = z_c/L: the variational equations along every segment, the
+    /// period map, ∂z(τ + T)/∂(z, q)(τ), z the section state ([`Simulation::z`]: x, x'
+    /// and the law's internal state, in its units), q = z_c/L: the variational equations along every segment, the
     /// free flight's transition matrix in closed form, and at every branch switch the
     /// saltation matrix: where the force jumps by Δf_ts as α̂ crosses its level, δx'
     /// gains Δf_ts(δx + δq)/(x' + x_b') (and an internal variable whose rate jumps, its
@@ -457,7 +459,19 @@ impl<L: ForceLaw> Simulation<'_, L> {
         } else {
             self.cycle_in::<TANGENT, _>(phase, &mut numeric::Ignore)
         }?;
-        Ok((integrals, derivative.expect("a tangent layout carries Φ")))
+        let mut derivative = derivative.expect("a tangent layout carries Φ");
+        // In the section's units (`Simulation::z`): internal rows times f_scale, internal
+        // columns divided by it.
+        let d = derivative.nrows();
+        for row in 2 * MODES..d {
+            for col in 0..=d {
+                derivative[(row, col)] *= self.cpl.f_scale;
+                if col < d {
+                    derivative[(col, row)] /= self.cpl.f_scale;
+                }
+            }
+        }
+        Ok((integrals, derivative))
     }
 
     /// Move `phase` back by whole drive periods to τ in [0, T): the drive is periodic,
@@ -476,10 +490,16 @@ impl<L: ForceLaw> Simulation<'_, L> {
     /// above the jump-out one).
     fn consistent_branch(&self, phase: &Phase) -> Branch {
         let alpha = self.cpl.alpha_hat(phase.x, self.osc.base_at(phase.tau).0);
-        match phase.branch {
-            Branch::Free if alpha <= self.law.jump_in_alpha_hat() => Branch::Contact,
-            Branch::Contact if alpha >= self.law.jump_out_alpha_hat() => Branch::Free,
-            b => b,
+        match self.law.exits(phase.branch) {
+            Exits {
+                below: Some((level, next)),
+                ..
+            } if alpha <= level => next,
+            Exits {
+                above: Some((level, next)),
+                ..
+            } if alpha >= level => next,
+            _ => phase.branch,
         }
     }
 
@@ -559,15 +579,25 @@ impl<L: ForceLaw> Simulation<'_, L> {
         // An internal state evolves in free flight too: in closed form if the law says
         // how it relaxes there, else integrated with the motion.
         let relaxation = self.law.free_relaxation_rates();
-        let closed_form = self.law.free_branch_is_force_free()
-            && (internal_count(N) == 0 || relaxation.is_some());
+        // (Closed-form free flight ends only falling to the jump-in, into contact.)
+        let (jump_in, closed_form) = match self.law.exits(Branch::Free) {
+            Exits {
+                below: Some((level, Branch::Contact)),
+                above: None,
+            } => (
+                level,
+                self.law.free_branch_is_force_free()
+                    && (internal_count(N) == 0 || relaxation.is_some()),
+            ),
+            _ => (f64::NAN, false),
+        };
         // Stop when the remaining time is round-off.
         while tau_end - tau > 1e-12 * period {
             let flight = (phase.branch == Branch::Free && closed_form)
                 .then(|| FreeFlight::new(&self.osc, tau, y[X], y[V]))
                 .flatten();
             if let Some(flight) = flight {
-                let level = self.cpl.x_at(self.law.jump_in_alpha_hat());
+                let level = self.cpl.x_at(jump_in);
                 let (hit, min_x) = flight.first_fall_to(level, tau, tau_end, period / 8.0);
                 let stop = hit.unwrap_or(tau_end);
                 flight.advance(&mut y, tau, stop);
@@ -584,11 +614,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 }
                 continue;
             }
-            let (level, crossing) = match phase.branch {
-                Branch::Free => (self.law.jump_in_alpha_hat(), Crossing::Down),
-                Branch::Contact => (self.law.jump_out_alpha_hat(), Crossing::Up),
+            let exits = self.law.exits(phase.branch);
+            let level = |exit: Option<(f64, Branch)>| exit.map(|e| e.0).filter(|l| l.is_finite());
+            let events = Events {
+                below: level(exits.below),
+                above: level(exits.above),
             };
-            let event = level.is_finite().then_some((level, crossing));
             let alpha_at =
                 |tau: f64, y: &State<N>| self.cpl.alpha_hat(y[X], self.osc.base_at(tau).0);
             let alpha_start = alpha_at(tau, &y);
@@ -599,7 +630,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 &self.osc,
                 &self.cpl,
                 phase.branch,
-                event,
+                events,
                 tau,
                 y,
                 tau_end,
@@ -619,17 +650,14 @@ impl<L: ForceLaw> Simulation<'_, L> {
             }
             tau = end.tau;
             y = end.y;
-            if end.switched {
-                let next = match phase.branch {
-                    Branch::Free => {
-                        jumps_in += 1;
-                        Branch::Contact
-                    }
-                    Branch::Contact => {
-                        jumps_out += 1;
-                        Branch::Free
-                    }
+            if let Some(crossing) = end.switched {
+                let exit = match crossing {
+                    Crossing::Down => exits.below,
+                    Crossing::Up => exits.above,
                 };
+                let next = exit.expect("a switch happens at an exit").1;
+                jumps_in += u32::from(next == Branch::Contact);
+                jumps_out += u32::from(phase.branch == Branch::Contact);
                 self.saltation(tau, &mut y, phase.branch, next);
                 phase.branch = next;
             }
@@ -701,17 +729,6 @@ impl<L: ForceLaw> Simulation<'_, L> {
             }
         }
         let back = p.branch == branch && self.z(&p).iter().all(|c| c.is_finite());
-        // The derivative in the section's units: internal rows times f_scale, internal
-        // columns divided by it.
-        let d = z.len();
-        for row in 2 * MODES..d {
-            for col in 0..=d {
-                derivative[(row, col)] *= self.cpl.f_scale;
-                if col < d {
-                    derivative[(col, row)] /= self.cpl.f_scale;
-                }
-            }
-        }
         Ok(back.then(|| MapValue {
             end: p,
             derivative,

@@ -214,23 +214,23 @@ impl ForceLaw for AdhesiveLaw {
     #[inline]
     fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         match (branch, &self.approach) {
-            (Branch::Free, None) => 0.0,
-            (Branch::Free, Some(a)) => a.t_hat(alpha_hat),
+            (Branch::Free | Branch::Necked, None) => 0.0,
+            (Branch::Free | Branch::Necked, Some(a)) => a.t_hat(alpha_hat),
             (Branch::Contact, _) => self.contact.t_hat(alpha_hat),
         }
     }
     #[inline]
     fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         match (branch, &self.approach) {
-            (Branch::Free, None) => 0.0,
-            (Branch::Free, Some(a)) => a.slope_hat(alpha_hat),
+            (Branch::Free | Branch::Necked, None) => 0.0,
+            (Branch::Free | Branch::Necked, Some(a)) => a.slope_hat(alpha_hat),
             (Branch::Contact, _) => self.contact.slope_hat(alpha_hat),
         }
     }
     fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         match (branch, &self.approach) {
-            (Branch::Free, None) => 0.0,
-            (Branch::Free, Some(a)) => a.work_hat(alpha_hat),
+            (Branch::Free | Branch::Necked, None) => 0.0,
+            (Branch::Free | Branch::Necked, Some(a)) => a.work_hat(alpha_hat),
             (Branch::Contact, _) => self.contact.work_hat(alpha_hat),
         }
     }

@@ -43,6 +43,24 @@ pub enum Branch {
     Free,
     /// In contact.
     Contact,
+    /// Out of contact with a capillary neck still attached: a neck on a hysteretic
+    /// contact law outlives the contact (no other law enters it).
+    Necked,
+}
+
+impl Branch {
+    /// How many there are (the integrator keeps a first step per branch).
+    pub const COUNT: usize = 3;
+}
+
+/// Where a branch ends and which branch follows: α̂ falling to `below.0` enters
+/// `below.1`, α̂ rising to `above.0` enters `above.1` (none: the branch runs on that way).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exits {
+    /// The level α̂ falls to and the branch entered there.
+    pub below: Option<(f64, Branch)>,
+    /// The level α̂ rises to and the branch entered there.
+    pub above: Option<(f64, Branch)>,
 }
 
 /// Most internal state variables a law may declare ([`ForceLaw::internal_states`]).
@@ -119,6 +137,22 @@ pub trait ForceLaw: Send + Sync {
     fn jump_in_alpha_hat(&self) -> f64;
     /// Separation at which the Contact branch gives way to Free on the way up.
     fn jump_out_alpha_hat(&self) -> f64;
+    /// Where `branch` ends and which branch follows. By default the two-branch law of
+    /// [`ForceLaw::jump_in_alpha_hat`] and [`ForceLaw::jump_out_alpha_hat`]: Free ends
+    /// falling to the jump-in separation (into Contact), Contact rising to the jump-out
+    /// one (into Free); a law that never enters [`Branch::Necked`] gives it Free's.
+    fn exits(&self, branch: Branch) -> Exits {
+        match branch {
+            Branch::Free | Branch::Necked => Exits {
+                below: Some((self.jump_in_alpha_hat(), Branch::Contact)),
+                above: None,
+            },
+            Branch::Contact => Exits {
+                below: None,
+                above: Some((self.jump_out_alpha_hat(), Branch::Free)),
+            },
+        }
+    }
     /// Whether T̂ is identically zero on the Free branch above the jump-in separation
     /// (motion there is then a linear oscillator with a closed-form solution).
     fn free_branch_is_force_free(&self) -> bool;
@@ -285,6 +319,9 @@ impl ForceLaw for Necked {
     fn jump_out_alpha_hat(&self) -> f64 {
         self.0.jump_out_alpha_hat()
     }
+    fn exits(&self, branch: Branch) -> Exits {
+        self.0.exits(branch)
+    }
     fn free_branch_is_force_free(&self) -> bool {
         self.0.free_branch_is_force_free()
     }
@@ -346,6 +383,9 @@ impl ForceLaw for Rheology {
     }
     fn jump_out_alpha_hat(&self) -> f64 {
         rheology!(self, l => l.jump_out_alpha_hat())
+    }
+    fn exits(&self, branch: Branch) -> Exits {
+        rheology!(self, l => l.exits(branch))
     }
     fn free_branch_is_force_free(&self) -> bool {
         rheology!(self, l => l.free_branch_is_force_free())
@@ -419,7 +459,7 @@ impl AnyLaw {
         };
         let elastic = match spec.neck() {
             Some(neck) => {
-                // The gap at contact: DMT's d = α + ε, Hertz's d = α.
+                // The gap at contact: DMT's d = α + ε, the other laws' d = α.
                 let contact_gap_m = if kind == LawKind::Dmt {
                     contact.range_m
                 } else {
@@ -488,6 +528,9 @@ impl ForceLaw for AnyLaw {
     }
     fn jump_out_alpha_hat(&self) -> f64 {
         dispatch!(self, l => l.jump_out_alpha_hat())
+    }
+    fn exits(&self, branch: Branch) -> Exits {
+        dispatch!(self, l => l.exits(branch))
     }
     fn free_branch_is_force_free(&self) -> bool {
         dispatch!(self, l => l.free_branch_is_force_free())

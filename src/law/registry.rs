@@ -112,9 +112,9 @@ pub const VISCOSITY: LawParam = LawParam {
     ),
 };
 
-/// Whether a law takes a capillary neck: one without hysteresis of its own.
+/// Whether a law takes a capillary neck: any with a contact.
 fn takes_a_neck(law: LawKind) -> bool {
-    matches!(law, LawKind::Hertz | LawKind::Dmt)
+    law != LawKind::None
 }
 
 /// A capillary neck's rupture distance: giving it puts the neck on.
@@ -122,9 +122,10 @@ pub const RUPTURE_DISTANCE: LawParam = LawParam {
     key: "rupture-distance",
     name: "capillary rupture distance",
     unit: "m",
-    help: "Capillary neck (VEDA's model, after Kober et al. 2008) on the hertz or dmt law: \
-           a meniscus forms at contact, pulls with 4πRγ cos θ, falling linearly to zero at \
-           this gap D₀ where it breaks, losing 2πRγ cos θ (D₀ − a₀) per cycle (e.g. 2nm) \
+    help: "Capillary neck (VEDA's model, after Kober et al. 2008) on any contact law: a \
+           meniscus forms at contact (a hysteretic law's jump-in), pulls with 4πRγ cos θ, \
+           falling linearly to zero at this gap D₀ where it breaks (beyond the contact's \
+           own let-go), losing 2πRγ cos θ (D₀ − a₀) per cycle on hertz or dmt (e.g. 2nm) \
            [m; default: none, no neck]",
     taken_by: takes_a_neck,
     range: (

@@ -112,6 +112,9 @@ impl<L: ForceLaw> ForceLaw for StandardLinearSolid<L> {
     fn jump_out_alpha_hat(&self) -> f64 {
         self.elastic.jump_out_alpha_hat()
     }
+    fn exits(&self, branch: Branch) -> super::Exits {
+        self.elastic.exits(branch)
+    }
     fn free_branch_is_force_free(&self) -> bool {
         // The Maxwell force acts only in contact (its memory relaxes outside, which the
         // integrator carries: see `internal_states`).
@@ -132,13 +135,13 @@ impl<L: ForceLaw> ForceLaw for StandardLinearSolid<L> {
             Branch::Contact => {
                 self.modulus_ratio * (state.internal[0] + hertz_t_hat(state.alpha_hat))
             }
-            Branch::Free => 0.0,
+            Branch::Free | Branch::Necked => 0.0,
         }
     }
     fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
         match state.branch {
             Branch::Contact => (self.modulus_ratio * hertz_slope_hat(state.alpha_hat), 0.0),
-            Branch::Free => (0.0, 0.0),
+            Branch::Free | Branch::Necked => (0.0, 0.0),
         }
     }
     #[inline]
@@ -156,7 +159,7 @@ impl<L: ForceLaw> ForceLaw for StandardLinearSolid<L> {
             rate_d_internal: [[-1.0 / self.relaxation_hat]],
             force_d_internal: [match state.branch {
                 Branch::Contact => self.modulus_ratio,
-                Branch::Free => 0.0,
+                Branch::Free | Branch::Necked => 0.0,
             }],
         }
     }

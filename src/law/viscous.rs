@@ -81,6 +81,9 @@ impl<L: ForceLaw> ForceLaw for KelvinVoigt<L> {
     fn jump_out_alpha_hat(&self) -> f64 {
         self.elastic.jump_out_alpha_hat()
     }
+    fn exits(&self, branch: Branch) -> super::Exits {
+        self.elastic.exits(branch)
+    }
     fn free_branch_is_force_free(&self) -> bool {
         // The viscous force acts only in contact.
         self.elastic.free_branch_is_force_free()

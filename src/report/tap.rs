@@ -218,12 +218,14 @@ pub fn trajectory_charts(run: &TapRun, title: &str) -> Vec<Chart> {
     let split = |pick: &dyn Fn(&TrajectorySample) -> (f64, f64)| -> Vec<Series> {
         let mut contact_named = false;
         let mut free_named = false;
+        let mut neck_named = false;
         runs(t, pick)
             .into_iter()
             .map(|(branch, pts)| {
                 let (name, color, named) = match branch {
                     Branch::Free => ("out of contact", 2, &mut free_named),
                     Branch::Contact => ("in contact", 1, &mut contact_named),
+                    Branch::Necked => ("neck attached", 3, &mut neck_named),
                 };
                 // Only the first run of each branch carries a legend entry.
                 let label = if *named {
