@@ -1254,6 +1254,15 @@ fn a_relaxing_sample_is_a_law_parameter_checked_against_the_law() {
     ];
     let v = json(&args);
     assert_eq!(v["law"], "hertz+sls");
+    // With a capillary neck too: every channel but the law's own (it has no loop).
+    let mut necked = args.to_vec();
+    necked.extend(["--rupture-distance", "2nm"]);
+    let n = json(&necked);
+    assert_eq!(n["law"], "hertz+capillary+sls");
+    assert!(
+        num(&n, "e_ts_capillary_j") > 0.0 && num(&n, "e_ts_viscous_j") > 0.0,
+        "{n}"
+    );
     assert_eq!(v["e_ts_viscous_j"], v["e_ts_j"]);
     assert!(num(&v, "e_ts_j") > 0.0 && num(&v, "energy_balance_rel") < 1e-6);
     // Its Floquet multipliers: one per dimension of the section state (x, x', memory).
@@ -1302,17 +1311,6 @@ fn a_relaxing_sample_is_a_law_parameter_checked_against_the_law() {
                 "5",
             ]),
             "takes no viscosity",
-        ),
-        (
-            sls(&[
-                "--unrelaxed-modulus",
-                "3GPa",
-                "--relaxation-time",
-                "1us",
-                "--rupture-distance",
-                "2nm",
-            ]),
-            "takes no capillary neck",
         ),
         (
             sls(&["--unrelaxed-modulus", "0.3GPa", "--relaxation-time", "1us"]),

@@ -101,6 +101,16 @@ impl<L: ForceLaw> Capillary<L> {
         })
     }
 
+    /// The same neck as a state of its own even on a law without hysteresis: the contact
+    /// ends where the law's does (α̂ = 0) and the neck holds on in [`Branch::Necked`], so
+    /// that a force acting only in contact (a relaxing sample's) stops there.
+    pub fn outliving_contact(self) -> Self {
+        Self {
+            outlives_contact: true,
+            ..self
+        }
+    }
+
     /// The contact law's branch under `branch`: out of contact with the neck attached
     /// is the law's approach branch.
     #[inline]

@@ -7,6 +7,46 @@
 //! back when α̂ rises to [`ForceLaw::jump_out_alpha_hat`]. Conservative laws switch both
 //! ways at the same separation; hysteretic laws enclose [`ForceLaw::loop_area_hat`].
 
+/// The methods of a wrapper around a contact law (its field `elastic`) that leaves the
+/// law's elastic part as it is: force, slope and work function per branch, the
+/// capillary share, the switches and the loop. A wrapper that adds a rate-dependent
+/// force (a viscous or relaxing sample) writes only what it adds.
+macro_rules! elastic_part_from_inside {
+    () => {
+        #[inline]
+        fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.elastic.t_hat(alpha_hat, branch)
+        }
+        #[inline]
+        fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.elastic.slope_hat(alpha_hat, branch)
+        }
+        fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.elastic.work_hat(alpha_hat, branch)
+        }
+        fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.elastic.capillary_work_hat(alpha_hat, branch)
+        }
+        fn jump_in_alpha_hat(&self) -> f64 {
+            self.elastic.jump_in_alpha_hat()
+        }
+        fn jump_out_alpha_hat(&self) -> f64 {
+            self.elastic.jump_out_alpha_hat()
+        }
+        fn exits(&self, branch: Branch) -> super::Exits {
+            self.elastic.exits(branch)
+        }
+        /// The added force acts only in contact.
+        fn free_branch_is_force_free(&self) -> bool {
+            self.elastic.free_branch_is_force_free()
+        }
+        /// The elastic law's own loop (what the added force loses depends on the motion).
+        fn loop_area_hat(&self) -> f64 {
+            self.elastic.loop_area_hat()
+        }
+    };
+}
+
 mod adhesive;
 mod capillary;
 mod conservative;
@@ -465,12 +505,14 @@ impl AnyLaw {
                 } else {
                     0.0
                 };
-                AnyLaw::Capillary(Necked(Box::new(Capillary::new(
-                    elastic,
-                    &neck,
-                    contact,
-                    contact_gap_m,
-                )?)))
+                let capillary = Capillary::new(elastic, &neck, contact, contact_gap_m)?;
+                // A relaxing sample's Maxwell force acts in contact only, so the neck
+                // takes a state of its own beyond it.
+                AnyLaw::Capillary(Necked(Box::new(if spec.relaxing().is_some() {
+                    capillary.outliving_contact()
+                } else {
+                    capillary
+                })))
             }
             None => elastic,
         };

@@ -354,13 +354,6 @@ impl LawSpec {
                     .into(),
             ));
         }
-        if self.relaxing().is_some() && self.rupture_distance_m.is_some() {
-            return Err(Error::NotApplicable(
-                "a standard-linear-solid sample takes no capillary neck: its Maxwell force \
-                 would act on the neck's part of the contact branch, beyond contact"
-                    .into(),
-            ));
-        }
         Ok(())
     }
 }

@@ -61,37 +61,7 @@ impl<L: ForceLaw> KelvinVoigt<L> {
 }
 
 impl<L: ForceLaw> ForceLaw for KelvinVoigt<L> {
-    #[inline]
-    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.elastic.t_hat(alpha_hat, branch)
-    }
-    #[inline]
-    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.elastic.slope_hat(alpha_hat, branch)
-    }
-    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.elastic.work_hat(alpha_hat, branch)
-    }
-    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.elastic.capillary_work_hat(alpha_hat, branch)
-    }
-    fn jump_in_alpha_hat(&self) -> f64 {
-        self.elastic.jump_in_alpha_hat()
-    }
-    fn jump_out_alpha_hat(&self) -> f64 {
-        self.elastic.jump_out_alpha_hat()
-    }
-    fn exits(&self, branch: Branch) -> super::Exits {
-        self.elastic.exits(branch)
-    }
-    fn free_branch_is_force_free(&self) -> bool {
-        // The viscous force acts only in contact.
-        self.elastic.free_branch_is_force_free()
-    }
-    fn loop_area_hat(&self) -> f64 {
-        // The elastic law's own loop; the viscous loss depends on the motion.
-        self.elastic.loop_area_hat()
-    }
+    elastic_part_from_inside!();
     fn is_rate_dependent(&self) -> bool {
         true
     }
