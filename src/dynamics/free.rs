@@ -2,7 +2,7 @@
 //! force: x'' + 2γx' + x = f₀ cos Ωτ. Exact, so free flight costs no integration steps,
 //! and so are the carried integrals.
 
-use super::model::{Carried, Drive, Oscillator, State, V, X, has_tangent, phi, set_phi};
+use super::model::{Carried, Drive, Oscillator, State, V, X, has_tangent, phi_column, section_dim};
 use crate::numeric::newton_bracketed;
 use nalgebra::{Complex, Matrix2};
 
@@ -146,12 +146,15 @@ impl FreeFlight {
         y[Carried::CosProjection] += sc;
         y[Carried::SinProjection] += ss;
         if has_tangent(N) {
-            // The rows of x and x' (a law's internal rows are the caller's:
-            // `relax_internal`).
-            let mut phi = phi(y);
-            let moved = self.transition(tau_b - tau_a) * phi.rows(0, 2);
-            phi.rows_mut(0, 2).copy_from(&moved);
-            set_phi(y, &phi);
+            // The rows of x and x', column by column (a law's internal rows are the
+            // caller's: `relax_internal`).
+            let t = self.transition(tau_b - tau_a);
+            for col in 0..=section_dim(N) {
+                let at = phi_column(N, col);
+                let (dx, dv) = (y[at], y[at + 1]);
+                y[at] = t[(0, 0)] * dx + t[(0, 1)] * dv;
+                y[at + 1] = t[(1, 0)] * dx + t[(1, 1)] * dv;
+            }
         }
     }
 

@@ -218,16 +218,14 @@ pub(crate) fn relax_internal<const N: usize>(
     if internal_count(N) == 0 {
         return;
     }
-    let mut phi = has_tangent(N).then(|| phi(y));
     for (k, rate) in rates.iter().enumerate().take(internal_count(N)) {
         let factor = (-rate * span).exp();
         y[Part::Internal(k)] *= factor;
-        if let Some(phi) = phi.as_mut() {
-            phi.row_mut(2 * MODES + k).scale_mut(factor);
+        if has_tangent(N) {
+            for col in 0..=section_dim(N) {
+                y[phi_column(N, col) + 2 * MODES + k] *= factor;
+            }
         }
-    }
-    if let Some(phi) = phi {
-        set_phi(y, &phi);
     }
 }
 
@@ -238,17 +236,28 @@ pub fn phi<const N: usize>(y: &State<N>) -> DMatrix<f64> {
     DMatrix::from_column_slice(d, d + 1, &y.as_slice()[at..at + phi_len(d)])
 }
 
-/// Store `m` as Φ of a state with a tangent.
-#[inline]
-pub(crate) fn set_phi<const N: usize>(y: &mut State<N>, m: &DMatrix<f64>) {
-    let at = phi_index(N);
-    y.as_mut_slice()[at..at + m.len()].copy_from_slice(m.as_slice());
-}
-
 /// Φ at the start of a span in a section of dimension `d`: the identity in z₀, nothing
 /// yet from q.
 pub(crate) fn phi_start(d: usize) -> DMatrix<f64> {
     DMatrix::identity(d, d + 1)
+}
+
+/// Where column `col` of Φ begins in layout `N` (its rows follow: x, x', the internal
+/// state); the last column, `section_dim(N)`, is ∂z/∂q. Φ is updated in place through
+/// these, with no matrix built, on the paths every shooting period takes.
+#[inline]
+pub(crate) const fn phi_column(n: usize, col: usize) -> usize {
+    phi_index(n) + section_dim(n) * col
+}
+
+/// Set Φ of `y` to its start ([`phi_start`]) in place.
+pub(crate) fn reset_phi<const N: usize>(y: &mut State<N>) {
+    let d = section_dim(N);
+    for col in 0..=d {
+        for row in 0..d {
+            y[phi_column(N, col) + row] = if row == col { 1.0 } else { 0.0 };
+        }
+    }
 }
 
 /// The derivative over two spans, `first` then `then` (each ∂z/∂(z₀, q)): the chain

@@ -20,7 +20,7 @@ use super::free::FreeFlight;
 use super::model::{
     BASE, Carried, Coupling, MEMORY, MEMORY_TANGENT, MODES, Oscillator, RATE, RATE_TANGENT, State,
     TANGENT, V, X, chain, dissipative_work_index, has_tangent, internal, internal_count, phi,
-    phi_start, relax_internal, section_dim, set_internal, set_phi,
+    phi_column, phi_start, relax_internal, reset_phi, section_dim, set_internal,
 };
 use super::numeric::{
     self, Crossing, Events, StepEnd, StepObserver, Tolerances, hermite, internal_at,
@@ -528,19 +528,18 @@ impl<L: ForceLaw> Simulation<'_, L> {
         if jump == 0.0 && !rate_jumps {
             return;
         }
-        let mut d = phi(y);
-        let dim = d.nrows();
+        let dim = section_dim(N);
         let speed = y[V] + v_b;
         let k = jump / speed;
         for col in 0..=dim {
+            let at = phi_column(N, col);
             // δx + δq of this column: how far the switch moves.
-            let shift = d[(0, col)] + if col == dim { 1.0 } else { 0.0 };
-            d[(1, col)] += k * shift;
+            let shift = y[at] + if col == dim { 1.0 } else { 0.0 };
+            y[at + 1] += k * shift;
             for i in 0..kinds {
-                d[(2 * MODES + i, col)] += (rates_to[i] - rates_from[i]) / speed * shift;
+                y[at + 2 * MODES + i] += (rates_to[i] - rates_from[i]) / speed * shift;
             }
         }
-        set_phi(y, &d);
     }
 
     fn cycle_in<const N: usize, O: StepObserver>(
@@ -557,7 +556,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         y[V] = phase.v;
         set_internal(&mut y, &phase.internal);
         if has_tangent(N) {
-            set_phi(&mut y, &phi_start(section_dim(N)));
+            reset_phi(&mut y);
         }
         let mechanical = |y: &State<N>| 0.5 * (y[X] * y[X] + y[V] * y[V]);
         let e0 = mechanical(&y);

@@ -214,24 +214,27 @@ impl ForceLaw for AdhesiveLaw {
     #[inline]
     fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         match (branch, &self.approach) {
-            (Branch::Free | Branch::Necked, None) => 0.0,
-            (Branch::Free | Branch::Necked, Some(a)) => a.t_hat(alpha_hat),
             (Branch::Contact, _) => self.contact.t_hat(alpha_hat),
+            // (Out of contact, with or without a neck: the approach branch.)
+            (_, None) => 0.0,
+            (_, Some(a)) => a.t_hat(alpha_hat),
         }
     }
     #[inline]
     fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         match (branch, &self.approach) {
-            (Branch::Free | Branch::Necked, None) => 0.0,
-            (Branch::Free | Branch::Necked, Some(a)) => a.slope_hat(alpha_hat),
             (Branch::Contact, _) => self.contact.slope_hat(alpha_hat),
+            // (Out of contact, with or without a neck: the approach branch.)
+            (_, None) => 0.0,
+            (_, Some(a)) => a.slope_hat(alpha_hat),
         }
     }
     fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         match (branch, &self.approach) {
-            (Branch::Free | Branch::Necked, None) => 0.0,
-            (Branch::Free | Branch::Necked, Some(a)) => a.work_hat(alpha_hat),
             (Branch::Contact, _) => self.contact.work_hat(alpha_hat),
+            // (Out of contact, with or without a neck: the approach branch.)
+            (_, None) => 0.0,
+            (_, Some(a)) => a.work_hat(alpha_hat),
         }
     }
     fn jump_in_alpha_hat(&self) -> f64 {

@@ -7,7 +7,7 @@
 //! back when α̂ rises to [`ForceLaw::jump_out_alpha_hat`]. Conservative laws switch both
 //! ways at the same separation; hysteretic laws enclose [`ForceLaw::loop_area_hat`].
 
-/// The methods of a wrapper around a contact law (its field `elastic`) that leaves the
+/// The methods of a wrapper around a contact law (`elastic_law()`) that leaves the
 /// law's elastic part as it is: force, slope and work function per branch, the
 /// capillary share, the switches and the loop. A wrapper that adds a rate-dependent
 /// force (a viscous or relaxing sample) writes only what it adds.
@@ -15,34 +15,34 @@ macro_rules! elastic_part_from_inside {
     () => {
         #[inline]
         fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-            self.elastic.t_hat(alpha_hat, branch)
+            self.elastic_law().t_hat(alpha_hat, branch)
         }
         #[inline]
         fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-            self.elastic.slope_hat(alpha_hat, branch)
+            self.elastic_law().slope_hat(alpha_hat, branch)
         }
         fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-            self.elastic.work_hat(alpha_hat, branch)
+            self.elastic_law().work_hat(alpha_hat, branch)
         }
         fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-            self.elastic.capillary_work_hat(alpha_hat, branch)
+            self.elastic_law().capillary_work_hat(alpha_hat, branch)
         }
         fn jump_in_alpha_hat(&self) -> f64 {
-            self.elastic.jump_in_alpha_hat()
+            self.elastic_law().jump_in_alpha_hat()
         }
         fn jump_out_alpha_hat(&self) -> f64 {
-            self.elastic.jump_out_alpha_hat()
+            self.elastic_law().jump_out_alpha_hat()
         }
-        fn exits(&self, branch: Branch) -> super::Exits {
-            self.elastic.exits(branch)
+        fn exits(&self, branch: Branch) -> $crate::law::Exits {
+            self.elastic_law().exits(branch)
         }
         /// The added force acts only in contact.
         fn free_branch_is_force_free(&self) -> bool {
-            self.elastic.free_branch_is_force_free()
+            self.elastic_law().free_branch_is_force_free()
         }
         /// The elastic law's own loop (what the added force loses depends on the motion).
         fn loop_area_hat(&self) -> f64 {
-            self.elastic.loop_area_hat()
+            self.elastic_law().loop_area_hat()
         }
     };
 }
@@ -406,36 +406,17 @@ macro_rules! rheology {
     };
 }
 
+impl Rheology {
+    /// The contact law under the sample, whichever model the sample follows: one
+    /// forwarding call for the elastic part, not one per model.
+    #[inline]
+    fn elastic_law(&self) -> &AnyLaw {
+        rheology!(self, l => l.elastic_law())
+    }
+}
+
 impl ForceLaw for Rheology {
-    #[inline]
-    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        rheology!(self, l => l.t_hat(alpha_hat, branch))
-    }
-    #[inline]
-    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        rheology!(self, l => l.slope_hat(alpha_hat, branch))
-    }
-    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        rheology!(self, l => l.work_hat(alpha_hat, branch))
-    }
-    fn jump_in_alpha_hat(&self) -> f64 {
-        rheology!(self, l => l.jump_in_alpha_hat())
-    }
-    fn jump_out_alpha_hat(&self) -> f64 {
-        rheology!(self, l => l.jump_out_alpha_hat())
-    }
-    fn exits(&self, branch: Branch) -> Exits {
-        rheology!(self, l => l.exits(branch))
-    }
-    fn free_branch_is_force_free(&self) -> bool {
-        rheology!(self, l => l.free_branch_is_force_free())
-    }
-    fn loop_area_hat(&self) -> f64 {
-        rheology!(self, l => l.loop_area_hat())
-    }
-    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        rheology!(self, l => l.capillary_work_hat(alpha_hat, branch))
-    }
+    elastic_part_from_inside!();
     fn is_rate_dependent(&self) -> bool {
         true
     }

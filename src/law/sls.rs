@@ -44,6 +44,12 @@ pub struct StandardLinearSolid<L> {
 }
 
 impl<L: ForceLaw> StandardLinearSolid<L> {
+    /// The contact law under the sample.
+    #[inline]
+    pub fn elastic_law(&self) -> &L {
+        &self.elastic
+    }
+
     /// `elastic` (a Hertzian contact whose modulus, the contact's E*, is the relaxed
     /// one) with a sample whose unrelaxed composite modulus is `unrelaxed_modulus_pa`
     /// (Pa, above the contact's) and relaxation time `relaxation_time_s` (s), for a

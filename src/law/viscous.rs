@@ -28,6 +28,12 @@ pub struct KelvinVoigt<L> {
 const SLOPE_FLOOR: f64 = 1e-6;
 
 impl<L: ForceLaw> KelvinVoigt<L> {
+    /// The contact law under the sample.
+    #[inline]
+    pub fn elastic_law(&self) -> &L {
+        &self.elastic
+    }
+
     /// `elastic` with a sample of viscosity `viscosity_pa_s` (Pa·s) under the tip of
     /// `contact`, for a cantilever resonating at `resonance_hz` (the time unit 1/ω₀).
     pub fn new(
