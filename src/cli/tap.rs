@@ -17,8 +17,11 @@ use std::path::PathBuf;
 /// by a flag or a TOML file (--config; keys are the flags' names, flags win).
 ///
 /// Laws (--law; each explained under it below): hybrid (default), hybrid-attractive,
-/// jkr, dmt, hertz, lj, none. A viscous sample (--viscosity, Kelvin–Voigt) adds to any
-/// of them but none.
+/// jkr, dmt, hertz, lj, none. On top of any of them but none: a viscous sample
+/// (--viscosity, Kelvin–Voigt) and a capillary neck (--rupture-distance, which on jkr,
+/// hybrid and lj outlives the contact); on hertz and dmt, a relaxing sample instead
+/// (--unrelaxed-modulus and --relaxation-time: a standard linear solid, whose memory
+/// the motion carries: its orbits have three Floquet multipliers).
 ///
 /// The motion starts from the free oscillation and settles on a steady state, which is
 /// named: a period-n orbit (n ≤ 8; its Floquet multipliers say whether it is stable) or
