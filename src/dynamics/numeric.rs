@@ -815,16 +815,22 @@ mod tests {
     }
 
     fn to_switch(v0: f64, land_on_switch: bool) -> SegmentEnd {
+        let events = Events {
+            below: None,
+            above: Some(LEVEL),
+        };
+        between(events, v0, land_on_switch)
+    }
+
+    /// The contact branch of [`Cusp`] from x = 0 at velocity `v0`, ending at `events`.
+    fn between(events: Events, v0: f64, land_on_switch: bool) -> SegmentEnd {
         let (osc, cpl, tol) = setup();
         let span = Span {
             law: &Cusp,
             osc: &osc,
             cpl: &cpl,
             branch: Branch::Contact,
-            events: Events {
-                below: None,
-                above: Some(LEVEL),
-            },
+            events,
             tau_end: 4.0,
             tol: &tol,
         };
@@ -832,6 +838,34 @@ mod tests {
         y[V] = v0;
         span.integrate(0.0, y, 0.0, land_on_switch, &mut Ignore)
             .expect("integrates")
+    }
+
+    #[test]
+    fn a_branch_bounded_both_ways_ends_at_the_level_it_meets_first() {
+        // Bounded below at −0.3 and above at the fold: heading down it ends below,
+        // heading up at the fold, landed on or located alike.
+        let events = Events {
+            below: Some(-0.3),
+            above: Some(LEVEL),
+        };
+        for land_on_switch in [true, false] {
+            let down = between(events, -0.6, land_on_switch);
+            assert_eq!(down.switched, Some(Crossing::Down));
+            assert!((down.y[X] + 0.3).abs() < 2e-8, "{}", down.y[X]);
+            let up = between(events, 0.8, land_on_switch);
+            assert_eq!(up.switched, Some(Crossing::Up));
+            assert!((up.y[X] - LEVEL).abs() < 2e-8, "{}", up.y[X]);
+            // The same end as with that level alone.
+            let alone = between(
+                Events {
+                    below: None,
+                    above: Some(LEVEL),
+                },
+                0.8,
+                land_on_switch,
+            );
+            assert_eq!(up.tau, alone.tau);
+        }
     }
 
     #[test]
