@@ -2,7 +2,9 @@
 //! doublings, and what a ramp or a settled orbit shows near them.
 
 use nalgebra::Complex;
-use tapsim::dynamics::continuation::{Branch, ContinuationOptions, PointKind, follow_period_one};
+use tapsim::dynamics::continuation::{
+    Branch, BranchPoint, ContinuationOptions, PointKind, follow_period_one,
+};
 use tapsim::dynamics::numeric::Ignore;
 use tapsim::dynamics::setup::{Numerics, Prepared, TapSetup, default_setup};
 use tapsim::dynamics::steady::Multipliers;
@@ -24,6 +26,17 @@ fn follow(setup: &TapSetup, from_nm: f64, to_nm: f64) -> Branch {
         ..ContinuationOptions::default()
     };
     follow_period_one(&sim, &phase, &opts).unwrap()
+}
+
+/// The folds of `branch`, which must be two.
+fn two_folds(branch: &Branch) -> Vec<&BranchPoint> {
+    let folds: Vec<_> = branch
+        .points
+        .iter()
+        .filter(|p| p.kind == PointKind::Fold)
+        .collect();
+    assert_eq!(folds.len(), 2, "{:?}", branch.stop);
+    folds
 }
 
 fn nm(setup: &TapSetup, q: f64) -> f64 {
@@ -50,12 +63,7 @@ fn near(m: &Multipliers, target: f64) -> f64 {
 fn a_bistable_branch_has_two_folds_where_the_ramps_jump() {
     let setup = bistable_dmt();
     let branch = follow(&setup, 22.0, 14.0);
-    let folds: Vec<_> = branch
-        .points
-        .iter()
-        .filter(|p| p.kind == PointKind::Fold)
-        .collect();
-    assert_eq!(folds.len(), 2, "{:?}", branch.stop);
+    let folds = two_folds(&branch);
     for f in &folds {
         let off = near(&f.multipliers, 1.0);
         println!(
@@ -126,12 +134,7 @@ fn a_relaxing_sample_keeps_the_folds_in_three_dimensions() {
             .iter()
             .all(|p| p.multipliers.as_slice().len() == 3)
     );
-    let folds: Vec<_> = branch
-        .points
-        .iter()
-        .filter(|p| p.kind == PointKind::Fold)
-        .collect();
-    assert_eq!(folds.len(), 2, "{:?}", branch.stop);
+    let folds = two_folds(&branch);
     let memory = (-1.0 / (setup.cantilever.resonance_hz * 1e-7)).exp();
     for f in &folds {
         let off = near(&f.multipliers, 1.0);
