@@ -784,17 +784,19 @@ impl<L: ForceLaw> Simulation<'_, L> {
             let trial = &z + step * scale;
             // Inexact Newton: far from the orbit the map need not be exact to the
             // integrator's tolerance, only well below the residual.
-            match self
+            let evaluated = self
                 .loosened(NEWTON_TOLERANCE * norm)
                 .period_map(start, &trial, n, spent)?
-            {
-                Some(value)
-                    if (self.z(&value.end) - &trial).amax() <= (1.0 - 0.1 * scale) * norm =>
-                {
+                .map(|value| {
+                    let residual = self.z(&value.end) - &trial;
+                    (value, residual)
+                });
+            match evaluated {
+                Some((value, residual)) if residual.amax() <= (1.0 - 0.1 * scale) * norm => {
                     z = trial;
                     m = value.monodromy();
                     end = value.end;
-                    r = self.z(&end) - &z;
+                    r = residual;
                     norm = r.amax();
                     radius = radius.max(2.0 * scale * length);
                     rejected = 0;
