@@ -48,6 +48,17 @@ fn succeeds_with_cache(args: &[&str], cache: &std::path::Path) -> Output {
     out
 }
 
+/// `tap --json` on a parameter file holding `toml` (written in a scratch directory
+/// `name`) gives the E_ts that `from_flags` reported.
+fn a_file_gives_what_the_flags_give(name: &str, toml: &str, from_flags: &serde_json::Value) {
+    let dir = scratch(name);
+    let cfg = dir.join("parameters.toml");
+    std::fs::write(&cfg, toml).unwrap();
+    let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
+    assert_eq!(w["e_ts_j"], from_flags["e_ts_j"], "{toml}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 fn json(args: &[&str]) -> serde_json::Value {
     let out = tapsim(args);
     assert!(
@@ -1197,15 +1208,11 @@ fn a_capillary_neck_is_a_law_parameter_checked_against_the_law() {
     assert_eq!(v["law"], "dmt+capillary");
     let (e, cap) = (num(&v, "e_ts_j"), num(&v, "e_ts_capillary_j"));
     assert!(cap > 0.0 && (e - cap).abs() <= 1e-9 * e, "{v}");
-    let dir = scratch("capillary-config");
-    let cfg = dir.join("neck.toml");
-    std::fs::write(
-        &cfg,
+    a_file_gives_what_the_flags_give(
+        "capillary-config",
         "law = \"dmt\"\nrupture-distance = \"2nm\"\ncontact-angle = 30\nseparation = \"9nm\"\n",
-    )
-    .unwrap();
-    let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
-    assert_eq!(w["e_ts_j"], v["e_ts_j"]);
+        &v,
+    );
     refused(&[
         (
             vec!["tap", "--law", "none", "--rupture-distance", "2nm"],
@@ -1236,7 +1243,6 @@ fn a_capillary_neck_is_a_law_parameter_checked_against_the_law() {
             "the neck breaks beyond contact",
         ),
     ]);
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -1271,16 +1277,11 @@ fn a_relaxing_sample_is_a_law_parameter_checked_against_the_law() {
         Some(3),
         "{v}"
     );
-    let dir = scratch("relaxing-config");
-    let cfg = dir.join("sample.toml");
-    std::fs::write(
-        &cfg,
+    a_file_gives_what_the_flags_give(
+        "relaxing-config",
         "law = \"hertz\"\nunrelaxed-modulus = \"1.8GPa\"\nrelaxation-time = \"100ns\"\n",
-    )
-    .unwrap();
-    let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
-    assert_eq!(w["e_ts_j"], v["e_ts_j"]);
-    std::fs::remove_dir_all(dir).unwrap();
+        &v,
+    );
     let sls = |extra: &[&'static str]| {
         let mut a = vec!["tap", "--law", "hertz"];
         a.extend_from_slice(extra);
@@ -1333,11 +1334,11 @@ fn a_viscous_sample_is_a_law_parameter_checked_against_the_law() {
     let v = json(&["tap", "--law", "hertz", "--viscosity", "50 Pa·s", "--json"]);
     assert_eq!(v["law"], "hertz+kelvin-voigt");
     assert!(num(&v, "e_ts_j") > 0.0 && num(&v, "energy_balance_rel") < 1e-6);
-    let dir = scratch("viscous-config");
-    let cfg = dir.join("sample.toml");
-    std::fs::write(&cfg, "law = \"hertz\"\nviscosity = \"50Pa*s\"\n").unwrap();
-    let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
-    assert_eq!(w["e_ts_j"], v["e_ts_j"]);
+    a_file_gives_what_the_flags_give(
+        "viscous-config",
+        "law = \"hertz\"\nviscosity = \"50Pa*s\"\n",
+        &v,
+    );
     // A parameter the law does not take is refused, naming the laws that take it.
     refused(&[
         (
