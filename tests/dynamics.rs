@@ -85,6 +85,8 @@ fn free_response<L: ForceLaw>(law: &L, omega: f64, q: f64) -> (f64, f64) {
         max_cycles: 100_000,
         shooting: false,
         max_steps: tapsim::dynamics::budget::STEPS,
+        marching_fraction: tapsim::dynamics::steady::MARCHING_TOLERANCE,
+        grazing_threshold: 0.0,
     };
     let state = sim.steady_state(&mut phase, &opts).unwrap();
     assert!(state.converged);

@@ -357,6 +357,9 @@ fn files(dir: &Path) -> Vec<PathBuf> {
 const OPTIONAL_KEYS: &[&str] = &[
     "period",
     "stable",
+    "grazing_margin_m",
+    "attractors",
+    "well_defined",
     "amplitude_std_err_m",
     "phase_std_err_deg",
     "e_ts_std_err_j",

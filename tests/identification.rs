@@ -51,6 +51,12 @@ fn adhesion_hysteresis_steps_to_a_plateau_that_a0_k_and_q_do_not_move() {
             ..base.clone()
         };
         let curve = approach(&setup, 0.4, 24);
+        // The most touches per period on the curve (1 where some setpoint touches every
+        // period; below where grazing locks skip touches everywhere, as at Q x 2).
+        let most = curve
+            .iter()
+            .map(|(p, _)| p.observables.jumps_in)
+            .fold(0.0, f64::max);
         let (mut plateau, mut step) = (Vec::new(), None);
         for (p, n) in &curve {
             let o = &p.observables;
@@ -62,10 +68,10 @@ fn adhesion_hysteresis_steps_to_a_plateau_that_a0_k_and_q_do_not_move() {
                 step.get_or_insert(o.amplitude_ratio);
                 continue;
             }
-            // Each touch loses the whole loop: E/E_max is the touches per period (below
-            // 1 where the motion skips touches: period-n or irregular).
+            // Each touch loses the whole loop: E/E_max is the touches per period over
+            // the most on the curve (below 1 where the motion skips touches).
             assert!(
-                (e - o.jumps_in).abs() < 1e-5,
+                (e - o.jumps_in / most).abs() < 1e-5,
                 "{name}: A/A0 {} ({}): {e} vs {} touches",
                 o.amplitude_ratio,
                 o.regime,
@@ -88,6 +94,18 @@ fn adhesion_hysteresis_steps_to_a_plateau_that_a0_k_and_q_do_not_move() {
             "{name}: plateau over A/A0 {low:.3}..{high:.3} ({} setpoints)",
             plateau.len()
         );
+        if most < 1.0 {
+            // No setpoint touches every period: the loop's loss per touch exceeds what
+            // the drive supplies, the turning point stays pinned at the jump-in, and
+            // every touching state grazes it (mode locks that skip touches).
+            assert!(
+                curve
+                    .iter()
+                    .all(|(p, _)| p.observables.jumps_in == 0.0 || p.observables.grazing),
+                "{name}: a touching setpoint that does not graze"
+            );
+            continue;
+        }
         assert!(
             plateau.len() >= 5 && low < 0.6,
             "{name}: plateau {low}..{high}"

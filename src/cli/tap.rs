@@ -55,6 +55,13 @@ pub struct TapArgs {
     /// Cycles recorded for --trajectory and --plot.
     #[arg(long, allow_hyphen_values = true, default_value_t = 3)]
     record_cycles: usize,
+    /// March from N documented starts and list every distinct attractor reached, with
+    /// how many starts reached it: 1 the free oscillation (what is reported), 2 the
+    /// same at tolerances / 100, 3 rest, 4 and 5 ramps from z_c ± 0.1 A₀, then phases
+    /// of the free oscillation. A state that grazes a switch lists its attractors from
+    /// 6 starts without it. At most 64.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=64))]
+    starts: Option<u64>,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
@@ -72,6 +79,7 @@ pub fn run(args: TapArgs) -> Result<()> {
     let observe = Observe {
         record_cycles: record,
         harmonics: true,
+        starts: args.starts.unwrap_or(0) as usize,
     };
     let run = tap(&setup, &numerics, observe)?;
     if let Some(path) = &args.trajectory {

@@ -6,6 +6,19 @@ use super::model::{Carried, Drive, Oscillator, State, V, X, has_tangent, phi_col
 use crate::numeric::newton_bracketed;
 use nalgebra::{Complex, Matrix2};
 
+/// What [`FreeFlight::first_fall_to`] found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Fall {
+    /// When x falls to the level, if it does.
+    pub hit: Option<f64>,
+    /// The lowest x met (the level, if it is hit).
+    pub min_x: f64,
+    /// The lowest turning point (x' rising through 0) before the hit (∞: none).
+    pub lowest_turn: f64,
+    /// The highest turning point (x' falling through 0) before the hit (−∞: none).
+    pub highest_turn: f64,
+}
+
 /// The free motion from a given state.
 #[derive(Debug, Clone, Copy)]
 pub struct FreeFlight {
@@ -194,35 +207,38 @@ impl FreeFlight {
         (total.re, total.im)
     }
 
-    /// The first τ in (`tau_a`, `tau_b`] at which x falls to `level`, if any, and the
-    /// smallest deflection met on the way (at τ_b if there is no crossing).
-    /// Sub-intervals of `max_dt` are checked at their ends and at their interior minimum
-    /// (x' = 0), so a tip that only grazes the level is still caught.
-    pub(crate) fn first_fall_to(
-        &self,
-        level: f64,
-        tau_a: f64,
-        tau_b: f64,
-        max_dt: f64,
-    ) -> (Option<f64>, f64) {
+    /// The first τ in [`tau_a`, `tau_b`] where x falls to `level` (`None` if it stays
+    /// above), the lowest x met up to there, and the turning points of x met before
+    /// it (what [`super::grazing`] measures against the law's switch levels). Sampled
+    /// at most `max_dt` apart; a turning point between samples is found by Newton on
+    /// x' = 0, so a minimum that just touches the level is not missed.
+    pub(crate) fn first_fall_to(&self, level: f64, tau_a: f64, tau_b: f64, max_dt: f64) -> Fall {
         let n = ((tau_b - tau_a) / max_dt).ceil().max(1.0) as usize;
         let h = (tau_b - tau_a) / n as f64;
-        let mut min_x = f64::INFINITY;
+        let mut fall = Fall {
+            hit: None,
+            min_x: f64::INFINITY,
+            lowest_turn: f64::INFINITY,
+            highest_turn: f64::NEG_INFINITY,
+        };
         let mut samples = self.samples(tau_a, h);
         let (mut t0, (mut x0, mut v0)) = (tau_a, samples.next().expect("endless"));
+        let zero_velocity =
+            |a, b| newton_bracketed(|t| self.velocity_and_acceleration(t), a, b, 1e-14);
         for i in 1..=n {
             let t1 = if i == n { tau_b } else { tau_a + h * i as f64 };
             let (x1, v1) = samples.next().expect("endless");
             // The lowest point inside, where x' changes from negative to positive.
-            let (t_low, x_low) = if v0 < 0.0 && v1 > 0.0 {
-                let t = newton_bracketed(|t| self.velocity_and_acceleration(t), t0, t1, 1e-14);
+            let turning = v0 < 0.0 && v1 > 0.0;
+            let (t_low, x_low) = if turning {
+                let t = zero_velocity(t0, t1);
                 (t, self.at(t).0)
             } else if x1 < x0 {
                 (t1, x1)
             } else {
                 (t0, x0)
             };
-            min_x = min_x.min(x_low);
+            fall.min_x = fall.min_x.min(x_low);
             if x_low <= level && x0 > level {
                 let hit = newton_bracketed(
                     |t| {
@@ -233,11 +249,20 @@ impl FreeFlight {
                     t_low,
                     1e-14,
                 );
-                return (Some(hit), min_x.min(level));
+                // (A turning point here lies past the hit, where the flight ends.)
+                fall.hit = Some(hit);
+                fall.min_x = fall.min_x.min(level);
+                return fall;
+            }
+            if turning {
+                fall.lowest_turn = fall.lowest_turn.min(x_low);
+            }
+            if v0 > 0.0 && v1 < 0.0 {
+                fall.highest_turn = fall.highest_turn.max(self.at(zero_velocity(t0, t1)).0);
             }
             (t0, x0, v0) = (t1, x1, v1);
         }
-        (None, min_x)
+        fall
     }
 }
 
@@ -339,10 +364,13 @@ mod tests {
         let f = FreeFlight::new(&osc, 0.0, a, b * osc.omega).unwrap();
         let amp = (a * a + b * b).sqrt();
         // A level just above the lowest point is reached; one just below is not.
-        let (hit, _) = f.first_fall_to(-amp + 1e-9, 0.0, osc.period(), 1.0);
-        assert!(hit.is_some());
-        let (miss, min_x) = f.first_fall_to(-amp - 1e-9, 0.0, osc.period(), 1.0);
-        assert!(miss.is_none());
-        assert!((min_x + amp).abs() < 1e-12);
+        let hit = f.first_fall_to(-amp + 1e-9, 0.0, osc.period(), 1.0);
+        assert!(hit.hit.is_some());
+        let miss = f.first_fall_to(-amp - 1e-9, 0.0, osc.period(), 1.0);
+        assert!(miss.hit.is_none());
+        assert!((miss.min_x + amp).abs() < 1e-12);
+        // Both turning points of the period are found, at the steady amplitude.
+        assert!((miss.lowest_turn + amp).abs() < 1e-12);
+        assert!((miss.highest_turn - amp).abs() < 1e-12);
     }
 }

@@ -2,10 +2,13 @@
 //! law, with located branch switches, steady-state detection and the observables of one
 //! steady cycle (docs/design.md §2).
 
+pub mod attractors;
 pub mod base_drive;
 pub mod budget;
+mod capture;
 pub mod continuation;
 pub mod free;
+pub mod grazing;
 pub mod harmonics;
 pub mod model;
 pub mod numeric;

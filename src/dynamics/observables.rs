@@ -1,5 +1,6 @@
 //! Observables of one steady-state cycle in SI units, and the whole tapping run.
 
+use super::attractors::{Attractor, DEFAULT_STARTS, MAX_STARTS, Start, attractors};
 use super::budget;
 use super::free::FreeFlight;
 use super::harmonics::{Harmonic, HarmonicsObserver};
@@ -91,11 +92,25 @@ pub struct TapObservables {
     /// Drive periods the reported values are averaged over.
     pub periods_averaged: u32,
     /// Whether the periodic orbit is stable (every Floquet multiplier inside the unit
-    /// circle); null for irregular motion.
+    /// circle); null for irregular motion and for an orbit that grazes a switch
+    /// (`grazing`), whose stability rests on the grazing contact.
     pub stable: Option<bool>,
     /// Floquet multipliers of the periodic orbit, [re, im] each; empty for irregular
     /// motion.
     pub floquet_multipliers: Vec<[f64; 2]>,
+    /// Whether the state grazes a switch ([`super::grazing`]): a turning point of the
+    /// separation lies closer to a level where the law switches branch than the
+    /// cantilever's thermal rms deflection at 300 K or the integration's resolution of
+    /// the state. Which touch pattern such motion follows is then decided by
+    /// perturbations below what an instrument or the integrator controls. Where the
+    /// force jumps at that level (a hysteretic law's jump-in or jump-out) the
+    /// deterministic answer is not well defined, and a periodic orbit's stability
+    /// rests on the grazing contact (`stable` is then null).
+    pub grazing: bool,
+    /// The grazing margin in m: the smallest distance from a turning point of the
+    /// separation to a switch level that matters on its branch; null where no turning
+    /// point comes near a level (or the law never switches).
+    pub grazing_margin_m: Option<f64>,
     /// Standard error of the amplitude in m (0 for a periodic orbit; null where the
     /// window was too short to estimate it).
     pub amplitude_std_err_m: Option<f64>,
@@ -185,6 +200,9 @@ impl TapObservables {
         let balance = (c.e_drive - c.e_damp - c.e_ts - c.delta_mechanical).abs() / c.e_drive.abs();
         let scale = contact.separation_scale_m();
         let min_sep = c.min_alpha_hat * scale;
+        let margin = c.grazing.any * scale;
+        let sim = p.simulation();
+        let grazing = sim.grazing(&p.steady, state);
         Self {
             law: p.setup.law.to_string(),
             tabor_mu: contact.tabor_mu(),
@@ -216,13 +234,15 @@ impl TapObservables {
             regime: state.motion.regime(),
             period: state.motion.period(),
             periods_averaged: c.periods,
-            stable: state.motion.stable(),
+            stable: state.motion.stable().filter(|_| !grazing.jump),
             floquet_multipliers: match state.motion {
                 Motion::Periodic { multipliers, .. } => {
                     multipliers.iter().map(|m| [m.re, m.im]).collect()
                 }
                 Motion::Irregular => Vec::new(),
             },
+            grazing: grazing.any,
+            grazing_margin_m: known(margin),
             amplitude_std_err_m: known(state.std_err.amplitude * a0),
             phase_std_err_deg: known(state.std_err.phase.to_degrees()),
             e_ts_std_err_j: known(state.std_err.e_ts * energy),
@@ -354,6 +374,10 @@ pub struct Observe {
     /// Whether to compute the higher harmonics of a periodic orbit (one more orbit
     /// integrated; nothing for irregular motion).
     pub harmonics: bool,
+    /// Starts to march from and list the attractors of ([`Start::list`], at most
+    /// [`MAX_STARTS`]); 0: [`DEFAULT_STARTS`] where the state grazes a switch, none
+    /// otherwise.
+    pub starts: usize,
 }
 
 impl Observe {
@@ -376,6 +400,19 @@ pub struct TapRun {
     /// Harmonics 2…10 of the deflection and the force over the periodic orbit, if asked
     /// for and the motion is periodic (null otherwise).
     pub harmonics: Option<Vec<Harmonic>>,
+    /// What the grazing margin is compared with ([`TapObservables::grazing`]): the
+    /// cantilever's rms thermal deflection at 300 K, √(k_B T/k), in m …
+    pub thermal_rms_m: f64,
+    /// … and how finely the integration resolves the state, in m: A₀ times the larger
+    /// of the orbit's closure tolerance and rtol (periodic), or the marching rtol
+    /// (irregular).
+    pub integration_error_m: f64,
+    /// The attractors reached from several starts ([`super::attractors`]), the free
+    /// oscillation's first; null where none were looked for (a state that does not
+    /// graze a switch, without `starts`).
+    pub attractors: Option<Vec<Attractor>>,
+    /// Whether every start reached the same attractor; null where only one was tried.
+    pub well_defined: Option<bool>,
     /// Trajectory samples (empty unless recorded).
     #[serde(skip)]
     pub trajectory: Vec<TrajectorySample>,
@@ -411,10 +448,25 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<Ta
             reason: "must be at most 1000 (the trajectory is kept in memory)",
         });
     }
+    if observe.starts > MAX_STARTS {
+        return Err(Error::InvalidParameter {
+            name: "starts",
+            value: observe.starts as f64,
+            reason: "must be at most 64",
+        });
+    }
     let p = Prepared::new(setup, numerics)?;
     let sim = p.simulation();
     let mut phase = sim.free_steady_start();
     let state = sim.steady_state(&mut phase, &p.steady)?;
+    let observables = TapObservables::new(&p, &state)?;
+    let starts = match observe.starts {
+        0 if observables.grazing => DEFAULT_STARTS,
+        n => n,
+    };
+    let attractors = (starts > 0)
+        .then(|| attractors(setup, numerics, &Start::list(starts)))
+        .transpose()?;
     let harmonics = match state.motion.period() {
         Some(n) if observe.harmonics => {
             let mut observer = HarmonicsObserver::new(&p.law, p.cpl, p.osc);
@@ -447,8 +499,16 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<Ta
         }
     }
     let scale = setup.contact.separation_scale_m();
+    let a0 = setup.cantilever.free_amplitude_m;
     Ok(TapRun {
-        observables: TapObservables::new(&p, &state)?,
+        thermal_rms_m: p.steady.grazing_threshold * a0,
+        integration_error_m: sim.resolution(&p.steady, &state.motion) * a0,
+        observables,
+        well_defined: attractors
+            .as_ref()
+            .filter(|_| starts > 1)
+            .map(|list| list.len() == 1),
+        attractors,
         harmonics,
         trajectory: recorder.to_si(&p),
         switch_separations_m: (

@@ -2,9 +2,10 @@
 //! force law — and its translation into the dimensionless [`Simulation`].
 
 use super::budget;
+use super::grazing::{ROOM_TEMPERATURE_K, thermal_rms_m};
 use super::model::{Coupling, Drive, Oscillator};
 use super::numeric::Tolerances;
-use super::steady::{MIN_CYCLES, Simulation, SteadyOptions};
+use super::steady::{MARCHING_TOLERANCE, MIN_CYCLES, Simulation, SteadyOptions};
 use crate::error::{Error, Result, finite, positive};
 use crate::law::{AnyLaw, LawKind, LawSpec};
 use crate::params::{Contact, composite_modulus};
@@ -434,6 +435,8 @@ impl Prepared {
             max_cycles: numerics.max_cycles,
             shooting: numerics.shooting,
             max_steps: numerics.max_steps,
+            marching_fraction: MARCHING_TOLERANCE,
+            grazing_threshold: thermal_rms_m(cantilever.stiffness_n_m, ROOM_TEMPERATURE_K) / a0_m,
         };
         Ok(Self {
             setup: TapSetup {

@@ -16,7 +16,9 @@
 //! window that grows until its batch means agree.
 
 use super::budget;
+use super::capture::Candidate;
 use super::free::FreeFlight;
+use super::grazing::{Margins, SwitchLevels};
 use super::model::{
     BASE, Carried, Coupling, MEMORY, MEMORY_TANGENT, MODES, Oscillator, RATE, RATE_TANGENT, State,
     TANGENT, V, X, chain, dissipative_work_index, has_tangent, internal, internal_count, phi,
@@ -126,6 +128,10 @@ pub struct CycleIntegrals {
     pub max_force: f64,
     /// Smallest (most attractive) f_ts met.
     pub min_force: f64,
+    /// The grazing margins ([`super::grazing`]): the smallest distance in α̂ from a
+    /// turning point of the separation to a switch level that matters on its branch,
+    /// and to one where the force jumps (∞: no turning point near such a level).
+    pub grazing: Margins,
     /// Number of jumps into contact.
     pub jumps_in: u32,
     /// Number of jumps out of contact.
@@ -172,6 +178,7 @@ impl CycleIntegrals {
             min_alpha_hat: self.min_alpha_hat.min(next.min_alpha_hat),
             max_force: self.max_force.max(next.max_force),
             min_force: self.min_force.min(next.min_force),
+            grazing: self.grazing.min(next.grazing),
             jumps_in: self.jumps_in + next.jumps_in,
             jumps_out: self.jumps_out + next.jumps_out,
         }
@@ -188,6 +195,18 @@ struct Tracker<'a, L: ForceLaw, O: StepObserver> {
     min_alpha: f64,
     max_f: f64,
     min_f: f64,
+    levels: SwitchLevels,
+    /// The grazing margins so far.
+    margins: Margins,
+}
+
+impl<L: ForceLaw, O: StepObserver> Tracker<'_, L, O> {
+    /// Take a turning point of the separation at `alpha_hat` on `branch` into the
+    /// grazing margin.
+    #[inline]
+    fn turn(&mut self, branch: Branch, alpha_hat: f64) {
+        self.margins = self.margins.min(self.levels.margins(branch, alpha_hat));
+    }
 }
 
 impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
@@ -200,8 +219,13 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
         // every contact branch is: sampling step ends alone would miss the peak.
         self.max_f = self.max_f.max(b.dy[Carried::Force]);
         self.min_f = self.min_f.min(b.dy[Carried::Force]);
+        if a.y[V] > 0.0 && b.y[V] < 0.0 {
+            let tau = a.tau + hermite_turn(a, b, false) * (b.tau - a.tau);
+            let top = alpha(tau, hermite(a, b, X, tau));
+            self.turn(branch, top);
+        }
         if a.y[V] < 0.0 && b.y[V] > 0.0 {
-            let t = hermite_minimum(a, b);
+            let t = hermite_turn(a, b, true);
             let tau = a.tau + t * (b.tau - a.tau);
             // (The tip is at rest there; the support may not be.)
             let turn = self.cpl.contact_state(
@@ -211,6 +235,7 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
                 internal_at(a, b, tau),
             );
             lowest = lowest.min(turn.alpha_hat);
+            self.turn(branch, turn.alpha_hat);
             let f = -self.cpl.f_scale * self.law.force_hat(&turn);
             self.max_f = self.max_f.max(f);
             self.min_f = self.min_f.min(f);
@@ -226,9 +251,10 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
     }
 }
 
-/// Step fraction in [0, 1] of the minimum of the deflection's Hermite cubic on a step
-/// where the velocity goes from negative to positive.
-fn hermite_minimum<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>) -> f64 {
+/// Step fraction in [0, 1] of the turning point of the deflection's Hermite cubic on a
+/// step where the velocity changes sign: its minimum (`rising`: from negative to
+/// positive) or its maximum.
+fn hermite_turn<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, rising: bool) -> f64 {
     let h = b.tau - a.tau;
     let (p0, p1, m0, m1) = (a.y[X], b.y[X], h * a.y[V], h * b.y[V]);
     // The cubic is p0 + m0 t + c2 t² + c3 t³; its derivative 3c3 t² + 2c2 t + m0.
@@ -240,8 +266,12 @@ fn hermite_minimum<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>) -> f64 {
     } else {
         let disc = (qb * qb - 4.0 * qa * qc).max(0.0).sqrt();
         let (r1, r2) = ((-qb - disc) / (2.0 * qa), (-qb + disc) / (2.0 * qa));
-        // The root where the derivative rises through zero.
-        if 2.0 * qa * r1 + qb > 0.0 { r1 } else { r2 }
+        // The root where the derivative rises (falls) through zero.
+        if (2.0 * qa * r1 + qb > 0.0) == rising {
+            r1
+        } else {
+            r2
+        }
     };
     if t.is_finite() {
         t.clamp(0.0, 1.0)
@@ -272,7 +302,18 @@ impl<L: ForceLaw> Clone for Simulation<'_, L> {
 impl<L: ForceLaw> Copy for Simulation<'_, L> {}
 
 /// The longest period looked for; motion that repeats after no n ≤ this is `irregular`.
-pub const MAX_PERIOD: usize = 8;
+/// Periods up to [`SHORT_PERIOD`] are looked for wherever the motion nearly repeats;
+/// longer ones (mode locks near grazing, such as 13 touches in 27 periods) where the
+/// section state has returned within [`LOCK_GAP`] three periods running.
+pub const MAX_PERIOD: usize = 1000;
+
+/// The longest period looked for from loose near-returns, and by time-marching alone
+/// (without shooting).
+pub const SHORT_PERIOD: usize = 8;
+
+/// How close (units of L) the section state must return after n > [`SHORT_PERIOD`]
+/// periods, three periods running, for a period-n orbit to be looked for.
+const LOCK_GAP: f64 = 1e-5;
 
 /// How the steady motion repeats.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -361,8 +402,8 @@ pub(crate) struct MapValue {
     pub derivative: DMatrix<f64>,
     /// The integrals over the n periods.
     pub integrals: CycleIntegrals,
-    /// |state after k + 1 periods − start|∞ for k < min(n, [`MAX_PERIOD`]).
-    pub returns: [f64; MAX_PERIOD],
+    /// |state after k + 1 periods − start|∞ for k < n.
+    pub returns: Vec<f64>,
 }
 
 impl MapValue {
@@ -569,6 +610,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
             min_alpha: f64::INFINITY,
             max_f: f64::NEG_INFINITY,
             min_f: f64::INFINITY,
+            levels: SwitchLevels::of(self.law),
+            margins: Margins::NONE,
         };
         let (mut contact_time, mut jumps_in, mut jumps_out) = (0.0, 0, 0);
         // E_ts = (RΔγ/(kL))/(L/(με)) ∫ T̂ dα̂ in units of kL².
@@ -597,8 +640,14 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 .flatten();
             if let Some(flight) = flight {
                 let level = self.cpl.x_at(jump_in);
-                let (hit, min_x) = flight.first_fall_to(level, tau, tau_end, period / 8.0);
+                let fall = flight.first_fall_to(level, tau, tau_end, period / 8.0);
+                let (hit, min_x) = (fall.hit, fall.min_x);
                 let stop = hit.unwrap_or(tau_end);
+                for turn in [fall.lowest_turn, fall.highest_turn] {
+                    if turn.is_finite() {
+                        tracker.turn(Branch::Free, self.cpl.alpha_hat(turn, 0.0));
+                    }
+                }
                 flight.advance(&mut y, tau, stop);
                 if let Some(rates) = &relaxation {
                     relax_internal(&mut y, rates, stop - tau);
@@ -690,6 +739,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             min_alpha_hat: tracker.min_alpha,
             max_force: tracker.max_f,
             min_force: tracker.min_f,
+            grazing: tracker.margins,
             jumps_in,
             jumps_out,
         };
@@ -712,7 +762,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let branch = self.consistent_branch(&p);
         let mut derivative = phi_start(z.len());
         let mut integrals: Option<CycleIntegrals> = None;
-        let mut returns = [f64::INFINITY; MAX_PERIOD];
+        let mut returns = vec![f64::INFINITY; n];
         for k in 0..n {
             *spent += 1;
             match self.cycle_with_derivative(&mut p) {
@@ -823,37 +873,84 @@ impl<L: ForceLaw> Simulation<'_, L> {
         }))
     }
 
-    /// Look for a stable period-n orbit near `phase` by Newton's method. On success
-    /// `phase` is moved onto it and the steady state over one pass of the orbit returned;
-    /// otherwise `phase` is left as it was. An orbit that is unstable, or whose least
-    /// period is below n, is not taken (it is not what the motion settles on).
+    /// Look for a stable period-n orbit near `phase` by Newton's method, leaving `phase`
+    /// as it is: the orbit with its steady state over one pass, a candidate for what the
+    /// motion settles on ([`Candidate`]). An orbit that is unstable, or whose least
+    /// period is below n, is not one (the motion does not settle on it).
     fn try_period(
         &self,
-        phase: &mut Phase,
+        phase: &Phase,
         n: usize,
         opts: &SteadyOptions,
         budget: usize,
         spent: &mut usize,
-    ) -> Result<Option<SteadyState>> {
+    ) -> Result<Option<Candidate>> {
         let target = (1e-2 * opts.tolerance).max(1e-13);
         let Some(orbit) = self.newton(phase, n, (target, opts.tolerance), budget, spent)? else {
             return Ok(None);
         };
-        if *spent + 2 * n > budget {
+        if *spent + 3 * n > budget {
             return Ok(None);
         }
         let mut on = orbit.phase;
-        let Some(state) = self.settle(&mut on, n, orbit.residual, spent)? else {
+        let Some((state, monodromy)) = self.settle(&mut on, n, orbit.residual, spent)? else {
             return Ok(None);
         };
         if state.motion.stable() != Some(true) {
             return Ok(None);
         }
-        *phase = on;
-        Ok(Some(SteadyState {
+        let state = SteadyState {
             converged: orbit.residual <= opts.tolerance,
             ..state
-        }))
+        };
+        *spent += state.window.periods as usize - 1;
+        let grazing = self.grazing(opts, &state).jump;
+        Ok(Some(Candidate::new(self, state, on, &monodromy, grazing)?))
+    }
+
+    /// Newton's method for a period-n orbit from `phase` ([`Self::try_period`]): if the
+    /// orbit found captures `phase` ([`Candidate::captures`]: the marching that led here
+    /// has begun converging onto it), `phase` is moved onto it and its steady state
+    /// returned; otherwise it joins `pending`, the orbits that later marching may reach.
+    fn shoot(
+        &self,
+        phase: &mut Phase,
+        n: usize,
+        (opts, budget): (&SteadyOptions, usize),
+        spent: &mut usize,
+        pending: &mut Vec<Candidate>,
+    ) -> Result<Option<SteadyState>> {
+        let Some(candidate) = self.try_period(phase, n, opts, budget, spent)? else {
+            return Ok(None);
+        };
+        if candidate.captures(self, phase) {
+            *phase = candidate.on;
+            return Ok(Some(SteadyState {
+                cycles: *spent,
+                ..candidate.state
+            }));
+        }
+        let known = |c: &Candidate| c.same_orbit(&candidate, 1e3 * opts.tolerance.max(1e-12));
+        if !pending.iter().any(known) {
+            pending.push(candidate);
+        }
+        Ok(None)
+    }
+
+    /// The steady state of the first of the `pending` orbits whose capture radius the
+    /// marched `phase` has entered (`phase` is moved onto it), if any.
+    fn reached(
+        &self,
+        phase: &mut Phase,
+        pending: &[Candidate],
+        spent: usize,
+    ) -> Option<SteadyState> {
+        let candidate = pending.iter().find(|c| c.captures(self, phase))?;
+        *phase = candidate.on;
+        Some(SteadyState {
+            cycles: spent,
+            ..candidate.state
+        })
     }
 
     /// The steady state on the orbit through `phase` that returns after n periods within
@@ -866,7 +963,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         n: usize,
         residual: f64,
         spent: &mut usize,
-    ) -> Result<Option<SteadyState>> {
+    ) -> Result<Option<(SteadyState, DMatrix<f64>)>> {
         let start = *phase;
         let z = self.z(&start);
         let Some(mut pass) = self.period_map(&start, &z, n, spent)? else {
@@ -882,16 +979,20 @@ impl<L: ForceLaw> Simulation<'_, L> {
             pass = shorter;
         }
         *phase = pass.end;
-        Ok(Some(SteadyState {
-            window: pass.integrals,
-            cycles: *spent,
-            converged: true,
-            motion: Motion::Periodic {
-                period: least,
-                multipliers: eigenvalues(&pass.monodromy()),
+        let monodromy = pass.monodromy();
+        Ok(Some((
+            SteadyState {
+                window: pass.integrals,
+                cycles: *spent,
+                converged: true,
+                motion: Motion::Periodic {
+                    period: least,
+                    multipliers: eigenvalues(&monodromy),
+                },
+                std_err: StdErr::default(),
             },
-            std_err: StdErr::default(),
-        }))
+            monodromy,
+        )))
     }
 
     /// The steady state reached from `phase` (which is left on it): the attractor the
@@ -933,8 +1034,11 @@ impl<L: ForceLaw> Simulation<'_, L> {
         self.rewind(phase);
         self.cycle(phase, &mut numeric::Ignore)?;
         let mut spent = 1;
+        // Orbits Newton's method found that the marching has not yet reached.
+        let mut pending = Vec::new();
         if opts.shooting {
-            if let Some(found) = self.try_period(phase, 1, opts, search_budget, &mut spent)? {
+            let limits = (opts, search_budget);
+            if let Some(found) = self.shoot(phase, 1, limits, &mut spent, &mut pending)? {
                 return Ok(found);
             }
         }
@@ -960,6 +1064,9 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 spent += 1;
                 ring.push(self.z(phase), phase.branch);
                 window.add(&c);
+                if let Some(found) = self.reached(phase, &pending, spent) {
+                    return Ok(found);
+                }
                 if !opts.shooting {
                     // A state contracting onto the orbit by a factor ρ per n periods
                     // is |Δz|·ρ/(1 − ρ) from it; ρ is at most the free oscillator's
@@ -972,7 +1079,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
                         let gap = ring.gap(0, n).unwrap_or(0.0);
                         let mut on = *phase;
                         // (`None`: the orbit grazes a fold, see `period_map`: march on.)
-                        if let Some(state) = self.settle(&mut on, n, gap, &mut spent)? {
+                        if let Some((state, _)) = self.settle(&mut on, n, gap, &mut spent)? {
                             *phase = on;
                             return Ok(state);
                         }
@@ -980,31 +1087,55 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 }
             }
             if opts.shooting {
-                for n in ring.candidates() {
+                for n in ring.candidates().into_iter().chain(ring.locked()) {
                     if spent >= search_budget {
                         break;
                     }
-                    if let Some(found) =
-                        self.try_period(phase, n, opts, search_budget, &mut spent)?
-                    {
+                    let limits = (opts, search_budget);
+                    if let Some(found) = self.shoot(phase, n, limits, &mut spent, &mut pending)? {
                         return Ok(found);
                     }
                 }
             }
             stretch *= 2;
         }
-        self.average(phase, opts, budget, spent, window, ring)
+        self.average(phase, opts, (budget, spent), window, ring, pending)
+    }
+
+    /// How finely a steady state of `motion` found with `opts` is resolved, in units of
+    /// L: for a periodic orbit the larger of its closure tolerance and the integrator's
+    /// relative tolerance (Newton aims 100× below the first, and a period integrated at
+    /// the second moves a state of size ~1 by about that much); for irregular motion the
+    /// tolerance its periods are marched at ([`Self::marching`]).
+    pub fn resolution(&self, opts: &SteadyOptions, motion: &Motion) -> f64 {
+        match motion {
+            Motion::Periodic { .. } => opts.tolerance.max(self.tol.rtol),
+            Motion::Irregular => self.marching(opts).tol.rtol,
+        }
+    }
+
+    /// Whether `state` (found with `opts`) grazes a switch: a grazing margin below the
+    /// larger of `opts.grazing_threshold` and the state's resolution.
+    pub fn grazing(&self, opts: &SteadyOptions, state: &SteadyState) -> Grazing {
+        let threshold = opts
+            .grazing_threshold
+            .max(self.resolution(opts, &state.motion));
+        let margins = state.window.grazing;
+        Grazing {
+            any: margins.any / self.cpl.a1 < threshold,
+            jump: margins.jump / self.cpl.a1 < threshold,
+        }
     }
 
     /// This simulation with the integrator tolerances loosened to
-    /// [`MARCHING_TOLERANCE`] × `opts.average_tolerance` (never tightened): the tolerance
+    /// `opts.marching_fraction` × `opts.average_tolerance` (never tightened): the tolerance
     /// at which periods are marched for averages. A marched trajectory of irregular
     /// motion parts from the exact one whatever the tolerance (that is what irregular
     /// means); what must hold is its statistics, which an integrator error 10⁵ below
     /// the averages' tolerance does not move (tests/steady.rs checks the averages
     /// against exact marching), and its energy balance (< 1e-8 at the defaults).
     fn marching(&self, opts: &SteadyOptions) -> Self {
-        self.loosened(MARCHING_TOLERANCE * opts.average_tolerance)
+        self.loosened(opts.marching_fraction * opts.average_tolerance)
     }
 
     /// This simulation with the integrator's relative tolerance raised to `rtol` (at most
@@ -1042,10 +1173,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
         &self,
         phase: &mut Phase,
         opts: &SteadyOptions,
-        budget: usize,
-        mut spent: usize,
+        (budget, mut spent): (usize, usize),
         mut window: Window,
         mut ring: Recurrence,
+        mut pending: Vec<Candidate>,
     ) -> Result<SteadyState> {
         let marching = self.marching(opts);
         loop {
@@ -1054,6 +1185,18 @@ impl<L: ForceLaw> Simulation<'_, L> {
             spent += 1;
             ring.push(self.z(phase), phase.branch);
             window.add(&c);
+            if let Some(found) = self.reached(phase, &pending, spent) {
+                return Ok(found);
+            }
+            // At the end of each batch: has the motion locked onto a long period?
+            if opts.shooting && window.current_len == 0 {
+                if let Some(n) = ring.locked() {
+                    let limits = (opts, budget);
+                    if let Some(found) = self.shoot(phase, n, limits, &mut spent, &mut pending)? {
+                        return Ok(found);
+                    }
+                }
+            }
             let count = window.batches.len();
             let full = count >= BATCHES;
             // From MIN_BATCHES batches on, each finished batch is a chance to stop early.
@@ -1092,8 +1235,9 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     // may yet settle on an orbit.
                     if opts.shooting {
                         for n in ring.candidates() {
+                            let limits = (opts, budget);
                             if let Some(found) =
-                                self.try_period(phase, n, opts, budget, &mut spent)?
+                                self.shoot(phase, n, limits, &mut spent, &mut pending)?
                             {
                                 return Ok(found);
                             }
@@ -1170,8 +1314,9 @@ const EARLY_MARGIN: f64 = 4.0;
 const FIRST_STRETCH: usize = 32;
 /// Periods the search for an orbit may integrate at most (with shooting).
 const SEARCH_PERIODS: usize = 1000;
-/// Marched periods are integrated at this fraction of the averages' tolerance.
-const MARCHING_TOLERANCE: f64 = 1e-5;
+/// Marched periods are integrated at this fraction of the averages' tolerance (the
+/// default of [`SteadyOptions::marching_fraction`]).
+pub const MARCHING_TOLERANCE: f64 = 1e-5;
 /// Newton's trial maps are integrated at this fraction of the residual they try to
 /// reduce (inexact Newton: the error of the map stays far below what a step must gain).
 const NEWTON_TOLERANCE: f64 = 1e-2;
@@ -1288,7 +1433,10 @@ pub(crate) fn eigenvalues(m: &DMatrix<f64>) -> Multipliers {
 #[derive(Default)]
 struct Recurrence {
     /// (section state, branch), newest last; at most 3 + [`MAX_PERIOD`].
-    states: Vec<(DVector<f64>, Branch)>,
+    states: std::collections::VecDeque<([f64; MAX_SECTION], Branch)>,
+    /// Long periods already looked for, with the return distance then
+    /// ([`Recurrence::locked`]).
+    tried: Vec<(usize, f64)>,
 }
 
 impl Recurrence {
@@ -1296,9 +1444,11 @@ impl Recurrence {
 
     fn push(&mut self, z: DVector<f64>, branch: Branch) {
         if self.states.len() == Self::KEEP {
-            self.states.remove(0);
+            self.states.pop_front();
         }
-        self.states.push((z, branch));
+        let mut a = [0.0; MAX_SECTION];
+        a[..z.len()].copy_from_slice(z.as_slice());
+        self.states.push_back((a, branch));
     }
 
     /// Distance between the state `back` places from the newest and the one n before it.
@@ -1308,21 +1458,31 @@ impl Recurrence {
             self.states.get(len.checked_sub(1 + back)?)?,
             self.states.get(len.checked_sub(1 + back + n)?)?,
         );
-        (a.1 == b.1).then(|| (&a.0 - &b.0).amax())
+        (a.1 == b.1).then(|| {
+            a.0.iter()
+                .zip(&b.0)
+                .fold(0.0, |m: f64, (x, y)| m.max((x - y).abs()))
+        })
     }
 
-    /// The least n whose return distance has been within `within(n)` for the last three
-    /// periods.
+    /// Whether the return distance after n periods has been within `within` for the
+    /// last three periods.
+    fn returns_within(&self, n: usize, within: f64) -> bool {
+        (0..3).all(|back| self.gap(back, n).is_some_and(|g| g <= within))
+    }
+
+    /// The least n ≤ [`SHORT_PERIOD`] whose return distance has been within `within(n)`
+    /// for the last three periods.
     fn repeats(&self, within: impl Fn(usize) -> f64) -> Option<usize> {
-        (1..=MAX_PERIOD)
-            .find(|&n| (0..3).all(|back| self.gap(back, n).is_some_and(|g| g <= within(n))))
+        (1..=SHORT_PERIOD).find(|&n| self.returns_within(n, within(n)))
     }
 
-    /// Periods worth a Newton search: those the newest state nearly returns with (within
-    /// 0.1 in x and x'), the nearest returns first, at most three; a multiple of a
-    /// period already listed is left out (its orbit would be found as the shorter one).
+    /// Periods worth a Newton search: those up to [`SHORT_PERIOD`] the newest state
+    /// nearly returns with (within 0.1 in x and x'), the nearest returns first, at most
+    /// three; a multiple of a period already listed is left out (its orbit would be
+    /// found as the shorter one).
     fn candidates(&self) -> Vec<usize> {
-        let mut near: Vec<(f64, usize)> = (1..=MAX_PERIOD)
+        let mut near: Vec<(f64, usize)> = (1..=SHORT_PERIOD)
             .filter_map(|n| self.gap(0, n).filter(|&g| g <= 0.1).map(|g| (g, n)))
             .collect();
         near.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -1333,6 +1493,24 @@ impl Recurrence {
             }
         }
         out
+    }
+
+    /// The least long period n (above [`SHORT_PERIOD`], at most [`MAX_PERIOD`]) the
+    /// motion has returned with within [`LOCK_GAP`] three periods running, unless it was
+    /// looked for already and the motion has not come 100× closer since (it is marked
+    /// with its return distance).
+    fn locked(&mut self) -> Option<usize> {
+        let (n, gap) = (SHORT_PERIOD + 1..=MAX_PERIOD).find_map(|n| {
+            let gap = self.gap(0, n)?;
+            let fresh = self
+                .tried
+                .iter()
+                .all(|&(m, then)| m != n || gap < 1e-2 * then);
+            (fresh && self.returns_within(n, LOCK_GAP)).then_some((n, gap))
+        })?;
+        self.tried.retain(|&(m, _)| m != n);
+        self.tried.push((n, gap));
+        Some(n)
     }
 }
 
@@ -1352,6 +1530,24 @@ pub struct SteadyOptions {
     pub shooting: bool,
     /// At most this many integrator steps ([`budget`]).
     pub max_steps: u64,
+    /// Periods marched for averages and for the choice of candidate periods are
+    /// integrated at this fraction of `average_tolerance` ([`MARCHING_TOLERANCE`]
+    /// unless tightened to re-decide a grazing state).
+    pub marching_fraction: f64,
+    /// A grazing margin below this (units of L) counts as grazing ([`super::grazing`]),
+    /// as does one below the state's resolution ([`Simulation::resolution`]): the
+    /// thermal rms deflection at 300 K over A₀ for a prepared experiment.
+    pub grazing_threshold: f64,
+}
+
+/// Whether a steady state grazes a switch ([`Simulation::grazing`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Grazing {
+    /// A turning point lies within the threshold of some switch level.
+    pub any: bool,
+    /// … of a level where the force jumps: the period map is discontinuous within that
+    /// distance, and an orbit's stability rests on the grazing contact.
+    pub jump: bool,
 }
 
 /// The outcome of [`Simulation::steady_state`].
@@ -1375,7 +1571,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn hermite_minimum_finds_the_turning_point_of_a_parabola() {
+    fn hermite_turn_finds_the_turning_points_of_parabolas() {
         // x = (τ − 0.3)², sampled at τ = 0 and 1 with exact slopes: the cubic is exact.
         let end = |tau: f64| {
             let mut y = State::<BASE>::zeros();
@@ -1387,7 +1583,17 @@ mod tests {
                 dy: State::<BASE>::zeros(),
             }
         };
-        let t = hermite_minimum(&end(0.0), &end(1.0));
+        let t = hermite_turn(&end(0.0), &end(1.0), true);
         assert!((t - 0.3).abs() < 1e-12, "{t}");
+        // And the top of x = −(τ − 0.6)².
+        let top = |tau: f64| {
+            let mut e = end(tau + 0.3 - 0.6);
+            e.tau = tau;
+            e.y[X] = -e.y[X];
+            e.y[V] = -e.y[V];
+            e
+        };
+        let t = hermite_turn(&top(0.0), &top(1.0), false);
+        assert!((t - 0.6).abs() < 1e-12, "{t}");
     }
 }

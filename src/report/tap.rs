@@ -2,11 +2,13 @@
 //! trajectory charts (deflection and force vs time, force vs separation).
 
 use super::chart::{Axis, Chart, Corner, Series, Style};
+use crate::dynamics::attractors::Attractor;
 use crate::dynamics::harmonics::Harmonic;
 use crate::dynamics::observables::{TapObservables, TapRun, TrajectorySample};
 use crate::dynamics::setup::TapSetup;
 use crate::error::Result;
 use crate::law::Branch;
+use crate::params::ELECTRONVOLT_J;
 use std::fmt::Write as _;
 
 /// A table of the setup and the observables (and the harmonics, if computed).
@@ -125,6 +127,17 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
     );
     line("contact fraction", format!("{:.4}", o.contact_fraction));
     line("jumps into contact per cycle", format!("{:.4}", o.jumps_in));
+    if let Some(margin) = o.grazing_margin_m {
+        line(
+            "grazing margin",
+            format!(
+                "{} (thermal rms at 300 K {}, integration {})",
+                picometres(margin),
+                picometres(run.thermal_rms_m),
+                picometres(run.integration_error_m)
+            ),
+        );
+    }
     if let Some(h) = &run.harmonics {
         let amplitudes = |pick: fn(&Harmonic) -> f64, scale: f64| {
             h.iter()
@@ -142,6 +155,23 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
             ),
         );
     }
+    if o.grazing {
+        let _ = writeln!(
+            s,
+            "note: grazing — a turning point of the separation comes closer to a switch of the \
+             force law than the thermal motion (or the integration's resolution): which \
+             touches a period makes is decided by perturbations nothing controls, so the \
+             state above is one of possibly several{}",
+            if o.stable.is_none() && o.period.is_some() {
+                "; the orbit's stability rests on the grazing contact"
+            } else {
+                ""
+            }
+        );
+    }
+    if let Some(list) = &run.attractors {
+        attractors_text(&mut s, list, run.well_defined);
+    }
     if !o.converged {
         let _ = writeln!(
             s,
@@ -157,6 +187,53 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
     s
 }
 
+/// A length in pm to three significant digits (below 0.01 pm in scientific form, from
+/// 1000 pm on in nm).
+fn picometres(m: f64) -> String {
+    let pm = m * 1e12;
+    if pm.abs() < 0.01 {
+        format!("{pm:.1e} pm")
+    } else if pm.abs() >= 1000.0 {
+        format!("{:.3} nm", pm * 1e-3)
+    } else {
+        let digits = (2.0 - pm.abs().log10().floor()).max(0.0) as usize;
+        format!("{pm:.digits$} pm")
+    }
+}
+
+/// The attractors reached from several starts, and what their number means.
+fn attractors_text(s: &mut String, list: &[Attractor], well_defined: Option<bool>) {
+    let starts: usize = list.iter().map(|a| a.count).sum();
+    let verdict = match well_defined {
+        Some(false) => "the deterministic answer is not defined here",
+        Some(true) => "every start reached the same state",
+        None => "one start",
+    };
+    let _ = writeln!(
+        s,
+        "Attractors from {starts} starts ({} distinct: {verdict})",
+        list.len()
+    );
+    let _ = writeln!(
+        s,
+        "  {:<12} {:>8} {:>10} {:>10} {:>10}  starts",
+        "regime", "touches", "A/A₀", "φ (°)", "E_ts (eV)"
+    );
+    for a in list {
+        let _ = writeln!(
+            s,
+            "  {:<12} {:>8.4} {:>10.6} {:>10.4} {:>10.4}  {}: {}",
+            a.regime,
+            a.touch_fraction,
+            a.amplitude_ratio,
+            a.phase_deg,
+            a.e_ts_j / ELECTRONVOLT_J,
+            a.count,
+            a.starts.join("; ")
+        );
+    }
+}
+
 /// The kind of motion, the periods the values are averaged over, and the stability of a
 /// periodic orbit with its largest Floquet multiplier.
 fn motion_text(o: &TapObservables) -> String {
@@ -165,13 +242,17 @@ fn motion_text(o: &TapObservables) -> String {
         .iter()
         .map(|m| m[0].hypot(m[1]))
         .fold(0.0, f64::max);
-    match o.stable {
-        Some(stable) => format!(
+    match (o.stable, o.period) {
+        (Some(stable), _) => format!(
             "{} ({}, largest |Floquet multiplier| {largest:.4})",
             o.regime,
             if stable { "stable" } else { "unstable" }
         ),
-        None => format!("{}: averages over {} periods", o.regime, o.periods_averaged),
+        (None, Some(_)) => format!(
+            "{} (grazing a switch, largest |Floquet multiplier| {largest:.4})",
+            o.regime
+        ),
+        (None, None) => format!("{}: averages over {} periods", o.regime, o.periods_averaged),
     }
 }
 
