@@ -54,6 +54,10 @@ pub struct ContrastRow {
     /// Whether each φ comes from steady states that met their tolerance (both ends of
     /// the interpolation).
     pub converged: Vec<Option<bool>>,
+    /// Whether either steady state each φ is interpolated between grazes a switch
+    /// ([`crate::dynamics::grazing`]): its touch pattern, and so φ, is then set by
+    /// perturbations below the thermal motion.
+    pub grazing: Vec<Option<bool>>,
     /// φ(last material) − φ(first material), degrees, where both are on this branch.
     pub delta_phase_deg: Option<f64>,
     /// E_ts per cycle of each material (J), interpolated as φ is; null where φ is.
@@ -75,6 +79,7 @@ struct AtSetpoint {
     e_ts_j: [f64; 4],
     regime: String,
     converged: bool,
+    grazing: bool,
 }
 
 /// φ and E_ts per mechanism interpolated linearly in A/A₀ at A/A₀ = `r` between two
@@ -122,6 +127,7 @@ fn states_at(
                 e_ts_j,
                 regime: "period-1".into(),
                 converged: a.converged && b.converged,
+                grazing: a.grazing || b.grazing,
             })
         })
         .collect();
@@ -148,6 +154,7 @@ fn states_at(
                     e_ts_j,
                     regime: nearer.regime.clone(),
                     converged: a.converged && b.converged,
+                    grazing: a.grazing || b.grazing,
                 });
             }
         }
@@ -262,6 +269,7 @@ pub fn contrast(
                     e_ts_viscous_j: share(2),
                     e_ts_capillary_j: share(3),
                     converged: on.iter().map(|s| s.map(|a| a.converged)).collect(),
+                    grazing: on.iter().map(|s| s.map(|a| a.grazing)).collect(),
                     phase_deg,
                 });
             }

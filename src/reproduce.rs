@@ -202,7 +202,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
                         let on: Vec<sweep_report::Located> = pts
                             .iter()
                             .filter(|p| p.direction == dir)
-                            .map(|p| sweep_report::locate(p, &xy))
+                            .map(|p| sweep_report::locate(p, &xy, i + 1))
                             .collect();
                         sweep_report::period_one_lines(&on, &format!("{law} {what}"), style, i + 1)
                     })
@@ -210,7 +210,8 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
                 .collect();
             let all: Vec<sweep_report::Located> = mine
                 .iter()
-                .flat_map(|c| c.2.iter().map(|p| sweep_report::locate(p, &xy)))
+                .enumerate()
+                .flat_map(|(i, c)| c.2.iter().map(move |p| sweep_report::locate(p, &xy, i + 1)))
                 .collect();
             series.extend(sweep_report::not_period_one(&all));
             series

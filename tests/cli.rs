@@ -1021,6 +1021,67 @@ fn branches_lists_the_folds_of_a_bistable_case_and_writes_every_output() {
 }
 
 #[test]
+fn branches_flags_the_orbits_that_graze_where_a_piece_ends() {
+    // On the hybrid defaults the first piece ends where the free orbit first reaches the
+    // jump-in separation: that orbit grazes (its margin past α_A below the thermal rms of
+    // about 10 pm), its stability is not claimed, and orbits far from it are not flagged.
+    let v = json(&["branches", "--json"]);
+    let n = v["separation_m"].as_array().unwrap().len();
+    let seg = |i: usize| v["segment"][i].as_u64().unwrap();
+    let last_of_first = (0..n).rev().find(|&i| seg(i) == 0).unwrap();
+    assert_eq!(v["grazing"][last_of_first], true);
+    let margin = v["grazing_margin_m"][last_of_first].as_f64().unwrap();
+    assert!(margin < 10e-12, "margin {margin:e} m");
+    let flagged: Vec<usize> = (0..n).filter(|&i| v["grazing"][i] == true).collect();
+    assert!(flagged.len() < n / 4, "{} of {n} flagged", flagged.len());
+    for &i in &flagged {
+        let m = v["grazing_margin_m"][i].as_f64().unwrap();
+        assert!(m < 20e-12, "point {i}: margin {m:e} m yet flagged");
+    }
+    // The deepest orbit (8 nm) is far from any switch.
+    assert_eq!(v["grazing"][n - 1], false);
+    let text = String::from_utf8_lossy(&tapsim(&["branches"]).stdout).to_string();
+    assert!(
+        text.contains(&format!("{} graze a switch", flagged.len())),
+        "{text}"
+    );
+}
+
+#[test]
+fn map_counts_its_grazing_cells_where_readme_says() {
+    // README (Speed): on the 10 x 10 default grid, 64 cells where the law applies: 52
+    // period-1 and 12 long locks, every lock grazing a switch, none irregular; the note
+    // on stderr counts them.
+    let out = tapsim(&["map", "--steps", "10", "--json"]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let flat = |key: &str| -> Vec<serde_json::Value> {
+        v["grid"][key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|r| r.as_array().unwrap().clone())
+            .collect()
+    };
+    let (regimes, grazing) = (flat("regime"), flat("grazing"));
+    let count =
+        |f: &dyn Fn(&str) -> bool| regimes.iter().filter(|r| r.as_str().is_some_and(f)).count();
+    assert_eq!(count(&|r| r == "period-1"), 52);
+    assert_eq!(count(&|r| r == "irregular"), 0);
+    assert_eq!(count(&|r| r.starts_with("period-") && r != "period-1"), 12);
+    for (r, g) in regimes.iter().zip(&grazing) {
+        if r.as_str().is_some_and(|r| r != "period-1") {
+            assert_eq!(g, true, "{r}");
+        }
+    }
+    let flagged = grazing.iter().filter(|g| **g == true).count();
+    assert_eq!(flagged, 12);
+    assert_eq!(v["grazing_cells"], 12);
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(note.contains("12 of 100 cells graze a switch"), "{note}");
+}
+
+#[test]
 fn bifurcation_samples_every_period_and_names_the_motion() {
     let v = json(&[
         "bifurcation",

@@ -1,7 +1,7 @@
 //! Steady states that are not period-1: Newton's method on the period map with its exact
 //! derivative, the classification of the motion, and what is reported for it.
 
-use tapsim::dynamics::observables::{Observe, TapObservables, tap};
+use tapsim::dynamics::observables::{Observe, Starts, TapObservables, tap};
 use tapsim::dynamics::setup::{Cantilever, Numerics, TapSetup, default_setup};
 use tapsim::law::LawKind;
 use tapsim::params::{Contact, composite_modulus};
@@ -96,11 +96,9 @@ fn quasi_periodic_with(numerics: Numerics) -> TapObservables {
         ..default_setup()
     };
     setup.cantilever.drive_frequency_hz = 305e3;
-    let observe = Observe {
-        starts: 1,
-        ..Observe::default()
-    };
-    tap(&setup, &numerics, observe).unwrap().observables
+    tap(&setup, &numerics, Observe::default())
+        .unwrap()
+        .observables
 }
 
 fn quasi_periodic(average_tolerance: f64) -> TapObservables {
@@ -119,7 +117,11 @@ fn jkr_on_the_defaults_locks_onto_a_long_period_that_grazes() {
         law: LawKind::Jkr.into(),
         ..default_setup()
     };
-    let run = tap(&setup, &Numerics::default(), Observe::default()).unwrap();
+    let observe = Observe {
+        starts: Starts::WhereGrazing,
+        ..Observe::default()
+    };
+    let run = tap(&setup, &Numerics::default(), observe).unwrap();
     let o = &run.observables;
     println!(
         "{}: A/A0 {:.6}, phase {:.4}, E_ts {:.3} eV, {} touches per period, margin {:?}",

@@ -93,7 +93,7 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         }
     }
     outln!(
-        "{:>9} {:>9} {:>10} {:>9} {:>10} {:>11} {:>10} {:>5}{}",
+        "{:>9} {:>9} {:>10} {:>9} {:>10} {:>11} {:>10} {:>5} {:>6}{}",
         "z_c (nm)",
         "dir",
         "motion",
@@ -102,6 +102,7 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         "E_ts (eV)",
         "F_pk (nN)",
         "conv",
+        "grazes",
         if normalized.is_some() {
             "  E_ts/E_max"
         } else {
@@ -118,7 +119,7 @@ pub fn run(args: ApproachArgs) -> Result<()> {
             })
             .unwrap_or_default();
         outln!(
-            "{:>9.3} {:>9} {:>10} {:>9.5} {:>10.4} {:>11.4} {:>10.4} {:>5}{share}",
+            "{:>9.3} {:>9} {:>10} {:>9.5} {:>10.4} {:>11.4} {:>10.4} {:>5} {:>6}{share}",
             p.separation_m * 1e9,
             match p.direction {
                 Direction::Approach => "approach",
@@ -129,7 +130,18 @@ pub fn run(args: ApproachArgs) -> Result<()> {
             o.phase_deg,
             o.e_ts_ev,
             o.peak_force_n * 1e9,
-            if o.converged { "yes" } else { "NO" }
+            if o.converged { "yes" } else { "NO" },
+            if o.grazing { "yes" } else { "" }
+        );
+    }
+    let grazing = points.iter().filter(|p| p.observables.grazing).count();
+    if grazing > 0 {
+        outln!(
+            "note: {grazing} of {} points graze a switch: a turning point of the separation \
+             lies closer to where the law switches than the thermal motion, so the touch \
+             pattern there is set by perturbations nothing controls and other states may \
+             coexist (`tapsim tap --separation Z` lists them)",
+            points.len()
         );
     }
     Ok(())

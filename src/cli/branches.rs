@@ -85,11 +85,24 @@ pub fn run(args: BranchesArgs) -> Result<()> {
         .iter()
         .filter(|p| p.observables.stable == Some(true))
         .count();
+    let grazing = branch
+        .points
+        .iter()
+        .filter(|p| p.observables.grazing)
+        .count();
     outln!(
-        "period-1 orbits of the {} law: {} points ({} stable)",
+        "period-1 orbits of the {} law: {} points ({} stable{})",
         setup.law,
         branch.points.len(),
         stable,
+        if grazing > 0 {
+            format!(
+                "; {grazing} graze a switch: whether they touch is decided by less than the \
+                 thermal motion, their stability not defined"
+            )
+        } else {
+            String::new()
+        },
     );
     for note in &branch.notes {
         outln!("  {note}");

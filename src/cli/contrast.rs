@@ -28,7 +28,7 @@ use clap::Args;
 /// JKR's contrast with the other laws', branch by branch.
 ///
 /// JSON (--json): one object per law, setpoint and branch with law, materials,
-/// amplitude_ratio, branch, phase_deg, regime, converged, e_ts_j, e_ts_adhesion_j,
+/// amplitude_ratio, branch, phase_deg, regime, converged, grazing, e_ts_j, e_ts_adhesion_j,
 /// e_ts_viscous_j and e_ts_capillary_j (one entry per material, null where it has no
 /// steady state on that branch; E_ts and its shares by mechanism interpolated at the
 /// setpoint as φ is) and

@@ -110,5 +110,15 @@ pub(super) fn emit<T: report::MapRecord>(
         records,
         || report::map_json(law, works, moduli, records),
         Some(&|path| plot::render_heatmaps(&report::heat_maps(law, works, moduli, records), path)),
-    )
+    )?;
+    let grazing = report::grazing_cells(records);
+    if grazing > 0 && !out.quiet {
+        eprintln!(
+            "note: {grazing} of {} cells graze a switch (column grazing, a dot on the heat \
+             maps): there the touch pattern is set by perturbations below the thermal \
+             motion and other attractors may coexist (`tapsim tap` at such a cell lists them)",
+            records.len()
+        );
+    }
+    Ok(())
 }

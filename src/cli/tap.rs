@@ -1,7 +1,7 @@
 //! `tapsim tap`: one tapping-mode simulation to its steady state.
 
 use crate::config::TapInputs;
-use crate::dynamics::observables::{Observe, tap};
+use crate::dynamics::observables::{Observe, Starts, tap};
 use crate::error::Result;
 use crate::report::{output, plot, tap as report};
 use clap::Args;
@@ -24,10 +24,19 @@ use std::path::PathBuf;
 /// the motion carries: its orbits have three Floquet multipliers).
 ///
 /// The motion starts from the free oscillation and settles on a steady state, which is
-/// named: a period-n orbit (n ≤ 8; its Floquet multipliers say whether it is stable) or
+/// named: a period-n orbit (n ≤ 1000; its Floquet multipliers say whether it is stable) or
 /// irregular motion. What is reported is what a lock-in and a dissipation measurement
 /// read: averages over the n periods of the orbit, or over a window of irregular motion
 /// (with standard errors), never one period of motion that is not period-1.
+///
+/// Near the onset of contact a turning point of the tip can pass a switch of the force
+/// law (the jump-in, the pull-off) by less than the thermal motion of the cantilever
+/// (√(k_BT/k) at 300 K, 10 pm on the defaults). Whether the tip touches in a period is
+/// then decided by perturbations nothing controls, several long mode locks can coexist,
+/// and the deterministic answer is not defined. Such a state is flagged "grazing a
+/// switch" (its grazing margin is printed beside the thermal rms); tapsim then marches
+/// from six documented starts and lists every attractor reached, with how many starts
+/// reached each, and says whether the answer is well defined (--starts N for any state).
 ///
 /// JSON keys (--json): amplitude_m, amplitude_ratio, phase_deg, phase_from_energy_deg,
 /// e_ts_j, e_ts_ev, e_ts_adhesion_j, e_ts_viscous_j and e_ts_capillary_j (E_ts by
@@ -35,7 +44,8 @@ use std::path::PathBuf;
 /// peak_force_n,
 /// min_separation_m, contact_fraction, jumps_in, loop_area_j, tabor_mu, regime, period,
 /// periods_averaged, stable, floquet_multipliers, amplitude_std_err_m,
-/// phase_std_err_deg, e_ts_std_err_j, cycles, converged, harmonics (harmonics 2…10 of
+/// phase_std_err_deg, e_ts_std_err_j, cycles, converged, grazing, grazing_margin_m,
+/// thermal_rms_m, integration_error_m, attractors, well_defined, harmonics (harmonics 2…10 of
 /// the deflection and the force over a periodic orbit: order, deflection_amplitude_m,
 /// deflection_phase_deg, force_amplitude_n, force_phase_deg; null for irregular
 /// motion), and more (see README).
@@ -79,7 +89,9 @@ pub fn run(args: TapArgs) -> Result<()> {
     let observe = Observe {
         record_cycles: record,
         harmonics: true,
-        starts: args.starts.unwrap_or(0) as usize,
+        starts: args
+            .starts
+            .map_or(Starts::WhereGrazing, |n| Starts::First(n as usize)),
     };
     let run = tap(&setup, &numerics, observe)?;
     if let Some(path) = &args.trajectory {

@@ -374,10 +374,22 @@ pub struct Observe {
     /// Whether to compute the higher harmonics of a periodic orbit (one more orbit
     /// integrated; nothing for irregular motion).
     pub harmonics: bool,
-    /// Starts to march from and list the attractors of ([`Start::list`], at most
-    /// [`MAX_STARTS`]); 0: [`DEFAULT_STARTS`] where the state grazes a switch, none
-    /// otherwise.
-    pub starts: usize,
+    /// The starts whose attractors the run lists ([`super::attractors`]).
+    pub starts: Starts,
+}
+
+/// Which starts a run lists the attractors of ([`super::attractors`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Starts {
+    /// None: the free oscillation's steady state alone (sweeps, maps and batches, which
+    /// carry the grazing flag per point instead).
+    #[default]
+    None,
+    /// [`DEFAULT_STARTS`] where the state grazes a switch, none otherwise (what
+    /// `tapsim tap` does).
+    WhereGrazing,
+    /// The first n of [`Start::list`] (1 to [`MAX_STARTS`]).
+    First(usize),
 }
 
 impl Observe {
@@ -411,7 +423,11 @@ pub struct TapRun {
     /// oscillation's first; null where none were looked for (a state that does not
     /// graze a switch, without `starts`).
     pub attractors: Option<Vec<Attractor>>,
-    /// Whether every start reached the same attractor; null where only one was tried.
+    /// Whether the deterministic answer is defined: every start reached the same
+    /// attractor, or those reached coexist without grazing a switch (a bistability: which
+    /// one is reached depends on the history, each is well defined). False where
+    /// attractors that graze coexist (their basins can be finer than the thermal
+    /// motion); null where only one start was tried.
     pub well_defined: Option<bool>,
     /// Trajectory samples (empty unless recorded).
     #[serde(skip)]
@@ -448,12 +464,14 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<Ta
             reason: "must be at most 1000 (the trajectory is kept in memory)",
         });
     }
-    if observe.starts > MAX_STARTS {
-        return Err(Error::InvalidParameter {
-            name: "starts",
-            value: observe.starts as f64,
-            reason: "must be at most 64",
-        });
+    if let Starts::First(n) = observe.starts {
+        if !(1..=MAX_STARTS).contains(&n) {
+            return Err(Error::InvalidParameter {
+                name: "starts",
+                value: n as f64,
+                reason: "must be 1 to 64",
+            });
+        }
     }
     let p = Prepared::new(setup, numerics)?;
     let sim = p.simulation();
@@ -461,8 +479,10 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<Ta
     let state = sim.steady_state(&mut phase, &p.steady)?;
     let observables = TapObservables::new(&p, &state)?;
     let starts = match observe.starts {
-        0 if observables.grazing => DEFAULT_STARTS,
-        n => n,
+        Starts::None => 0,
+        Starts::WhereGrazing if observables.grazing => DEFAULT_STARTS,
+        Starts::WhereGrazing => 0,
+        Starts::First(n) => n,
     };
     let attractors = (starts > 0)
         .then(|| attractors(setup, numerics, &Start::list(starts)))
@@ -507,7 +527,7 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<Ta
         well_defined: attractors
             .as_ref()
             .filter(|_| starts > 1)
-            .map(|list| list.len() == 1),
+            .map(|list| list.len() == 1 || list.iter().all(|a| !a.grazing)),
         attractors,
         harmonics,
         trajectory: recorder.to_si(&p),

@@ -304,7 +304,7 @@ impl<L: ForceLaw> Copy for Simulation<'_, L> {}
 /// The longest period looked for; motion that repeats after no n ≤ this is `irregular`.
 /// Periods up to [`SHORT_PERIOD`] are looked for wherever the motion nearly repeats;
 /// longer ones (mode locks near grazing, such as 13 touches in 27 periods) where the
-/// section state has returned within [`LOCK_GAP`] three periods running.
+/// section state has returned within `LOCK_GAP` (1e-5) three periods running.
 pub const MAX_PERIOD: usize = 1000;
 
 /// The longest period looked for from loose near-returns, and by time-marching alone
@@ -1106,7 +1106,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
     /// L: for a periodic orbit the larger of its closure tolerance and the integrator's
     /// relative tolerance (Newton aims 100× below the first, and a period integrated at
     /// the second moves a state of size ~1 by about that much); for irregular motion the
-    /// tolerance its periods are marched at ([`Self::marching`]).
+    /// tolerance its periods are marched at (`marching`).
     pub fn resolution(&self, opts: &SteadyOptions, motion: &Motion) -> f64 {
         match motion {
             Motion::Periodic { .. } => opts.tolerance.max(self.tol.rtol),

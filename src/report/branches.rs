@@ -27,9 +27,10 @@ const QUANTITIES: [(&str, &str, &str, &str, Pick); 3] = [
 
 /// Runs of consecutive points of one stability and one piece of the branch, each with
 /// the neighbouring point of the run before where only the stability changes, so the
-/// lines join there and break between pieces.
+/// lines join there and break between pieces. An orbit whose stability rests on a
+/// grazing contact (`stable` null) is drawn with the stable ones and marked as grazing.
 fn runs(points: &[BranchRecord]) -> Vec<(bool, Vec<&BranchRecord>)> {
-    let stable = |p: &BranchRecord| p.observables.stable == Some(true);
+    let stable = |p: &BranchRecord| p.observables.stable != Some(false);
     let mut out: Vec<(bool, Vec<&BranchRecord>)> = Vec::new();
     for p in points {
         match out.last_mut() {
@@ -51,8 +52,8 @@ fn runs(points: &[BranchRecord]) -> Vec<(bool, Vec<&BranchRecord>)> {
 }
 
 /// One chart per quantity against z_c (nm), E_ts only for a law with a loop (a
-/// conservative law's is round-off); `ramp`, if given, is drawn as markers (approach and
-/// retract).
+/// conservative law's is round-off); orbits that graze a switch marked by squares;
+/// `ramp`, if given, is drawn as markers (approach and retract).
 pub fn branch_charts(points: &[BranchRecord], ramp: &[SweepPoint], title: &str) -> Vec<Chart> {
     let nm = |m: f64| m * 1e9;
     let lossless = points.iter().all(|p| p.observables.loop_area_j == 0.0);
@@ -97,6 +98,14 @@ pub fn branch_charts(points: &[BranchRecord], ramp: &[SweepPoint], title: &str) 
                 if !marks.is_empty() {
                     series.push(Series::new(legend, marks, Style::Markers, color));
                 }
+            }
+            let grazing: Vec<(f64, f64)> = points
+                .iter()
+                .filter(|p| p.observables.grazing)
+                .map(|p| (nm(p.separation_m), pick(&p.observables)))
+                .collect();
+            if !grazing.is_empty() {
+                series.push(Series::new("grazes a switch", grazing, Style::Squares, 6));
             }
             series.extend(super::sweep::ramp_markers(ramp, &|p: &SweepPoint| {
                 (nm(p.separation_m), pick(&p.observables))

@@ -67,12 +67,14 @@ pub enum Style {
     /// Squares at the points, no line (a second kind of marker, to tell coinciding
     /// sets apart).
     Squares,
+    /// Crosses at the points, no line (a third kind of marker).
+    Crosses,
 }
 
 impl Style {
     /// Whether points are marked rather than joined.
     pub fn is_marker(self) -> bool {
-        matches!(self, Style::Markers | Style::Squares)
+        matches!(self, Style::Markers | Style::Squares | Style::Crosses)
     }
 }
 

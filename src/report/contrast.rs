@@ -15,7 +15,8 @@ pub fn branch_name(b: PhaseBranch) -> &'static str {
     }
 }
 
-/// The rows as CSV: law, setpoint, branch, each material's phase and regime, Δφ, then
+/// The rows as CSV: law, setpoint, branch, each material's phase, regime and grazing
+/// flag, Δφ, then
 /// each material's E_ts and its adhesion and viscous shares (J). An error is the CSV
 /// writer's reason.
 pub fn contrast_csv(
@@ -26,6 +27,7 @@ pub fn contrast_csv(
     let mut header = vec!["law".to_string(), "amplitude_ratio".into(), "branch".into()];
     header.extend(materials.iter().map(|m| format!("phase_deg_{}", m.name)));
     header.extend(materials.iter().map(|m| format!("regime_{}", m.name)));
+    header.extend(materials.iter().map(|m| format!("grazing_{}", m.name)));
     header.push("delta_phase_deg".into());
     for column in [
         "e_ts_j",
@@ -47,6 +49,11 @@ pub fn contrast_csv(
         ];
         rec.extend(r.phase_deg.iter().map(|&p| cell(p)));
         rec.extend(r.regime.iter().map(|g| g.clone().unwrap_or_default()));
+        rec.extend(
+            r.grazing
+                .iter()
+                .map(|g| g.map_or(String::new(), |g| g.to_string())),
+        );
         rec.push(cell(r.delta_phase_deg));
         for shares in [
             &r.e_ts_j,
@@ -174,10 +181,18 @@ pub fn contrast_text(laws: &[LawKind], rows: &[ContrastRow]) -> String {
         "law", "A/A0", "branch", "Δφ (deg)"
     );
     for r in rows {
-        let regimes: Vec<&str> = r
+        let regimes: Vec<String> = r
             .regime
             .iter()
-            .map(|g| g.as_deref().unwrap_or("none"))
+            .zip(&r.grazing)
+            .map(|(g, grazing)| {
+                let mark = if *grazing == Some(true) {
+                    " (grazing)"
+                } else {
+                    ""
+                };
+                format!("{}{mark}", g.as_deref().unwrap_or("none"))
+            })
             .collect();
         let _ = writeln!(
             s,

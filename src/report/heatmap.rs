@@ -1,7 +1,7 @@
 //! A quantity over a two-dimensional grid of parameters, drawn as a heat map: one
 //! coloured cell per grid point on a perceptually uniform scale (viridis) with its colour
 //! bar, cells where the law does not apply left grey, cells whose motion is not
-//! period-1 marked.
+//! period-1 marked, and cells whose motion grazes a switch marked too.
 
 /// One cell of a heat map.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -13,6 +13,8 @@ pub enum Cell {
         value: f64,
         /// Whether the motion is period-1.
         period_one: bool,
+        /// Whether the motion grazes a switch (marked by a black dot).
+        grazing: bool,
     },
     /// The law does not apply here.
     NotApplicable,

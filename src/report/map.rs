@@ -13,9 +13,9 @@ use serde::Serialize;
 use serde_json::value::RawValue;
 
 /// What a heat map shows of one cell: E_ts per cycle (eV), the phase (deg), A/A₀ and the
-/// viscous share of E_ts (eV), and whether the motion is period-1; `None` where the law
-/// does not apply.
-pub type Plotted = Option<([f64; 4], bool)>;
+/// viscous share of E_ts (eV), whether the motion is period-1 and whether it grazes a
+/// switch; `None` where the law does not apply.
+pub type Plotted = Option<([f64; 4], bool, bool)>;
 
 /// A map cell as its record serialises, and what its heat maps show.
 pub trait MapRecord: Serialize {
@@ -34,6 +34,7 @@ impl MapRecord for MapCell {
                 o.e_ts_viscous_j / ELECTRONVOLT_J,
             ],
             o.period == Some(1),
+            o.grazing,
         ))
     }
 }
@@ -46,6 +47,7 @@ struct PlottedFields {
     amplitude_ratio: Option<f64>,
     e_ts_viscous_j: Option<f64>,
     period: Option<u64>,
+    grazing: Option<bool>,
 }
 
 impl MapRecord for Box<RawValue> {
@@ -60,6 +62,7 @@ impl MapRecord for Box<RawValue> {
                 f.e_ts_viscous_j? / ELECTRONVOLT_J,
             ],
             f.period == Some(1),
+            f.grazing == Some(true),
         ))
     }
 }
@@ -87,9 +90,10 @@ pub fn heat_maps<T: MapRecord>(
             .map(|row| {
                 row.iter()
                     .map(|c| match c {
-                        Some((values, period_one)) => Cell::Value {
+                        Some((values, period_one, grazing)) => Cell::Value {
                             value: values[which],
                             period_one: *period_one,
+                            grazing: *grazing,
                         },
                         None => Cell::NotApplicable,
                     })
@@ -102,7 +106,7 @@ pub fn heat_maps<T: MapRecord>(
         map("phase", "phase lag φ (deg)", 1),
         map("amplitude", "A/A₀", 2),
     ];
-    if plotted.iter().flatten().any(|(values, _)| values[3] > 0.0) {
+    if plotted.iter().flatten().any(|(values, ..)| values[3] > 0.0) {
         maps.push(map(
             "viscous share of the dissipation",
             "E_ts in the viscous sample per cycle (eV)",
@@ -114,7 +118,7 @@ pub fn heat_maps<T: MapRecord>(
 
 /// The grid as one JSON object: the law, both axes, and per observable an array of rows
 /// (one per modulus) of values (one per work of adhesion).
-pub fn map_json<T: Serialize>(
+pub fn map_json<T: MapRecord>(
     law: &str,
     works: &[f64],
     moduli: &[f64],
@@ -124,6 +128,15 @@ pub fn map_json<T: Serialize>(
         "law": law,
         "work_of_adhesion_j_m2": works,
         "modulus_pa": moduli,
+        "grazing_cells": grazing_cells(cells),
         "grid": records::grid_json(cells, works.len())?,
     }))
+}
+
+/// How many cells' motion grazes a switch.
+pub fn grazing_cells<T: MapRecord>(cells: &[T]) -> usize {
+    cells
+        .iter()
+        .filter(|c| c.plotted().is_some_and(|p| p.2))
+        .count()
 }

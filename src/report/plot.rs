@@ -266,16 +266,20 @@ fn draw_heatmap<DB: DrawingBackend>(
             };
             ctx.draw_series(std::iter::once(Rectangle::new(corners, fill.filled())))
                 .map_err(|e| err(&e))?;
+            let centre = (map.x[i], map.y[j]);
             if let Cell::Value {
                 period_one: false, ..
             } = cell
             {
-                let centre = (map.x[i], map.y[j]);
                 ctx.draw_series([
                     Circle::new(centre, 6, WHITE.filled()),
                     Circle::new(centre, 6, BLACK.stroke_width(2)),
                 ])
                 .map_err(|e| err(&e))?;
+            }
+            if let Cell::Value { grazing: true, .. } = cell {
+                ctx.draw_series([Circle::new(centre, 3, BLACK.filled())])
+                    .map_err(|e| err(&e))?;
             }
         }
     }
@@ -319,12 +323,20 @@ fn draw_heatmap<DB: DrawingBackend>(
         key.clone(),
     ))
     .map_err(|e| err(&e))?;
+    side.draw(&Circle::new(at(32), 3, BLACK.filled()))
+        .map_err(|e| err(&e))?;
+    side.draw(&Text::new(
+        "grazes a switch",
+        (at(24).0 + 14, at(24).1),
+        key.clone(),
+    ))
+    .map_err(|e| err(&e))?;
     side.draw(&Rectangle::new(
-        [at(24), (at(24).0 + 12, at(24).1 + 12)],
+        [at(48), (at(48).0 + 12, at(48).1 + 12)],
         grey.filled(),
     ))
     .map_err(|e| err(&e))?;
-    side.draw(&Text::new("law n/a", (at(24).0 + 18, at(24).1), key))
+    side.draw(&Text::new("law n/a", (at(48).0 + 18, at(48).1), key))
         .map_err(|e| err(&e))?;
     Ok(Drawn {
         area: ctx.plotting_area().get_pixel_range(),
@@ -459,12 +471,28 @@ where
                     });
                 }
             }
+            Style::Crosses => {
+                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
+                let anno = ctx
+                    .draw_series(inside.map(|p| Cross::new(p, 5, style)))
+                    .map_err(|e| err(&e))?;
+                if !series.name.is_empty() {
+                    anno.label(series.name.as_str())
+                        .legend(move |(x, y)| Cross::new((x + 10, y), 5, style));
+                }
+            }
             Style::Line | Style::Dashed | Style::Dotted => {
                 let (dash, gap) = match series.style {
                     Style::Dashed => (12, 8),
                     _ => (3, 5),
                 };
-                for (i, run) in clip.runs(&series.points).into_iter().enumerate() {
+                // A named series with no points is a legend entry alone (a curve whose
+                // every point is drawn as a marker).
+                let mut runs = clip.runs(&series.points);
+                if series.points.is_empty() && !series.name.is_empty() {
+                    runs.push(Vec::new());
+                }
+                for (i, run) in runs.into_iter().enumerate() {
                     let anno = if series.style == Style::Line {
                         ctx.draw_series(LineSeries::new(run, style))
                     } else {
@@ -565,7 +593,10 @@ where
     let mut text = MultiLineText::<_, &str>::new((0, 0), &style);
     // Labelled as drawn: a line only if some of it is inside the box.
     for series in chart.series.iter().filter(|s| !s.name.is_empty()) {
-        if series.style.is_marker() || !clip.runs(&series.points).is_empty() {
+        if series.style.is_marker()
+            || series.points.is_empty()
+            || !clip.runs(&series.points).is_empty()
+        {
             text.push_line(series.name.as_str());
         }
     }
@@ -895,10 +926,12 @@ mod tests {
                     Cell::Value {
                         value: 0.0,
                         period_one: true,
+                        grazing: false,
                     },
                     Cell::Value {
                         value: 1.0,
                         period_one: false,
+                        grazing: false,
                     },
                 ],
                 vec![
@@ -906,6 +939,7 @@ mod tests {
                     Cell::Value {
                         value: 0.5,
                         period_one: true,
+                        grazing: false,
                     },
                 ],
             ],

@@ -17,6 +17,7 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
     type Pick = fn(&SweepPoint) -> f64;
     let nm = |p: &SweepPoint| p.separation_m * 1e9;
     let series = |x: &dyn Fn(&SweepPoint) -> f64, y: Pick| -> Vec<Series> {
+        let mut all: Vec<Located> = Vec::new();
         let mut out: Vec<Series> = [
             (Direction::Approach, "approach", 1),
             (Direction::Retract, "retract", 2),
@@ -31,15 +32,13 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             let on: Vec<Located> = points
                 .iter()
                 .filter(|p| p.direction == dir)
-                .map(|p| locate(p, &|p| (x(p), y(p))))
+                .map(|p| locate(p, &|p| (x(p), y(p)), color))
                 .collect();
-            period_one_lines(&on, name, style, color)
+            let lines = period_one_lines(&on, name, style, color);
+            all.extend(on);
+            lines
         })
         .collect();
-        let all: Vec<Located> = points
-            .iter()
-            .map(|p| locate(p, &|p| (x(p), y(p))))
-            .collect();
         out.extend(not_period_one(&all));
         out
     };
@@ -168,7 +167,7 @@ pub fn identification_chart(
                 .filter(|(p, _)| touching_on_approach(p))
                 .filter_map(|(p, n)| {
                     let e = n.of(mechanism)?;
-                    Some(locate(p, &|p| (p.observables.amplitude_ratio, e)))
+                    Some(locate(p, &|p| (p.observables.amplitude_ratio, e), color))
                 })
                 .collect();
             let name = match (curves.len(), present.len()) {
@@ -221,7 +220,7 @@ pub fn vs_amplitude(
     for (i, (label, points)) in curves.iter().enumerate() {
         let kept: Vec<&SweepPoint> = points.iter().filter(|p| touching_on_approach(p)).collect();
         for (k, part) in split_at_jumps(&kept).into_iter().enumerate() {
-            let on: Vec<Located> = part.iter().map(|p| locate(p, &xy)).collect();
+            let on: Vec<Located> = part.iter().map(|p| locate(p, &xy, i + 1)).collect();
             series.extend(period_one_lines(
                 &on,
                 if k == 0 { label } else { "" },
@@ -249,8 +248,18 @@ fn touching_on_approach(p: &SweepPoint) -> bool {
     p.direction == Direction::Approach && p.observables.amplitude_ratio < 0.999
 }
 
-/// A value to plot and the period of the motion behind it (`None`: irregular).
-pub type Located = (Option<usize>, (f64, f64));
+/// A value to plot and what it is.
+#[derive(Debug, Clone, Copy)]
+pub struct Located {
+    /// The period of the motion behind it (`None`: irregular).
+    pub period: Option<usize>,
+    /// Whether that motion grazes a switch.
+    pub grazing: bool,
+    /// The point.
+    pub xy: (f64, f64),
+    /// Palette colour of the curve it belongs to.
+    pub color: usize,
+}
 
 /// A change of φ between neighbouring setpoints (degrees) that is a jump between
 /// branches, not a slope.
@@ -271,47 +280,77 @@ fn split_at_jumps<'a>(points: &[&'a SweepPoint]) -> Vec<Vec<&'a SweepPoint>> {
 }
 
 /// Lines through `points` (in order) that join neighbouring period-1 points only, the
-/// first named `name`: a value of motion that is not period-1 is no point of a smooth
+/// first named `name` (a legend entry alone where there is none): a value of motion that is not period-1 is no point of a smooth
 /// curve ([`not_period_one`] marks those).
 pub fn period_one_lines(points: &[Located], name: &str, style: Style, color: usize) -> Vec<Series> {
     let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for &(period, xy) in points {
-        if period == Some(1) {
-            runs.last_mut().expect("a run").push(xy);
+    for p in points {
+        if p.period == Some(1) {
+            runs.last_mut().expect("a run").push(p.xy);
         } else if !runs.last().expect("a run").is_empty() {
             runs.push(Vec::new());
         }
     }
+    runs.retain(|r| !r.is_empty());
+    if runs.is_empty() {
+        // No period-1 point: the curve's name still goes in the legend, its points are
+        // all markers in its colour.
+        return vec![Series::new(name, vec![], style, color)];
+    }
     runs.into_iter()
-        .filter(|r| !r.is_empty())
         .enumerate()
         .map(|(i, r)| Series::new(if i == 0 { name } else { "" }, r, style, color))
         .collect()
 }
 
-/// Points that are not period-1, as markers of their own: periodic orbits of higher
-/// period, and irregular motion (its values averages over a window).
+/// Points that are not period-1, as markers in their curve's colour: circles for
+/// periodic orbits of higher period, crosses for irregular motion (its values averages
+/// over a window) and, around them, squares for every point whose motion grazes a switch
+/// (its touch pattern set by perturbations below the thermal motion). Each kind has one
+/// legend entry, in black; the curves' colours say whose points they are.
 pub fn not_period_one(points: &[Located]) -> Vec<Series> {
-    let pick = |keep: &dyn Fn(Option<usize>) -> bool| -> Vec<(f64, f64)> {
-        points.iter().filter(|p| keep(p.0)).map(|p| p.1).collect()
-    };
-    [
-        (
-            pick(&|n| n.is_some_and(|n| n > 1)),
-            "period-n orbit (n ≥ 2)",
-            0,
-        ),
-        (pick(&|n| n.is_none()), "irregular (window average)", 4),
-    ]
-    .into_iter()
-    .filter(|(pts, _, _)| !pts.is_empty())
-    .map(|(pts, name, color)| Series::new(name, pts, Style::Markers, color))
-    .collect()
+    type Kind = (&'static str, Style, fn(&Located) -> bool);
+    let kinds: [Kind; 3] = [
+        ("period-n orbit (n ≥ 2)", Style::Markers, |p| {
+            p.period.is_some_and(|n| n > 1)
+        }),
+        ("irregular (window average)", Style::Crosses, |p| {
+            p.period.is_none()
+        }),
+        ("grazes a switch", Style::Squares, |p| p.grazing),
+    ];
+    let mut colors: Vec<usize> = points.iter().map(|p| p.color).collect();
+    colors.sort_unstable();
+    colors.dedup();
+    let mut out = Vec::new();
+    for (name, style, keep) in kinds {
+        if !points.iter().any(keep) {
+            continue;
+        }
+        out.push(Series::new(name, vec![], style, 0));
+        for &color in &colors {
+            let pts: Vec<(f64, f64)> = points
+                .iter()
+                .filter(|p| p.color == color && keep(p))
+                .map(|p| p.xy)
+                .collect();
+            if !pts.is_empty() {
+                out.push(Series::new("", pts, style, color));
+            }
+        }
+    }
+    out
 }
 
-/// A sweep point located for a plot by `xy`.
-pub fn locate(p: &SweepPoint, xy: &dyn Fn(&SweepPoint) -> (f64, f64)) -> Located {
-    (p.observables.period, xy(p))
+/// A sweep point located for a plot by `xy`, on the curve drawn in palette colour
+/// `color`.
+pub fn locate(p: &SweepPoint, xy: &dyn Fn(&SweepPoint) -> (f64, f64), color: usize) -> Located {
+    Located {
+        period: p.observables.period,
+        grazing: p.observables.grazing,
+        xy: xy(p),
+        color,
+    }
 }
 
 /// An approach ramp drawn over an orbit branch: its points as markers, approach and

@@ -204,10 +204,14 @@ fn picometres(m: f64) -> String {
 /// The attractors reached from several starts, and what their number means.
 fn attractors_text(s: &mut String, list: &[Attractor], well_defined: Option<bool>) {
     let starts: usize = list.iter().map(|a| a.count).sum();
-    let verdict = match well_defined {
-        Some(false) => "the deterministic answer is not defined here",
-        Some(true) => "every start reached the same state",
-        None => "one start",
+    let verdict = match (well_defined, list.len()) {
+        (None, _) => "one start",
+        (Some(false), _) => {
+            "the deterministic answer is not defined here: states that graze a switch \
+             coexist, their basins finer than the thermal motion"
+        }
+        (Some(true), 1) => "every start reached the same state",
+        (Some(true), _) => "coexisting states: which one is reached depends on the history",
     };
     let _ = writeln!(
         s,
