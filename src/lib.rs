@@ -30,6 +30,8 @@ pub mod config;
 #[cfg(feature = "app")]
 pub mod figures;
 #[cfg(feature = "app")]
+pub mod fnv;
+#[cfg(feature = "app")]
 pub mod lj_cache;
 #[cfg(feature = "app")]
 pub mod report;

@@ -1693,7 +1693,8 @@ fn merge_refuses_what_is_not_a_part_file_of_a_job_tapsim_can_run() {
         format!(
             "{{\"format\":\"tapsim-part\",\"tapsim_version\":\"0.1.0\",\"config_hash\":\"0\",\
              \"shards\":{shards},\"shard\":0,\"job\":{{\"kind\":\"map\",\"law\":\"hybrid\",\
-             \"work_of_adhesion_j_m2\":{axes},\"modulus_pa\":{axes}}},\"items\":[],\"records\":[]}}"
+             \"work_of_adhesion_j_m2\":{axes},\"modulus_pa\":{axes}}},\"config\":[],\
+             \"item_configs\":[],\"items\":[],\"records\":[],\"records_checksum\":\"0\"}}"
         )
     };
     write("many-shards.json", &header("1000000000000000000", "[1,2]"));
@@ -1704,7 +1705,7 @@ fn merge_refuses_what_is_not_a_part_file_of_a_job_tapsim_can_run() {
         ("garbage.json", "not a tapsim part file"),
         ("other.json", "not a tapsim part file"),
         ("many-shards.json", "parts"),
-        ("huge-grid.json", "more than any tapsim job has"),
+        ("huge-grid.json", "is not an axis tapsim map takes"),
         ("cut-short.json", "changed or cut short"),
         ("missing.json", "No such file"),
         (".", "not a regular file"),

@@ -3,7 +3,7 @@
 
 use crate::config::TapInputs;
 use crate::error::{Error, Result};
-use crate::report::part::{self, Job};
+use crate::report::part::{self, Job, MAX_CASES};
 use crate::report::records;
 use crate::sweep::{self, Shard};
 use clap::Args;
@@ -22,6 +22,11 @@ use std::path::{Path, PathBuf};
 ///   command   tap or approach
 ///   points, from, to, no-retract   an approach's setpoints (as `tapsim approach`)
 /// Options given on the command line apply to every row that does not set them.
+///
+/// A row with a value tapsim refuses (unreadable, or outside what `tapsim tap` accepts,
+/// such as a 1 mm tip) refuses the whole batch before any case runs, naming the row; a
+/// case where the law does not apply (a law outside its μ range) gets a note instead of
+/// observables, as a map cell does.
 ///
 /// Output: CSV on stdout (or --csv FILE), or --json (one object of equal-length
 /// columns): one row per tap case (case, command, and every observable of `tapsim tap
@@ -48,9 +53,6 @@ pub struct BatchArgs {
 
 /// The largest table read, in bytes.
 const MAX_TABLE_BYTES: u64 = 16 * 1024 * 1024;
-
-/// The most cases a table may hold.
-const MAX_CASES: usize = 100_000;
 
 /// What a case runs.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -128,6 +130,15 @@ fn read_rows(path: &Path) -> Result<Vec<Row>> {
             .iter()
             .map(str::to_string)
             .collect();
+        if let Some(twice) = header
+            .iter()
+            .enumerate()
+            .find_map(|(i, h)| header[..i].contains(h).then_some(h))
+        {
+            return Err(fail(format!(
+                "column {twice:?} is given twice: give each column once"
+            )));
+        }
         reader
             .records()
             .map(|r| {
@@ -174,7 +185,19 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
             "to" => {
                 to = Some(crate::config::length(text).map_err(|e| at(Error::NotApplicable(e)))?)
             }
-            "no-retract" => retract = !matches!(text.as_str(), "true" | "yes" | "1"),
+            "no-retract" => {
+                retract = match text.to_ascii_lowercase().as_str() {
+                    "true" | "yes" | "1" => false,
+                    "false" | "no" | "0" => true,
+                    _ => {
+                        return Err(at(Error::Parse {
+                            name: "no-retract",
+                            text: text.clone(),
+                            reason: "expected true or false".into(),
+                        }));
+                    }
+                }
+            }
             "law" => {
                 inputs.law = Some(crate::law::LawKind::from_name(text).ok_or_else(|| {
                     at(Error::Parse {
@@ -202,6 +225,8 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
     }
     let inputs = inputs.or(base.clone());
     let (setup, numerics) = inputs.resolve().map_err(at)?;
+    // A value `tap` refuses refuses the batch here, before any case runs.
+    setup.check_plausible().map_err(at)?;
     let (run, numerics) = match command.as_str() {
         "tap" => (Run::Tap, numerics),
         "approach" => (
@@ -319,7 +344,12 @@ pub fn run(args: BatchArgs) -> Result<()> {
         Some(shard) => args.split.write(
             ("batch", shard, args.out.quiet),
             Job::Batch { cases: cases.len() },
-            &cases,
+            &part::Config::PerItem(
+                cases
+                    .iter()
+                    .map(|c| serde_json::to_value(c).expect("a case serialises"))
+                    .collect(),
+            ),
             items,
             records,
         ),

@@ -84,7 +84,10 @@ pub fn run(args: MapArgs) -> Result<()> {
                 work_of_adhesion_j_m2: works.clone(),
                 modulus_pa: moduli.clone(),
             },
-            &(&setup, &numerics, &works, &moduli),
+            &part::Config::Whole(
+                serde_json::to_value((&setup, &numerics, &works, &moduli))
+                    .expect("a configuration serialises"),
+            ),
             cells,
             computed
                 .iter()

@@ -10,9 +10,13 @@ use std::path::PathBuf;
 /// Slurm job array) into exactly the outputs the whole run writes: the CSV, the JSON and
 /// a map's heat maps are byte for byte those of one unsharded run.
 ///
-/// Every part must come from the same configuration (the hash in its header) and the
-/// same split, and every part 0 … N−1 must be there exactly once. A missing part is
-/// named in the form `sbatch --array=` takes, to resubmit it:
+/// A part file is checked like any input before anything is drawn from it: written by
+/// this tapsim, its job one `map` or `batch` would run, its configuration hash recomputed
+/// from the configuration it carries, exactly its items with the records each should
+/// have, and a checksum of those records; a mismatch is refused, naming the file and the
+/// field. Every part must come from the same configuration and the same split, and every
+/// part 0 … N−1 must be there exactly once. A missing part is named in the form
+/// `sbatch --array=` takes, to resubmit it:
 ///
 ///   tapsim merge parts/*.json --out map.csv --out map.png
 ///   error: 2 of 7 parts missing: 3,5 (rerun them with sbatch --array=3,5)

@@ -3,7 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::report::output;
-use crate::report::part::{Job, Part};
+use crate::report::part::{Config, Job, Part};
 use crate::sweep::Shard;
 use serde_json::value::RawValue;
 use std::path::PathBuf;
@@ -92,7 +92,7 @@ impl ShardArgs {
         &self,
         (command, shard, quiet): (&str, Shard, bool),
         job: Job,
-        config: &impl serde::Serialize,
+        config: &Config,
         items: Vec<usize>,
         records: Vec<Vec<Box<RawValue>>>,
     ) -> Result<()> {
