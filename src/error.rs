@@ -30,6 +30,11 @@ pub enum Error {
     /// A model was asked for a result outside the range where it applies.
     #[error("{0}")]
     NotApplicable(String),
+    /// A value is outside what an AFM can be or what tapsim resolves (a tip radius of
+    /// 1 mm, Q = 0.1): refused for the whole run, never turned into a per-cell note as a
+    /// law that does not apply at one cell's μ is.
+    #[error("{0}")]
+    OutOfRange(String),
     /// The Lennard-Jones force–separation curve has no loop at this μ: approach and
     /// retraction follow one curve and nothing is lost (a result, not a failure, for
     /// `tapsim lj`).

@@ -531,6 +531,14 @@ fn each_reported_hostile_input_is_refused_with_its_reason() {
     .unwrap();
     std::fs::write(dir.join("broken.toml"), "radius = \n").unwrap();
     std::fs::write(dir.join("law.toml"), "law = \"magic\"\n").unwrap();
+    // Issue 25: a batch refuses a row tap refuses, naming it; and its own misreadings.
+    std::fs::write(dir.join("radius.csv"), "name,radius\na,20nm\nb,1mm\n").unwrap();
+    std::fs::write(dir.join("twice.csv"), "name,radius,radius\na,20nm,30nm\n").unwrap();
+    std::fs::write(
+        dir.join("maybe.toml"),
+        "[[case]]\ncommand = \"approach\"\npoints = 3\nno-retract = \"maybe\"\n",
+    )
+    .unwrap();
     let long = "7".repeat(10_000);
     let mut cases: Vec<(Vec<&str>, i32, &str)> = vec![
         (vec!["tap", "--max-cycles", "1"], 1, "max cycles"),
@@ -622,6 +630,39 @@ fn each_reported_hostile_input_is_refused_with_its_reason() {
         ),
         (vec!["reproduce", "--out", "/"], 1, "not empty"),
         (vec!["tap", "--radius", &long], 2, "10000 characters"),
+        // Issue 25: input that applies to the whole run is refused by map and batch as
+        // tap refuses it, not turned into a note per cell.
+        (
+            vec!["map", "--steps", "2", "--radius", "1mm"],
+            1,
+            "tip radius R = 1 mm",
+        ),
+        (
+            vec!["map", "--steps", "2", "--viscosity", "-1"],
+            1,
+            "sample viscosity",
+        ),
+        (
+            vec!["map", "--steps", "2", "--quality", "0.1"],
+            1,
+            "quality factor",
+        ),
+        (
+            vec![
+                "map",
+                "--steps",
+                "2",
+                "--contact-angle",
+                "95",
+                "--rupture-distance",
+                "2nm",
+            ],
+            1,
+            "contact angle",
+        ),
+        (vec!["batch", "radius.csv"], 1, "row 2: tip radius R = 1 mm"),
+        (vec!["batch", "twice.csv"], 1, "\"radius\" is given twice"),
+        (vec!["batch", "maybe.toml"], 1, "expected true or false"),
         // In range, but a cantilever 10⁵ times softer than the contact: the work budget
         // ends it.
         (vec!["tap", "--stiffness", "1e-3"], 1, "work budget"),

@@ -251,7 +251,7 @@ impl Range {
                 );
             }
         }
-        Err(Error::NotApplicable(message))
+        Err(Error::OutOfRange(message))
     }
 }
 
@@ -261,7 +261,7 @@ fn separation_in_range(separation_m: f64, a0_m: f64) -> Result<()> {
     if (-10.0 * a0_m..=1000.0 * a0_m).contains(&separation_m) {
         return Ok(());
     }
-    Err(Error::NotApplicable(format!(
+    Err(Error::OutOfRange(format!(
         "rest separation z_c = {} is outside −10 A₀ to 1000 A₀ ({} to {}): farther the tip \
          never reaches the sample, deeper it indents far beyond where the contact models hold",
         with_prefix(separation_m, "m"),
