@@ -10,7 +10,7 @@ use crate::report::output;
 use std::path::PathBuf;
 
 /// Layout version of the cached data: bump when [`LjSolution`] changes shape.
-const CACHE_VERSION: u32 = 5;
+const CACHE_VERSION: u32 = 6;
 
 /// Every source file a solution depends on: the cache key carries their fingerprint, so
 /// a cache written by a build with other numerics is never read.
@@ -28,20 +28,133 @@ const SOLVER_SOURCES: [&str; 9] = [
 
 /// FNV-1a over [`SOLVER_SOURCES`], computed at compile time.
 const SOLVER_FINGERPRINT: u64 = {
-    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut hash = crate::fnv::OFFSET;
     let mut f = 0;
     while f < SOLVER_SOURCES.len() {
-        let bytes = SOLVER_SOURCES[f].as_bytes();
-        let mut i = 0;
-        while i < bytes.len() {
-            hash ^= bytes[i] as u64;
-            hash = hash.wrapping_mul(0x0100_0000_01b3);
-            i += 1;
-        }
+        hash = crate::fnv::continued(hash, SOLVER_SOURCES[f].as_bytes());
         f += 1;
     }
     hash
 };
+
+/// A cache file: the solution and a checksum of it (FNV-1a of the solver's fingerprint
+/// and the solution's canonical JSON), so that a file changed after it was written is
+/// never used.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Entry {
+    checksum: String,
+    solution: serde_json::Value,
+}
+
+/// The checksum a cache file carries for `solution` (its JSON): FNV-1a of the solver's
+/// fingerprint and the solution's canonical JSON.
+pub fn checksum(solution: &serde_json::Value) -> String {
+    let h = crate::fnv::continued(
+        crate::fnv::hash(&SOLVER_FINGERPRINT.to_le_bytes()),
+        solution.to_string().as_bytes(),
+    );
+    format!("{h:016x}")
+}
+
+/// Whether a solution read back is one the solver could have given for `tabor_mu` and
+/// `reach`: its own μ and reach, every number finite, errors and the loop not negative,
+/// and the folds where the traced curve has them (its α̂ at their arclengths within 1 %
+/// of theirs: the curve is the production mesh's, the folds extrapolated from it). `Err` says what is wrong.
+fn plausible(s: &LjSolution, tabor_mu: f64, reach: Reach) -> std::result::Result<(), String> {
+    if s.tabor_mu.to_bits() != tabor_mu.to_bits() || s.reach != reach {
+        return Err(format!(
+            "it holds μ = {} ({:?}), not μ = {tabor_mu} ({reach:?})",
+            s.tabor_mu, s.reach
+        ));
+    }
+    let estimates = [
+        ("alpha_hat_a", s.alpha_hat_a),
+        ("t_hat_a", s.t_hat_a),
+        ("alpha_hat_c", s.alpha_hat_c),
+        ("t_hat_c", s.t_hat_c),
+        ("pull_off_hat", s.pull_off_hat),
+        ("w_hat", s.w_hat),
+    ];
+    for (name, e) in estimates {
+        if !e.value.is_finite() || !e.error.is_finite() || e.error < 0.0 {
+            return Err(format!("{name} is {} ± {}", e.value, e.error));
+        }
+    }
+    if s.w_hat.value < 0.0 {
+        return Err(format!("the loss w_hat is negative ({})", s.w_hat.value));
+    }
+    let curve_ok = !s.curve.is_empty()
+        && s.curve.windows(2).all(|w| w[1].s >= w[0].s)
+        && s.curve.iter().all(|p| {
+            p.s.is_finite()
+                && p.alpha_hat.is_finite()
+                && p.t_hat.is_finite()
+                && p.central_gap.is_finite()
+        });
+    let span = s.curve.first().map_or(0.0, |p| p.s)..=s.curve.last().map_or(0.0, |p| p.s);
+    if !curve_ok || !span.contains(&s.s_a) || !span.contains(&s.s_c) || s.nodes == 0 {
+        return Err("its traced curve is not one the solver gives".into());
+    }
+    // α̂ on the curve at arclength `at`, by linear interpolation.
+    let alpha_at = |at: f64| {
+        let k = s
+            .curve
+            .partition_point(|p| p.s < at)
+            .clamp(1, s.curve.len() - 1);
+        let (p, q) = (&s.curve[k - 1], &s.curve[k]);
+        let t = if q.s > p.s {
+            (at - p.s) / (q.s - p.s)
+        } else {
+            0.0
+        };
+        p.alpha_hat + t * (q.alpha_hat - p.alpha_hat)
+    };
+    for (name, fold, at) in [
+        ("alpha_hat_a", s.alpha_hat_a.value, s.s_a),
+        ("alpha_hat_c", s.alpha_hat_c.value, s.s_c),
+    ] {
+        let on_curve = if s.curve.len() > 1 {
+            alpha_at(at)
+        } else {
+            fold
+        };
+        if (on_curve - fold).abs() > 1e-2 * (1.0 + fold.abs()) {
+            return Err(format!(
+                "{name} is {fold}, where its curve has α̂ = {on_curve}"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The solution cached at `path`, if the file is there and sound; `Err` says why a file
+/// that is there cannot be used.
+fn read(
+    path: &std::path::Path,
+    tabor_mu: f64,
+    reach: Reach,
+) -> std::result::Result<Option<LjSolution>, String> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Ok(None);
+    };
+    let entry: Entry = serde_json::from_str(&text).map_err(|e| format!("unreadable: {e}"))?;
+    if checksum(&entry.solution) != entry.checksum {
+        return Err("its checksum does not match its content: it was changed".into());
+    }
+    let solution: LjSolution =
+        serde_json::from_value(entry.solution).map_err(|e| format!("unreadable: {e}"))?;
+    plausible(&solution, tabor_mu, reach)?;
+    Ok(Some(solution))
+}
+
+/// Whether this process has used a cached solution (a numerical failure then names the
+/// cache, which may be the cause).
+static READ_FROM_CACHE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Whether a cached Lennard-Jones solution was used in this run.
+pub fn cache_was_read() -> bool {
+    READ_FROM_CACHE.load(std::sync::atomic::Ordering::Relaxed)
+}
 
 /// Where cached solutions live: `$TAPSIM_CACHE`, else `$XDG_CACHE_HOME/tapsim`, else
 /// `$HOME/.cache/tapsim`, else `.tapsim-cache`.
@@ -78,20 +191,35 @@ fn cache_path(tabor_mu: f64, reach: Reach) -> PathBuf {
 
 /// The solution for `tabor_mu` and `reach`: read from the cache when `use_cache` and
 /// there, else computed ([`result::solve`]) and written to the cache (a cache that
-/// cannot be written only costs time later).
+/// cannot be written only costs time later). A cache file that fails its checksum or
+/// holds a solution the solver could not have given (`plausible`) is treated as
+/// missing: recomputed and replaced, with a note on stderr.
 pub fn solve(tabor_mu: f64, reach: Reach, use_cache: bool) -> Result<LjSolution> {
     let path = cache_path(tabor_mu, reach);
     if use_cache {
-        if let Ok(text) = std::fs::read_to_string(&path) {
-            if let Ok(cached) = serde_json::from_str::<LjSolution>(&text) {
+        match read(&path, tabor_mu, reach) {
+            Ok(Some(cached)) => {
+                READ_FROM_CACHE.store(true, std::sync::atomic::Ordering::Relaxed);
                 return Ok(cached);
             }
+            Ok(None) => {}
+            Err(why) => eprintln!(
+                "note: the cached Lennard-Jones solution {} is not used ({why}); solving \
+                 again and replacing it",
+                path.display()
+            ),
         }
     }
     let solution = result::solve(tabor_mu, reach)?;
-    if let Ok(text) = serde_json::to_string(&solution) {
-        let _ = std::fs::create_dir_all(cache_dir());
-        let _ = output::write_bytes(&path, text.as_bytes());
+    if let Ok(value) = serde_json::to_value(&solution) {
+        let entry = Entry {
+            checksum: checksum(&value),
+            solution: value,
+        };
+        if let Ok(text) = serde_json::to_string(&entry) {
+            let _ = std::fs::create_dir_all(cache_dir());
+            let _ = output::write_bytes(&path, text.as_bytes());
+        }
     }
     Ok(solution)
 }

@@ -307,6 +307,14 @@ pub fn main() -> ExitCode {
         Ok(()) | Err(crate::Error::StdoutClosed) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
+            if matches!(e, crate::Error::Numerical(_)) && crate::lj_cache::cache_was_read() {
+                eprintln!(
+                    "note: Lennard-Jones solutions were read from the cache in {}: if one \
+                     is damaged, `tapsim lj --mu <μ> --no-cache` solves it again and \
+                     replaces it (or delete that directory)",
+                    crate::lj_cache::cache_dir().display()
+                );
+            }
             ExitCode::FAILURE
         }
     }
