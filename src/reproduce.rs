@@ -91,14 +91,21 @@ fn write_records<T: serde::Serialize>(out: &Path, stem: &str, records: &[T]) -> 
 /// The first line of the generated README.md, which marks a directory as ours.
 const README_TITLE: &str = "# tapsim results";
 
-/// `out` must be new, empty, or an earlier output of this command: it is filled with
-/// some thirty files of fixed names, which must not overwrite someone else's.
+/// The file written into `out` before anything else and removed once README.md is
+/// written: it marks a directory that a run which was interrupted was filling, so the
+/// run can be repeated into it.
+const MARKER: &str = ".tapsim-reproduce-running";
+
+/// `out` must be new, empty, or an earlier output of this command (finished, with our
+/// README.md, or interrupted, with [`MARKER`]): it is filled with some thirty files of
+/// fixed names, which must not overwrite someone else's.
 fn check_out_dir(out: &Path) -> Result<()> {
     let Ok(mut entries) = std::fs::read_dir(out) else {
         return Ok(());
     };
     let ours = std::fs::read_to_string(out.join("README.md"))
-        .is_ok_and(|text| text.starts_with(README_TITLE));
+        .is_ok_and(|text| text.starts_with(README_TITLE))
+        || std::fs::symlink_metadata(out.join(MARKER)).is_ok_and(|m| m.is_file());
     if entries.next().is_none() || ours {
         Ok(())
     } else {
@@ -116,6 +123,11 @@ fn check_out_dir(out: &Path) -> Result<()> {
 pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest> {
     check_out_dir(out)?;
     output::ensure_dir(out)?;
+    let marker = out.join(MARKER);
+    output::write_bytes(
+        &marker,
+        b"tapsim reproduce is writing here (or was, and was interrupted)\n",
+    )?;
     let mut entries: Vec<Entry> = Vec::new();
     let mut written: Vec<PathBuf> = Vec::new();
     let mut add = |paths: Vec<PathBuf>, what: &str, entries: &mut Vec<Entry>| {
@@ -447,6 +459,8 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
     let readme = out.join("README.md");
     output::write_bytes(&readme, md.as_bytes())?;
     written.push(readme);
+    // README.md marks the directory now.
+    let _ = std::fs::remove_file(&marker);
     entries.push(Entry {
         file: "README.md".into(),
         what: "this list and the headline numbers".into(),

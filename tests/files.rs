@@ -311,3 +311,48 @@ fn peak_memory_is_bounded_at_the_largest_requests() {
         assert!(peak < 64 << 20, "{args:?}: peak {} MB", peak >> 20);
     }
 }
+
+#[test]
+fn an_interrupted_reproduce_can_be_rerun_into_its_own_directory() {
+    let dir = scratch("reproduce-interrupted");
+    let out = dir.join("results");
+    let mut child = tapsim()
+        .args(["reproduce", "--quiet", "--out", path(&out)])
+        .env("TAPSIM_CACHE", dir.join("cache"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Interrupted once it has begun writing (its first figure).
+    let start = Instant::now();
+    while !out.join("fig1_jkr_cycle.csv").exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "nothing written");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    assert_eq!(child.wait().unwrap().code(), Some(130));
+    assert!(!out.join("README.md").exists(), "it was not interrupted");
+    assert!(
+        listing(&out)
+            .iter()
+            .any(|n| n.starts_with(".tapsim-reproduce"))
+    );
+    // Run again into the same directory: accepted, and finished it is marked by its
+    // README alone.
+    let again = tapsim()
+        .args(["reproduce", "--quiet", "--out", path(&out)])
+        .env("TAPSIM_CACHE", dir.join("cache"))
+        .output()
+        .unwrap();
+    assert!(again.status.success(), "{}", stderr(&again));
+    assert!(out.join("README.md").is_file());
+    assert!(
+        !listing(&out)
+            .iter()
+            .any(|n| n.starts_with(".tapsim-reproduce"))
+    );
+}
