@@ -37,6 +37,10 @@ const SOLVER_FINGERPRINT: u64 = {
     hash
 };
 
+/// The largest cache file read (the largest solutions, μ = 50 traced whole, are a few
+/// hundred kB).
+const MAX_ENTRY_BYTES: u64 = 64 << 20;
+
 /// A cache file: the solution and a checksum of it (FNV-1a of the solver's fingerprint
 /// and the solution's canonical JSON), so that a file changed after it was written is
 /// never used.
@@ -134,10 +138,13 @@ fn read(
     tabor_mu: f64,
     reach: Reach,
 ) -> std::result::Result<Option<LjSolution>, String> {
-    let Ok(text) = std::fs::read_to_string(path) else {
+    if std::fs::symlink_metadata(path).is_err() {
         return Ok(None);
-    };
-    let entry: Entry = serde_json::from_str(&text).map_err(|e| format!("unreadable: {e}"))?;
+    }
+    // A regular file of a sane size only: a FIFO put there would block the read.
+    let text = crate::config::read_input(path, MAX_ENTRY_BYTES, crate::Error::NotApplicable)
+        .map_err(|e| e.to_string())?;
+    let entry: Entry = serde_json::from_slice(&text).map_err(|e| format!("unreadable: {e}"))?;
     if checksum(&entry.solution) != entry.checksum {
         return Err("its checksum does not match its content: it was changed".into());
     }
@@ -205,7 +212,7 @@ pub fn solve(tabor_mu: f64, reach: Reach, use_cache: bool) -> Result<LjSolution>
             Ok(None) => {}
             Err(why) => eprintln!(
                 "note: the cached Lennard-Jones solution {} is not used ({why}); solving \
-                 again and replacing it",
+                 again",
                 path.display()
             ),
         }
@@ -216,7 +223,13 @@ pub fn solve(tabor_mu: f64, reach: Reach, use_cache: bool) -> Result<LjSolution>
             checksum: checksum(&value),
             solution: value,
         };
-        if let Ok(text) = serde_json::to_string(&entry) {
+        // Into a new file or over a regular one only: whatever else sits there (a FIFO,
+        // a device, a link) is left alone, and the solution not cached.
+        let replaceable = match std::fs::symlink_metadata(&path) {
+            Ok(meta) => meta.is_file(),
+            Err(_) => true,
+        };
+        if let (true, Ok(text)) = (replaceable, serde_json::to_string(&entry)) {
             let _ = std::fs::create_dir_all(cache_dir());
             let _ = output::write_bytes(&path, text.as_bytes());
         }

@@ -528,3 +528,26 @@ fn a_doctored_cache_never_moves_a_tap_with_the_lj_law() {
         }
     }
 }
+
+#[test]
+fn a_fifo_in_the_cache_is_neither_read_nor_written_through() {
+    let dir = scratch("cache-fifo");
+    let fresh = run(&["lj", "--mu", "3", "--json"], &dir);
+    ok(&fresh, "lj");
+    let file = cache_file(&dir, 3.0f64.to_bits(), "rigid");
+    std::fs::remove_file(&file).unwrap();
+    let made = Command::new("mkfifo").arg(&file).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("skipped: mkfifo not permitted here");
+        return;
+    }
+    // Reading it would block for a writer, writing it for a reader: neither happens.
+    let r = run(&["lj", "--mu", "3", "--json"], &dir);
+    ok(&r, "a FIFO in the cache");
+    assert_eq!(r.stdout, fresh.stdout);
+    assert!(r.stderr.contains("not a regular file"), "{}", r.stderr);
+    assert!(
+        !std::fs::metadata(&file).unwrap().is_file(),
+        "the FIFO was replaced"
+    );
+}
