@@ -322,20 +322,15 @@ impl Marcher<'_> {
         )
     }
 
-    /// Integrate on `branch` from (t, y) to `t_end` with no event.
-    fn plain(&self, branch: Branch, (t, y): (f64, Y), t_end: f64) -> Y {
-        if t_end <= t {
-            return y;
-        }
-        let log = Log::from(t, y);
-        let seg = Segment {
-            model: &self.model,
-            branch,
-            below: f64::NEG_INFINITY,
-            above: f64::INFINITY,
-            log: &log,
-        };
-        let mut s = Dop853::from_param(
+    /// Dop853 over `seg` from (t, y) to `t_end`: this marcher's tolerances (atol 1 % of
+    /// rtol), Hairer's step controls, steps of at most `h_max`, no stiffness test.
+    fn stepper<'s>(
+        &self,
+        seg: Segment<'s>,
+        (t, y): (f64, Y),
+        t_end: f64,
+    ) -> Dop853<f64, Y, Segment<'s>> {
+        Dop853::from_param(
             seg,
             t,
             t_end,
@@ -352,7 +347,23 @@ impl Marcher<'_> {
             1_000_000,
             u32::MAX,
             OutputType::Sparse,
-        );
+        )
+    }
+
+    /// Integrate on `branch` from (t, y) to `t_end` with no event.
+    fn plain(&self, branch: Branch, (t, y): (f64, Y), t_end: f64) -> Y {
+        if t_end <= t {
+            return y;
+        }
+        let log = Log::from(t, y);
+        let seg = Segment {
+            model: &self.model,
+            branch,
+            below: f64::NEG_INFINITY,
+            above: f64::INFINITY,
+            log: &log,
+        };
+        let mut s = self.stepper(seg, (t, y), t_end);
         s.integrate().unwrap();
         *s.y_out().last().unwrap()
     }
@@ -371,24 +382,7 @@ impl Marcher<'_> {
                 above,
                 log: &log,
             };
-            let mut s = Dop853::from_param(
-                seg,
-                t,
-                t_end,
-                0.0,
-                y,
-                self.rtol,
-                self.rtol * 1e-2,
-                0.9,
-                0.0,
-                0.333,
-                6.0,
-                self.h_max,
-                0.0,
-                1_000_000,
-                u32::MAX,
-                OutputType::Sparse,
-            );
+            let mut s = self.stepper(seg, (t, y), t_end);
             s.integrate().unwrap();
             let end = (*s.x_out().last().unwrap(), *s.y_out().last().unwrap());
             let Some((start, when, falling)) = log.borrow().crossed else {

@@ -15,12 +15,13 @@
 //! draws its own: the limit is on how long a refusal or a hopeless case takes, not on a
 //! large sweep asked for on purpose.
 
+mod common;
+use common::Run;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
-use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 /// The longest any run may take.
 const LIMIT: Duration = Duration::from_secs(10);
@@ -28,51 +29,9 @@ const LIMIT: Duration = Duration::from_secs(10);
 /// Cases per test (four tests: 2 000 in all).
 const CASES: u32 = 500;
 
-struct Run {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-    elapsed: Duration,
-}
-
 /// Run the binary in `dir`, killing it at [`LIMIT`].
-fn run(args: &[String], dir: &Path) -> Run {
-    let start = Instant::now();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tapsim"))
-        .args(args)
-        .current_dir(dir)
-        .env("TAPSIM_CACHE", dir.join("cache"))
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the binary starts");
-    let drain = |mut pipe: Box<dyn Read + Send>| {
-        std::thread::spawn(move || {
-            let mut text = Vec::new();
-            let _ = pipe.read_to_end(&mut text);
-            String::from_utf8_lossy(&text).into_owned()
-        })
-    };
-    let out = drain(Box::new(child.stdout.take().expect("piped")));
-    let err = drain(Box::new(child.stderr.take().expect("piped")));
-    let status = loop {
-        if let Some(status) = child.try_wait().expect("wait") {
-            break Some(status);
-        }
-        if start.elapsed() > LIMIT {
-            let _ = child.kill();
-            let _ = child.wait();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    Run {
-        code: status.and_then(|s| s.code()),
-        elapsed: start.elapsed(),
-        stdout: out.join().unwrap_or_default(),
-        stderr: err.join().unwrap_or_default(),
-    }
+fn run<S: AsRef<std::ffi::OsStr>>(args: &[S], dir: &Path) -> Run {
+    common::run_limited(args, dir, LIMIT)
 }
 
 /// A number as a hostile user types it.
