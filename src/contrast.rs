@@ -22,16 +22,7 @@ pub struct Material {
     pub numerics: Numerics,
 }
 
-/// The regime an oscillating tip is in, told by its phase: attractive where φ lies above
-/// the free oscillator's phase (90° at resonance), repulsive below.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum PhaseBranch {
-    /// Net attractive tip–sample force over the cycle: φ above the free phase.
-    Attractive,
-    /// Net repulsive: φ below the free phase.
-    Repulsive,
-}
+pub use crate::setpoint::PhaseBranch;
 
 /// φ at one amplitude setpoint on one branch for every material, and the contrast.
 #[derive(Debug, Clone, Serialize)]
@@ -105,13 +96,7 @@ fn states_at(
     r: f64,
     free_phase_deg: f64,
 ) -> Vec<AtSetpoint> {
-    let branch_of = |phase: f64| {
-        if phase > free_phase_deg {
-            PhaseBranch::Attractive
-        } else {
-            PhaseBranch::Repulsive
-        }
-    };
+    let branch_of = |phase: f64| PhaseBranch::of(phase, free_phase_deg);
     let mut out: Vec<AtSetpoint> = family
         .windows(2)
         .filter(|w| {
@@ -213,8 +198,7 @@ pub fn contrast(
         let (setup, numerics) = (&m.setup, &m.numerics);
         let a0 = setup.cantilever.free_amplitude_m;
         let ramp = sweep::ramp(1.2 * a0, 0.3 * a0, points, false)?;
-        let (w, q) = (setup.cantilever.omega_ratio(), setup.cantilever.quality);
-        let free_phase_deg = (w / q).atan2(1.0 - w * w).to_degrees();
+        let free_phase_deg = crate::setpoint::free_phase_deg(setup);
         for &law in laws {
             progress(&format!("{}, {law}", m.name));
             let s = TapSetup {

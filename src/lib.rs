@@ -3,7 +3,7 @@
 //! The physics follows Ciavarella, Greenwood & Barber, "Effect of Tabor parameter on
 //! hysteresis losses during adhesive contact"; equation numbers in the documentation
 //! are that paper's. Data flows one way: [`params`] → [`contact`] (force laws) →
-//! [`law`] → [`dynamics`] / [`quasistatic`] → [`sweep`] → [`identification`] →
+//! [`law`] → [`dynamics`] / [`quasistatic`] → [`sweep`] / [`setpoint`] → [`identification`] →
 //! [`figures`] → [`report`].
 
 #![forbid(unsafe_code)]
@@ -19,6 +19,7 @@ pub mod law;
 pub mod numeric;
 pub mod params;
 pub mod quasistatic;
+pub mod setpoint;
 pub mod summary;
 pub mod sweep;
 

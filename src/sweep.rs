@@ -314,6 +314,10 @@ pub struct BranchRecord {
     /// The orbit's observables (`stable` and `floquet_multipliers` among them).
     #[serde(flatten)]
     pub observables: TapObservables,
+    /// The oscillator's state on the orbit at the drive phase (to start a neighbouring
+    /// steady state from; not written out).
+    #[serde(skip)]
+    pub phase: crate::dynamics::steady::Phase,
 }
 
 /// The period-1 orbit family followed from one rest separation to another.
@@ -426,6 +430,7 @@ pub fn orbit_branch(
                     PointKind::PeriodDoubling => BranchPointKind::PeriodDoubling,
                 },
                 observables: TapObservables::new(&p, &state)?,
+                phase: b.phase,
             });
         }
         match branch.stop {

@@ -1,9 +1,10 @@
 //! `tapsim tap`: one tapping-mode simulation to its steady state.
 
-use crate::config::TapInputs;
+use crate::config::{TapInputs, length, number};
 use crate::dynamics::observables::{Observe, Starts, tap};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::report::{output, plot, tap as report};
+use crate::setpoint::{PhaseBranch, states_at_setpoint};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -72,14 +73,44 @@ pub struct TapArgs {
     /// 6 starts without it. At most 64.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=64))]
     starts: Option<u64>,
+    /// Amplitude setpoint A/A₀ (between 0 and 1), as an AFM's z feedback holds it,
+    /// instead of a rest separation: every stable period-1 steady state whose amplitude
+    /// is the setpoint, on each branch (--branch), with the rest separation z_c that
+    /// gives it. Not with --separation, --trajectory or --plot.
+    #[arg(long, value_name = "A/A0", allow_hyphen_values = true, value_parser = number,
+          conflicts_with = "amplitude_setpoint")]
+    setpoint: Option<f64>,
+    /// The amplitude setpoint as an amplitude (e.g. 16nm): --setpoint A_sp/A₀.
+    #[arg(long, allow_hyphen_values = true, value_parser = length)]
+    amplitude_setpoint: Option<f64>,
+    /// With a setpoint: the branch whose states are listed. Attractive: the phase lag
+    /// above the free oscillator's (90° at resonance), net attractive force; repulsive:
+    /// below it.
+    #[arg(long, value_enum, default_value_t = BranchChoice::All)]
+    branch: BranchChoice,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
 }
 
+/// `--branch`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum BranchChoice {
+    /// Both branches.
+    All,
+    /// φ above the free phase: the tip feels a net attraction.
+    Attractive,
+    /// φ below the free phase: the tip presses into the sample.
+    Repulsive,
+}
+
 /// Run the subcommand.
 pub fn run(args: TapArgs) -> Result<()> {
-    let (setup, numerics) = args.inputs.with_config()?.resolve()?;
+    let inputs = args.inputs.clone().with_config()?;
+    if args.setpoint.is_some() || args.amplitude_setpoint.is_some() {
+        return at_setpoint(&args, inputs);
+    }
+    let (setup, numerics) = inputs.resolve()?;
     let wants_trajectory = args.trajectory.is_some() || args.plot.is_some();
     let record = if wants_trajectory {
         args.record_cycles.max(1)
@@ -108,6 +139,53 @@ pub fn run(args: TapArgs) -> Result<()> {
         );
     } else {
         out!("{}", report::to_text(&setup, &run));
+    }
+    Ok(())
+}
+
+/// `tap --setpoint`: the states at the setpoint, listed.
+fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
+    if inputs.separation.is_some() {
+        return Err(Error::NotApplicable(
+            "give either a rest separation (--separation) or an amplitude setpoint \
+             (--setpoint), not both: at a setpoint the separation is what is solved for"
+                .into(),
+        ));
+    }
+    if args.trajectory.is_some() || args.plot.is_some() {
+        return Err(Error::NotApplicable(
+            "--trajectory and --plot draw one state: run `tapsim tap --separation <z_c>` \
+             with the separation_m of the state at the setpoint you want"
+                .into(),
+        ));
+    }
+    let (setup, numerics) = inputs.resolve()?;
+    let ratio = match (args.setpoint, args.amplitude_setpoint) {
+        (Some(r), _) => r,
+        (None, Some(a)) => a / setup.cantilever.free_amplitude_m,
+        (None, None) => unreachable!("called with a setpoint"),
+    };
+    let branch = match args.branch {
+        BranchChoice::All => None,
+        BranchChoice::Attractive => Some(PhaseBranch::Attractive),
+        BranchChoice::Repulsive => Some(PhaseBranch::Repulsive),
+    };
+    let states = states_at_setpoint(&setup, &numerics, ratio, branch)?;
+    if args.json {
+        let mut top = serde_json::to_value(&states[0]).expect("a state serialises");
+        if let serde_json::Value::Object(m) = &mut top {
+            m.insert("setpoint".into(), ratio.into());
+            m.insert(
+                "states".into(),
+                serde_json::to_value(&states).expect("states serialise"),
+            );
+        }
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&top).expect("serialises")
+        );
+    } else {
+        out!("{}", report::setpoint_text(&setup, ratio, &states));
     }
     Ok(())
 }

@@ -388,3 +388,49 @@ pub fn trajectory_charts(run: &TapRun, title: &str) -> Vec<Chart> {
     };
     vec![deflection, force, separation, portrait]
 }
+
+/// A table of the steady states at amplitude setpoint `ratio` (A/A₀): for each, its
+/// branch, the rest separation that gives it, A/A₀, φ, E_ts and the motion.
+pub fn setpoint_text(
+    setup: &TapSetup,
+    ratio: f64,
+    states: &[crate::setpoint::SetpointState],
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Steady states at the amplitude setpoint A/A₀ = {ratio} (A = {:.4} nm), {} law",
+        ratio * setup.cantilever.free_amplitude_m * 1e9,
+        setup.law
+    );
+    let _ = writeln!(
+        s,
+        "  {:<11} {:>10} {:>10} {:>10} {:>10} {:>9}  motion",
+        "branch", "z_c (nm)", "A/A₀", "φ (°)", "E_ts (eV)", "contact"
+    );
+    for st in states {
+        let o = &st.observables;
+        let _ = writeln!(
+            s,
+            "  {:<11} {:>10.4} {:>10.6} {:>10.4} {:>10.4} {:>9.4}  {}{}",
+            st.branch.to_string(),
+            st.separation_m * 1e9,
+            o.amplitude_ratio,
+            o.phase_deg,
+            // (+ 0.0: a conservative law's round-off −0 prints as 0.)
+            o.e_ts_ev + 0.0,
+            o.contact_fraction,
+            o.regime,
+            if o.grazing { ", grazing a switch" } else { "" }
+        );
+    }
+    if states.len() > 1 {
+        let _ = writeln!(
+            s,
+            "note: {} states hold this setpoint; which one an AFM images on depends on how \
+             it got there (approach or retract, the drive's history)",
+            states.len()
+        );
+    }
+    s
+}

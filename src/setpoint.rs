@@ -1,0 +1,299 @@
+//! Steady states at an amplitude setpoint A/A₀, as an AFM's z feedback holds it: the rest
+//! separations z_c at which the tip's amplitude is the setpoint, on each branch.
+//!
+//! The stable period-1 orbit family is followed through z_c by continuation
+//! ([`sweep::orbit_branch`]) from 1.2 A₀ in to deep contact; wherever two neighbouring
+//! stable orbits of one piece bracket the setpoint, the rest separation is refined by
+//! the Illinois method on A(z_c)/A₀ − setpoint, each steady state started from the
+//! orbit next to it (so that it stays on its branch), until the amplitude is the
+//! setpoint to [`AMPLITUDE_TOLERANCE`]. Each state is named by its branch: attractive
+//! where its phase lag lies above the free oscillator's (90° at resonance), repulsive
+//! below (García & San Paulo, PRB 60, 4961, 1999).
+
+use crate::dynamics::observables::TapObservables;
+use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
+use crate::dynamics::steady::Phase;
+use crate::error::{Error, Result};
+use crate::sweep::{self, BranchRecord};
+use serde::Serialize;
+
+/// The branch a steady state of the tapping tip lies on, told by its phase: attractive
+/// where φ lies above the free oscillator's phase (90° at resonance), repulsive below.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PhaseBranch {
+    /// Net attractive tip–sample force over the cycle: φ above the free phase.
+    Attractive,
+    /// Net repulsive: φ below the free phase.
+    Repulsive,
+}
+
+impl PhaseBranch {
+    /// The branch of a state with phase lag `phase_deg` for a cantilever whose free phase
+    /// is `free_phase_deg`.
+    pub fn of(phase_deg: f64, free_phase_deg: f64) -> Self {
+        if phase_deg > free_phase_deg {
+            Self::Attractive
+        } else {
+            Self::Repulsive
+        }
+    }
+}
+
+impl std::fmt::Display for PhaseBranch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Attractive => "attractive",
+            Self::Repulsive => "repulsive",
+        })
+    }
+}
+
+/// How close to the setpoint a state's A/A₀ is brought.
+pub const AMPLITUDE_TOLERANCE: f64 = 1e-9;
+
+/// One steady state at the setpoint.
+#[derive(Debug, Clone, Serialize)]
+pub struct SetpointState {
+    /// Its branch.
+    pub branch: PhaseBranch,
+    /// The rest separation z_c at which the amplitude is the setpoint, in m.
+    pub separation_m: f64,
+    /// Every observable of the steady state there.
+    #[serde(flatten)]
+    pub observables: TapObservables,
+}
+
+/// The free oscillator's phase lag in degrees, atan2(Ω/Q, 1 − Ω²) (the border between
+/// the attractive and the repulsive branch).
+pub fn free_phase_deg(setup: &TapSetup) -> f64 {
+    let (w, q) = (setup.cantilever.omega_ratio(), setup.cantilever.quality);
+    (w / q).atan2(1.0 - w * w).to_degrees()
+}
+
+/// Every stable period-1 steady state whose amplitude is `ratio` × A₀ (0 < ratio < 1),
+/// on `branch` (`None`: both), attractive ones first, each at the rest separation that
+/// gives it. An empty list is an error saying which branches exist and what amplitudes
+/// they reach.
+pub fn states_at_setpoint(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    ratio: f64,
+    branch: Option<PhaseBranch>,
+) -> Result<Vec<SetpointState>> {
+    if !(ratio > 0.0 && ratio < 1.0) {
+        return Err(Error::OutOfRange(format!(
+            "amplitude setpoint A/A₀ = {ratio} is outside (0, 1): the amplitude of a tip \
+             that touches lies below the free amplitude"
+        )));
+    }
+    let family = families(setup, numerics, ratio)?;
+    let p = Prepared::new(setup, numerics)?;
+    let free = free_phase_deg(setup);
+    let stable = |b: &BranchRecord| b.observables.stable == Some(true);
+    let mut out: Vec<SetpointState> = Vec::new();
+    for w in family.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        let (ra, rb) = (a.observables.amplitude_ratio, b.observables.amplitude_ratio);
+        if a.segment != b.segment || !stable(a) || !stable(b) || (ra - ratio) * (rb - ratio) > 0.0 {
+            continue;
+        }
+        let side = PhaseBranch::of(a.observables.phase_deg, free);
+        if PhaseBranch::of(b.observables.phase_deg, free) != side
+            || branch.is_some_and(|want| want != side)
+        {
+            continue;
+        }
+        if let Some(state) = refine(&p, (a, b), ratio, side, free)? {
+            out.push(state);
+        }
+    }
+    // The same state reached along two families once.
+    let a0 = setup.cantilever.free_amplitude_m;
+    out.sort_by(|x, y| x.separation_m.total_cmp(&y.separation_m));
+    out.dedup_by(|x, y| {
+        x.branch == y.branch && (x.separation_m - y.separation_m).abs() < 1e-6 * a0
+    });
+    out.sort_by_key(|s| s.branch == PhaseBranch::Repulsive);
+    if out.is_empty() {
+        return Err(Error::NotApplicable(unreached(
+            &family, ratio, branch, free,
+        )));
+    }
+    Ok(out)
+}
+
+/// The stable period-1 families a setpoint `ratio` may lie on, as one list whose pieces
+/// are told apart by `segment`: the one the free oscillation settles on far from the
+/// sample (followed from 1.2 A₀ in to deep contact), and the one it settles on at each
+/// of the seeds z_c = (ratio − 0.3 … ratio + 0.1)·A₀ where that is another family than
+/// those followed already, followed out and in from there. In a bistable zone these are
+/// the attractive and the repulsive branch: the free oscillation started close to the
+/// sample lands on the repulsive one, far from it on the attractive one.
+fn families(setup: &TapSetup, numerics: &Numerics, ratio: f64) -> Result<Vec<BranchRecord>> {
+    let a0 = setup.cantilever.free_amplitude_m;
+    let (far, deep, step) = (1.2 * a0, (ratio - 0.35).max(0.02) * a0, 0.01 * a0);
+    let p = Prepared::new(setup, numerics)?;
+    let free = free_phase_deg(setup);
+    let mut all: Vec<BranchRecord> = Vec::new();
+    let follow = |all: &mut Vec<BranchRecord>, from: f64, to: f64| {
+        // A start where the motion is not period-1 only loses that family.
+        if let Ok(family) = sweep::orbit_branch(setup, numerics, (from, to), step) {
+            let offset = all.last().map_or(0, |b| b.segment + 1);
+            all.extend(family.points.into_iter().map(|mut b| {
+                b.segment += offset;
+                b
+            }));
+        }
+    };
+    follow(&mut all, far, deep);
+    for k in [0.0, -0.1, -0.2, -0.3, 0.1] {
+        let seed = (ratio + k) * a0;
+        if seed <= deep || seed >= far {
+            continue;
+        }
+        let mut phase = p.simulation().free_steady_start();
+        let Ok(state) = p.simulation_at(seed)?.steady_state(&mut phase, &p.steady) else {
+            continue;
+        };
+        let o = TapObservables::new(&p, &state)?;
+        if o.period != Some(1) || o.stable != Some(true) {
+            continue;
+        }
+        let side = PhaseBranch::of(o.phase_deg, free);
+        // Already followed: a stable orbit of the same branch and amplitude nearby.
+        let known = all.iter().any(|b| {
+            (b.separation_m - seed).abs() < 2.0 * step
+                && b.observables.stable == Some(true)
+                && PhaseBranch::of(b.observables.phase_deg, free) == side
+                && (b.observables.amplitude_ratio - o.amplitude_ratio).abs() < 0.02
+        });
+        if !known {
+            follow(&mut all, seed, far);
+            follow(&mut all, seed, deep);
+        }
+    }
+    Ok(all)
+}
+
+/// Why no state was found: the amplitudes each branch's stable period-1 orbits reach.
+fn unreached(
+    family: &[BranchRecord],
+    ratio: f64,
+    branch: Option<PhaseBranch>,
+    free: f64,
+) -> String {
+    let reach = |side: PhaseBranch| {
+        let on: Vec<f64> = family
+            .iter()
+            .filter(|b| {
+                b.observables.stable == Some(true)
+                    && b.observables.jumps_in > 0.0
+                    && PhaseBranch::of(b.observables.phase_deg, free) == side
+            })
+            .map(|b| b.observables.amplitude_ratio)
+            .collect();
+        match (
+            on.iter().copied().reduce(f64::min),
+            on.iter().copied().reduce(f64::max),
+        ) {
+            (Some(lo), Some(hi)) => format!("{side} from A/A₀ {lo:.4} to {hi:.4}"),
+            _ => format!("none {side}"),
+        }
+    };
+    let which = branch.map_or("any branch".to_string(), |b| format!("the {b} branch"));
+    format!(
+        "no stable period-1 steady state on {which} has A/A₀ = {ratio} (stable period-1 \
+         orbits that touch reach: {}; {}). Near the onset of contact the motion is not \
+         period-1: `tapsim approach` shows what it does there",
+        reach(PhaseBranch::Attractive),
+        reach(PhaseBranch::Repulsive)
+    )
+}
+
+/// The steady state at amplitude `ratio` between the neighbouring stable orbits `a` and
+/// `b` of one piece of the family on branch `side`: the Illinois method on the rest
+/// separation, each steady state started from the bracketing orbit nearer to it. `None`
+/// where a steady state leaves the branch or the period-1 family (the family is then not
+/// smooth here).
+fn refine(
+    p: &Prepared,
+    (a, b): (&BranchRecord, &BranchRecord),
+    ratio: f64,
+    side: PhaseBranch,
+    free: f64,
+) -> Result<Option<SetpointState>> {
+    // (z_c, A/A₀ − ratio, the state's phase at the drive phase) at both ends.
+    let end = |r: &BranchRecord| {
+        (
+            r.separation_m,
+            r.observables.amplitude_ratio - ratio,
+            r.phase,
+        )
+    };
+    let (mut lo, mut hi) = (end(a), end(b));
+    let mut best: Option<(f64, SetpointState)> = None;
+    let mut side_moved: i32 = 0;
+    for _ in 0..60 {
+        let (z0, f0, _) = lo;
+        let (z1, f1, _) = hi;
+        let z = if f1 != f0 {
+            z0 - f0 * (z1 - z0) / (f1 - f0)
+        } else {
+            0.5 * (z0 + z1)
+        };
+        let z = if (z - z0) * (z - z1) < 0.0 {
+            z
+        } else {
+            0.5 * (z0 + z1)
+        };
+        let mut phase: Phase = if (z - z0).abs() < (z - z1).abs() {
+            lo.2
+        } else {
+            hi.2
+        };
+        let sim = p.simulation_at(z)?;
+        let state = sim.steady_state(&mut phase, &p.steady)?;
+        let o = TapObservables::new(p, &state)?;
+        if o.period != Some(1)
+            || o.stable != Some(true)
+            || PhaseBranch::of(o.phase_deg, free) != side
+        {
+            return Ok(None);
+        }
+        let f = o.amplitude_ratio - ratio;
+        if best.as_ref().is_none_or(|(e, _)| f.abs() < *e) {
+            best = Some((
+                f.abs(),
+                SetpointState {
+                    branch: side,
+                    separation_m: z,
+                    observables: o,
+                },
+            ));
+        }
+        if f.abs() <= AMPLITUDE_TOLERANCE {
+            break;
+        }
+        // Illinois: halve the value kept at the end that stays twice running.
+        if (f < 0.0) == (f0 < 0.0) {
+            lo = (z, f, phase);
+            if side_moved == -1 {
+                hi.1 *= 0.5;
+            }
+            side_moved = -1;
+        } else {
+            hi = (z, f, phase);
+            if side_moved == 1 {
+                lo.1 *= 0.5;
+            }
+            side_moved = 1;
+        }
+        if (hi.0 - lo.0).abs() < 1e-15 * p.setup.cantilever.free_amplitude_m {
+            break;
+        }
+    }
+    Ok(best
+        .filter(|(e, _)| *e <= 100.0 * AMPLITUDE_TOLERANCE)
+        .map(|(_, s)| s))
+}

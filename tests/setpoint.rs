@@ -1,0 +1,121 @@
+//! Steady states at an amplitude setpoint (issue 26): `tap --setpoint` solves for the
+//! rest separations at which the amplitude is the setpoint, on each branch; each state
+//! is then found again by a plain `tap` at that separation, marched from the documented
+//! starts — a different path (time-marching and shooting from fixed starts, no
+//! continuation, no root-finding).
+
+use serde_json::Value;
+use std::process::Command;
+
+fn tapsim(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn json(args: &[&str]) -> Value {
+    let out = tapsim(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object")
+}
+
+fn num(v: &Value, key: &str) -> f64 {
+    v[key].as_f64().unwrap_or_else(|| panic!("{key} in {v}"))
+}
+
+#[test]
+fn every_state_at_the_setpoint_is_a_state_tap_finds_at_its_separation() {
+    let v = json(&["tap", "--setpoint", "0.8", "--json"]);
+    let states = v["states"].as_array().unwrap();
+    // The defaults are bistable at 0.8: both branches, attractive first.
+    let branches: Vec<&str> = states
+        .iter()
+        .map(|s| s["branch"].as_str().unwrap())
+        .collect();
+    assert_eq!(branches, ["attractive", "repulsive"]);
+    // The top-level keys are the first state's.
+    assert_eq!(v["separation_m"], states[0]["separation_m"]);
+    assert_eq!(v["phase_deg"], states[0]["phase_deg"]);
+    assert_eq!(num(&v, "setpoint"), 0.8);
+    // README's numbers.
+    let at = |i: usize, key: &str| num(&states[i], key);
+    assert!((at(0, "separation_m") * 1e9 - 16.7895).abs() < 5e-5);
+    assert!((at(0, "phase_deg") - 123.632).abs() < 5e-4);
+    assert!((at(1, "separation_m") * 1e9 - 12.9425).abs() < 5e-5);
+    assert!((at(1, "phase_deg") - 56.368).abs() < 5e-4);
+    for i in 0..2 {
+        assert!((at(i, "e_ts_ev") - 20.46).abs() < 5e-3);
+    }
+    for s in states {
+        assert!((num(s, "amplitude_ratio") - 0.8).abs() < 1e-6, "{s}");
+        assert_eq!(s["regime"], "period-1");
+        let phase = num(s, "phase_deg");
+        match s["branch"].as_str().unwrap() {
+            "attractive" => assert!(phase > 90.0, "{phase}"),
+            _ => assert!(phase < 90.0, "{phase}"),
+        }
+        // Marched from the documented starts at that separation, tap reaches it.
+        let z = format!("{:e}", num(s, "separation_m"));
+        let t = json(&["tap", "--separation", &z, "--starts", "6", "--json"]);
+        let mut found = vec![(num(&t, "phase_deg"), num(&t, "e_ts_j"))];
+        for a in t["attractors"].as_array().unwrap() {
+            found.push((num(a, "phase_deg"), num(a, "e_ts_j")));
+        }
+        let e = num(s, "e_ts_j");
+        assert!(
+            found
+                .iter()
+                .any(|&(p, et)| (p - phase).abs() < 1e-6 * phase && (et - e).abs() < 1e-6 * e),
+            "{} state at {z} m (φ {phase}, E_ts {e}) not among tap's {found:?}",
+            s["branch"]
+        );
+    }
+}
+
+#[test]
+fn a_branch_can_be_asked_for_and_the_setpoint_given_as_an_amplitude() {
+    let both = json(&["tap", "--setpoint", "0.8", "--json"]);
+    let repulsive = json(&[
+        "tap",
+        "--amplitude-setpoint",
+        "16nm",
+        "--branch",
+        "repulsive",
+        "--json",
+    ]);
+    let states = repulsive["states"].as_array().unwrap();
+    assert_eq!(states.len(), 1);
+    assert_eq!(states[0]["branch"], "repulsive");
+    assert_eq!(states[0]["separation_m"], both["states"][1]["separation_m"]);
+}
+
+#[test]
+fn a_setpoint_is_refused_where_it_cannot_be_held() {
+    for (args, says) in [
+        (
+            vec!["tap", "--setpoint", "0.8", "--separation", "16nm"],
+            "not both",
+        ),
+        (vec!["tap", "--setpoint", "1.2"], "outside (0, 1)"),
+        (vec!["tap", "--setpoint", "0"], "outside (0, 1)"),
+        (
+            vec!["tap", "--setpoint", "0.8", "--plot", "x.png"],
+            "--separation <z_c>",
+        ),
+        (
+            vec!["tap", "--setpoint", "0.8", "--law", "none"],
+            "no stable period-1 steady state",
+        ),
+    ] {
+        let out = tapsim(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(out.stdout.is_empty());
+    }
+}
