@@ -2,11 +2,11 @@
 //! or more samples, for several force laws side by side — how much contrast the classic
 //! JKR law overstates against the hybrid and the exact Lennard-Jones law.
 
-use crate::dynamics::observables::TapObservables;
-use crate::dynamics::setup::{Numerics, TapSetup};
+use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
 use crate::identification::Mechanism;
 use crate::law::LawKind;
+use crate::setpoint;
 use crate::sweep::{self, Direction, SweepPoint};
 use serde::Serialize;
 
@@ -51,6 +51,13 @@ pub struct ContrastRow {
     pub grazing: Vec<Option<bool>>,
     /// φ(last material) − φ(first material), degrees, where both are on this branch.
     pub delta_phase_deg: Option<f64>,
+    /// The rest separation z_c at which each material holds the setpoint on this branch
+    /// (m): where the z feedback puts the sample.
+    pub separation_m: Vec<Option<f64>>,
+    /// The apparent height of the last material over the first, z_c(last) − z_c(first)
+    /// (m): over a flat sample of both, the feedback moves the sample by this much
+    /// between them, and the topography shows a step that is not there.
+    pub apparent_height_m: Option<f64>,
     /// E_ts per cycle of each material (J), interpolated as φ is; null where φ is.
     pub e_ts_j: Vec<Option<f64>>,
     /// Its adhesion-hysteresis share (J).
@@ -65,6 +72,7 @@ pub struct ContrastRow {
 #[derive(Debug, Clone)]
 struct AtSetpoint {
     branch: PhaseBranch,
+    separation_m: f64,
     phase_deg: f64,
     /// E_ts per mechanism ([`Mechanism::ALL`]), J.
     e_ts_j: [f64; 4],
@@ -73,14 +81,16 @@ struct AtSetpoint {
     grazing: bool,
 }
 
-/// φ and E_ts per mechanism interpolated linearly in A/A₀ at A/A₀ = `r` between two
-/// steady states, if they bracket it.
-fn crossing(a: &TapObservables, b: &TapObservables, r: f64) -> Option<(f64, [f64; 4])> {
+/// z_c, φ and E_ts per mechanism interpolated linearly in A/A₀ at A/A₀ = `r` between
+/// two approach points, if they bracket it.
+fn crossing(pa: &SweepPoint, pb: &SweepPoint, r: f64) -> Option<(f64, f64, [f64; 4])> {
+    let (a, b) = (&pa.observables, &pb.observables);
     let (ra, rb) = (a.amplitude_ratio, b.amplitude_ratio);
     ((ra - r) * (rb - r) <= 0.0 && ra != rb).then(|| {
         let t = (r - ra) / (rb - ra);
         let at = |va: f64, vb: f64| va + t * (vb - va);
         (
+            at(pa.separation_m, pb.separation_m),
             at(a.phase_deg, b.phase_deg),
             Mechanism::ALL.map(|m| at(m.energy_j(a), m.energy_j(b))),
         )
@@ -88,35 +98,28 @@ fn crossing(a: &TapObservables, b: &TapObservables, r: f64) -> Option<(f64, [f64
 }
 
 /// The steady states of one material and law at amplitude setpoint `r`: every stable
-/// period-1 orbit of the continued family there, and, on a branch with none, the approach
-/// curve's states (orbits of higher period or irregular motion) interpolated there.
-fn states_at(
-    family: &[sweep::BranchRecord],
-    ramp: &[SweepPoint],
-    r: f64,
-    free_phase_deg: f64,
-) -> Vec<AtSetpoint> {
-    let branch_of = |phase: f64| PhaseBranch::of(phase, free_phase_deg);
-    let mut out: Vec<AtSetpoint> = family
-        .windows(2)
-        .filter(|w| {
-            w[0].segment == w[1].segment
-                && w[0].observables.stable == Some(true)
-                && w[1].observables.stable == Some(true)
-        })
-        .filter_map(|w| {
-            let (a, b) = (&w[0].observables, &w[1].observables);
-            crossing(a, b, r).map(|(phase_deg, e_ts_j)| AtSetpoint {
-                branch: branch_of(phase_deg),
-                phase_deg,
-                e_ts_j,
-                regime: "period-1".into(),
-                converged: a.converged && b.converged,
-                grazing: a.grazing || b.grazing,
-            })
+/// period-1 orbit of its families there, solved exactly ([`setpoint::states_on`]), and,
+/// on a branch with none, the approach curve's states (orbits of higher period or
+/// irregular motion) interpolated there.
+fn states_at(curve: &LawCurve, numerics: &Numerics, r: f64) -> Result<Vec<AtSetpoint>> {
+    let p = Prepared::new(&curve.setup, numerics)?;
+    let mut out: Vec<AtSetpoint> = setpoint::states_on(&p, &curve.family, r, None)?
+        .into_iter()
+        .map(|s| {
+            let o = &s.observables;
+            AtSetpoint {
+                branch: s.branch,
+                separation_m: s.separation_m,
+                phase_deg: o.phase_deg,
+                e_ts_j: Mechanism::ALL.map(|m| m.energy_j(o)),
+                regime: o.regime.clone(),
+                converged: o.converged,
+                grazing: o.grazing,
+            }
         })
         .collect();
-    let approach: Vec<&SweepPoint> = ramp
+    let approach: Vec<&SweepPoint> = curve
+        .points
         .iter()
         .filter(|p| p.direction == Direction::Approach)
         .collect();
@@ -125,8 +128,8 @@ fn states_at(
         if a.period == Some(1) && b.period == Some(1) {
             continue;
         }
-        if let Some((phase_deg, e_ts_j)) = crossing(a, b, r) {
-            let branch = branch_of(phase_deg);
+        if let Some((separation_m, phase_deg, e_ts_j)) = crossing(w[0], w[1], r) {
+            let branch = PhaseBranch::of(phase_deg, curve.free_phase_deg);
             if !out.iter().any(|s| s.branch == branch) {
                 let nearer = if (a.amplitude_ratio - r).abs() < (b.amplitude_ratio - r).abs() {
                     a
@@ -135,6 +138,7 @@ fn states_at(
                 };
                 out.push(AtSetpoint {
                     branch,
+                    separation_m,
                     phase_deg,
                     e_ts_j,
                     regime: nearer.regime.clone(),
@@ -144,7 +148,7 @@ fn states_at(
             }
         }
     }
-    out
+    Ok(out)
 }
 
 /// The approach curve and the period-1 family of one material under one law.
@@ -156,8 +160,10 @@ pub struct LawCurve {
     pub law: LawKind,
     /// The approach points.
     pub points: Vec<SweepPoint>,
-    /// The period-1 orbit family over the same range ([`sweep::orbit_branch`]).
+    /// The stable period-1 families over the same range ([`setpoint::families`]).
     pub family: Vec<sweep::BranchRecord>,
+    /// The material's setup under this law.
+    pub setup: TapSetup,
     /// The free oscillator's phase in degrees, atan2(Ω/Q, 1 − Ω²): the border between
     /// the attractive and the repulsive branch.
     pub free_phase_deg: f64,
@@ -209,8 +215,9 @@ pub fn contrast(
                 material: m.name.clone(),
                 law,
                 points: sweep::approach_curve(&s, numerics, &ramp, |_, _| {})?,
-                family: sweep::orbit_branch(&s, numerics, (1.2 * a0, 0.3 * a0), 0.01 * a0)?.points,
+                family: setpoint::families(&s, numerics, (1.2 * a0, 0.3 * a0))?,
                 free_phase_deg,
+                setup: s,
             });
         }
     }
@@ -223,8 +230,9 @@ pub fn contrast(
         for &r in ratios {
             let states: Vec<Vec<AtSetpoint>> = of_law
                 .iter()
-                .map(|c| states_at(&c.family, &c.points, r, c.free_phase_deg))
-                .collect();
+                .zip(materials)
+                .map(|(c, m)| states_at(c, &m.numerics, r))
+                .collect::<Result<_>>()?;
             for branch in [PhaseBranch::Attractive, PhaseBranch::Repulsive] {
                 let on: Vec<Option<&AtSetpoint>> = states
                     .iter()
@@ -235,6 +243,8 @@ pub fn contrast(
                 }
                 let phase_deg: Vec<Option<f64>> =
                     on.iter().map(|s| s.map(|a| a.phase_deg)).collect();
+                let separation_m: Vec<Option<f64>> =
+                    on.iter().map(|s| s.map(|a| a.separation_m)).collect();
                 let share = |i: usize| -> Vec<Option<f64>> {
                     on.iter().map(|s| s.map(|a| a.e_ts_j[i])).collect()
                 };
@@ -247,6 +257,12 @@ pub fn contrast(
                         (Some(first), Some(last)) => Some(last - first),
                         _ => None,
                     },
+                    apparent_height_m: match (separation_m[0], separation_m[separation_m.len() - 1])
+                    {
+                        (Some(first), Some(last)) => Some(last - first),
+                        _ => None,
+                    },
+                    separation_m,
                     regime: on.iter().map(|s| s.map(|a| a.regime.clone())).collect(),
                     e_ts_j: share(0),
                     e_ts_adhesion_j: share(1),

@@ -87,9 +87,30 @@ pub fn states_at_setpoint(
              that touches lies below the free amplitude"
         )));
     }
-    let family = families(setup, numerics, ratio)?;
+    let a0 = setup.cantilever.free_amplitude_m;
+    let family = families(setup, numerics, (1.2 * a0, (ratio - 0.35).max(0.02) * a0))?;
     let p = Prepared::new(setup, numerics)?;
-    let free = free_phase_deg(setup);
+    let out = states_on(&p, &family, ratio, branch)?;
+    if out.is_empty() {
+        let free = free_phase_deg(setup);
+        return Err(Error::NotApplicable(unreached(
+            &family, ratio, branch, free,
+        )));
+    }
+    Ok(out)
+}
+
+/// The states at amplitude `ratio` on the stable period-1 `family` ([`families`]), on
+/// `branch` (`None`: both), attractive first: wherever two neighbouring stable orbits of
+/// one piece bracket the setpoint, the rest separation refined until the amplitude is
+/// the setpoint to [`AMPLITUDE_TOLERANCE`].
+pub fn states_on(
+    p: &Prepared,
+    family: &[BranchRecord],
+    ratio: f64,
+    branch: Option<PhaseBranch>,
+) -> Result<Vec<SetpointState>> {
+    let free = free_phase_deg(&p.setup);
     let stable = |b: &BranchRecord| b.observables.stable == Some(true);
     let mut out: Vec<SetpointState> = Vec::new();
     for w in family.windows(2) {
@@ -104,35 +125,34 @@ pub fn states_at_setpoint(
         {
             continue;
         }
-        if let Some(state) = refine(&p, (a, b), ratio, side, free)? {
+        if let Some(state) = refine(p, (a, b), ratio, side, free)? {
             out.push(state);
         }
     }
     // The same state reached along two families once.
-    let a0 = setup.cantilever.free_amplitude_m;
+    let a0 = p.setup.cantilever.free_amplitude_m;
     out.sort_by(|x, y| x.separation_m.total_cmp(&y.separation_m));
     out.dedup_by(|x, y| {
         x.branch == y.branch && (x.separation_m - y.separation_m).abs() < 1e-6 * a0
     });
     out.sort_by_key(|s| s.branch == PhaseBranch::Repulsive);
-    if out.is_empty() {
-        return Err(Error::NotApplicable(unreached(
-            &family, ratio, branch, free,
-        )));
-    }
     Ok(out)
 }
 
-/// The stable period-1 families a setpoint `ratio` may lie on, as one list whose pieces
-/// are told apart by `segment`: the one the free oscillation settles on far from the
-/// sample (followed from 1.2 A₀ in to deep contact), and the one it settles on at each
-/// of the seeds z_c = (ratio − 0.3 … ratio + 0.1)·A₀ where that is another family than
-/// those followed already, followed out and in from there. In a bistable zone these are
-/// the attractive and the repulsive branch: the free oscillation started close to the
-/// sample lands on the repulsive one, far from it on the attractive one.
-fn families(setup: &TapSetup, numerics: &Numerics, ratio: f64) -> Result<Vec<BranchRecord>> {
+/// The stable period-1 families between the rest separations `far` and `deep`, as one
+/// list whose pieces are told apart by `segment`: the one the free oscillation settles
+/// on at `far`, followed in to `deep`, and the one it settles on at each seed z_c =
+/// `deep` + 0.1 A₀, + 0.2 A₀, … where that is another family than those followed
+/// already, followed out and in from there. In a bistable zone these are the attractive
+/// and the repulsive branch: the free oscillation started close to the sample lands on
+/// the repulsive one, started far on the attractive one.
+pub fn families(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    (far, deep): (f64, f64),
+) -> Result<Vec<BranchRecord>> {
     let a0 = setup.cantilever.free_amplitude_m;
-    let (far, deep, step) = (1.2 * a0, (ratio - 0.35).max(0.02) * a0, 0.01 * a0);
+    let step = 0.01 * a0;
     let p = Prepared::new(setup, numerics)?;
     let free = free_phase_deg(setup);
     let mut all: Vec<BranchRecord> = Vec::new();
@@ -147,11 +167,9 @@ fn families(setup: &TapSetup, numerics: &Numerics, ratio: f64) -> Result<Vec<Bra
         }
     };
     follow(&mut all, far, deep);
-    for k in [0.0, -0.1, -0.2, -0.3, 0.1] {
-        let seed = (ratio + k) * a0;
-        if seed <= deep || seed >= far {
-            continue;
-        }
+    let seeds = ((far - deep) / (0.1 * a0)).floor() as usize;
+    for k in 1..=seeds {
+        let seed = deep + 0.1 * a0 * k as f64;
         let mut phase = p.simulation().free_steady_start();
         let Ok(state) = p.simulation_at(seed)?.steady_state(&mut phase, &p.steady) else {
             continue;

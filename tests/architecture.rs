@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 /// The library's modules (everything outside the `app` feature).
-const LIBRARY: [&str; 12] = [
+const LIBRARY: [&str; 13] = [
     "src/lib.rs",
     "src/contact",
     "src/contrast.rs",
@@ -17,6 +17,7 @@ const LIBRARY: [&str; 12] = [
     "src/numeric.rs",
     "src/params.rs",
     "src/quasistatic.rs",
+    "src/setpoint.rs",
     "src/summary.rs",
     "src/sweep.rs",
 ];

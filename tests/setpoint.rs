@@ -119,3 +119,72 @@ fn a_setpoint_is_refused_where_it_cannot_be_held() {
         assert!(out.stdout.is_empty());
     }
 }
+
+#[test]
+fn contrast_and_tap_at_a_setpoint_agree_and_the_apparent_height_is_the_step_in_z_c() {
+    let rows = json(&[
+        "contrast",
+        "--laws",
+        "hybrid",
+        "--setpoints",
+        "0.8",
+        "--json",
+    ]);
+    let tap = json(&["tap", "--setpoint", "0.8", "--json"]);
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 2, "both branches at 0.8");
+    for row in rows {
+        // Material A is tap's defaults.
+        let state = tap["states"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["branch"] == row["branch"])
+            .expect("the same branches");
+        let phase = row["phase_deg"][0].as_f64().unwrap();
+        assert!((phase - num(state, "phase_deg")).abs() < 1e-6, "{row}");
+        let z: Vec<f64> = row["separation_m"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|z| z.as_f64().unwrap())
+            .collect();
+        assert!((z[0] - num(state, "separation_m")).abs() < 1e-15, "{row}");
+        assert_eq!(num(row, "apparent_height_m"), z[1] - z[0]);
+        assert!(num(row, "apparent_height_m").abs() > 1e-11, "{row}");
+    }
+}
+
+#[test]
+fn readme_contrast_numbers() {
+    // README: Δφ (deg) and Δz_c (nm) between the default polymers at 0.8 and 0.9.
+    let rows = json(&["contrast", "--setpoints", "0.9,0.8", "--quiet", "--json"]);
+    let row = |law: &str, r: f64, branch: &str| {
+        rows.as_array()
+            .unwrap()
+            .iter()
+            .find(|x| x["law"] == law && x["amplitude_ratio"] == r && x["branch"] == branch)
+            .unwrap_or_else(|| panic!("{law} {r} {branch}"))
+            .clone()
+    };
+    for (law, r, branch, dphi, dz_nm) in [
+        ("jkr", 0.8, "repulsive", -8.17, Some(1.07)),
+        ("hybrid", 0.8, "repulsive", -2.80, Some(1.19)),
+        ("lj", 0.8, "repulsive", -2.83, None),
+        ("jkr", 0.8, "attractive", 4.44, None),
+        ("hybrid", 0.8, "attractive", 2.80, Some(-0.64)),
+        ("lj", 0.8, "attractive", 2.83, None),
+        ("jkr", 0.9, "attractive", 2.08, None),
+        ("hybrid", 0.9, "attractive", 3.59, None),
+        ("lj", 0.9, "attractive", 3.09, None),
+    ] {
+        let x = row(law, r, branch);
+        assert!((num(&x, "delta_phase_deg") - dphi).abs() < 0.005, "{x}");
+        if let Some(dz) = dz_nm {
+            assert!(
+                (num(&x, "apparent_height_m") * 1e9 - dz).abs() < 0.005,
+                "{x}"
+            );
+        }
+    }
+}

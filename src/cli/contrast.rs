@@ -18,21 +18,24 @@ use clap::Args;
 /// (without --material: these two). Every other `tapsim tap` option sets the common
 /// cantilever and tip.
 ///
-/// At each amplitude setpoint every steady state of each material is found: the stable
-/// orbits of its period-1 family (continued through z_c as `tapsim branches` does), or,
-/// on a branch where there is none, the approach curve's states there (orbits of
-/// higher period, irregular motion). Each lies on the attractive (φ above the free
-/// phase, 90° at resonance) or the repulsive branch. Δφ = φ(last material) − φ(first)
-/// is taken only between materials on the same branch; where a setpoint is bistable,
-/// both branches get a row. The table names the motion behind every φ and compares
-/// JKR's contrast with the other laws', branch by branch.
+/// At each amplitude setpoint every steady state of each material is found, as
+/// `tapsim tap --setpoint` finds them: the stable orbits of its period-1 families
+/// (continued through z_c as `tapsim branches` does) at the rest separation z_c where
+/// the amplitude is the setpoint, or, on a branch where there is none, the approach
+/// curve's states there (orbits of higher period, irregular motion; interpolated).
+/// Each lies on the attractive (φ above the free phase, 90° at resonance) or the
+/// repulsive branch. Δφ = φ(last material) − φ(first) is taken only between materials
+/// on the same branch; where a setpoint is bistable, both branches get a row. Beside it,
+/// Δz_c = z_c(last) − z_c(first): the height step a topography image shows between the
+/// materials over a flat sample, where the z feedback moves the sample to hold the
+/// setpoint. The table names the motion behind every φ and compares JKR's contrast with
+/// the other laws', branch by branch.
 ///
 /// JSON (--json): one object per law, setpoint and branch with law, materials,
-/// amplitude_ratio, branch, phase_deg, regime, converged, grazing, e_ts_j, e_ts_adhesion_j,
-/// e_ts_viscous_j and e_ts_capillary_j (one entry per material, null where it has no
-/// steady state on that branch; E_ts and its shares by mechanism interpolated at the
-/// setpoint as φ is) and
-/// delta_phase_deg. --csv has the same, a column per material. --plot: φ and E_ts (and
+/// amplitude_ratio, branch, phase_deg, regime, converged, grazing, separation_m, e_ts_j,
+/// e_ts_adhesion_j, e_ts_viscous_j and e_ts_capillary_j (one entry per material, null
+/// where it has no steady state on that branch), delta_phase_deg and
+/// apparent_height_m. --csv has the same, a column per material. --plot: φ and E_ts (and
 /// a viscous sample's share) against A/A₀ per law, and Δφ against the setpoint.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]

@@ -16,7 +16,8 @@ pub fn branch_name(b: PhaseBranch) -> &'static str {
 }
 
 /// The rows as CSV: law, setpoint, branch, each material's phase, regime and grazing
-/// flag, Δφ, then
+/// flag, Δφ, each material's z_c at the setpoint and the apparent height (the last
+/// material's z_c less the first's), then
 /// each material's E_ts and its adhesion and viscous shares (J). An error is the CSV
 /// writer's reason.
 pub fn contrast_csv(
@@ -29,6 +30,8 @@ pub fn contrast_csv(
     header.extend(materials.iter().map(|m| format!("regime_{}", m.name)));
     header.extend(materials.iter().map(|m| format!("grazing_{}", m.name)));
     header.push("delta_phase_deg".into());
+    header.extend(materials.iter().map(|m| format!("separation_m_{}", m.name)));
+    header.push("apparent_height_m".into());
     for column in [
         "e_ts_j",
         "e_ts_adhesion_j",
@@ -55,6 +58,8 @@ pub fn contrast_csv(
                 .map(|g| g.map_or(String::new(), |g| g.to_string())),
         );
         rec.push(cell(r.delta_phase_deg));
+        rec.extend(r.separation_m.iter().map(|&z| cell(z)));
+        rec.push(cell(r.apparent_height_m));
         for shares in [
             &r.e_ts_j,
             &r.e_ts_adhesion_j,
@@ -171,14 +176,15 @@ pub fn contrast_charts(
     charts
 }
 
-/// The table for people, then how much more (or less) contrast JKR shows than each
-/// other law, branch by branch (only materials on the same branch are compared).
+/// The table for people (Δφ and the apparent height Δz_c of the last material over the
+/// first), then how much more (or less) contrast JKR shows than each other law, branch
+/// by branch (only materials on the same branch are compared).
 pub fn contrast_text(laws: &[LawKind], rows: &[ContrastRow]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:>18} {:>8} {:>11} {:>10}  motion",
-        "law", "A/A0", "branch", "Δφ (deg)"
+        "{:>18} {:>8} {:>11} {:>10} {:>10}  motion",
+        "law", "A/A0", "branch", "Δφ (deg)", "Δz_c (nm)"
     );
     for r in rows {
         let regimes: Vec<String> = r
@@ -196,11 +202,13 @@ pub fn contrast_text(laws: &[LawKind], rows: &[ContrastRow]) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "{:>18} {:>8.3} {:>11} {:>10}  {}",
+            "{:>18} {:>8.3} {:>11} {:>10} {:>10}  {}",
             r.law,
             r.amplitude_ratio,
             branch_name(r.branch),
             r.delta_phase_deg.map_or("—".into(), |d| format!("{d:.3}")),
+            r.apparent_height_m
+                .map_or("—".into(), |h| format!("{:.3}", h * 1e9)),
             regimes.join(", ")
         );
     }
