@@ -194,6 +194,69 @@ pub fn families(
     Ok(all)
 }
 
+/// The stable period-1 states at rest separation `separation_m` other than `reported`
+/// (the one the free oscillation settles on there): on each family followed from
+/// 1.2 A₀ in past `separation_m` ([`families`]) whose stable orbits bracket it, the
+/// steady state at `separation_m` started from the nearer orbit, kept where it is a
+/// stable period-1 orbit on another branch or of another amplitude than `reported`.
+pub fn coexisting(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    reported: &TapObservables,
+) -> Result<Vec<SetpointState>> {
+    let a0 = setup.cantilever.free_amplitude_m;
+    let z = setup.separation_m;
+    let (far, deep) = (1.2 * a0, z - 0.05 * a0);
+    if z >= far {
+        return Ok(Vec::new());
+    }
+    let family = families(setup, numerics, (far, deep))?;
+    let p = Prepared::new(setup, numerics)?;
+    let free = free_phase_deg(setup);
+    let sim = p.simulation_at(z)?;
+    let mut out: Vec<SetpointState> = Vec::new();
+    for w in family.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        let stable = |r: &BranchRecord| r.observables.stable == Some(true);
+        if a.segment != b.segment
+            || !stable(a)
+            || !stable(b)
+            || (a.separation_m - z) * (b.separation_m - z) > 0.0
+        {
+            continue;
+        }
+        let nearer = if (a.separation_m - z).abs() < (b.separation_m - z).abs() {
+            a
+        } else {
+            b
+        };
+        let mut phase = nearer.phase;
+        let Ok(state) = sim.steady_state(&mut phase, &p.steady) else {
+            continue;
+        };
+        let o = TapObservables::new(&p, &state)?;
+        let branch = PhaseBranch::of(o.phase_deg, free);
+        // The same state: amplitude and phase equal to the orbits' resolution (its
+        // branch alone would not do: a free orbit's phase is 90° up to round-off).
+        let same = |x: &TapObservables| {
+            (x.amplitude_ratio - o.amplitude_ratio).abs() < 1e-6
+                && (x.phase_deg - o.phase_deg).abs() < 1e-4
+        };
+        if o.period == Some(1)
+            && o.stable == Some(true)
+            && !same(reported)
+            && !out.iter().any(|s| same(&s.observables))
+        {
+            out.push(SetpointState {
+                branch,
+                separation_m: z,
+                observables: o,
+            });
+        }
+    }
+    Ok(out)
+}
+
 /// Why no state was found: the amplitudes each branch's stable period-1 orbits reach.
 fn unreached(
     family: &[BranchRecord],

@@ -188,3 +188,32 @@ fn readme_contrast_numbers() {
         }
     }
 }
+
+#[test]
+fn tap_names_the_other_stable_state_at_its_separation() {
+    // The defaults are bistable: the free oscillation settles on the repulsive branch,
+    // and tap lists the attractive state beside it, as marching from rest finds it.
+    let v = json(&["tap", "--starts", "3", "--json"]);
+    assert!(num(&v, "phase_deg") < 90.0);
+    let other = v["coexisting"].as_array().unwrap();
+    assert_eq!(other.len(), 1, "{other:?}");
+    let o = &other[0];
+    assert_eq!(o["branch"], "attractive");
+    assert_eq!(num(o, "separation_m"), 16e-9);
+    // README: A/A₀ = 0.7622, φ = 127.21°.
+    assert!((num(o, "amplitude_ratio") - 0.7622).abs() < 5e-5);
+    assert!((num(o, "phase_deg") - 127.21).abs() < 5e-3);
+    let from_rest = v["attractors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["starts"].as_array().unwrap().iter().any(|s| s == "rest"))
+        .expect("the rest start's attractor");
+    for key in ["amplitude_ratio", "phase_deg", "e_ts_j"] {
+        let (a, b) = (num(o, key), num(from_rest, key));
+        assert!((a - b).abs() <= 1e-6 * b.abs(), "{key}: {a} vs {b}");
+    }
+    // Far from the sample nothing else exists.
+    let far = json(&["tap", "--separation", "23nm", "--json"]);
+    assert!(far["coexisting"].as_array().unwrap().is_empty());
+}

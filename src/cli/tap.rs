@@ -30,6 +30,10 @@ use std::path::PathBuf;
 /// read: averages over the n periods of the orbit, or over a window of irregular motion
 /// (with standard errors), never one period of motion that is not period-1.
 ///
+/// Where another stable period-1 state exists at the same rest separation (a bistable
+/// setpoint: the attractive and the repulsive branch), tap names it (JSON `coexisting`),
+/// from the period-1 families continued through z_c.
+///
 /// Near the onset of contact a turning point of the tip can pass a switch of the force
 /// law (the jump-in, the pull-off) by less than the thermal motion of the cantilever
 /// (√(k_BT/k) at 300 K, 10 pm on the defaults). Whether the tip touches in a period is
@@ -132,13 +136,21 @@ pub fn run(args: TapArgs) -> Result<()> {
         let title = format!("{} law", setup.law);
         plot::render_stack(&report::trajectory_charts(&run, &title), path)?;
     }
+    // Another stable period-1 state at this z_c (a bistable setpoint: the free
+    // oscillation settles on one, an approach or a retract may sit on the other).
+    let coexisting = crate::setpoint::coexisting(&setup, &numerics, &run.observables)?;
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&run).expect("observables serialise")
-        );
+        let mut v = serde_json::to_value(&run).expect("observables serialise");
+        if let serde_json::Value::Object(m) = &mut v {
+            m.insert(
+                "coexisting".into(),
+                serde_json::to_value(&coexisting).expect("states serialise"),
+            );
+        }
+        outln!("{}", serde_json::to_string_pretty(&v).expect("serialises"));
     } else {
         out!("{}", report::to_text(&setup, &run));
+        out!("{}", report::coexisting_text(&coexisting));
     }
     Ok(())
 }

@@ -434,3 +434,23 @@ pub fn setpoint_text(
     }
     s
 }
+
+/// Lines naming the other stable period-1 states at the same rest separation (none:
+/// nothing).
+pub fn coexisting_text(states: &[crate::setpoint::SetpointState]) -> String {
+    let mut s = String::new();
+    for st in states {
+        let o = &st.observables;
+        let _ = writeln!(
+            s,
+            "note: another stable state exists at this z_c, on the {} branch: A/A₀ {:.6}, \
+             φ {:.4}°, E_ts {:.4} eV (an approach or a retract may sit on it; `tapsim tap \
+             --setpoint` lists the states at a setpoint)",
+            st.branch,
+            o.amplitude_ratio,
+            o.phase_deg,
+            o.e_ts_ev + 0.0
+        );
+    }
+    s
+}
