@@ -83,19 +83,20 @@ pub fn states_at_setpoint(
 ) -> Result<Vec<SetpointState>> {
     if !(ratio > 0.0 && ratio < 1.0) {
         return Err(Error::OutOfRange(format!(
-            "amplitude setpoint A/A₀ = {ratio} is outside (0, 1): the amplitude of a tip \
-             that touches lies below the free amplitude"
+            "amplitude setpoint A/A₀ = {} is outside (0, 1): the amplitude of a tip \
+             that touches lies below the free amplitude",
+            shown(ratio)
         )));
     }
     let a0 = setup.cantilever.free_amplitude_m;
-    let family = families(setup, numerics, (1.2 * a0, (ratio - 0.35).max(0.02) * a0))?;
+    let range = (1.2 * a0, (ratio - 0.35).max(0.02) * a0);
+    let family = families(setup, numerics, range)?;
     let p = Prepared::new(setup, numerics)?;
     let out = states_on(&p, &family, ratio, branch)?;
     if out.is_empty() {
         let free = free_phase_deg(setup);
-        return Err(Error::NotApplicable(unreached(
-            &family, ratio, branch, free,
-        )));
+        let why = unreached(&family, ratio, branch, free, range);
+        return Err(Error::NotApplicable(why));
     }
     Ok(out)
 }
@@ -263,6 +264,7 @@ fn unreached(
     ratio: f64,
     branch: Option<PhaseBranch>,
     free: f64,
+    (far, deep): (f64, f64),
 ) -> String {
     let reach = |side: PhaseBranch| {
         let on: Vec<f64> = family
@@ -284,12 +286,25 @@ fn unreached(
     };
     let which = branch.map_or("any branch".to_string(), |b| format!("the {b} branch"));
     format!(
-        "no stable period-1 steady state on {which} has A/A₀ = {ratio} (stable period-1 \
-         orbits that touch reach: {}; {}). Near the onset of contact the motion is not \
-         period-1: `tapsim approach` shows what it does there",
+        "no stable period-1 steady state on {which} has A/A₀ = {} (between z_c = {:.3} \
+         and {:.3} nm the stable period-1 orbits that touch reach: {}; {}). Near the onset \
+         of contact the motion is not period-1: `tapsim approach` shows what it does there",
+        shown(ratio),
+        far * 1e9,
+        deep * 1e9,
         reach(PhaseBranch::Attractive),
         reach(PhaseBranch::Repulsive)
     )
+}
+
+/// A setpoint as a message shows it: plainly, or with an exponent where it is tiny or
+/// huge.
+fn shown(ratio: f64) -> String {
+    if (1e-4..1e4).contains(&ratio.abs()) {
+        format!("{ratio}")
+    } else {
+        format!("{ratio:e}")
+    }
 }
 
 /// The steady state at amplitude `ratio` between the neighbouring stable orbits `a` and

@@ -182,7 +182,13 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
         BranchChoice::Attractive => Some(PhaseBranch::Attractive),
         BranchChoice::Repulsive => Some(PhaseBranch::Repulsive),
     };
-    let states = states_at_setpoint(&setup, &numerics, ratio, branch)?;
+    let states = states_at_setpoint(&setup, &numerics, ratio, branch).map_err(|e| match e {
+        Error::OutOfRange(why) if args.amplitude_setpoint.is_some() => Error::OutOfRange(format!(
+            "{why} (--amplitude-setpoint is an amplitude, bare numbers in m: e.g. 16nm; \
+             --setpoint takes A/A₀)"
+        )),
+        e => e,
+    })?;
     if args.json {
         let mut top = serde_json::to_value(&states[0]).expect("a state serialises");
         if let serde_json::Value::Object(m) = &mut top {
