@@ -139,6 +139,18 @@ impl Job {
     }
 }
 
+/// A change of the parts.
+type Change = Box<dyn Fn(&mut Vec<Value>)>;
+
+/// The change that sets the value at `pointer` to `value` in every part.
+fn set_all(pointer: &'static str, value: Value) -> Change {
+    Box::new(move |ps| {
+        for p in ps {
+            *p.pointer_mut(pointer).expect("the field is there") = value.clone();
+        }
+    })
+}
+
 #[test]
 fn merge_refuses_the_reported_doctored_parts() {
     let job = map_job(&scratch("reported-map"));
@@ -151,7 +163,6 @@ fn merge_refuses_the_reported_doctored_parts() {
     // Unchanged (read and written again): merged, the whole run's CSV.
     ok(&job.merge(&|_| {}), "unchanged");
     job.refused_or_same(&job.merge(&|_| {}), "unchanged");
-    type Change = Box<dyn Fn(&mut Vec<Value>)>;
     let cases: Vec<(&str, Change, &str)> = vec![
         (
             "records doubled",
@@ -179,20 +190,12 @@ fn merge_refuses_the_reported_doctored_parts() {
         ),
         (
             "a log axis holding 0",
-            Box::new(|ps| {
-                for p in ps {
-                    p["job"]["work_of_adhesion_j_m2"] = serde_json::json!([0.0, 0.2]);
-                }
-            }),
+            set_all("/job/work_of_adhesion_j_m2", serde_json::json!([0.0, 0.2])),
             "job.work_of_adhesion_j_m2 is not an axis",
         ),
         (
             "a span of 1e-300 to 1e300",
-            Box::new(|ps| {
-                for p in ps {
-                    p["job"]["modulus_pa"] = serde_json::json!([1e-300, 1e300]);
-                }
-            }),
+            set_all("/job/modulus_pa", serde_json::json!([1e-300, 1e300])),
             "job.modulus_pa is not",
         ),
         (
@@ -207,11 +210,7 @@ fn merge_refuses_the_reported_doctored_parts() {
         ),
         (
             "a zeroed hash",
-            Box::new(|ps| {
-                for p in ps {
-                    p["config_hash"] = "0000000000000000".into();
-                }
-            }),
+            set_all("/config_hash", serde_json::json!("0000000000000000")),
             "config_hash does not match",
         ),
         (
@@ -227,20 +226,12 @@ fn merge_refuses_the_reported_doctored_parts() {
         ),
         (
             "a descending axis",
-            Box::new(|ps| {
-                for p in ps {
-                    p["job"]["modulus_pa"] = serde_json::json!([3e9, 3e8]);
-                }
-            }),
+            set_all("/job/modulus_pa", serde_json::json!([3e9, 3e8])),
             "job.modulus_pa is not an axis",
         ),
         (
             "a negative axis",
-            Box::new(|ps| {
-                for p in ps {
-                    p["job"]["modulus_pa"] = serde_json::json!([-3e9, 3e8]);
-                }
-            }),
+            set_all("/job/modulus_pa", serde_json::json!([-3e9, 3e8])),
             "job.modulus_pa is not an axis",
         ),
         (
@@ -270,29 +261,17 @@ fn merge_refuses_the_reported_doctored_parts() {
         ),
         (
             "the law renamed",
-            Box::new(|ps| {
-                for p in ps {
-                    p["job"]["law"] = "jkr".into();
-                }
-            }),
+            set_all("/job/law", serde_json::json!("jkr")),
             "config_hash does not match",
         ),
         (
             "the configuration changed",
-            Box::new(|ps| {
-                for p in ps {
-                    p["config"][0]["separation_m"] = 1.5e-8.into();
-                }
-            }),
+            set_all("/config/0/separation_m", serde_json::json!(1.5e-8)),
             "config_hash does not match",
         ),
         (
             "a batch of 0 cases",
-            Box::new(|ps| {
-                for p in ps {
-                    p["job"] = serde_json::json!({"kind": "batch", "cases": 0});
-                }
-            }),
+            set_all("/job", serde_json::json!({"kind": "batch", "cases": 0})),
             "job.cases is 0",
         ),
         (
