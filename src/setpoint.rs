@@ -19,7 +19,7 @@ use serde::Serialize;
 
 /// The branch a steady state of the tapping tip lies on, told by its phase: attractive
 /// where φ lies above the free oscillator's phase (90° at resonance), repulsive below.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PhaseBranch {
     /// Net attractive tip–sample force over the cycle: φ above the free phase.
@@ -140,11 +140,14 @@ pub fn states_on(
     Ok(out)
 }
 
+/// How far out and in a family is followed from a seed, in units of A₀.
+const WINDOW: f64 = 0.15;
+
 /// The stable period-1 families between the rest separations `far` and `deep`, as one
 /// list whose pieces are told apart by `segment`: the one the free oscillation settles
 /// on at `far`, followed in to `deep`, and the one it settles on at each seed z_c =
 /// `deep` + 0.1 A₀, + 0.2 A₀, … where that is another family than those followed
-/// already, followed out and in from there. In a bistable zone these are the attractive
+/// already, followed `WINDOW` (0.15 A₀) out and in from there. In a bistable zone these are the attractive
 /// and the repulsive branch: the free oscillation started close to the sample lands on
 /// the repulsive one, started far on the attractive one.
 pub fn families(
@@ -188,8 +191,10 @@ pub fn families(
                 && (b.observables.amplitude_ratio - o.amplitude_ratio).abs() < 0.02
         });
         if !known {
-            follow(&mut all, seed, far);
-            follow(&mut all, seed, deep);
+            // A window around the seed: the next seed lies inside it, and a setpoint
+            // near the seed's amplitude is bracketed within it.
+            follow(&mut all, seed, (seed + WINDOW * a0).min(far));
+            follow(&mut all, seed, (seed - WINDOW * a0).max(deep));
         }
     }
     Ok(all)

@@ -124,6 +124,10 @@ pub struct MapCell {
     pub modulus_pa: f64,
     /// Tabor parameter μ of the cell.
     pub tabor_mu: f64,
+    /// With an amplitude setpoint: the rest separation z_c at which the cell holds it, in
+    /// m (a map at one z_c leaves it out).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub separation_m: Option<f64>,
     /// Steady-state observables; `None` where the law does not apply.
     #[serde(flatten)]
     pub observables: Option<TapObservables>,
@@ -222,6 +226,11 @@ pub fn adhesion_modulus_map(
     )
 }
 
+/// What a map cell solves: the steady state of a cell's setup, and the rest separation
+/// it was found at where that is solved for (an amplitude setpoint); an
+/// [`Error::NotApplicable`] becomes the cell's note.
+pub type CellSolver<'a> = dyn Fn(&TapSetup) -> Result<(TapObservables, Option<f64>)> + Sync + 'a;
+
 /// The cells numbered `cells` of the map [`adhesion_modulus_map`] computes (numbered in
 /// its order: cell k has modulus k / (number of works), work k mod (number of works)),
 /// in the order given: a part of a map split over machines ([`Shard`]). Each cell is
@@ -229,10 +238,31 @@ pub fn adhesion_modulus_map(
 pub fn map_cells(
     setup: &TapSetup,
     numerics: &Numerics,
+    axes: (&[f64], &[f64]),
+    cells: &[usize],
+    threads: usize,
+    progress: impl Fn() + Sync,
+) -> Result<Vec<MapCell>> {
+    let at_separation = |s: &TapSetup| {
+        crate::dynamics::observables::tap(
+            s,
+            numerics,
+            crate::dynamics::observables::Observe::default(),
+        )
+        .map(|run| (run.observables, None))
+    };
+    map_cells_with(setup, axes, cells, threads, progress, &at_separation)
+}
+
+/// [`map_cells`] with each cell's steady state found by `solve` (a map at an amplitude
+/// setpoint: [`crate::setpoint`]).
+pub fn map_cells_with(
+    setup: &TapSetup,
     (works_j_m2, moduli_pa): (&[f64], &[f64]),
     cells: &[usize],
     threads: usize,
     progress: impl Fn() + Sync,
+    solve: &CellSolver<'_>,
 ) -> Result<Vec<MapCell>> {
     use rayon::prelude::*;
     let pool = thread_pool(threads)?;
@@ -261,22 +291,20 @@ pub fn map_cells(
                 s.contact.work_of_adhesion_j_m2 = w;
                 s.contact.modulus_pa = e;
                 let tabor_mu = s.contact.tabor_mu();
-                let cell = match crate::dynamics::observables::tap(
-                    &s,
-                    numerics,
-                    crate::dynamics::observables::Observe::default(),
-                ) {
-                    Ok(run) => MapCell {
+                let cell = match solve(&s) {
+                    Ok((observables, separation_m)) => MapCell {
                         work_of_adhesion_j_m2: w,
                         modulus_pa: e,
                         tabor_mu,
-                        observables: Some(run.observables),
+                        separation_m,
+                        observables: Some(observables),
                         note: None,
                     },
                     Err(Error::NotApplicable(why)) => MapCell {
                         work_of_adhesion_j_m2: w,
                         modulus_pa: e,
                         tabor_mu,
+                        separation_m: None,
                         observables: None,
                         note: Some(why),
                     },

@@ -217,3 +217,101 @@ fn tap_names_the_other_stable_state_at_its_separation() {
     let far = json(&["tap", "--separation", "23nm", "--json"]);
     assert!(far["coexisting"].as_array().unwrap().is_empty());
 }
+
+#[test]
+fn a_map_at_a_setpoint_holds_it_in_every_cell_and_merges_like_any_map() {
+    let dir = std::env::temp_dir().join(format!("tapsim-setpoint-map-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let at = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let common = [
+        "map",
+        "--setpoint",
+        "0.8",
+        "--branch",
+        "repulsive",
+        "--steps",
+        "3",
+    ];
+    let mut args: Vec<String> = common.iter().map(|s| s.to_string()).collect();
+    args.extend(["--json".into(), "--csv".into(), at("whole.csv")]);
+    let v = json(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(v["setpoint"]["amplitude_ratio"], 0.8);
+    let flat = |key: &str| -> Vec<Value> {
+        v["grid"][key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|r| r.as_array().unwrap().clone())
+            .collect()
+    };
+    let (ratio, phase, z) = (
+        flat("amplitude_ratio"),
+        flat("phase_deg"),
+        flat("separation_m"),
+    );
+    let heights: Vec<Value> = v["apparent_height_m"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|r| r.as_array().unwrap().clone())
+        .collect();
+    let reference = z.iter().find_map(Value::as_f64).expect("a cell holds it");
+    let mut held = 0;
+    for k in 0..ratio.len() {
+        let Some(r) = ratio[k].as_f64() else {
+            assert!(heights[k].is_null());
+            continue;
+        };
+        held += 1;
+        assert!((r - 0.8).abs() < 1e-6, "cell {k}: {r}");
+        // The repulsive branch throughout: no cell jumps to the other branch.
+        assert!(phase[k].as_f64().unwrap() < 90.0, "cell {k}");
+        // The apparent height is the cell's z_c less the reference cell's.
+        let h = heights[k].as_f64().unwrap();
+        assert_eq!(h, z[k].as_f64().unwrap() - reference, "cell {k}");
+    }
+    assert!(held >= 4, "{held} cells hold the setpoint");
+    // Split in two and merged: the whole map's CSV, byte for byte.
+    let mut parts = Vec::new();
+    for i in 0..2 {
+        let part = at(&format!("p{i}.json"));
+        let mut args: Vec<String> = common.iter().map(|s| s.to_string()).collect();
+        args.extend([
+            "--quiet".into(),
+            "--shard".into(),
+            format!("{i}/2"),
+            "--part".into(),
+            part.clone(),
+        ]);
+        let out = tapsim(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        parts.push(part);
+    }
+    let merged = at("merged.csv");
+    let out = tapsim(&["merge", &parts[0], &parts[1], "--quiet", "--out", &merged]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(&merged).unwrap(),
+        std::fs::read(at("whole.csv")).unwrap()
+    );
+    // A separation and a setpoint are not both given.
+    let out = tapsim(&[
+        "map",
+        "--setpoint",
+        "0.8",
+        "--separation",
+        "16nm",
+        "--steps",
+        "2",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+}

@@ -1,16 +1,21 @@
 //! `tapsim map`: dissipation and phase over a grid of work of adhesion and modulus.
 
-use crate::config::{TapInputs, pressure, surface_energy};
-use crate::error::Result;
-use crate::report::part::{self, Job};
+use crate::config::{TapInputs, number, pressure, surface_energy};
+use crate::error::{Error, Result};
+use crate::report::part::{self, Job, MapSetpoint};
 use crate::report::{map as report, plot};
+use crate::setpoint::{PhaseBranch, states_at_setpoint};
 use crate::sweep;
 use crate::sweep::Shard;
 use clap::Args;
 
 /// E_ts and phase over a grid of work of adhesion Δγ and composite modulus E* (log
-/// spaced), at one setpoint: every cell an independent `tapsim tap`, computed in
-/// parallel. The result is the same whatever the number of threads. Every `tapsim tap`
+/// spaced): every cell an independent `tapsim tap`, computed in parallel. With
+/// --setpoint A/A₀ (as an AFM images: the phase image at constant amplitude setpoint)
+/// every cell is solved where its amplitude is the setpoint on --branch (repulsive by
+/// default), and the third heat map is the apparent height Δz_c (the cell's rest
+/// separation less the first cell's: the topography a flat sample of these materials
+/// shows); without it, every cell sits at one rest separation. The result is the same whatever the number of threads. Every `tapsim tap`
 /// option applies (--modulus and --work-of-adhesion are replaced by the grid).
 ///
 /// Output: CSV (--csv, one row per cell; without --csv, --json or --plot it goes to
@@ -47,13 +52,54 @@ pub struct MapArgs {
     /// Worker threads (0: all cores).
     #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
     threads: usize,
+    /// Solve every cell at this amplitude setpoint A/A₀ (between 0 and 1) on --branch,
+    /// as an AFM images, instead of at one rest separation: the phase image at constant
+    /// setpoint, with the apparent height (z_c less the first cell's) in place of A/A₀.
+    /// Cells the branch does not reach stay empty, with a note. Not with --separation.
+    #[arg(long, value_name = "A/A0", allow_hyphen_values = true, value_parser = number)]
+    setpoint: Option<f64>,
+    /// With --setpoint: the branch every cell is solved on.
+    #[arg(long, value_enum, default_value_t = Side::Repulsive)]
+    branch: Side,
     #[command(flatten)]
     split: super::shard::ShardArgs,
 }
 
+/// `--branch` of a map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Side {
+    /// φ above the free phase: net attraction.
+    Attractive,
+    /// φ below the free phase: the tip presses into the sample.
+    Repulsive,
+}
+
 /// Run the subcommand.
 pub fn run(args: MapArgs) -> Result<()> {
-    let (setup, numerics) = args.inputs.with_config()?.resolve()?;
+    let inputs = args.inputs.clone().with_config()?;
+    if args.setpoint.is_some() && inputs.separation.is_some() {
+        return Err(Error::NotApplicable(
+            "give either a rest separation (--separation) or an amplitude setpoint \
+             (--setpoint), not both: at a setpoint each cell's separation is solved for"
+                .into(),
+        ));
+    }
+    let (setup, numerics) = inputs.resolve()?;
+    let setpoint = args.setpoint.map(|amplitude_ratio| MapSetpoint {
+        amplitude_ratio,
+        branch: match args.branch {
+            Side::Attractive => PhaseBranch::Attractive,
+            Side::Repulsive => PhaseBranch::Repulsive,
+        },
+    });
+    if let Some(s) = setpoint {
+        if !(s.amplitude_ratio > 0.0 && s.amplitude_ratio < 1.0) {
+            return Err(Error::OutOfRange(format!(
+                "amplitude setpoint A/A₀ = {} is outside (0, 1)",
+                s.amplitude_ratio
+            )));
+        }
+    }
     let works = sweep::log_grid(
         "work of adhesion",
         args.adhesion_from,
@@ -67,14 +113,31 @@ pub fn run(args: MapArgs) -> Result<()> {
     let shard = args.split.resolve("map", whole_outputs)?;
     let cells = shard.unwrap_or(Shard::WHOLE).items(total);
     let bar = args.out.progress_bar(cells.len());
-    let computed = sweep::map_cells(
-        &setup,
-        &numerics,
-        (&works, &moduli),
-        &cells,
-        args.threads,
-        || bar.inc(1),
-    )?;
+    let computed = match setpoint {
+        None => sweep::map_cells(
+            &setup,
+            &numerics,
+            (&works, &moduli),
+            &cells,
+            args.threads,
+            || bar.inc(1),
+        )?,
+        Some(sp) => {
+            let solve = |s: &crate::dynamics::setup::TapSetup| {
+                let states = states_at_setpoint(s, &numerics, sp.amplitude_ratio, Some(sp.branch))?;
+                let first = states.into_iter().next().expect("a list is never empty");
+                Ok((first.observables, Some(first.separation_m)))
+            };
+            sweep::map_cells_with(
+                &setup,
+                (&works, &moduli),
+                &cells,
+                args.threads,
+                || bar.inc(1),
+                &solve,
+            )?
+        }
+    };
     bar.finish_and_clear();
     match shard {
         Some(shard) => args.split.write(
@@ -83,6 +146,7 @@ pub fn run(args: MapArgs) -> Result<()> {
                 law,
                 work_of_adhesion_j_m2: works.clone(),
                 modulus_pa: moduli.clone(),
+                setpoint,
             },
             &part::Config::Whole(
                 serde_json::to_value((&setup, &numerics, &works, &moduli))
@@ -94,7 +158,14 @@ pub fn run(args: MapArgs) -> Result<()> {
                 .map(|c| part::raw_records(std::slice::from_ref(c)))
                 .collect::<Result<_>>()?,
         ),
-        None => emit(&args.out, &[], &law, &works, &moduli, &computed),
+        None => emit(
+            &args.out,
+            &[],
+            (&law, setpoint.as_ref()),
+            &works,
+            &moduli,
+            &computed,
+        ),
     }
 }
 
@@ -103,16 +174,20 @@ pub fn run(args: MapArgs) -> Result<()> {
 pub(super) fn emit<T: report::MapRecord>(
     out: &super::SweepOutput,
     extra: &[std::path::PathBuf],
-    law: &str,
+    (law, setpoint): (&str, Option<&MapSetpoint>),
     works: &[f64],
     moduli: &[f64],
     records: &[T],
 ) -> Result<()> {
+    let caption = setpoint.map(MapSetpoint::caption);
     out.emit(
         ("map", extra),
         records,
-        || report::map_json(law, works, moduli, records),
-        Some(&|path| plot::render_heatmaps(&report::heat_maps(law, works, moduli, records), path)),
+        || report::map_json(law, setpoint, works, moduli, records),
+        Some(&|path| {
+            let maps = report::heat_maps(law, caption.as_deref(), works, moduli, records);
+            plot::render_heatmaps(&maps, path)
+        }),
     )?;
     let grazing = report::grazing_cells(records);
     if grazing > 0 && !out.quiet {

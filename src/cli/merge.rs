@@ -73,10 +73,11 @@ pub fn run(args: MergeArgs) -> Result<()> {
             law,
             work_of_adhesion_j_m2,
             modulus_pa,
+            setpoint,
         } => super::map::emit(
             &args.output,
             &args.out,
-            law,
+            (law, setpoint.as_ref()),
             work_of_adhesion_j_m2,
             modulus_pa,
             &merged.records,

@@ -37,6 +37,8 @@ pub struct HeatMap {
     pub y: Vec<f64>,
     /// Cells, `cells[j][i]` at `(x[i], y[j])`.
     pub cells: Vec<Vec<Cell>>,
+    /// What a grey (empty) cell means, as the key says it ("law n/a").
+    pub empty_label: String,
 }
 
 impl HeatMap {

@@ -13,11 +13,12 @@ use serde::Serialize;
 use serde_json::value::RawValue;
 
 /// What a heat map shows of one cell: E_ts per cycle (eV), the phase (deg), A/A₀ and the
-/// viscous share of E_ts (eV), whether the motion is period-1 and whether it grazes a
-/// switch; `None` where the law does not apply.
-pub type Plotted = Option<([f64; 4], bool, bool)>;
+/// viscous share of E_ts (eV), the rest separation (m) where it was solved for (an
+/// amplitude setpoint), whether the motion is period-1 and whether it grazes a switch;
+/// `None` where the law does not apply.
+pub type Plotted = Option<([f64; 4], Option<f64>, bool, bool)>;
 
-/// A map cell as its record serialises, and what its heat maps show.
+/// A cell as its record serialises, and what its heat maps show.
 pub trait MapRecord: Serialize {
     /// The cell's plotted values.
     fn plotted(&self) -> Plotted;
@@ -33,6 +34,7 @@ impl MapRecord for MapCell {
                 o.amplitude_ratio,
                 o.e_ts_viscous_j / ELECTRONVOLT_J,
             ],
+            self.separation_m,
             o.period == Some(1),
             o.grazing,
         ))
@@ -46,6 +48,7 @@ struct PlottedFields {
     phase_deg: Option<f64>,
     amplitude_ratio: Option<f64>,
     e_ts_viscous_j: Option<f64>,
+    separation_m: Option<f64>,
     period: Option<u64>,
     grazing: Option<bool>,
 }
@@ -61,37 +64,66 @@ impl MapRecord for Box<RawValue> {
                 f.amplitude_ratio?,
                 f.e_ts_viscous_j? / ELECTRONVOLT_J,
             ],
+            f.separation_m,
             f.period == Some(1),
             f.grazing == Some(true),
         ))
     }
 }
 
+/// The apparent height of each cell at an amplitude setpoint (m): its rest separation
+/// less the reference cell's (the first that holds the setpoint) — the height a
+/// topography image shows over a flat sample of the cells' materials. `None` where a
+/// cell has no rest separation.
+pub fn apparent_heights<T: MapRecord>(cells: &[T]) -> Vec<Option<f64>> {
+    let z: Vec<Option<f64>> = cells
+        .iter()
+        .map(|c| c.plotted().and_then(|p| p.1))
+        .collect();
+    let reference = z.iter().flatten().next().copied();
+    z.iter()
+        .map(|z| z.zip(reference).map(|(z, r)| z - r))
+        .collect()
+}
+
 /// Heat maps of E_ts per cycle, phase and A/A₀ over the grid for `law` (and of E_ts's
-/// viscous share, where a sample is viscous). The records come
-/// row by row, one row per modulus (as [`map_json`] lays them out); a cell without the
-/// value (the law does not apply there) is grey.
+/// viscous share, where a sample is viscous); at an amplitude setpoint (`setpoint`, its
+/// caption) the apparent height ([`apparent_heights`]) instead of A/A₀, which is the
+/// setpoint everywhere. The records come row by row, one row per modulus (as
+/// [`map_json`] lays them out); a cell without the value (the law does not apply there,
+/// or the branch does not reach the setpoint) is grey.
 pub fn heat_maps<T: MapRecord>(
     law: &str,
+    setpoint: Option<&str>,
     works: &[f64],
     moduli: &[f64],
     cells: &[T],
 ) -> Vec<HeatMap> {
     let plotted: Vec<Plotted> = cells.iter().map(MapRecord::plotted).collect();
-    let map = |title: &str, value_label: &str, which: usize| HeatMap {
-        title: format!("{law} law: {title}"),
+    let heights = apparent_heights(cells);
+    let at = setpoint.map_or(String::new(), |s| format!(" at {s}"));
+    let map = |title: &str, value_label: &str, value: &dyn Fn(usize, &[f64; 4]) -> f64| HeatMap {
+        title: format!("{law} law{at}: {title}"),
         x_label: "work of adhesion Δγ (J/m²)".into(),
         y_label: "composite modulus E* (GPa)".into(),
         value_label: value_label.into(),
+        empty_label: if setpoint.is_some() {
+            "law n/a or not reached".into()
+        } else {
+            "law n/a".into()
+        },
         x: works.to_vec(),
         y: moduli.iter().map(|e| e * 1e-9).collect(),
         cells: plotted
+            .iter()
+            .enumerate()
+            .collect::<Vec<_>>()
             .chunks(works.len())
             .map(|row| {
                 row.iter()
-                    .map(|c| match c {
-                        Some((values, period_one, grazing)) => Cell::Value {
-                            value: values[which],
+                    .map(|(k, c)| match c {
+                        Some((values, _, period_one, grazing)) => Cell::Value {
+                            value: value(*k, values),
                             period_one: *period_one,
                             grazing: *grazing,
                         },
@@ -102,41 +134,63 @@ pub fn heat_maps<T: MapRecord>(
             .collect(),
     };
     let mut maps = vec![
-        map("dissipation per cycle", "E_ts per cycle (eV)", 0),
-        map("phase", "phase lag φ (deg)", 1),
-        map("amplitude", "A/A₀", 2),
+        map("dissipation per cycle", "E_ts per cycle (eV)", &|_, v| v[0]),
+        map("phase", "phase lag φ (deg)", &|_, v| v[1]),
     ];
+    if setpoint.is_some() {
+        maps.push(map(
+            "apparent height Δz_c",
+            "Δz_c from the first cell (nm)",
+            &|k, _| heights[k].map_or(f64::NAN, |h| h * 1e9),
+        ));
+    } else {
+        maps.push(map("amplitude", "A/A₀", &|_, v| v[2]));
+    }
     if plotted.iter().flatten().any(|(values, ..)| values[3] > 0.0) {
         maps.push(map(
             "viscous share of the dissipation",
             "E_ts in the viscous sample per cycle (eV)",
-            3,
+            &|_, v| v[3],
         ));
     }
     maps
 }
 
-/// The grid as one JSON object: the law, both axes, and per observable an array of rows
-/// (one per modulus) of values (one per work of adhesion).
+/// The grid as one JSON object: the law, the setpoint (if any), both axes, and per
+/// observable an array of rows (one per modulus) of values (one per work of adhesion);
+/// at a setpoint also the apparent heights ([`apparent_heights`]).
 pub fn map_json<T: MapRecord>(
     law: &str,
+    setpoint: Option<&super::part::MapSetpoint>,
     works: &[f64],
     moduli: &[f64],
     cells: &[T],
 ) -> Result<serde_json::Value> {
-    Ok(serde_json::json!({
+    let mut v = serde_json::json!({
         "law": law,
         "work_of_adhesion_j_m2": works,
         "modulus_pa": moduli,
         "grazing_cells": grazing_cells(cells),
         "grid": records::grid_json(cells, works.len())?,
-    }))
+    });
+    if let (Some(sp), serde_json::Value::Object(m)) = (setpoint, &mut v) {
+        m.insert(
+            "setpoint".into(),
+            serde_json::to_value(sp).expect("serialises"),
+        );
+        let heights: Vec<Vec<Option<f64>>> = apparent_heights(cells)
+            .chunks(works.len())
+            .map(<[Option<f64>]>::to_vec)
+            .collect();
+        m.insert("apparent_height_m".into(), serde_json::json!(heights));
+    }
+    Ok(v)
 }
 
 /// How many cells' motion grazes a switch.
 pub fn grazing_cells<T: MapRecord>(cells: &[T]) -> usize {
     cells
         .iter()
-        .filter(|c| c.plotted().is_some_and(|p| p.2))
+        .filter(|c| c.plotted().is_some_and(|p| p.3))
         .count()
 }

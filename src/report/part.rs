@@ -25,6 +25,23 @@ pub const MAX_CASES: usize = 100_000;
 /// What a part file says it is.
 pub const FORMAT: &str = "tapsim-part";
 
+/// The amplitude setpoint of a map: every cell solved where A/A₀ is `amplitude_ratio`
+/// on `branch`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MapSetpoint {
+    /// A/A₀.
+    pub amplitude_ratio: f64,
+    /// The branch.
+    pub branch: crate::setpoint::PhaseBranch,
+}
+
+impl MapSetpoint {
+    /// How titles name it: "A/A₀ = 0.8, repulsive branch".
+    pub fn caption(&self) -> String {
+        format!("A/A₀ = {}, {} branch", self.amplitude_ratio, self.branch)
+    }
+}
+
 /// The job a part belongs to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
@@ -37,6 +54,10 @@ pub enum Job {
         work_of_adhesion_j_m2: Vec<f64>,
         /// The modulus axis in Pa.
         modulus_pa: Vec<f64>,
+        /// The amplitude setpoint every cell is solved at, if any (else one rest
+        /// separation).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        setpoint: Option<MapSetpoint>,
     },
     /// `tapsim batch`: one record per tap case, one per setpoint of an approach case.
     Batch {
@@ -73,9 +94,16 @@ impl Job {
                 law,
                 work_of_adhesion_j_m2,
                 modulus_pa,
+                setpoint,
             } => {
                 if law.is_empty() || law.len() > 64 {
                     return Err(refuse("law", "is not a law's name".into()));
+                }
+                if setpoint.is_some_and(|s| !(s.amplitude_ratio > 0.0 && s.amplitude_ratio < 1.0)) {
+                    return Err(refuse(
+                        "setpoint",
+                        "is not an amplitude setpoint between 0 and 1".into(),
+                    ));
                 }
                 for (field, axis) in [
                     ("work_of_adhesion_j_m2", work_of_adhesion_j_m2),

@@ -336,8 +336,12 @@ fn draw_heatmap<DB: DrawingBackend>(
         grey.filled(),
     ))
     .map_err(|e| err(&e))?;
-    side.draw(&Text::new("law n/a", (at(48).0 + 18, at(48).1), key))
-        .map_err(|e| err(&e))?;
+    side.draw(&Text::new(
+        map.empty_label.as_str(),
+        (at(48).0 + 18, at(48).1),
+        key,
+    ))
+    .map_err(|e| err(&e))?;
     Ok(Drawn {
         area: ctx.plotting_area().get_pixel_range(),
         legend_covers: 0,
@@ -919,6 +923,7 @@ mod tests {
             x_label: "x".into(),
             y_label: "y".into(),
             value_label: "v".into(),
+            empty_label: "law n/a".into(),
             x: vec![1.0, 10.0],
             y: vec![1.0, 10.0],
             cells: vec![
