@@ -1,14 +1,9 @@
 //! The `tapsim` command line, run as a user would.
 
+mod common;
+use common::{json, num, tapsim};
 use std::path::PathBuf;
 use std::process::{Command, Output};
-
-fn tapsim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tapsim"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 /// Run `args`, asserting success.
 fn succeeds(args: &[&str]) -> Output {
@@ -57,22 +52,6 @@ fn a_file_gives_what_the_flags_give(name: &str, toml: &str, from_flags: &serde_j
     let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
     assert_eq!(w["e_ts_j"], from_flags["e_ts_j"], "{toml}");
     std::fs::remove_dir_all(dir).unwrap();
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let out = tapsim(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("exactly one JSON object on stdout")
-}
-
-fn num(v: &serde_json::Value, key: &str) -> f64 {
-    v[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("key {key} missing or not a number in {v}"))
 }
 
 fn scratch(name: &str) -> PathBuf {

@@ -4,29 +4,9 @@
 //! starts — a different path (time-marching and shooting from fixed starts, no
 //! continuation, no root-finding).
 
+mod common;
+use common::{json, num, tapsim};
 use serde_json::Value;
-use std::process::Command;
-
-fn tapsim(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_tapsim"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn json(args: &[&str]) -> Value {
-    let out = tapsim(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON object")
-}
-
-fn num(v: &Value, key: &str) -> f64 {
-    v[key].as_f64().unwrap_or_else(|| panic!("{key} in {v}"))
-}
 
 #[test]
 fn every_state_at_the_setpoint_is_a_state_tap_finds_at_its_separation() {

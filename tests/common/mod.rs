@@ -1,4 +1,5 @@
-//! What several test files share: running the binary with a time limit.
+//! What several test files share: running the binary (plainly, for its JSON, or with a
+//! time limit).
 
 // Each test file that includes this uses what it needs of it.
 #![allow(dead_code)]
@@ -6,7 +7,7 @@
 use std::ffi::OsStr;
 use std::io::Read;
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// How a run of the binary ended.
@@ -57,4 +58,30 @@ pub fn run_limited<S: AsRef<OsStr>>(args: &[S], dir: &Path, limit: Duration) -> 
         stdout: out.join().unwrap_or_default(),
         stderr: err.join().unwrap_or_default(),
     }
+}
+
+/// Run the binary with `args`.
+pub fn tapsim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// Run `args`, asserting success, and read the one JSON object it prints.
+pub fn json(args: &[&str]) -> serde_json::Value {
+    let out = tapsim(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("exactly one JSON object on stdout")
+}
+
+/// The number under `key`.
+pub fn num(v: &serde_json::Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("key {key} missing or not a number in {v}"))
 }
