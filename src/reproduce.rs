@@ -88,6 +88,12 @@ fn write_records<T: serde::Serialize>(out: &Path, stem: &str, records: &[T]) -> 
     Ok(path)
 }
 
+/// Grid points per axis of the two maps.
+const MAP_STEPS: usize = 6;
+
+/// The amplitude setpoint of the phase image at constant setpoint.
+const MAP_SETPOINT: f64 = 0.8;
+
 /// The first line of the generated README.md, which marks a directory as ours.
 const README_TITLE: &str = "# tapsim results";
 
@@ -379,6 +385,65 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         "identification curves: each setpoint's dissipation by mechanism, normalized",
         &mut entries,
     );
+
+    // Phase images: at one rest separation, and at a constant amplitude setpoint as an
+    // AFM images (repulsive branch), over the same (Δγ, E*) grid.
+    progress("maps at one separation and at a setpoint");
+    let map_setup = default_setup();
+    let map_numerics = Numerics::default();
+    let works = sweep::log_grid("work of adhesion", 0.02, 0.2, MAP_STEPS)?;
+    let moduli = sweep::log_grid("modulus", 0.3e9, 3e9, MAP_STEPS)?;
+    let law = map_setup.law.to_string();
+    let cells: Vec<usize> = (0..MAP_STEPS * MAP_STEPS).collect();
+    let at_separation = sweep::map_cells(
+        &map_setup,
+        &map_numerics,
+        (&works, &moduli),
+        &cells,
+        0,
+        || {},
+    )?;
+    let setpoint = crate::report::part::MapSetpoint {
+        amplitude_ratio: MAP_SETPOINT,
+        branch: crate::setpoint::PhaseBranch::Repulsive,
+    };
+    let solve = |s: &TapSetup| {
+        let states = crate::setpoint::states_at_setpoint(
+            s,
+            &map_numerics,
+            setpoint.amplitude_ratio,
+            Some(setpoint.branch),
+        )?;
+        let first = states.into_iter().next().expect("a list is never empty");
+        Ok((first.observables, Some(first.separation_m)))
+    };
+    let at_setpoint =
+        sweep::map_cells_with(&map_setup, (&works, &moduli), &cells, 0, || {}, &solve)?;
+    for (stem, cells, caption, what) in [
+        (
+            "tap_map_separation",
+            &at_separation,
+            None,
+            "map over (Δγ, E*) at the default rest separation 16 nm: E_ts, φ, A/A₀",
+        ),
+        (
+            "tap_map_setpoint",
+            &at_setpoint,
+            Some(setpoint.caption()),
+            "map over (Δγ, E*) at the amplitude setpoint A/A₀ = 0.8, repulsive branch: E_ts, \
+             φ and the apparent height Δz_c",
+        ),
+    ] {
+        let maps = crate::report::map::heat_maps(&law, caption.as_deref(), &works, &moduli, cells);
+        let mut paths = Vec::new();
+        for ext in ["png", "svg"] {
+            let path = out.join(format!("{stem}.{ext}"));
+            plot::render_heatmaps(&maps, &path)?;
+            paths.push(path);
+        }
+        paths.push(write_records(out, stem, cells)?);
+        add(paths, what, &mut entries);
+    }
 
     // Headline numbers and the README.
     progress("README.md");
