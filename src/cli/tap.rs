@@ -138,7 +138,10 @@ pub fn run(args: TapArgs) -> Result<()> {
     }
     // Another stable period-1 state at this z_c (a bistable setpoint: the free
     // oscillation settles on one, an approach or a retract may sit on the other).
-    let coexisting = crate::setpoint::coexisting(&setup, &numerics, &run.observables)?;
+    let spinner = spinner("looking for other stable states at this z_c");
+    let coexisting = crate::setpoint::coexisting(&setup, &numerics, &run.observables);
+    spinner.finish_and_clear();
+    let coexisting = coexisting?;
     if args.json {
         let mut v = serde_json::to_value(&run).expect("observables serialise");
         if let serde_json::Value::Object(m) = &mut v {
@@ -182,7 +185,10 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
         BranchChoice::Attractive => Some(PhaseBranch::Attractive),
         BranchChoice::Repulsive => Some(PhaseBranch::Repulsive),
     };
-    let states = states_at_setpoint(&setup, &numerics, ratio, branch).map_err(|e| match e {
+    let spinner = spinner("following the period-1 families to the setpoint");
+    let states = states_at_setpoint(&setup, &numerics, ratio, branch);
+    spinner.finish_and_clear();
+    let states = states.map_err(|e| match e {
         Error::OutOfRange(why) if args.amplitude_setpoint.is_some() => Error::OutOfRange(format!(
             "{why} (--amplitude-setpoint is an amplitude, bare numbers in m: e.g. 16nm; \
              --setpoint takes A/A₀)"
@@ -206,4 +212,17 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
         out!("{}", report::setpoint_text(&setup, ratio, &states));
     }
     Ok(())
+}
+
+/// A spinner saying `what` on stderr while it runs, ticking every half second (hidden
+/// where stderr is not a terminal).
+fn spinner(what: &str) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_message(what.to_string());
+    bar.enable_steady_tick(std::time::Duration::from_millis(500));
+    bar
 }
