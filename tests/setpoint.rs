@@ -295,3 +295,46 @@ fn a_map_at_a_setpoint_holds_it_in_every_cell_and_merges_like_any_map() {
     ]);
     assert_eq!(out.status.code(), Some(1));
 }
+
+#[test]
+fn a_batch_row_at_a_setpoint_gives_the_states_tap_gives() {
+    let dir = std::env::temp_dir().join(format!("tapsim-setpoint-batch-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let table = dir.join("t.csv");
+    std::fs::write(
+        &table,
+        "name,setpoint,branch,separation\nboth,0.8,,\nrep,0.8,repulsive,\nz,,,16nm\n",
+    )
+    .unwrap();
+    let v = json(&["batch", table.to_str().unwrap(), "--json"]);
+    let col = |key: &str| v[key].as_array().unwrap().clone();
+    let (case, branch, phase) = (col("case"), col("branch"), col("phase_deg"));
+    assert_eq!(case, ["both", "both", "rep", "z"]);
+    assert_eq!(branch[..3], ["attractive", "repulsive", "repulsive"]);
+    let tap = json(&["tap", "--setpoint", "0.8", "--json"]);
+    for (i, s) in [0, 1, 1].into_iter().enumerate() {
+        let (a, b) = (
+            phase[i].as_f64().unwrap(),
+            num(&tap["states"][s], "phase_deg"),
+        );
+        assert!((a - b).abs() < 1e-6, "row {i}: {a} vs {b}");
+    }
+    // A setpoint beside a separation, or outside (0, 1), refuses the batch, naming the row.
+    for (text, says) in [
+        (
+            "name,setpoint,separation\nx,0.8,16nm\n",
+            "row 1: give either",
+        ),
+        ("name,setpoint\nx,1.5\n", "row 1: amplitude setpoint"),
+        (
+            "name,setpoint,branch\nx,0.8,up\n",
+            "expected attractive, repulsive or all",
+        ),
+    ] {
+        std::fs::write(&table, text).unwrap();
+        let out = tapsim(&["batch", table.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&out.stderr).contains(says));
+    }
+}

@@ -20,6 +20,9 @@ use std::path::{Path, PathBuf};
 /// the command line; an empty cell keeps the default), and
 ///   name      the case's name (default: its row number, from 1)
 ///   command   tap or approach
+///   setpoint, branch   a tap case at an amplitude setpoint A/A₀ instead of a rest
+///             separation (as `tapsim tap --setpoint`): a row per state there, each with
+///             its branch and separation_m; branch attractive, repulsive or all
 ///   points, from, to, no-retract   an approach's setpoints (as `tapsim approach`)
 /// Options given on the command line apply to every row that does not set them.
 ///
@@ -58,6 +61,11 @@ const MAX_TABLE_BYTES: u64 = 16 * 1024 * 1024;
 #[derive(Debug, Clone, serde::Serialize)]
 enum Run {
     Tap,
+    /// A tap at an amplitude setpoint: every state there, on one branch or both.
+    Setpoint {
+        ratio: f64,
+        branch: Option<crate::setpoint::PhaseBranch>,
+    },
     Approach {
         points: usize,
         from: Option<f64>,
@@ -166,6 +174,8 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
     let mut command = "tap".to_string();
     let (mut points, mut from, mut to, mut retract) =
         (super::approach::DEFAULT_POINTS, None, None, true);
+    let (mut setpoint, mut branch): (Option<f64>, Option<crate::setpoint::PhaseBranch>) =
+        (None, None);
     for (key, text) in row {
         match key.as_str() {
             "name" => name = text.clone(),
@@ -184,6 +194,25 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
             }
             "to" => {
                 to = Some(crate::config::length(text).map_err(|e| at(Error::NotApplicable(e)))?)
+            }
+            "setpoint" => {
+                setpoint =
+                    Some(crate::config::number(text).map_err(|e| at(Error::NotApplicable(e)))?)
+            }
+            "branch" => {
+                use crate::setpoint::PhaseBranch;
+                branch = match text.to_ascii_lowercase().as_str() {
+                    "attractive" => Some(PhaseBranch::Attractive),
+                    "repulsive" => Some(PhaseBranch::Repulsive),
+                    "all" => None,
+                    _ => {
+                        return Err(at(Error::Parse {
+                            name: "branch",
+                            text: text.clone(),
+                            reason: "expected attractive, repulsive or all".into(),
+                        }));
+                    }
+                }
             }
             "no-retract" => {
                 retract = match text.to_ascii_lowercase().as_str() {
@@ -228,7 +257,31 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
     // A value `tap` refuses refuses the batch here, before any case runs.
     setup.check_plausible().map_err(at)?;
     let (run, numerics) = match command.as_str() {
-        "tap" => (Run::Tap, numerics),
+        "tap" => match setpoint {
+            None => (Run::Tap, numerics),
+            Some(ratio) => {
+                if inputs.separation.is_some() {
+                    return Err(at(Error::NotApplicable(
+                        "give either a separation or a setpoint, not both: at a setpoint \
+                         the separation is what is solved for"
+                            .into(),
+                    )));
+                }
+                if !(ratio > 0.0 && ratio < 1.0) {
+                    return Err(at(Error::OutOfRange(format!(
+                        "amplitude setpoint A/A₀ = {ratio} is outside (0, 1)"
+                    ))));
+                }
+                (Run::Setpoint { ratio, branch }, numerics)
+            }
+        },
+        "approach" if setpoint.is_some() => {
+            return Err(at(Error::NotApplicable(
+                "an approach case runs over rest separations (from, to); a setpoint is for \
+                 a tap case"
+                    .into(),
+            )));
+        }
         "approach" => (
             Run::Approach {
                 points,
@@ -270,6 +323,20 @@ fn run_case(c: &Case) -> Result<Vec<Map<String, Value>>> {
             crate::dynamics::observables::Observe::default(),
         )
         .and_then(|run| Ok(vec![joined(head("tap"), &run.observables)?])),
+        Run::Setpoint { ratio, branch } => {
+            crate::setpoint::states_at_setpoint(&c.setup, &c.numerics, *ratio, *branch).and_then(
+                |states| {
+                    states
+                        .iter()
+                        .map(|st| {
+                            let mut m = head("tap");
+                            m.insert("setpoint".into(), Value::from(*ratio));
+                            joined(m, st)
+                        })
+                        .collect()
+                },
+            )
+        }
         Run::Approach {
             points,
             from,
@@ -291,7 +358,7 @@ fn run_case(c: &Case) -> Result<Vec<Map<String, Value>>> {
         Ok(records) => Ok(records),
         Err(Error::NotApplicable(why)) => {
             let mut m = head(match c.run {
-                Run::Tap => "tap",
+                Run::Tap | Run::Setpoint { .. } => "tap",
                 Run::Approach { .. } => "approach",
             });
             m.insert("note".into(), Value::String(why));
