@@ -1,7 +1,7 @@
 //! The `tapsim` command line, run as a user would.
 
 mod common;
-use common::{json, num, tapsim};
+use common::{cells, json, num, tapsim};
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -1034,15 +1034,7 @@ fn map_counts_its_grazing_cells_where_readme_says() {
     let out = tapsim(&["map", "--steps", "10", "--json"]);
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let flat = |key: &str| -> Vec<serde_json::Value> {
-        v["grid"][key]
-            .as_array()
-            .unwrap()
-            .iter()
-            .flat_map(|r| r.as_array().unwrap().clone())
-            .collect()
-    };
-    let (regimes, grazing) = (flat("regime"), flat("grazing"));
+    let (regimes, grazing) = (cells(&v["grid"]["regime"]), cells(&v["grid"]["grazing"]));
     let count =
         |f: &dyn Fn(&str) -> bool| regimes.iter().filter(|r| r.as_str().is_some_and(f)).count();
     assert_eq!(count(&|r| r == "period-1"), 52);

@@ -42,61 +42,19 @@ struct Job {
     parts: Vec<Value>,
 }
 
-fn map_job(dir: &Path) -> Job {
-    let whole = dir.join("whole.csv");
-    ok(
-        &run(
-            &["map", "--steps", "2", "--quiet", "--csv", "whole.csv"],
-            dir,
-        ),
-        "map",
-    );
+/// A job run whole into `whole.csv` and in two parts, by `command` (its arguments
+/// before the output flags).
+fn sharded(dir: &Path, command: &[&str]) -> Job {
+    let mut whole = command.to_vec();
+    whole.extend(["--quiet", "--csv", "whole.csv"]);
+    ok(&run(&whole, dir), command[0]);
     let parts = (0..2)
         .map(|i| {
             let name = format!("p{i}.json");
             let shard = format!("{i}/2");
-            ok(
-                &run(
-                    &[
-                        "map", "--steps", "2", "--quiet", "--shard", &shard, "--part", &name,
-                    ],
-                    dir,
-                ),
-                "map part",
-            );
-            serde_json::from_slice(&std::fs::read(dir.join(&name)).unwrap()).unwrap()
-        })
-        .collect();
-    Job {
-        dir: dir.to_path_buf(),
-        whole_csv: std::fs::read(whole).unwrap(),
-        parts,
-    }
-}
-
-fn batch_job(dir: &Path) -> Job {
-    std::fs::write(
-        dir.join("t.csv"),
-        "name,separation,command,points\na,16nm,tap,\nb,18nm,tap,\nc,,approach,3\n",
-    )
-    .unwrap();
-    ok(
-        &run(&["batch", "t.csv", "--quiet", "--csv", "whole.csv"], dir),
-        "batch",
-    );
-    let parts = (0..2)
-        .map(|i| {
-            let name = format!("p{i}.json");
-            let shard = format!("{i}/2");
-            ok(
-                &run(
-                    &[
-                        "batch", "t.csv", "--quiet", "--shard", &shard, "--part", &name,
-                    ],
-                    dir,
-                ),
-                "batch part",
-            );
+            let mut args = command.to_vec();
+            args.extend(["--quiet", "--shard", &shard, "--part", &name]);
+            ok(&run(&args, dir), "a part");
             serde_json::from_slice(&std::fs::read(dir.join(&name)).unwrap()).unwrap()
         })
         .collect();
@@ -105,6 +63,19 @@ fn batch_job(dir: &Path) -> Job {
         dir: dir.to_path_buf(),
         parts,
     }
+}
+
+fn map_job(dir: &Path) -> Job {
+    sharded(dir, &["map", "--steps", "2"])
+}
+
+fn batch_job(dir: &Path) -> Job {
+    std::fs::write(
+        dir.join("t.csv"),
+        "name,separation,command,points\na,16nm,tap,\nb,18nm,tap,\nc,,approach,3\n",
+    )
+    .unwrap();
+    sharded(dir, &["batch", "t.csv"])
 }
 
 impl Job {

@@ -5,7 +5,7 @@
 //! continuation, no root-finding).
 
 mod common;
-use common::{json, num, tapsim};
+use common::{cells, json, num, tapsim};
 use serde_json::Value;
 
 #[test]
@@ -217,25 +217,13 @@ fn a_map_at_a_setpoint_holds_it_in_every_cell_and_merges_like_any_map() {
     args.extend(["--json".into(), "--csv".into(), at("whole.csv")]);
     let v = json(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(v["setpoint"]["amplitude_ratio"], 0.8);
-    let flat = |key: &str| -> Vec<Value> {
-        v["grid"][key]
-            .as_array()
-            .unwrap()
-            .iter()
-            .flat_map(|r| r.as_array().unwrap().clone())
-            .collect()
-    };
+    let grid = &v["grid"];
     let (ratio, phase, z) = (
-        flat("amplitude_ratio"),
-        flat("phase_deg"),
-        flat("separation_m"),
+        cells(&grid["amplitude_ratio"]),
+        cells(&grid["phase_deg"]),
+        cells(&grid["separation_m"]),
     );
-    let heights: Vec<Value> = v["apparent_height_m"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .flat_map(|r| r.as_array().unwrap().clone())
-        .collect();
+    let heights = cells(&v["apparent_height_m"]);
     let reference = z.iter().find_map(Value::as_f64).expect("a cell holds it");
     let mut held = 0;
     for k in 0..ratio.len() {

@@ -85,3 +85,12 @@ pub fn num(v: &serde_json::Value, key: &str) -> f64 {
         .as_f64()
         .unwrap_or_else(|| panic!("key {key} missing or not a number in {v}"))
 }
+
+/// The cells of a map's grid (an array of rows) in the order the CSV lists them.
+pub fn cells(rows: &serde_json::Value) -> Vec<serde_json::Value> {
+    rows.as_array()
+        .expect("an array of rows")
+        .iter()
+        .flat_map(|r| r.as_array().expect("a row").clone())
+        .collect()
+}
