@@ -71,6 +71,19 @@ pub fn free_phase_deg(setup: &TapSetup) -> f64 {
     (w / q).atan2(1.0 - w * w).to_degrees()
 }
 
+/// Refuse an amplitude setpoint outside (0, 1) (what every command that takes one
+/// checks before it runs anything).
+pub fn check_ratio(ratio: f64) -> Result<()> {
+    if ratio > 0.0 && ratio < 1.0 {
+        return Ok(());
+    }
+    Err(Error::OutOfRange(format!(
+        "amplitude setpoint A/A₀ = {} is outside (0, 1): the amplitude of a tip that \
+         touches lies below the free amplitude",
+        shown(ratio)
+    )))
+}
+
 /// Every stable period-1 steady state whose amplitude is `ratio` × A₀ (0 < ratio < 1),
 /// on `branch` (`None`: both), attractive ones first, each at the rest separation that
 /// gives it. An empty list is an error saying which branches exist and what amplitudes
@@ -81,13 +94,7 @@ pub fn states_at_setpoint(
     ratio: f64,
     branch: Option<PhaseBranch>,
 ) -> Result<Vec<SetpointState>> {
-    if !(ratio > 0.0 && ratio < 1.0) {
-        return Err(Error::OutOfRange(format!(
-            "amplitude setpoint A/A₀ = {} is outside (0, 1): the amplitude of a tip \
-             that touches lies below the free amplitude",
-            shown(ratio)
-        )));
-    }
+    check_ratio(ratio)?;
     let a0 = setup.cantilever.free_amplitude_m;
     let range = (1.2 * a0, (ratio - 0.35).max(0.02) * a0);
     let family = families(setup, numerics, range)?;

@@ -261,17 +261,9 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
             None => (Run::Tap, numerics),
             Some(ratio) => {
                 if inputs.separation.is_some() {
-                    return Err(at(Error::NotApplicable(
-                        "give either a separation or a setpoint, not both: at a setpoint \
-                         the separation is what is solved for"
-                            .into(),
-                    )));
+                    return Err(at(super::separation_and_setpoint()));
                 }
-                if !(ratio > 0.0 && ratio < 1.0) {
-                    return Err(at(Error::OutOfRange(format!(
-                        "amplitude setpoint A/A₀ = {ratio} is outside (0, 1)"
-                    ))));
-                }
+                crate::setpoint::check_ratio(ratio).map_err(at)?;
                 (Run::Setpoint { ratio, branch }, numerics)
             }
         },

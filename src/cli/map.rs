@@ -1,7 +1,7 @@
 //! `tapsim map`: dissipation and phase over a grid of work of adhesion and modulus.
 
 use crate::config::{TapInputs, number, pressure, surface_energy};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::report::part::{self, Job, MapSetpoint};
 use crate::report::{map as report, plot};
 use crate::setpoint::{PhaseBranch, states_at_setpoint};
@@ -78,11 +78,7 @@ enum Side {
 pub fn run(args: MapArgs) -> Result<()> {
     let inputs = args.inputs.clone().with_config()?;
     if args.setpoint.is_some() && inputs.separation.is_some() {
-        return Err(Error::NotApplicable(
-            "give either a rest separation (--separation) or an amplitude setpoint \
-             (--setpoint), not both: at a setpoint each cell's separation is solved for"
-                .into(),
-        ));
+        return Err(super::separation_and_setpoint());
     }
     let (setup, numerics) = inputs.resolve()?;
     let setpoint = args.setpoint.map(|amplitude_ratio| MapSetpoint {
@@ -93,12 +89,7 @@ pub fn run(args: MapArgs) -> Result<()> {
         },
     });
     if let Some(s) = setpoint {
-        if !(s.amplitude_ratio > 0.0 && s.amplitude_ratio < 1.0) {
-            return Err(Error::OutOfRange(format!(
-                "amplitude setpoint A/A₀ = {} is outside (0, 1)",
-                s.amplitude_ratio
-            )));
-        }
+        crate::setpoint::check_ratio(s.amplitude_ratio)?;
     }
     let works = sweep::log_grid(
         "work of adhesion",

@@ -139,6 +139,16 @@ pub struct SweepOutput {
     pub quiet: bool,
 }
 
+/// The refusal of a rest separation beside an amplitude setpoint (tap, map, a batch
+/// row): at a setpoint the separation is what is solved for.
+pub(crate) fn separation_and_setpoint() -> crate::Error {
+    crate::Error::NotApplicable(
+        "give either a rest separation (--separation, a separation column) or an amplitude \
+         setpoint (--setpoint), not both: at a setpoint the separation is what is solved for"
+            .into(),
+    )
+}
+
 impl SweepOutput {
     /// A progress bar over `len` items on stderr, hidden with --quiet or when stderr is
     /// not a terminal.

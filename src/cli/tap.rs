@@ -161,11 +161,7 @@ pub fn run(args: TapArgs) -> Result<()> {
 /// `tap --setpoint`: the states at the setpoint, listed.
 fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
     if inputs.separation.is_some() {
-        return Err(Error::NotApplicable(
-            "give either a rest separation (--separation) or an amplitude setpoint \
-             (--setpoint), not both: at a setpoint the separation is what is solved for"
-                .into(),
-        ));
+        return Err(super::separation_and_setpoint());
     }
     if args.trajectory.is_some() || args.plot.is_some() {
         return Err(Error::NotApplicable(
