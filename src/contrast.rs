@@ -101,9 +101,8 @@ fn crossing(pa: &SweepPoint, pb: &SweepPoint, r: f64) -> Option<(f64, f64, [f64;
 /// period-1 orbit of its families there, solved exactly ([`setpoint::states_on`]), and,
 /// on a branch with none, the approach curve's states (orbits of higher period or
 /// irregular motion) interpolated there.
-fn states_at(curve: &LawCurve, numerics: &Numerics, r: f64) -> Result<Vec<AtSetpoint>> {
-    let p = Prepared::new(&curve.setup, numerics)?;
-    let mut out: Vec<AtSetpoint> = setpoint::states_on(&p, &curve.family, r, None)?
+fn states_at(p: &Prepared, curve: &LawCurve, r: f64) -> Result<Vec<AtSetpoint>> {
+    let mut out: Vec<AtSetpoint> = setpoint::states_on(p, &curve.family, r, None)?
         .into_iter()
         .map(|s| {
             let o = &s.observables;
@@ -215,7 +214,11 @@ pub fn contrast(
                 material: m.name.clone(),
                 law,
                 points: sweep::approach_curve(&s, numerics, &ramp, |_, _| {})?,
-                family: setpoint::families(&s, numerics, (1.2 * a0, 0.3 * a0))?,
+                family: setpoint::families(
+                    &Prepared::new(&s, numerics)?,
+                    numerics,
+                    (1.2 * a0, 0.3 * a0),
+                )?,
                 free_phase_deg,
                 setup: s,
             });
@@ -227,11 +230,17 @@ pub fn contrast(
             .iter()
             .filter_map(|m| curves.iter().find(|c| c.material == m.name && c.law == law))
             .collect();
+        // Each curve's simulation prepared once for all its setpoints.
+        let prepared: Vec<Prepared> = of_law
+            .iter()
+            .zip(materials)
+            .map(|(c, m)| Prepared::new(&c.setup, &m.numerics))
+            .collect::<Result<_>>()?;
         for &r in ratios {
             let states: Vec<Vec<AtSetpoint>> = of_law
                 .iter()
-                .zip(materials)
-                .map(|(c, m)| states_at(c, &m.numerics, r))
+                .zip(&prepared)
+                .map(|(c, p)| states_at(p, c, r))
                 .collect::<Result<_>>()?;
             for branch in [PhaseBranch::Attractive, PhaseBranch::Repulsive] {
                 let on: Vec<Option<&AtSetpoint>> = states

@@ -97,8 +97,8 @@ pub fn states_at_setpoint(
     check_ratio(ratio)?;
     let a0 = setup.cantilever.free_amplitude_m;
     let range = (1.2 * a0, (ratio - 0.35).max(0.02) * a0);
-    let family = families(setup, numerics, range)?;
     let p = Prepared::new(setup, numerics)?;
+    let family = families(&p, numerics, range)?;
     let out = states_on(&p, &family, ratio, branch)?;
     if out.is_empty() {
         let free = free_phase_deg(setup);
@@ -152,19 +152,20 @@ const WINDOW: f64 = 0.15;
 
 /// The stable period-1 families between the rest separations `far` and `deep`, as one
 /// list whose pieces are told apart by `segment`: the one the free oscillation settles
-/// on at `far`, followed in to `deep`, and the one it settles on at each seed z_c =
+/// on at `far` (over `p`, run with `numerics`), followed in to `deep`, and the one it
+/// settles on at each seed z_c =
 /// `deep` + 0.1 A₀, + 0.2 A₀, … where that is another family than those followed
 /// already, followed `WINDOW` (0.15 A₀) out and in from there. In a bistable zone these are the attractive
 /// and the repulsive branch: the free oscillation started close to the sample lands on
 /// the repulsive one, started far on the attractive one.
 pub fn families(
-    setup: &TapSetup,
+    p: &Prepared,
     numerics: &Numerics,
     (far, deep): (f64, f64),
 ) -> Result<Vec<BranchRecord>> {
+    let setup = &p.setup;
     let a0 = setup.cantilever.free_amplitude_m;
     let step = 0.01 * a0;
-    let p = Prepared::new(setup, numerics)?;
     let free = free_phase_deg(setup);
     let mut all: Vec<BranchRecord> = Vec::new();
     let follow = |all: &mut Vec<BranchRecord>, from: f64, to: f64| {
@@ -185,7 +186,7 @@ pub fn families(
         let Ok(state) = p.simulation_at(seed)?.steady_state(&mut phase, &p.steady) else {
             continue;
         };
-        let o = TapObservables::new(&p, &state)?;
+        let o = TapObservables::new(p, &state)?;
         if o.period != Some(1) || o.stable != Some(true) {
             continue;
         }
@@ -223,8 +224,8 @@ pub fn coexisting(
     if z >= far {
         return Ok(Vec::new());
     }
-    let family = families(setup, numerics, (far, deep))?;
     let p = Prepared::new(setup, numerics)?;
+    let family = families(&p, numerics, (far, deep))?;
     let free = free_phase_deg(setup);
     let sim = p.simulation_at(z)?;
     let mut out: Vec<SetpointState> = Vec::new();
