@@ -152,5 +152,45 @@ fn map(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, settle, map);
+/// States at an amplitude setpoint (issue 26) on the defaults: `tapsim tap --setpoint 0.8`
+/// (both branches, each state refined until A/A₀ is the setpoint to 1e-9) and `tapsim map
+/// --setpoint 0.8 --steps 10` on one thread (repulsive branch, the map's default; every
+/// cell solved or noted as unreachable), checked before timing.
+fn setpoint(c: &mut Criterion) {
+    use tapsim::setpoint::{PhaseBranch, map_cells, states_at_setpoint};
+    use tapsim::sweep::log_grid;
+    let setup = default_setup();
+    let numerics = Numerics::default();
+    let mut group = c.benchmark_group("setpoint");
+    let states = states_at_setpoint(&setup, &numerics, 0.8, None).expect("states");
+    assert_eq!(states.len(), 2);
+    group.bench_function("tap --setpoint 0.8", |b| {
+        b.iter(|| states_at_setpoint(&setup, &numerics, 0.8, None).expect("states"))
+    });
+    group.sample_size(10);
+    let works = log_grid("work of adhesion", 0.02, 0.2, 10).expect("grid");
+    let moduli = log_grid("modulus", 0.3e9, 3e9, 10).expect("grid");
+    let all: Vec<usize> = (0..100).collect();
+    let run = || {
+        let axes = (&works[..], &moduli[..]);
+        map_cells(
+            &setup,
+            &numerics,
+            axes,
+            &all,
+            1,
+            || {},
+            (0.8, PhaseBranch::Repulsive),
+        )
+    };
+    let cells = run().expect("map");
+    let held = cells.iter().filter(|c| c.observables.is_some()).count();
+    eprintln!("map at A/A0 = 0.8, repulsive, 10x10: {held} cells hold it");
+    group.bench_function("map --setpoint 0.8, 10x10, one thread", |b| {
+        b.iter(|| run().expect("map"))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, settle, map, setpoint);
 criterion_main!(benches);

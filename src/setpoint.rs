@@ -95,17 +95,184 @@ pub fn states_at_setpoint(
     branch: Option<PhaseBranch>,
 ) -> Result<Vec<SetpointState>> {
     check_ratio(ratio)?;
+    let p = Prepared::new(setup, numerics)?;
+    let sides = branch.map_or(vec![PhaseBranch::Attractive, PhaseBranch::Repulsive], |b| {
+        vec![b]
+    });
+    let mut out = Vec::new();
+    for &side in &sides {
+        out.extend(near_estimate(&p, numerics, ratio, side)?);
+    }
+    if out.len() == sides.len() {
+        return Ok(out);
+    }
+    // A branch the estimate did not lead to: the whole search.
     let a0 = setup.cantilever.free_amplitude_m;
     let range = (1.2 * a0, (ratio - 0.35).max(0.02) * a0);
-    let p = Prepared::new(setup, numerics)?;
     let family = families(&p, numerics, range)?;
-    let out = states_on(&p, &family, ratio, branch)?;
+    out.extend(states_on(&p, &family, ratio, branch)?);
+    let out = distinct(out, a0);
     if out.is_empty() {
         let free = free_phase_deg(setup);
         let why = unreached(&family, ratio, branch, free, range);
         return Err(Error::NotApplicable(why));
     }
     Ok(out)
+}
+
+/// The cells numbered `cells` of the adhesion × modulus map ([`sweep::map_cells`]) at the
+/// amplitude setpoint `ratio` on `branch`: each cell's first state there
+/// ([`states_at_setpoint`]) and the rest separation that holds it; a cell whose law does
+/// not apply or whose branch does not reach the setpoint carries the reason as its note.
+pub fn map_cells(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    axes: (&[f64], &[f64]),
+    cells: &[usize],
+    threads: usize,
+    progress: impl Fn() + Sync,
+    (ratio, branch): (f64, PhaseBranch),
+) -> Result<Vec<sweep::MapCell>> {
+    check_ratio(ratio)?;
+    let solve = |s: &TapSetup| {
+        let states = states_at_setpoint(s, numerics, ratio, Some(branch))?;
+        let first = states.into_iter().next().expect("a list is never empty");
+        Ok((first.observables, Some(first.separation_m)))
+    };
+    sweep::map_cells_with(setup, axes, cells, threads, progress, &solve)
+}
+
+/// The state at amplitude `ratio` on `side` found from the harmonic estimate of it, if
+/// that leads to one. The estimate: the motion x = A cos(Ωτ − φ) with A = ratio·A₀ and,
+/// from the balance of drive and damping with a conservative contact (García & San Paulo,
+/// PRB 60, 4961, 1999), sin φ = ratio·sin φ_free (φ above 90° on the attractive branch,
+/// below on the repulsive), at a rest separation z_c = A + 0.04 A₀ (attractive: the
+/// tip reaches into the attraction) or A − 0.15 A₀ (repulsive: it indents and is pushed
+/// back), then 0.1 A₀ deeper, 0.1 A₀ out and 0.2 A₀ deeper ([`seed_at`]: Newton's method
+/// from the estimate, or the motion settled from it). From the first stable period-1
+/// orbit on `side` its family is followed (0.02 A₀ steps) towards the rest separation at
+/// which a unit slope dA/dz_c would put the setpoint, 0.05 A₀ beyond, and the state
+/// refined between the stable orbits that bracket the setpoint ([`states_on`]). `None`
+/// where the orbit found is not stable or on another branch, or the family is not
+/// followed as far as the setpoint; the caller then searches the whole family.
+fn near_estimate(
+    p: &Prepared,
+    numerics: &Numerics,
+    ratio: f64,
+    side: PhaseBranch,
+) -> Result<Option<SetpointState>> {
+    use crate::dynamics::continuation::{ContinuationOptions, follow_period_one};
+    let a0 = p.setup.cantilever.free_amplitude_m;
+    let free = free_phase_deg(&p.setup);
+    let lag = (ratio * free.to_radians().sin()).clamp(-1.0, 1.0).asin();
+    let (phi, q) = match side {
+        PhaseBranch::Attractive => (std::f64::consts::PI - lag, ratio + 0.04),
+        PhaseBranch::Repulsive => (lag, ratio - 0.15),
+    };
+    let tolerance = (1e-2 * numerics.tolerance).max(1e-12);
+    // The estimate's rest separation first, then 0.1 A₀ deeper, out and 0.2 A₀ deeper
+    // (a sample that pulls the tip in or gives under it moves the state inwards).
+    let mut found = None;
+    for q in [q, q - 0.1, q + 0.1, q - 0.2] {
+        if q > 0.02 {
+            found = seed_at(p, tolerance, (ratio, phi), side, q)?;
+        }
+        if found.is_some() {
+            break;
+        }
+    }
+    let Some((q, seed)) = found else {
+        return Ok(None);
+    };
+    let sim = p.simulation_at(q * a0)?;
+    let o = &seed.observables;
+    // Towards the setpoint at unit slope, and 0.05 A₀ beyond.
+    let shift = ratio - o.amplitude_ratio;
+    let q_end = (q + shift + 0.05 * shift.signum()).max(0.02);
+    let opts = ContinuationOptions {
+        q_end,
+        max_step: 0.02,
+        tolerance,
+        ..ContinuationOptions::default()
+    };
+    let Ok(followed) = follow_period_one(&sim, &seed.phase, &opts) else {
+        return Ok(None);
+    };
+    let family = followed
+        .points
+        .iter()
+        .map(|b| sweep::BranchRecord::new(p, b, 0))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(states_on(p, &family, ratio, Some(side))?.into_iter().next())
+}
+
+/// A stable period-1 orbit on `side` at rest separation q·A₀ from the harmonic estimate
+/// of amplitude ratio·A₀ and phase lag φ ([`near_estimate`]): Newton's method from it,
+/// or, where that does not converge, the motion settled from it. `None` where neither
+/// gives one.
+fn seed_at(
+    p: &Prepared,
+    tolerance: f64,
+    (ratio, phi): (f64, f64),
+    side: PhaseBranch,
+    q: f64,
+) -> Result<Option<(f64, BranchRecord)>> {
+    use crate::dynamics::continuation::{ContinuationOptions, follow_period_one};
+    let a0 = p.setup.cantilever.free_amplitude_m;
+    let sim = p.simulation_at(q * a0)?;
+    let free = sim.free_steady_start();
+    let omega = sim.osc.omega;
+    let amplitude = free.x.hypot(free.v / omega);
+    if amplitude == 0.0 {
+        // A base drive: no harmonic estimate.
+        return Ok(None);
+    }
+    let scale = ratio * amplitude;
+    let (s, c) = phi.sin_cos();
+    let start = Phase {
+        x: scale * c,
+        v: omega * scale * s,
+        branch: sim.branch_at(0.0, scale * c),
+        ..free
+    };
+    let first = ContinuationOptions {
+        q_end: q - 0.1,
+        max_points: 1,
+        tolerance,
+        ..ContinuationOptions::default()
+    };
+    let seed = match follow_period_one(&sim, &start, &first) {
+        Ok(seed) => BranchRecord::new(p, &seed.points[0], 0)?,
+        Err(_) => {
+            let mut phase = start;
+            let Ok(state) = sim.steady_state(&mut phase, &p.steady) else {
+                return Ok(None);
+            };
+            BranchRecord {
+                separation_m: q * a0,
+                segment: 0,
+                point: sweep::BranchPointKind::Regular,
+                observables: TapObservables::new(p, &state)?,
+                phase,
+            }
+        }
+    };
+    let o = &seed.observables;
+    let on = o.period == Some(1)
+        && o.stable == Some(true)
+        && PhaseBranch::of(o.phase_deg, free_phase_deg(&p.setup)) == side;
+    Ok(on.then_some((q, seed)))
+}
+
+/// `states` without repeats (the same branch within 1e-6 A₀ of rest separation),
+/// attractive first, each branch in order of rest separation.
+fn distinct(mut states: Vec<SetpointState>, a0: f64) -> Vec<SetpointState> {
+    states.sort_by(|x, y| x.separation_m.total_cmp(&y.separation_m));
+    states.dedup_by(|x, y| {
+        x.branch == y.branch && (x.separation_m - y.separation_m).abs() < 1e-6 * a0
+    });
+    states.sort_by_key(|s| s.branch == PhaseBranch::Repulsive);
+    states
 }
 
 /// The states at amplitude `ratio` on the stable period-1 `family` ([`families`]), on
@@ -138,13 +305,7 @@ pub fn states_on(
         }
     }
     // The same state reached along two families once.
-    let a0 = p.setup.cantilever.free_amplitude_m;
-    out.sort_by(|x, y| x.separation_m.total_cmp(&y.separation_m));
-    out.dedup_by(|x, y| {
-        x.branch == y.branch && (x.separation_m - y.separation_m).abs() < 1e-6 * a0
-    });
-    out.sort_by_key(|s| s.branch == PhaseBranch::Repulsive);
-    Ok(out)
+    Ok(distinct(out, p.setup.cantilever.free_amplitude_m))
 }
 
 /// How far out and in a family is followed from a seed, in units of A₀.
@@ -170,7 +331,10 @@ pub fn families(
     let mut all: Vec<BranchRecord> = Vec::new();
     let follow = |all: &mut Vec<BranchRecord>, from: f64, to: f64| {
         // A start where the motion is not period-1 only loses that family.
-        if let Ok(family) = sweep::orbit_branch(setup, numerics, (from, to), step) {
+        // Motion that is not period-1 crossed in strides of 0.05 A₀.
+        let gap = (5.0 * step).min((from - to).abs()).max(step);
+        if let Ok(family) = sweep::orbit_branch_across_gaps(setup, numerics, (from, to), step, gap)
+        {
             let offset = all.last().map_or(0, |b| b.segment + 1);
             all.extend(family.points.into_iter().map(|mut b| {
                 b.segment += offset;

@@ -348,6 +348,39 @@ pub struct BranchRecord {
     pub phase: crate::dynamics::steady::Phase,
 }
 
+impl BranchRecord {
+    /// The record of the continuation's point `b` of piece `segment` over `p`.
+    pub(crate) fn new(
+        p: &Prepared,
+        b: &crate::dynamics::continuation::BranchPoint,
+        segment: usize,
+    ) -> Result<Self> {
+        use crate::dynamics::continuation::PointKind;
+        use crate::dynamics::steady::{Motion, StdErr, SteadyState};
+        let state = SteadyState {
+            window: b.integrals,
+            cycles: 1,
+            converged: true,
+            motion: Motion::Periodic {
+                period: 1,
+                multipliers: b.multipliers,
+            },
+            std_err: StdErr::default(),
+        };
+        Ok(Self {
+            separation_m: b.q * p.setup.cantilever.free_amplitude_m,
+            segment,
+            point: match b.kind {
+                PointKind::Regular => BranchPointKind::Regular,
+                PointKind::Fold => BranchPointKind::Fold,
+                PointKind::PeriodDoubling => BranchPointKind::PeriodDoubling,
+            },
+            observables: TapObservables::new(p, &state)?,
+            phase: b.phase,
+        })
+    }
+}
+
 /// The period-1 orbit family followed from one rest separation to another.
 #[derive(Debug, Clone)]
 pub struct OrbitBranch {
@@ -371,11 +404,26 @@ pub struct OrbitBranch {
 pub fn orbit_branch(
     setup: &TapSetup,
     numerics: &Numerics,
-    (from_m, to_m): (f64, f64),
+    range_m: (f64, f64),
     max_step_m: f64,
 ) -> Result<OrbitBranch> {
-    use crate::dynamics::continuation::{ContinuationOptions, PointKind, Stop, follow_period_one};
-    use crate::dynamics::steady::{Motion, StdErr, SteadyState};
+    orbit_branch_across_gaps(setup, numerics, range_m, max_step_m, max_step_m)
+}
+
+/// [`orbit_branch`], moving the rest separation on by `gap_step_m` (≥ `max_step_m`) at a
+/// time where the motion is not on a stable period-1 orbit. Where a piece starts after
+/// such a stride longer than `max_step_m`, the family is first followed back from there
+/// towards the last separation the motion was not period-1 at, so that no stable orbit of
+/// the stride is left out; a coarse stride only saves the settling of motion that is not
+/// period-1 (the costly part of crossing a wide window of it).
+pub fn orbit_branch_across_gaps(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    (from_m, to_m): (f64, f64),
+    max_step_m: f64,
+    gap_step_m: f64,
+) -> Result<OrbitBranch> {
+    use crate::dynamics::continuation::{ContinuationOptions, Stop, follow_period_one};
     finite("start separation (from)", from_m)?;
     finite("end separation (to)", to_m)?;
     crate::error::positive("largest step (max step)", max_step_m)?;
@@ -400,8 +448,16 @@ pub fn orbit_branch(
     let mut phase = p.simulation().free_steady_start();
     let mut points: Vec<BranchRecord> = Vec::new();
     let mut notes = Vec::new();
+    if !(gap_step_m >= max_step_m && gap_step_m <= range) {
+        return Err(Error::NotApplicable(format!(
+            "the stride across motion that is not period-1 ({gap_step_m:e} m) must lie \
+             between the largest step ({max_step_m:e} m) and the range ({range:e} m)"
+        )));
+    }
     let mut at = from_m;
     let mut segment = 0;
+    // The last separation where the motion was not on a stable period-1 orbit.
+    let mut not_period_one: Option<f64> = None;
     loop {
         // Settle at `at`; a piece of the family starts on a stable period-1 orbit.
         let sim = p.simulation_at(at)?;
@@ -414,7 +470,8 @@ pub fn orbit_branch(
                     settled.motion.regime()
                 ));
             }
-            at += toward * max_step_m;
+            not_period_one = Some(at);
+            at += toward * gap_step_m;
             if (at - to_m) * toward > 0.0 {
                 notes.push(format!(
                     "no stable period-1 orbit from there to the end separation ({:.4} nm)",
@@ -437,29 +494,21 @@ pub fn orbit_branch(
             tolerance: (1e-2 * numerics.tolerance).max(1e-12),
             ..ContinuationOptions::default()
         };
+        // Back across the stride first, in the order of the branch.
+        if let Some(behind) = not_period_one.take().filter(|_| gap_step_m > max_step_m) {
+            let back = ContinuationOptions {
+                q_end: behind / a0,
+                ..opts
+            };
+            if let Ok(branch) = follow_period_one(&sim, &phase, &back) {
+                for b in branch.points.iter().skip(1).rev() {
+                    points.push(BranchRecord::new(&p, b, segment)?);
+                }
+            }
+        }
         let branch = follow_period_one(&sim, &phase, &opts)?;
         for b in &branch.points {
-            let state = SteadyState {
-                window: b.integrals,
-                cycles: 1,
-                converged: true,
-                motion: Motion::Periodic {
-                    period: 1,
-                    multipliers: b.multipliers,
-                },
-                std_err: StdErr::default(),
-            };
-            points.push(BranchRecord {
-                separation_m: b.q * a0,
-                segment,
-                point: match b.kind {
-                    PointKind::Regular => BranchPointKind::Regular,
-                    PointKind::Fold => BranchPointKind::Fold,
-                    PointKind::PeriodDoubling => BranchPointKind::PeriodDoubling,
-                },
-                observables: TapObservables::new(&p, &state)?,
-                phase: b.phase,
-            });
+            points.push(BranchRecord::new(&p, b, segment)?);
         }
         match branch.stop {
             Stop::Reached => {

@@ -326,3 +326,59 @@ fn a_batch_row_at_a_setpoint_gives_the_states_tap_gives() {
         assert!(String::from_utf8_lossy(&out.stderr).contains(says));
     }
 }
+
+/// The search from the harmonic estimate of each branch's state (what `tap --setpoint`
+/// runs first, in milliseconds) against the whole search of the period-1 families from
+/// 1.2 A₀ in, seeded every 0.1 A₀ (what it falls back on): the same states, to the
+/// refinement's 1e-9 in A/A₀, over setpoints from 0.2 to 0.95 and three laws, including
+/// setpoints where the estimate leads nowhere and a branch that does not reach them.
+#[test]
+fn the_quick_search_at_a_setpoint_finds_what_the_whole_family_search_finds() {
+    use tapsim::dynamics::setup::{Numerics, Prepared, TapSetup, default_setup};
+    use tapsim::law::LawKind;
+    use tapsim::setpoint::{families, states_at_setpoint, states_on};
+    let numerics = Numerics::default();
+    for (law, ratios) in [
+        (LawKind::Hybrid, &[0.2, 0.5, 0.8, 0.9, 0.95][..]),
+        (LawKind::Dmt, &[0.4, 0.85][..]),
+        (LawKind::Hertz, &[0.7][..]),
+    ] {
+        let setup = TapSetup {
+            law: law.into(),
+            ..default_setup()
+        };
+        let a0 = setup.cantilever.free_amplitude_m;
+        let p = Prepared::new(&setup, &numerics).unwrap();
+        for &r in ratios {
+            let range = (1.2 * a0, (r - 0.35f64).max(0.02) * a0);
+            let family = families(&p, &numerics, range).unwrap();
+            let whole = states_on(&p, &family, r, None).unwrap();
+            let quick = states_at_setpoint(&setup, &numerics, r, None).unwrap();
+            let show = |v: &[tapsim::setpoint::SetpointState]| {
+                v.iter()
+                    .map(|s| (s.branch, s.separation_m, s.observables.phase_deg))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(
+                quick.len(),
+                whole.len(),
+                "{law:?} at {r}: {:?} vs {:?}",
+                show(&quick),
+                show(&whole)
+            );
+            for (q, w) in quick.iter().zip(&whole) {
+                assert_eq!(q.branch, w.branch, "{law:?} at {r}");
+                assert!(
+                    (q.separation_m - w.separation_m).abs() < 1e-8 * a0,
+                    "{law:?} at {r}: {:?} vs {:?}",
+                    show(&quick),
+                    show(&whole)
+                );
+                assert!(
+                    (q.observables.phase_deg - w.observables.phase_deg).abs() < 1e-5,
+                    "{law:?} at {r}"
+                );
+            }
+        }
+    }
+}

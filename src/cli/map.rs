@@ -4,7 +4,7 @@ use crate::config::{TapInputs, number, pressure, surface_energy};
 use crate::error::Result;
 use crate::report::part::{self, Job, MapSetpoint};
 use crate::report::{map as report, plot};
-use crate::setpoint::{PhaseBranch, states_at_setpoint};
+use crate::setpoint::PhaseBranch;
 use crate::sweep;
 use crate::sweep::Shard;
 use clap::Args;
@@ -113,21 +113,15 @@ pub fn run(args: MapArgs) -> Result<()> {
             args.threads,
             || bar.inc(1),
         )?,
-        Some(sp) => {
-            let solve = |s: &crate::dynamics::setup::TapSetup| {
-                let states = states_at_setpoint(s, &numerics, sp.amplitude_ratio, Some(sp.branch))?;
-                let first = states.into_iter().next().expect("a list is never empty");
-                Ok((first.observables, Some(first.separation_m)))
-            };
-            sweep::map_cells_with(
-                &setup,
-                (&works, &moduli),
-                &cells,
-                args.threads,
-                || bar.inc(1),
-                &solve,
-            )?
-        }
+        Some(sp) => crate::setpoint::map_cells(
+            &setup,
+            &numerics,
+            (&works, &moduli),
+            &cells,
+            args.threads,
+            || bar.inc(1),
+            (sp.amplitude_ratio, sp.branch),
+        )?,
     };
     bar.finish_and_clear();
     match shard {
