@@ -1,7 +1,7 @@
 //! The `tapsim` command line, run as a user would.
 
 mod common;
-use common::{cells, json, num, tapsim};
+use common::{cells, json, num, scratch, tapsim};
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -52,13 +52,6 @@ fn a_file_gives_what_the_flags_give(name: &str, toml: &str, from_flags: &serde_j
     let w = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
     assert_eq!(w["e_ts_j"], from_flags["e_ts_j"], "{toml}");
     std::fs::remove_dir_all(dir).unwrap();
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tapsim-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 #[test]

@@ -16,7 +16,7 @@
 //! large sweep asked for on purpose.
 
 mod common;
-use common::Run;
+use common::{Run, scratch};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
 use std::path::{Path, PathBuf};
@@ -387,13 +387,6 @@ fn check(args: Vec<String>, config: Option<&str>, scratch: &Path) -> Result<(), 
         }
     }
     Ok(())
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tapsim-hostile-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch directory");
-    dir
 }
 
 /// A runner of [`CASES`] cases from a fixed seed, so that CI is reproducible; set

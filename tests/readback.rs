@@ -4,7 +4,7 @@
 //! a number that a whole run would not.
 
 mod common;
-use common::Run;
+use common::{Run, scratch};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -16,13 +16,6 @@ const LIMIT: Duration = Duration::from_secs(20);
 /// Run the binary in `dir`, killing it at [`LIMIT`].
 fn run<S: AsRef<std::ffi::OsStr>>(args: &[S], dir: &Path) -> Run {
     common::run_limited(args, dir, LIMIT)
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tapsim-readback-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn ok(r: &Run, what: &str) {

@@ -6,7 +6,7 @@
 
 use std::ffi::OsStr;
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
@@ -93,4 +93,17 @@ pub fn cells(rows: &serde_json::Value) -> Vec<serde_json::Value> {
         .iter()
         .flat_map(|r| r.as_array().expect("a row").clone())
         .collect()
+}
+
+/// An empty scratch directory `name` of this test binary and process, under the system's
+/// temporary directory.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "tapsim-{}-{}-{name}",
+        env!("CARGO_CRATE_NAME"),
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
 }
