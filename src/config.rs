@@ -16,6 +16,7 @@ use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
 use crate::error::{Error, Result};
 use crate::law::{LAW_PARAMS, LawKind, LawParam, LawSpec};
 use crate::params::{self, Contact};
+use crate::setpoint::PhaseBranch;
 use crate::units::{self, Dimension};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -299,6 +300,39 @@ pub struct TapInputs {
     /// E_ts relative, φ in rad [default 1e-3].
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
     pub average_tolerance: Option<f64>,
+    /// The amplitude setpoint A/A₀ (a parameter file's `setpoint`, or `tap`'s and `map`'s
+    /// --setpoint): exclusive with `separation`.
+    #[arg(skip)]
+    pub setpoint: Option<f64>,
+    /// The amplitude setpoint as an amplitude in m (`amplitude-setpoint`).
+    #[arg(skip)]
+    pub amplitude_setpoint: Option<f64>,
+    /// Which branch at the setpoint (`branch`).
+    #[arg(skip)]
+    pub branch: Option<BranchChoice>,
+}
+
+/// Which branch's states at an amplitude setpoint (`--branch`, a parameter file's
+/// `branch`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BranchChoice {
+    /// Both branches.
+    All,
+    /// φ above the free phase: the tip feels a net attraction.
+    Attractive,
+    /// φ below the free phase: the tip presses into the sample.
+    Repulsive,
+}
+
+impl BranchChoice {
+    /// The one branch asked for (`None`: both).
+    pub fn only(self) -> Option<PhaseBranch> {
+        match self {
+            Self::All => None,
+            Self::Attractive => Some(PhaseBranch::Attractive),
+            Self::Repulsive => Some(PhaseBranch::Repulsive),
+        }
+    }
 }
 
 /// The largest parameter file read, in bytes.
@@ -375,6 +409,8 @@ const FIELDS: &[Field] = fields![
     "free-amplitude" => Length => |i| i.free_amplitude,
     "drive-frequency" => Frequency => |i| i.drive_frequency,
     "separation" => Length => |i| i.separation,
+    "setpoint" => Dimensionless => |i| i.setpoint,
+    "amplitude-setpoint" => Length => |i| i.amplitude_setpoint,
     "rtol" => Dimensionless => |i| i.rtol,
     "max-cycles" => Dimensionless => |i| i.max_cycles,
     "tolerance" => Dimensionless => |i| i.tolerance,
@@ -439,6 +475,19 @@ impl TapInputs {
         })?;
         let mut inputs = Self::default();
         for (key, value) in &table {
+            if key == "branch" {
+                let name = value.as_str().unwrap_or_default();
+                inputs.branch = Some(
+                    <BranchChoice as clap::ValueEnum>::from_str(name, false).map_err(|_| {
+                        Error::Parse {
+                            name: "branch",
+                            text: value.to_string(),
+                            reason: "expected one of all, attractive, repulsive".into(),
+                        }
+                    })?,
+                );
+                continue;
+            }
             if key == "law" {
                 let name = value.as_str().unwrap_or_default();
                 inputs.law = Some(LawKind::from_name(name).ok_or_else(|| Error::Parse {
@@ -462,11 +511,48 @@ impl TapInputs {
             };
             inputs.set(key, &text)?;
         }
+        let held = [
+            ("separation", inputs.separation),
+            ("setpoint", inputs.setpoint),
+            ("amplitude-setpoint", inputs.amplitude_setpoint),
+        ];
+        let given: Vec<&str> = held
+            .iter()
+            .filter(|(_, v)| v.is_some())
+            .map(|(k, _)| *k)
+            .collect();
+        if given.len() > 1 {
+            return Err(Error::Parse {
+                name: "config",
+                text: String::new(),
+                reason: format!(
+                    "{} are exclusive: a rest separation, or the amplitude setpoint the z \
+                     feedback holds (A/A₀ or an amplitude), not both",
+                    given.join(" and ")
+                ),
+            });
+        }
         Ok(inputs)
+    }
+
+    /// Refuse an amplitude setpoint (from a parameter file) in `command`, which does
+    /// not take one.
+    pub fn no_setpoint(&self, command: &str) -> Result<()> {
+        if self.setpoint.is_none() && self.amplitude_setpoint.is_none() {
+            return Ok(());
+        }
+        Err(Error::NotApplicable(format!(
+            "the parameter file sets an amplitude setpoint, which `tapsim {command}` does \
+             not take: `tapsim tap` and `tapsim map` work at it (remove `setpoint` from \
+             the file for this command)"
+        )))
     }
 
     /// Field-wise: `self` where given, else `base`.
     pub fn or(self, base: Self) -> Self {
+        let holds = self.separation.is_some()
+            || self.setpoint.is_some()
+            || self.amplitude_setpoint.is_some();
         Self {
             config: self.config.or(base.config),
             law: self.law.or(base.law),
@@ -477,7 +563,20 @@ impl TapInputs {
             quality: self.quality.or(base.quality),
             free_amplitude: self.free_amplitude.or(base.free_amplitude),
             drive_frequency: self.drive_frequency.or(base.drive_frequency),
-            separation: self.separation.or(base.separation),
+            // Where the flags hold the tip (a separation or a setpoint), the file's
+            // separation and setpoint give way together.
+            separation: if holds {
+                self.separation
+            } else {
+                base.separation
+            },
+            setpoint: if holds { self.setpoint } else { base.setpoint },
+            amplitude_setpoint: if holds {
+                self.amplitude_setpoint
+            } else {
+                base.amplitude_setpoint
+            },
+            branch: self.branch.or(base.branch),
             rtol: self.rtol.or(base.rtol),
             max_cycles: self.max_cycles.or(base.max_cycles),
             tolerance: self.tolerance.or(base.tolerance),
@@ -570,9 +669,12 @@ mod tests {
             .filter_map(|a| a.get_long().map(str::to_string))
             .filter(|long| !["config", "law"].contains(&long.as_str()))
             .collect();
+        // The setpoint keys are flags of `tap` and `map` alone (the other commands
+        // refuse them).
         let mut keys: Vec<String> = FIELDS
             .iter()
             .map(|f| f.0.to_string())
+            .filter(|k| !["setpoint", "amplitude-setpoint"].contains(&k.as_str()))
             .chain(LAW_PARAMS.iter().map(|p| p.key.to_string()))
             .collect();
         flags.sort();

@@ -5,7 +5,7 @@
 //! continuation, no root-finding).
 
 mod common;
-use common::{cells, json, num, tapsim};
+use common::{cells, json, num, scratch, tapsim};
 use serde_json::Value;
 
 #[test]
@@ -200,9 +200,7 @@ fn tap_names_the_other_stable_state_at_its_separation() {
 
 #[test]
 fn a_map_at_a_setpoint_holds_it_in_every_cell_and_merges_like_any_map() {
-    let dir = std::env::temp_dir().join(format!("tapsim-setpoint-map-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("map");
     let at = |name: &str| dir.join(name).to_str().unwrap().to_string();
     let common = [
         "map",
@@ -380,5 +378,66 @@ fn the_quick_search_at_a_setpoint_finds_what_the_whole_family_search_finds() {
                 );
             }
         }
+    }
+}
+
+/// A parameter file may hold the tip at a setpoint (`setpoint`, `amplitude-setpoint`,
+/// `branch`) as the flags do; a flag that holds it (a separation or a setpoint) wins over
+/// the file's; a file with a separation and a setpoint is refused, and so is a file
+/// setpoint in a command that takes none.
+#[test]
+fn a_parameter_file_holds_a_setpoint_as_the_flags_do() {
+    let dir = scratch("config");
+    let file = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let at = file("at.toml", "setpoint = 0.8\nbranch = \"repulsive\"\n");
+    let amp = file("amp.toml", "amplitude-setpoint = \"16nm\"\n");
+    let sep = file("sep.toml", "separation = \"15nm\"\n");
+    let both = file("both.toml", "setpoint = 0.8\nseparation = \"16nm\"\n");
+    let flags = json(&["tap", "--setpoint", "0.8", "--json"]);
+    let states = flags["states"].as_array().unwrap();
+    // The file's setpoint and branch: the repulsive state the flags give.
+    let v = json(&["tap", "--config", &at, "--json"]);
+    assert_eq!(v["states"].as_array().unwrap().len(), 1);
+    assert_eq!(v["branch"], "repulsive");
+    assert_eq!(num(&v, "separation_m"), num(&states[1], "separation_m"));
+    // A flag's branch over the file's.
+    let v = json(&["tap", "--config", &at, "--branch", "all", "--json"]);
+    assert_eq!(v["states"], flags["states"]);
+    // An amplitude setpoint in the file: A/A₀ = 16 nm / 20 nm.
+    let v = json(&["tap", "--config", &amp, "--json"]);
+    assert_eq!(v["states"], flags["states"]);
+    // A flag's setpoint over the file's separation, a flag's separation over its setpoint.
+    let v = json(&["tap", "--config", &sep, "--setpoint", "0.8", "--json"]);
+    assert_eq!(v["states"], flags["states"]);
+    let v = json(&["tap", "--config", &at, "--separation", "15nm", "--json"]);
+    assert_eq!(v, json(&["tap", "--separation", "15nm", "--json"]));
+    assert!(v.get("states").is_none());
+    // The map's cells at the file's setpoint are the flags'.
+    let map = |extra: &[&str]| {
+        let mut args = vec!["map", "--steps", "2", "--quiet", "--json"];
+        args.extend_from_slice(extra);
+        json(&args)
+    };
+    assert_eq!(map(&["--config", &at]), map(&["--setpoint", "0.8"]));
+    // Refused: both in one file; a file setpoint where no setpoint is taken.
+    let out = tapsim(&["tap", "--config", &both]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("separation and setpoint are exclusive"),
+        "{err}"
+    );
+    for cmd in ["approach", "branches", "contrast"] {
+        let out = tapsim(&[cmd, "--config", &at]);
+        assert_eq!(out.status.code(), Some(1), "{cmd}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(&format!("`tapsim {cmd}` does not take")),
+            "{err}"
+        );
     }
 }

@@ -57,7 +57,7 @@ pub(super) const DEFAULT_POINTS: usize = 60;
 
 /// Run the subcommand.
 pub fn run(args: ApproachArgs) -> Result<()> {
-    let start = super::SweepStart::new(args.inputs, &args.range)?;
+    let start = super::SweepStart::new("approach", args.inputs, &args.range)?;
     let (setup, numerics, (from, to)) = (&start.setup, &start.sweep_numerics, start.range);
     let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
     let bar = args.out.progress_bar(ramp.len());

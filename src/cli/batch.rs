@@ -375,6 +375,7 @@ pub fn run(args: BatchArgs) -> Result<()> {
     // Before any case runs.
     args.out.refuse_plots("batch", &[])?;
     let base = args.inputs.clone().with_config()?;
+    base.no_setpoint("batch")?;
     let rows = read_rows(&args.table)?;
     let cases = rows
         .iter()

@@ -35,7 +35,7 @@ pub struct BifurcationArgs {
 
 /// Run the subcommand.
 pub fn run(args: BifurcationArgs) -> Result<()> {
-    let start = super::SweepStart::new(args.inputs, &args.range)?;
+    let start = super::SweepStart::new("bifurcation", args.inputs, &args.range)?;
     let (setup, numerics, (from, to)) = (&start.setup, &start.sweep_numerics, start.range);
     let ramp = sweep::ramp(from, to, args.points, false)?;
     let separations: Vec<f64> = ramp.iter().map(|r| r.0).collect();

@@ -47,7 +47,7 @@ pub struct BranchesArgs {
 
 /// Run the subcommand.
 pub fn run(args: BranchesArgs) -> Result<()> {
-    let start = super::SweepStart::new(args.inputs, &args.range)?;
+    let start = super::SweepStart::new("branches", args.inputs, &args.range)?;
     let (setup, (from, to)) = (&start.setup, start.range);
     let a0 = setup.cantilever.free_amplitude_m;
     let branch = sweep::orbit_branch(

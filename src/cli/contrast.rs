@@ -62,6 +62,7 @@ pub struct ContrastArgs {
 /// Run the subcommand.
 pub fn run(args: ContrastArgs) -> Result<()> {
     let base = args.inputs.with_config()?;
+    base.no_setpoint("contrast")?;
     let materials = if args.materials.is_empty() {
         vec![
             MaterialSpec::parse("A:sample-modulus=0.5GPa,work-of-adhesion=0.1")?,

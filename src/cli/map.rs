@@ -1,10 +1,9 @@
 //! `tapsim map`: dissipation and phase over a grid of work of adhesion and modulus.
 
-use crate::config::{TapInputs, number, pressure, surface_energy};
-use crate::error::Result;
+use crate::config::{BranchChoice, TapInputs, number, pressure, surface_energy};
+use crate::error::{Error, Result};
 use crate::report::part::{self, Job, MapSetpoint};
 use crate::report::{map as report, plot};
-use crate::setpoint::PhaseBranch;
 use crate::sweep;
 use crate::sweep::Shard;
 use clap::Args;
@@ -56,41 +55,51 @@ pub struct MapArgs {
     /// as an AFM images, instead of at one rest separation: the phase image at constant
     /// setpoint, with the apparent height (z_c less the first cell's) in place of A/A₀.
     /// Cells the branch does not reach stay empty, with a note. Not with --separation.
-    #[arg(long, value_name = "A/A0", allow_hyphen_values = true, value_parser = number)]
+    #[arg(long, value_name = "A/A0", allow_hyphen_values = true, value_parser = number,
+          conflicts_with = "amplitude_setpoint")]
     setpoint: Option<f64>,
-    /// With --setpoint: the branch every cell is solved on.
-    #[arg(long, value_enum, default_value_t = Side::Repulsive)]
-    branch: Side,
+    /// The amplitude setpoint as an amplitude (e.g. 16nm): --setpoint A_sp/A₀.
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::config::length)]
+    amplitude_setpoint: Option<f64>,
+    /// With a setpoint: the branch every cell is solved on [default: repulsive].
+    #[arg(long, value_enum)]
+    branch: Option<BranchChoice>,
     #[command(flatten)]
     split: super::shard::ShardArgs,
 }
 
-/// `--branch` of a map.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum Side {
-    /// φ above the free phase: net attraction.
-    Attractive,
-    /// φ below the free phase: the tip presses into the sample.
-    Repulsive,
-}
-
 /// Run the subcommand.
 pub fn run(args: MapArgs) -> Result<()> {
-    let inputs = args.inputs.clone().with_config()?;
-    if args.setpoint.is_some() && inputs.separation.is_some() {
+    let inputs = TapInputs {
+        setpoint: args.setpoint,
+        amplitude_setpoint: args.amplitude_setpoint,
+        branch: args.branch,
+        ..args.inputs.clone()
+    }
+    .with_config()?;
+    let held = inputs.setpoint.is_some() || inputs.amplitude_setpoint.is_some();
+    if held && inputs.separation.is_some() {
         return Err(super::separation_and_setpoint());
     }
     let (setup, numerics) = inputs.resolve()?;
-    let setpoint = args.setpoint.map(|amplitude_ratio| MapSetpoint {
-        amplitude_ratio,
-        branch: match args.branch {
-            Side::Attractive => PhaseBranch::Attractive,
-            Side::Repulsive => PhaseBranch::Repulsive,
-        },
-    });
-    if let Some(s) = setpoint {
-        crate::setpoint::check_ratio(s.amplitude_ratio)?;
-    }
+    let ratio = inputs.setpoint.or(inputs
+        .amplitude_setpoint
+        .map(|a| a / setup.cantilever.free_amplitude_m));
+    let setpoint = match ratio {
+        None => None,
+        Some(amplitude_ratio) => {
+            crate::setpoint::check_ratio(amplitude_ratio)?;
+            let Some(branch) = inputs.branch.unwrap_or(BranchChoice::Repulsive).only() else {
+                return Err(Error::NotApplicable(
+                    "a map is solved on one branch: --branch attractive or repulsive".into(),
+                ));
+            };
+            Some(MapSetpoint {
+                amplitude_ratio,
+                branch,
+            })
+        }
+    };
     let works = sweep::log_grid(
         "work of adhesion",
         args.adhesion_from,

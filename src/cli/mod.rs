@@ -101,12 +101,14 @@ pub struct SweepStart {
 }
 
 impl SweepStart {
-    /// Resolve `inputs` and `range`.
+    /// Resolve `inputs` and `range` for `command` (which takes no amplitude setpoint).
     pub fn new(
+        command: &str,
         inputs: crate::config::TapInputs,
         range: &SeparationRange,
     ) -> crate::error::Result<Self> {
         let inputs = inputs.with_config()?;
+        inputs.no_setpoint(command)?;
         let (setup, numerics) = inputs.resolve()?;
         let sweep_numerics = inputs.sweep_numerics(numerics);
         let range = range.resolve(setup.cantilever.free_amplitude_m);

@@ -1,21 +1,28 @@
 //! `tapsim tap`: one tapping-mode simulation to its steady state.
 
-use crate::config::{TapInputs, length, number};
+use crate::config::{BranchChoice, TapInputs, length, number};
 use crate::dynamics::observables::{Observe, Starts, tap};
 use crate::error::{Error, Result};
 use crate::report::{output, plot, tap as report};
-use crate::setpoint::{PhaseBranch, states_at_setpoint};
+use crate::setpoint::states_at_setpoint;
 use clap::Args;
 use std::path::PathBuf;
 
 /// Simulate a tapping-mode cantilever against a tip–sample force law to its steady state:
 /// amplitude, phase, energy dissipated per cycle and the phase that follows from it.
 ///
+/// An AFM holds the amplitude at a setpoint while its z feedback moves the sample:
+/// `tapsim tap --setpoint 0.8` lists every stable steady state whose A/A₀ is 0.8, each
+/// with the rest separation z_c that gives it and its branch (attractive: φ above the
+/// free phase, 90° at resonance; repulsive: below). Without a setpoint the tip is held
+/// at a rest separation (--separation) and the state it settles on is reported.
+///
 /// Built-in defaults: a silicon cantilever (k = 40 N/m, f₀ = 300 kHz, Q = 400,
 /// A₀ = 20 nm, driven at f₀) with a 20 nm silicon tip on a soft polymer
 /// (E = 0.5 GPa, ν = 0.4; E* = 0.59 GPa), Δγ = 0.1 J/m², ε = 0.3 nm (μ ≈ 2.8),
 /// rest separation z_c = 16 nm, the paper's hybrid law. Every value can be changed
-/// by a flag or a TOML file (--config; keys are the flags' names, flags win).
+/// by a flag or a TOML file (--config; keys are the flags' names, flags win; a file
+/// may hold `setpoint` and `branch` in place of `separation`).
 ///
 /// Laws (--law; each explained under it below): hybrid (default), hybrid-attractive,
 /// jkr, dmt, hertz, lj, none. On top of any of them but none: a viscous sample
@@ -87,31 +94,26 @@ pub struct TapArgs {
     /// The amplitude setpoint as an amplitude (e.g. 16nm): --setpoint A_sp/A₀.
     #[arg(long, allow_hyphen_values = true, value_parser = length)]
     amplitude_setpoint: Option<f64>,
-    /// With a setpoint: the branch whose states are listed. Attractive: the phase lag
-    /// above the free oscillator's (90° at resonance), net attractive force; repulsive:
-    /// below it.
-    #[arg(long, value_enum, default_value_t = BranchChoice::All)]
-    branch: BranchChoice,
+    /// With a setpoint: the branch whose states are listed [default: all]. Attractive:
+    /// the phase lag above the free oscillator's (90° at resonance), net attractive
+    /// force; repulsive: below it.
+    #[arg(long, value_enum)]
+    branch: Option<BranchChoice>,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
 }
 
-/// `--branch`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum BranchChoice {
-    /// Both branches.
-    All,
-    /// φ above the free phase: the tip feels a net attraction.
-    Attractive,
-    /// φ below the free phase: the tip presses into the sample.
-    Repulsive,
-}
-
 /// Run the subcommand.
 pub fn run(args: TapArgs) -> Result<()> {
-    let inputs = args.inputs.clone().with_config()?;
-    if args.setpoint.is_some() || args.amplitude_setpoint.is_some() {
+    let inputs = TapInputs {
+        setpoint: args.setpoint,
+        amplitude_setpoint: args.amplitude_setpoint,
+        branch: args.branch,
+        ..args.inputs.clone()
+    }
+    .with_config()?;
+    if inputs.setpoint.is_some() || inputs.amplitude_setpoint.is_some() {
         return at_setpoint(&args, inputs);
     }
     let (setup, numerics) = inputs.resolve()?;
@@ -171,24 +173,22 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
         ));
     }
     let (setup, numerics) = inputs.resolve()?;
-    let ratio = match (args.setpoint, args.amplitude_setpoint) {
+    let ratio = match (inputs.setpoint, inputs.amplitude_setpoint) {
         (Some(r), _) => r,
         (None, Some(a)) => a / setup.cantilever.free_amplitude_m,
         (None, None) => unreachable!("called with a setpoint"),
     };
-    let branch = match args.branch {
-        BranchChoice::All => None,
-        BranchChoice::Attractive => Some(PhaseBranch::Attractive),
-        BranchChoice::Repulsive => Some(PhaseBranch::Repulsive),
-    };
+    let branch = inputs.branch.unwrap_or(BranchChoice::All).only();
     let spinner = spinner("following the period-1 families to the setpoint");
     let states = states_at_setpoint(&setup, &numerics, ratio, branch);
     spinner.finish_and_clear();
     let states = states.map_err(|e| match e {
-        Error::OutOfRange(why) if args.amplitude_setpoint.is_some() => Error::OutOfRange(format!(
-            "{why} (--amplitude-setpoint is an amplitude, bare numbers in m: e.g. 16nm; \
+        Error::OutOfRange(why) if inputs.amplitude_setpoint.is_some() => {
+            Error::OutOfRange(format!(
+                "{why} (--amplitude-setpoint is an amplitude, bare numbers in m: e.g. 16nm; \
              --setpoint takes A/A₀)"
-        )),
+            ))
+        }
         e => e,
     })?;
     if args.json {
