@@ -37,7 +37,9 @@ pub struct TapObservables {
     /// drive's end term); both vanish on a periodic orbit. It differs from the lock-in
     /// phase by the damping of the higher harmonics, which the relation leaves out.
     pub phase_from_energy_deg: f64,
-    /// Energy dissipated in the contact per cycle, ∮ T dα, in J.
+    /// Energy dissipated in the contact per cycle, ∮ T dα, in J (0 where below 1e-12 of
+    /// the drive's energy per cycle: the round-off of a loop that cancels, as a
+    /// conservative law's does; likewise each part by mechanism, whose sum it is).
     pub e_ts_j: f64,
     /// The same in eV.
     pub e_ts_ev: f64,
@@ -198,6 +200,22 @@ impl TapObservables {
         let asin = sin_phi.clamp(-1.0, 1.0).asin().to_degrees();
         let phase_from_energy_deg = if cos_phi >= 0.0 { asin } else { 180.0 - asin };
         let balance = (c.e_drive - c.e_damp - c.e_ts - c.delta_mechanical).abs() / c.e_drive.abs();
+        // An energy per period below 1e-12 of the drive's is the round-off of a loop
+        // integral that cancels (a conservative law's): zero, not a signed remainder.
+        let resolved = |e: f64| {
+            if e.abs() <= 1e-12 * c.e_drive_per_period().abs() {
+                0.0
+            } else {
+                e
+            }
+        };
+        let (viscous, capillary) = (
+            resolved(c.e_viscous / periods),
+            resolved(c.e_capillary / periods),
+        );
+        let adhesion = resolved((c.e_ts - c.e_viscous - c.e_capillary) / periods);
+        // The whole is the sum of its resolved parts.
+        let e_ts = adhesion + viscous + capillary;
         let scale = contact.separation_scale_m();
         let min_sep = c.min_alpha_hat * scale;
         let margin = c.grazing.any * scale;
@@ -210,11 +228,11 @@ impl TapObservables {
             amplitude_ratio: amp,
             phase_deg: c.phase().to_degrees(),
             phase_from_energy_deg,
-            e_ts_j: c.e_ts_per_period() * energy,
-            e_ts_ev: c.e_ts_per_period() * energy / ELECTRONVOLT_J,
-            e_ts_adhesion_j: (c.e_ts - c.e_viscous - c.e_capillary) / periods * energy,
-            e_ts_viscous_j: c.e_viscous / periods * energy,
-            e_ts_capillary_j: c.e_capillary / periods * energy,
+            e_ts_j: e_ts * energy,
+            e_ts_ev: e_ts * energy / ELECTRONVOLT_J,
+            e_ts_adhesion_j: adhesion * energy,
+            e_ts_viscous_j: viscous * energy,
+            e_ts_capillary_j: capillary * energy,
             e_damp_j: c.e_damp / periods * energy,
             e_drive_j: c.e_drive_per_period() * energy,
             energy_balance_rel: balance,

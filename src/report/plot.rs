@@ -374,8 +374,17 @@ fn data_range(chart: &Chart, pick: impl Fn(&(f64, f64)) -> f64, scale: Scale) ->
     }
     match scale {
         Scale::Linear => {
-            let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.5 };
-            (lo - pad, hi + pad)
+            // A spread below 1e-6 of the values is below what the numbers resolve (a
+            // quantity constant along the curve, up to round-off): not zoomed into.
+            let floor = 1e-6 * lo.abs().max(hi.abs());
+            if hi - lo > floor {
+                let pad = 0.05 * (hi - lo);
+                (lo - pad, hi + pad)
+            } else {
+                let mid = 0.5 * (lo + hi);
+                let half = if mid == 0.0 { 0.5 } else { 0.05 * mid.abs() };
+                (mid - half, mid + half)
+            }
         }
         Scale::Log => {
             let pad = if hi > lo { (hi / lo).powf(0.05) } else { 2.0 };
