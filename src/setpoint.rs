@@ -62,6 +62,10 @@ pub struct SetpointState {
     /// Every observable of the steady state there.
     #[serde(flatten)]
     pub observables: TapObservables,
+    /// The oscillator's state on the orbit at the drive phase (to carry on from; not
+    /// written out).
+    #[serde(skip)]
+    pub phase: Phase,
 }
 
 /// The free oscillator's phase lag in degrees, atan2(Ω/Q, 1 − Ω²) (the border between
@@ -116,6 +120,158 @@ pub fn states_at_setpoint(
         let free = free_phase_deg(setup);
         let why = unreached(&family, ratio, branch, free, range);
         return Err(Error::NotApplicable(why));
+    }
+    Ok(out)
+}
+
+/// An approach–retract curve in amplitude setpoints: what an AFM records while its z
+/// feedback holds each setpoint of `ratios` in turn (A/A₀ with the ramp's direction),
+/// carrying the oscillator from one to the next.
+#[derive(Debug, Clone)]
+pub struct SetpointSweep {
+    /// The states, one per setpoint held (each at A/A₀ = its setpoint to
+    /// [`AMPLITUDE_TOLERANCE`]), in the ramp's order.
+    pub points: Vec<sweep::SweepPoint>,
+    /// The setpoints not held, each with why (the amplitude jumps across it between two
+    /// rest separations, or the motion around it is not period-1).
+    pub not_held: Vec<(f64, sweep::Direction, String)>,
+}
+
+/// Most steady states one setpoint of a [`sweep_setpoints`] ramp may take to bracket it.
+const WALK_STEPS: usize = 200;
+
+/// The approach–retract curve at the setpoints `ratios` ((A/A₀, direction) in order):
+/// from the free oscillation at 1.2 A₀, the rest separation is walked towards each
+/// setpoint in turn as a z feedback moves it (steps of the amplitude error times A₀, a
+/// unit slope dA/dz_c, at most 0.05 A₀), each steady state started from the one before,
+/// until two neighbouring states bracket it; the rest separation is then refined between
+/// them (Illinois, as [`states_on`]) to [`AMPLITUDE_TOLERANCE`]. The states carried are
+/// those a z-sweep through the same rest separations reaches
+/// ([`sweep::approach_curve`]). A setpoint bracketed by states that are not both stable
+/// period-1 orbits of one branch (the amplitude jumps across it, or the motion there is
+/// not period-1) is not held; it is listed with why, and the walk goes on from the
+/// bracket's far end.
+pub fn sweep_setpoints(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    ratios: &[(f64, sweep::Direction)],
+    mut progress: impl FnMut(usize, usize),
+) -> Result<SetpointSweep> {
+    for &(r, _) in ratios {
+        check_ratio(r)?;
+    }
+    let p = Prepared::new(setup, numerics)?;
+    let a0 = setup.cantilever.free_amplitude_m;
+    let free = free_phase_deg(setup);
+    let settle = |z: f64, phase: &mut Phase| -> Result<BranchRecord> {
+        let state = p.simulation_at(z)?.steady_state(phase, &p.steady)?;
+        Ok(BranchRecord {
+            separation_m: z,
+            segment: 0,
+            point: sweep::BranchPointKind::Regular,
+            observables: TapObservables::new(&p, &state)?,
+            phase: *phase,
+        })
+    };
+    let mut phase = p.simulation().free_steady_start();
+    let mut here = settle(1.2 * a0, &mut phase)?;
+    let mut out = SetpointSweep {
+        points: Vec::with_capacity(ratios.len()),
+        not_held: Vec::new(),
+    };
+    let held =
+        |b: &BranchRecord| b.observables.period == Some(1) && b.observables.stable == Some(true);
+    for (i, &(ratio, direction)) in ratios.iter().enumerate() {
+        let mut bracket = None;
+        for _ in 0..WALK_STEPS {
+            let error = here.observables.amplitude_ratio - ratio;
+            if error == 0.0 {
+                bracket = Some((here.clone(), here.clone()));
+                break;
+            }
+            let step = (-error * a0).clamp(-0.05 * a0, 0.05 * a0);
+            let step = if step.abs() < 1e-4 * a0 {
+                1e-4 * a0 * step.signum()
+            } else {
+                step
+            };
+            let mut next_phase = here.phase;
+            let next = settle(here.separation_m + step, &mut next_phase)?;
+            let crossed = (next.observables.amplitude_ratio - ratio) * error <= 0.0;
+            let before = std::mem::replace(&mut here, next);
+            if crossed {
+                bracket = Some((before, here.clone()));
+                break;
+            }
+        }
+        let Some((a, b)) = bracket else {
+            out.not_held.push((
+                ratio,
+                direction,
+                format!("not bracketed within {WALK_STEPS} steps of the rest separation"),
+            ));
+            progress(i + 1, ratios.len());
+            continue;
+        };
+        let side = PhaseBranch::of(a.observables.phase_deg, free);
+        let same_branch = PhaseBranch::of(b.observables.phase_deg, free) == side;
+        let state = if held(&a) && held(&b) && same_branch {
+            refine(&p, (&a, &b), ratio, side, free)?
+        } else {
+            None
+        };
+        match state {
+            Some(s) => {
+                // Carry on from the state at the setpoint.
+                here = BranchRecord {
+                    separation_m: s.separation_m,
+                    segment: 0,
+                    point: sweep::BranchPointKind::Regular,
+                    observables: s.observables.clone(),
+                    phase: s.phase,
+                };
+                out.points.push(sweep::SweepPoint {
+                    separation_m: s.separation_m,
+                    direction,
+                    observables: s.observables,
+                });
+            }
+            None => {
+                let describe = |o: &TapObservables| {
+                    // (A periodic orbit without a stability grazes a jump of the law.)
+                    if o.grazing || (o.period.is_some() && o.stable.is_none()) {
+                        format!("{} grazing a switch", o.regime)
+                    } else if o.stable == Some(false) {
+                        format!("an unstable {}", o.regime)
+                    } else {
+                        o.regime.clone()
+                    }
+                };
+                let why = if !(held(&a) && held(&b)) {
+                    format!(
+                        "the states that bracket it (z_c = {:.4} and {:.4} nm) are {} and \
+                         {}; a setpoint is solved between stable period-1 orbits only",
+                        a.separation_m * 1e9,
+                        b.separation_m * 1e9,
+                        describe(&a.observables),
+                        describe(&b.observables)
+                    )
+                } else {
+                    format!(
+                        "the amplitude jumps across it between z_c = {:.4} and {:.4} nm \
+                         (A/A₀ {:.4} to {:.4}, the {} to the {} branch)",
+                        a.separation_m * 1e9,
+                        b.separation_m * 1e9,
+                        a.observables.amplitude_ratio,
+                        b.observables.amplitude_ratio,
+                        side,
+                        PhaseBranch::of(b.observables.phase_deg, free)
+                    )
+                };
+                out.not_held.push((ratio, direction, why));
+            }
+        }
+        progress(i + 1, ratios.len());
     }
     Ok(out)
 }
@@ -429,6 +585,7 @@ pub fn coexisting(
                 branch,
                 separation_m: z,
                 observables: o,
+                phase,
             });
         }
     }
@@ -542,6 +699,7 @@ fn refine(
                     branch: side,
                     separation_m: z,
                     observables: o,
+                    phase,
                 },
             ));
         }

@@ -441,3 +441,110 @@ fn a_parameter_file_holds_a_setpoint_as_the_flags_do() {
         );
     }
 }
+
+/// An approach in setpoints (`approach --sweep setpoint`), as a z feedback lowers the
+/// setpoint and raises it again: every state holds its setpoint; the states are those
+/// a z_c sweep through the same rest separations reaches, carrying the oscillator the
+/// same way (a plain ramp, no walking, no root-finding); and each is a state `tap
+/// --setpoint` finds at that setpoint by continuation of the period-1 families (the
+/// attractive one: lowered from far, the setpoint stays on the branch the free
+/// oscillation starts on).
+#[test]
+fn an_approach_in_setpoints_gives_the_states_of_the_z_sweep_through_its_separations() {
+    use tapsim::dynamics::setup::{Numerics, default_setup};
+    use tapsim::setpoint::sweep_setpoints;
+    use tapsim::sweep::{Direction, approach_curve, ramp};
+    let setup = default_setup();
+    let numerics = Numerics::default();
+    let a0 = setup.cantilever.free_amplitude_m;
+    let ratios = ramp(0.95, 0.4, 12, true).unwrap();
+    let swept = sweep_setpoints(&setup, &numerics, &ratios, |_, _| {}).unwrap();
+    // 0.95 lies in the window near the onset of contact where the motion locks onto long
+    // periods: not held, with why, on the way in and out.
+    assert!(swept.not_held.iter().any(|(r, d, why)| *r == 0.95
+        && *d == Direction::Approach
+        && why.contains("grazing a switch")));
+    assert!(swept.points.len() >= 18, "{}", swept.points.len());
+    for p in &swept.points {
+        let r = ratios
+            .iter()
+            .filter(|(_, d)| *d == p.direction)
+            .map(|(r, _)| *r)
+            .min_by(|a, b| {
+                (a - p.observables.amplitude_ratio)
+                    .abs()
+                    .total_cmp(&(b - p.observables.amplitude_ratio).abs())
+            })
+            .unwrap();
+        assert!(
+            (p.observables.amplitude_ratio - r).abs() < 1e-8,
+            "{r}: {}",
+            p.observables.amplitude_ratio
+        );
+    }
+    // The z sweep from the free oscillation at 1.2 A₀ through the same separations.
+    let mut through = vec![(1.2 * a0, Direction::Approach)];
+    through.extend(swept.points.iter().map(|p| (p.separation_m, p.direction)));
+    let plain = approach_curve(&setup, &numerics, &through, |_, _| {}).unwrap();
+    for (s, z) in swept.points.iter().zip(&plain[1..]) {
+        assert_eq!(s.separation_m, z.separation_m);
+        let (a, b) = (&s.observables, &z.observables);
+        assert!(
+            (a.amplitude_ratio - b.amplitude_ratio).abs() < 1e-7,
+            "{a:?} vs {b:?}"
+        );
+        assert!(
+            (a.phase_deg - b.phase_deg).abs() < 1e-5,
+            "{} vs {}",
+            a.phase_deg,
+            b.phase_deg
+        );
+        assert!((a.e_ts_j - b.e_ts_j).abs() < 1e-6 * a.e_drive_j);
+    }
+    // From the command line, each state is one `tap --setpoint` lists.
+    let v = json(&[
+        "approach",
+        "--sweep",
+        "setpoint",
+        "--from",
+        "0.9",
+        "--to",
+        "0.4",
+        "--points",
+        "3",
+        "--no-retract",
+        "--json",
+    ]);
+    let ratio = v["amplitude_ratio"].as_array().unwrap();
+    assert_eq!(ratio.len(), 3);
+    for (i, want) in [0.9, 0.65, 0.4].iter().enumerate() {
+        let r = ratio[i].as_f64().unwrap();
+        assert!((r - want).abs() < 1e-6, "{r} vs {want}");
+        let phase = v["phase_deg"][i].as_f64().unwrap();
+        let t = json(&["tap", "--setpoint", &want.to_string(), "--json"]);
+        let phases: Vec<f64> = t["states"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| num(s, "phase_deg"))
+            .collect();
+        assert!(
+            phases.iter().any(|p| (p - phase).abs() < 1e-5),
+            "{phase} at {want} not among {phases:?}"
+        );
+    }
+    // A setpoint sweep's range is in A/A₀, from far to near.
+    for (args, says) in [
+        (&["--from", "16nm"][..], "is an amplitude setpoint A/A₀"),
+        (
+            &["--from", "0.3", "--to", "0.5"][..],
+            "an approach lowers the setpoint",
+        ),
+    ] {
+        let mut all = vec!["approach", "--sweep", "setpoint"];
+        all.extend_from_slice(args);
+        let out = tapsim(&all);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&out.stderr).contains(says));
+    }
+}

@@ -1,15 +1,19 @@
 //! `tapsim approach`: an approach–retract curve.
 
 use crate::config::TapInputs;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::identification::{self, Normalized};
 use crate::report::sweep as report;
+use crate::setpoint;
 use crate::sweep::{self, Direction, SweepPoint};
 use clap::Args;
 
 /// Sweep the rest separation z_c down (approach) and back up (retract), carrying the
 /// oscillator from point to point as a slow piezo ramp does, so the attractive/repulsive
-/// bistability and its hysteresis appear. Every `tapsim tap` option applies.
+/// bistability and its hysteresis appear; or, with --sweep setpoint, lower and raise the
+/// amplitude setpoint A/A₀ as a z feedback holds it (`tapsim approach --sweep setpoint
+/// --from 0.95 --to 0.4`): each point the state at its setpoint and the z_c that gives
+/// it. Every `tapsim tap` option applies.
 ///
 /// Per point: the steady-state observables of `tapsim tap`. Output: a table on stdout,
 /// or --json (one object of equal-length arrays: separation_m, direction, amplitude_m,
@@ -41,6 +45,23 @@ pub struct ApproachArgs {
     /// steps up to a plateau once the loop is traversed; a viscous sample peaks inside.
     #[arg(long)]
     normalize: bool,
+    /// What the ramp sweeps. separation: the rest separation z_c (--from, --to in m;
+    /// default 1.2 A₀ down to 0.4 A₀). setpoint: the amplitude setpoint A/A₀ a z
+    /// feedback holds (--from, --to as A/A₀, bare numbers; default 0.95 down to 0.4),
+    /// each point the state at its setpoint (to 1e-9) and the z_c that gives it; a
+    /// setpoint the amplitude jumps across, or where the motion is not period-1, is not
+    /// held and is listed with why.
+    #[arg(long, value_enum, default_value_t = Sweep::Separation)]
+    sweep: Sweep,
+}
+
+/// `--sweep`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Sweep {
+    /// The rest separation z_c.
+    Separation,
+    /// The amplitude setpoint A/A₀.
+    Setpoint,
 }
 
 /// A setpoint with its identification values (`--normalize`).
@@ -59,12 +80,48 @@ pub(super) const DEFAULT_POINTS: usize = 60;
 pub fn run(args: ApproachArgs) -> Result<()> {
     let start = super::SweepStart::new("approach", args.inputs, &args.range)?;
     let (setup, numerics, (from, to)) = (&start.setup, &start.sweep_numerics, start.range);
-    let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
-    let bar = args.out.progress_bar(ramp.len());
-    let points = sweep::approach_curve(setup, numerics, &ramp, |done, _| {
-        bar.set_position(done as u64)
-    })?;
-    bar.finish_and_clear();
+    let (points, not_held) = match args.sweep {
+        Sweep::Separation => {
+            let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
+            let bar = args.out.progress_bar(ramp.len());
+            let points = sweep::approach_curve(setup, numerics, &ramp, |done, _| {
+                bar.set_position(done as u64)
+            })?;
+            bar.finish_and_clear();
+            (points, Vec::new())
+        }
+        Sweep::Setpoint => {
+            let from = args.range.from.unwrap_or(0.95);
+            let to = args.range.to.unwrap_or(0.4);
+            for (flag, r) in [("--from", from), ("--to", to)] {
+                if !(0.01..1.0).contains(&r) {
+                    return Err(Error::OutOfRange(format!(
+                        "with --sweep setpoint, {flag} is an amplitude setpoint A/A₀ from \
+                         0.01 to below 1 (a bare number), not {r}"
+                    )));
+                }
+            }
+            if to >= from {
+                return Err(Error::OutOfRange(format!(
+                    "an approach lowers the setpoint: --from ({from}) must exceed --to ({to})"
+                )));
+            }
+            let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
+            let bar = args.out.progress_bar(ramp.len());
+            let swept = setpoint::sweep_setpoints(setup, numerics, &ramp, |done, _| {
+                bar.set_position(done as u64)
+            })?;
+            bar.finish_and_clear();
+            (swept.points, swept.not_held)
+        }
+    };
+    for (r, direction, why) in &not_held {
+        let dir = match direction {
+            Direction::Approach => "approach",
+            Direction::Retract => "retract",
+        };
+        eprintln!("note: setpoint A/A₀ = {r:.4} ({dir}) not held: {why}");
+    }
     let title = format!("{} law", setup.law);
     let normalized = args.normalize.then(|| identification::normalize(&points));
     if let Some(normalized) = &normalized {
