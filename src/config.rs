@@ -419,8 +419,17 @@ const FIELDS: &[Field] = fields![
 
 impl TapInputs {
     /// Set the quantity named `key` (a flag's name) from `text` (a number with an
-    /// optional unit).
+    /// optional unit; for `branch`, all, attractive or repulsive).
     pub fn set(&mut self, key: &str, text: &str) -> Result<()> {
+        if key == "branch" {
+            let choice = <BranchChoice as clap::ValueEnum>::from_str(text.trim(), true);
+            self.branch = Some(choice.map_err(|_| Error::Parse {
+                name: "branch",
+                text: text.to_string(),
+                reason: "expected one of all, attractive, repulsive".into(),
+            })?);
+            return Ok(());
+        }
         if let Some(&(name, dim, slot)) = FIELDS.iter().find(|(k, _, _)| *k == key) {
             *slot(self) = Some(units::parse(name, text, dim)?);
             return Ok(());
@@ -438,7 +447,7 @@ impl TapInputs {
         Err(Error::Parse {
             name: "key",
             text: key.to_string(),
-            reason: format!("unknown key; known keys: law, {}", known.join(", ")),
+            reason: format!("unknown key; known keys: law, branch, {}", known.join(", ")),
         })
     }
 
@@ -475,19 +484,6 @@ impl TapInputs {
         })?;
         let mut inputs = Self::default();
         for (key, value) in &table {
-            if key == "branch" {
-                let name = value.as_str().unwrap_or_default();
-                inputs.branch = Some(
-                    <BranchChoice as clap::ValueEnum>::from_str(name, false).map_err(|_| {
-                        Error::Parse {
-                            name: "branch",
-                            text: value.to_string(),
-                            reason: "expected one of all, attractive, repulsive".into(),
-                        }
-                    })?,
-                );
-                continue;
-            }
             if key == "law" {
                 let name = value.as_str().unwrap_or_default();
                 inputs.law = Some(LawKind::from_name(name).ok_or_else(|| Error::Parse {

@@ -315,7 +315,7 @@ fn a_batch_row_at_a_setpoint_gives_the_states_tap_gives() {
         ("name,setpoint\nx,1.5\n", "row 1: amplitude setpoint"),
         (
             "name,setpoint,branch\nx,0.8,up\n",
-            "expected attractive, repulsive or all",
+            "expected one of all, attractive, repulsive",
         ),
     ] {
         std::fs::write(&table, text).unwrap();

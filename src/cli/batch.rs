@@ -174,8 +174,6 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
     let mut command = "tap".to_string();
     let (mut points, mut from, mut to, mut retract) =
         (super::approach::DEFAULT_POINTS, None, None, true);
-    let (mut setpoint, mut branch): (Option<f64>, Option<crate::setpoint::PhaseBranch>) =
-        (None, None);
     for (key, text) in row {
         match key.as_str() {
             "name" => name = text.clone(),
@@ -194,25 +192,6 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
             }
             "to" => {
                 to = Some(crate::config::length(text).map_err(|e| at(Error::NotApplicable(e)))?)
-            }
-            "setpoint" => {
-                setpoint =
-                    Some(crate::config::number(text).map_err(|e| at(Error::NotApplicable(e)))?)
-            }
-            "branch" => {
-                use crate::setpoint::PhaseBranch;
-                branch = match text.to_ascii_lowercase().as_str() {
-                    "attractive" => Some(PhaseBranch::Attractive),
-                    "repulsive" => Some(PhaseBranch::Repulsive),
-                    "all" => None,
-                    _ => {
-                        return Err(at(Error::Parse {
-                            name: "branch",
-                            text: text.clone(),
-                            reason: "expected attractive, repulsive or all".into(),
-                        }));
-                    }
-                }
             }
             "no-retract" => {
                 retract = match text.to_ascii_lowercase().as_str() {
@@ -256,6 +235,13 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
     let (setup, numerics) = inputs.resolve().map_err(at)?;
     // A value `tap` refuses refuses the batch here, before any case runs.
     setup.check_plausible().map_err(at)?;
+    let setpoint = inputs.setpoint.or(inputs
+        .amplitude_setpoint
+        .map(|a| a / setup.cantilever.free_amplitude_m));
+    let branch = inputs
+        .branch
+        .unwrap_or(crate::config::BranchChoice::All)
+        .only();
     let (run, numerics) = match command.as_str() {
         "tap" => match setpoint {
             None => (Run::Tap, numerics),
