@@ -90,8 +90,10 @@ pub fn check_ratio(ratio: f64) -> Result<()> {
 
 /// Every stable period-1 steady state whose amplitude is `ratio` × A₀ (0 < ratio < 1),
 /// on `branch` (`None`: both), attractive ones first, each at the rest separation that
-/// gives it. An empty list is an error saying which branches exist and what amplitudes
-/// they reach.
+/// gives it: from each branch's harmonic estimate, else on the period-1 families
+/// followed by continuation, else at the end of a ramp lowering the setpoint from far
+/// ([`sweep_setpoints`]). None is an error saying what amplitudes the branches' stable
+/// orbits reach and why the ramp does not hold the setpoint.
 pub fn states_at_setpoint(
     setup: &TapSetup,
     numerics: &Numerics,
@@ -117,9 +119,24 @@ pub fn states_at_setpoint(
     out.extend(states_on(&p, &family, ratio, branch)?);
     let out = distinct(out, a0);
     if out.is_empty() {
+        // Where the families hold no stable period-1 state: a ramp lowering the setpoint
+        // from far, as a z feedback would.
         let free = free_phase_deg(setup);
-        let why = unreached(&family, ratio, branch, free, range);
-        return Err(Error::NotApplicable(why));
+        let ramp = hold(&p, &mut far_from_the_sample(&p)?, ratio)?;
+        return match ramp {
+            Ok(s) if branch.is_none_or(|b| b == s.branch) => Ok(vec![s]),
+            ramp => {
+                let mut why = unreached(&family, ratio, branch, free, range);
+                if let Err(ramp_why) = ramp {
+                    why += &format!(
+                        ". Lowered from far as a z feedback lowers it, the setpoint is not \
+                         held either: {ramp_why}"
+                    );
+                }
+                why += ". `tapsim approach --sweep setpoint` shows what the motion does there";
+                Err(Error::NotApplicable(why))
+            }
+        };
     }
     Ok(out)
 }
@@ -161,119 +178,129 @@ pub fn sweep_setpoints(
         check_ratio(r)?;
     }
     let p = Prepared::new(setup, numerics)?;
-    let a0 = setup.cantilever.free_amplitude_m;
-    let free = free_phase_deg(setup);
-    let settle = |z: f64, phase: &mut Phase| -> Result<BranchRecord> {
-        let state = p.simulation_at(z)?.steady_state(phase, &p.steady)?;
-        Ok(BranchRecord {
-            separation_m: z,
-            segment: 0,
-            point: sweep::BranchPointKind::Regular,
-            observables: TapObservables::new(&p, &state)?,
-            phase: *phase,
-        })
-    };
-    let mut phase = p.simulation().free_steady_start();
-    let mut here = settle(1.2 * a0, &mut phase)?;
+    let mut here = far_from_the_sample(&p)?;
     let mut out = SetpointSweep {
         points: Vec::with_capacity(ratios.len()),
         not_held: Vec::new(),
     };
-    let held =
-        |b: &BranchRecord| b.observables.period == Some(1) && b.observables.stable == Some(true);
     for (i, &(ratio, direction)) in ratios.iter().enumerate() {
-        let mut bracket = None;
-        for _ in 0..WALK_STEPS {
-            let error = here.observables.amplitude_ratio - ratio;
-            if error == 0.0 {
-                bracket = Some((here.clone(), here.clone()));
-                break;
-            }
-            let step = (-error * a0).clamp(-0.05 * a0, 0.05 * a0);
-            let step = if step.abs() < 1e-4 * a0 {
-                1e-4 * a0 * step.signum()
-            } else {
-                step
-            };
-            let mut next_phase = here.phase;
-            let next = settle(here.separation_m + step, &mut next_phase)?;
-            let crossed = (next.observables.amplitude_ratio - ratio) * error <= 0.0;
-            let before = std::mem::replace(&mut here, next);
-            if crossed {
-                bracket = Some((before, here.clone()));
-                break;
-            }
-        }
-        let Some((a, b)) = bracket else {
-            out.not_held.push((
-                ratio,
+        match hold(&p, &mut here, ratio)? {
+            Ok(s) => out.points.push(sweep::SweepPoint {
+                separation_m: s.separation_m,
                 direction,
-                format!("not bracketed within {WALK_STEPS} steps of the rest separation"),
-            ));
-            progress(i + 1, ratios.len());
-            continue;
-        };
-        let side = PhaseBranch::of(a.observables.phase_deg, free);
-        let same_branch = PhaseBranch::of(b.observables.phase_deg, free) == side;
-        let state = if held(&a) && held(&b) && same_branch {
-            refine(&p, (&a, &b), ratio, side, free)?
-        } else {
-            None
-        };
-        match state {
-            Some(s) => {
-                // Carry on from the state at the setpoint.
-                here = BranchRecord {
-                    separation_m: s.separation_m,
-                    segment: 0,
-                    point: sweep::BranchPointKind::Regular,
-                    observables: s.observables.clone(),
-                    phase: s.phase,
-                };
-                out.points.push(sweep::SweepPoint {
-                    separation_m: s.separation_m,
-                    direction,
-                    observables: s.observables,
-                });
-            }
-            None => {
-                let describe = |o: &TapObservables| {
-                    // (A periodic orbit without a stability grazes a jump of the law.)
-                    if o.grazing || (o.period.is_some() && o.stable.is_none()) {
-                        format!("{} grazing a switch", o.regime)
-                    } else if o.stable == Some(false) {
-                        format!("an unstable {}", o.regime)
-                    } else {
-                        o.regime.clone()
-                    }
-                };
-                let why = if !(held(&a) && held(&b)) {
-                    format!(
-                        "the states that bracket it (z_c = {:.4} and {:.4} nm) are {} and \
-                         {}; a setpoint is solved between stable period-1 orbits only",
-                        a.separation_m * 1e9,
-                        b.separation_m * 1e9,
-                        describe(&a.observables),
-                        describe(&b.observables)
-                    )
-                } else {
-                    format!(
-                        "the amplitude jumps across it between z_c = {:.4} and {:.4} nm \
-                         (A/A₀ {:.4} to {:.4}, the {} to the {} branch)",
-                        a.separation_m * 1e9,
-                        b.separation_m * 1e9,
-                        a.observables.amplitude_ratio,
-                        b.observables.amplitude_ratio,
-                        side,
-                        PhaseBranch::of(b.observables.phase_deg, free)
-                    )
-                };
-                out.not_held.push((ratio, direction, why));
-            }
+                observables: s.observables,
+            }),
+            Err(why) => out.not_held.push((ratio, direction, why)),
         }
         progress(i + 1, ratios.len());
     }
     Ok(out)
+}
+
+/// The free oscillation settled at 1.2 A₀, where a ramp starts.
+fn far_from_the_sample(p: &Prepared) -> Result<BranchRecord> {
+    let mut phase = p.simulation().free_steady_start();
+    settled(p, 1.2 * p.setup.cantilever.free_amplitude_m, &mut phase)
+}
+
+/// The steady state at rest separation `z_m` started from `phase` (left on it).
+fn settled(p: &Prepared, z_m: f64, phase: &mut Phase) -> Result<BranchRecord> {
+    let state = p.simulation_at(z_m)?.steady_state(phase, &p.steady)?;
+    Ok(BranchRecord {
+        separation_m: z_m,
+        segment: 0,
+        point: sweep::BranchPointKind::Regular,
+        observables: TapObservables::new(p, &state)?,
+        phase: *phase,
+    })
+}
+
+/// Walk the rest separation from the state `here` to the setpoint `ratio`, as a z
+/// feedback moves it ([`sweep_setpoints`]), and solve the state there; `here` is left on
+/// the state reached (the solved one, or the bracket's far end). `Err(why)` (inside the
+/// `Ok`) where the setpoint is not held.
+fn hold(
+    p: &Prepared,
+    here: &mut BranchRecord,
+    ratio: f64,
+) -> Result<std::result::Result<SetpointState, String>> {
+    let a0 = p.setup.cantilever.free_amplitude_m;
+    let free = free_phase_deg(&p.setup);
+    let held =
+        |b: &BranchRecord| b.observables.period == Some(1) && b.observables.stable == Some(true);
+    let mut bracket = None;
+    for _ in 0..WALK_STEPS {
+        let error = here.observables.amplitude_ratio - ratio;
+        if error == 0.0 {
+            bracket = Some((here.clone(), here.clone()));
+            break;
+        }
+        let step = (-error * a0).clamp(-0.05 * a0, 0.05 * a0);
+        let step = if step.abs() < 1e-4 * a0 {
+            1e-4 * a0 * step.signum()
+        } else {
+            step
+        };
+        if here.separation_m + step < -a0 {
+            // A tip pressed in by more than A₀ at rest: no setpoint lies beyond.
+            break;
+        }
+        let mut phase = here.phase;
+        let next = settled(p, here.separation_m + step, &mut phase)?;
+        let crossed = (next.observables.amplitude_ratio - ratio) * error <= 0.0;
+        let before = std::mem::replace(here, next);
+        if crossed {
+            bracket = Some((before, here.clone()));
+            break;
+        }
+    }
+    let Some((a, b)) = bracket else {
+        return Ok(Err(format!(
+            "the amplitude does not reach it (A/A₀ = {:.4} at z_c = {:.4} nm)",
+            here.observables.amplitude_ratio,
+            here.separation_m * 1e9
+        )));
+    };
+    let side = PhaseBranch::of(a.observables.phase_deg, free);
+    let other = PhaseBranch::of(b.observables.phase_deg, free);
+    if held(&a) && held(&b) && other == side {
+        if let Some(s) = refine(p, (&a, &b), ratio, side, free)? {
+            // Carry on from the state at the setpoint.
+            *here = BranchRecord {
+                separation_m: s.separation_m,
+                segment: 0,
+                point: sweep::BranchPointKind::Regular,
+                observables: s.observables.clone(),
+                phase: s.phase,
+            };
+            return Ok(Ok(s));
+        }
+    }
+    let describe = |o: &TapObservables| {
+        // (A periodic orbit without a stability grazes a jump of the law.)
+        if o.grazing || (o.period.is_some() && o.stable.is_none()) {
+            format!("{} grazing a switch", o.regime)
+        } else if o.stable == Some(false) {
+            format!("an unstable {}", o.regime)
+        } else {
+            o.regime.clone()
+        }
+    };
+    let (za, zb) = (a.separation_m * 1e9, b.separation_m * 1e9);
+    Ok(Err(if !(held(&a) && held(&b)) {
+        format!(
+            "the states that bracket it (z_c = {za:.4} and {zb:.4} nm) are {} and {}; a \
+             setpoint is solved between stable period-1 orbits only",
+            describe(&a.observables),
+            describe(&b.observables)
+        )
+    } else {
+        format!(
+            "the amplitude jumps across it between z_c = {za:.4} and {zb:.4} nm (A/A₀ \
+             {:.4} to {:.4}, the {side} to the {other} branch)",
+            a.observables.amplitude_ratio, b.observables.amplitude_ratio,
+        )
+    }))
 }
 
 /// The cells numbered `cells` of the adhesion × modulus map ([`sweep::map_cells`]) at the
@@ -621,8 +648,7 @@ fn unreached(
     let which = branch.map_or("any branch".to_string(), |b| format!("the {b} branch"));
     format!(
         "no stable period-1 steady state on {which} has A/A₀ = {} (between z_c = {:.3} \
-         and {:.3} nm the stable period-1 orbits that touch reach: {}; {}). Near the onset \
-         of contact the motion is not period-1: `tapsim approach` shows what it does there",
+         and {:.3} nm the stable period-1 orbits that touch reach: {}; {})",
         shown(ratio),
         far * 1e9,
         deep * 1e9,
