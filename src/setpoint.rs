@@ -133,7 +133,7 @@ pub fn states_at_setpoint(
                          held either: {ramp_why}"
                     );
                 }
-                why += ". `tapsim approach --sweep setpoint` shows what the motion does there";
+                why += ". An approach curve in setpoints (`tapsim approach`) shows what the motion does there";
                 Err(Error::NotApplicable(why))
             }
         };
