@@ -216,9 +216,16 @@ fn a_map_at_a_setpoint_holds_it_in_every_cell_and_merges_like_any_map() {
         "--steps",
         "3",
     ];
-    let mut args: Vec<String> = common.iter().map(|s| s.to_string()).collect();
-    args.extend(["--json".into(), "--csv".into(), at("whole.csv")]);
-    let v = json(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let v = json(&[
+        "map",
+        "--setpoint",
+        "0.8",
+        "--branch",
+        "repulsive",
+        "--steps",
+        "10",
+        "--json",
+    ]);
     assert_eq!(v["setpoint"]["amplitude_ratio"], 0.8);
     let grid = &v["grid"];
     let (ratio, phase, z) = (
@@ -242,8 +249,28 @@ fn a_map_at_a_setpoint_holds_it_in_every_cell_and_merges_like_any_map() {
         let h = heights[k].as_f64().unwrap();
         assert_eq!(h, z[k].as_f64().unwrap() - reference, "cell {k}");
     }
-    assert!(held >= 4, "{held} cells hold the setpoint");
+    assert!(held >= 50, "{held} cells hold the setpoint");
+    // φ varies smoothly: along each row (work of adhesion rising) it rises, down each
+    // column (modulus rising) it falls, between every two neighbouring cells that hold
+    // the setpoint.
+    let rows = v["grid"]["phase_deg"].as_array().unwrap();
+    let at_cell = |i: usize, j: usize| rows[i][j].as_f64();
+    for i in 0..10 {
+        for j in 0..10 {
+            let Some(here) = at_cell(i, j) else { continue };
+            if let Some(right) = (j < 9).then(|| at_cell(i, j + 1)).flatten() {
+                assert!(right > here, "row {i}: {here} then {right}");
+            }
+            if let Some(below) = (i < 9).then(|| at_cell(i + 1, j)).flatten() {
+                assert!(below < here, "column {j}: {here} then {below}");
+            }
+        }
+    }
     // Split in two and merged: the whole map's CSV, byte for byte.
+    let mut args: Vec<String> = common.iter().map(|s| s.to_string()).collect();
+    args.extend(["--quiet".into(), "--csv".into(), at("whole.csv")]);
+    let out = tapsim(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success());
     let mut parts = Vec::new();
     for i in 0..2 {
         let part = at(&format!("p{i}.json"));
