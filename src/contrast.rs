@@ -284,5 +284,26 @@ pub fn contrast(
             }
         }
     }
+    // A setpoint no material holds under any law on any branch is refused, with the
+    // amplitudes the curves do reach.
+    let unreached: Vec<String> = ratios
+        .iter()
+        .filter(|&&r| !rows.iter().any(|row| row.amplitude_ratio == r))
+        .map(|r| r.to_string())
+        .collect();
+    if !unreached.is_empty() {
+        let amplitudes = curves
+            .iter()
+            .flat_map(|c| c.points.iter().map(|p| p.observables.amplitude_ratio));
+        let (lo, hi) = amplitudes.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), a| {
+            (lo.min(a), hi.max(a))
+        });
+        return Err(Error::NotApplicable(format!(
+            "no material holds the amplitude setpoint A/A₀ = {} under any of the laws, on \
+             either branch: their approach curves from 1.2 A₀ in to 0.3 A₀ reach A/A₀ \
+             {lo:.3} to {hi:.3}",
+            unreached.join(", ")
+        )));
+    }
     Ok((rows, curves))
 }

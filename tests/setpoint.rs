@@ -96,6 +96,20 @@ fn a_setpoint_is_refused_where_it_cannot_be_held() {
             vec!["tap", "--setpoint", "0.95", "--branch", "attractive"],
             "not held either: the states that bracket it",
         ),
+        // A contrast at a setpoint no material holds (it printed an empty table).
+        (
+            vec![
+                "contrast",
+                "--setpoints",
+                "0.1",
+                "--laws",
+                "hybrid",
+                "--points",
+                "8",
+                "--quiet",
+            ],
+            "no material holds the amplitude setpoint A/A₀ = 0.1",
+        ),
     ] {
         let out = tapsim(&args);
         let err = String::from_utf8_lossy(&out.stderr);
