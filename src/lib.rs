@@ -15,6 +15,7 @@ pub mod contrast;
 pub mod dynamics;
 pub mod error;
 pub mod identification;
+pub mod instrument;
 pub mod law;
 pub mod numeric;
 pub mod params;

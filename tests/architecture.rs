@@ -6,13 +6,14 @@
 use std::path::{Path, PathBuf};
 
 /// The library's modules (everything outside the `app` feature).
-const LIBRARY: [&str; 13] = [
+const LIBRARY: [&str; 14] = [
     "src/lib.rs",
     "src/contact",
     "src/contrast.rs",
     "src/dynamics",
     "src/error.rs",
     "src/identification.rs",
+    "src/instrument",
     "src/law",
     "src/numeric.rs",
     "src/params.rs",

@@ -482,6 +482,23 @@ impl<L: ForceLaw> Simulation<'_, L> {
         })
     }
 
+    /// March `periods` drive periods from `phase` (left at their end, its τ kept within
+    /// one period of the drive's origin), every integrator step and free flight shown
+    /// to `observer`: the motion in time, as an instrument watching it sees it (a
+    /// [`crate::instrument::lockin::LockIn`], say).
+    pub fn march<O: StepObserver>(
+        &self,
+        phase: &mut Phase,
+        periods: usize,
+        observer: &mut O,
+    ) -> Result<()> {
+        for _ in 0..periods {
+            self.rewind(phase);
+            self.cycle(phase, observer)?;
+        }
+        Ok(())
+    }
+
     /// Integrate one drive period from `phase`, updating it, with the derivative of the
     /// period map, ∂z(τ + T)/∂(z, q)(τ), z the section state ([`Simulation::z`]: x, x'
     /// and the law's internal state, in its units), q = z_c/L: the variational equations along every segment, the

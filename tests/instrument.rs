@@ -1,0 +1,72 @@
+//! The instrument's pieces (issue 27) against what they must reproduce without
+//! sharing their code: the lock-in's filter against the closed-form step response of an
+//! RC cascade, and its reading of a settled orbit against `tap`'s amplitude and phase
+//! (integrals over the period carried by the integrator).
+
+use tapsim::dynamics::observables::TapObservables;
+use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};
+use tapsim::instrument::lockin::{LockIn, step_response};
+
+#[test]
+fn the_lock_in_filter_has_the_step_response_of_an_rc_cascade() {
+    for order in 1..=4 {
+        for t_const in [0.3, 7.0] {
+            let mut lockin = LockIn::new(order, t_const, 1.0).unwrap();
+            let mut at = 0.0;
+            // Uneven intervals: the propagation composes.
+            for t in [0.05, 0.4, 1.0, 2.5, 6.0, 13.0, 40.0] {
+                let t = t * t_const;
+                lockin.filter(at, t, |_| (1.0, -2.0));
+                at = t;
+                let want = step_response(order, t / t_const);
+                let (i, q) = lockin.output();
+                assert!(
+                    (i - want).abs() < 1e-6,
+                    "n {order}, t/T {}: {i} vs {want}",
+                    t / t_const
+                );
+                assert!((q + 2.0 * want).abs() < 2e-6, "n {order}: {q}");
+            }
+        }
+    }
+    // Refused: an order outside 1–4, a time constant that is not positive.
+    assert!(LockIn::new(0, 1.0, 1.0).is_err());
+    assert!(LockIn::new(5, 1.0, 1.0).is_err());
+    assert!(LockIn::new(2, 0.0, 1.0).is_err());
+    assert!(LockIn::new(2, f64::NAN, 1.0).is_err());
+}
+
+#[test]
+fn the_lock_in_reads_a_settled_orbit_as_tap_does() {
+    let setup = default_setup();
+    let p = Prepared::new(&setup, &Numerics::default()).unwrap();
+    let sim = p.simulation();
+    let mut phase = sim.free_steady_start();
+    let state = sim.steady_state(&mut phase, &p.steady).unwrap();
+    let o = TapObservables::new(&p, &state).unwrap();
+    assert_eq!(o.period, Some(1));
+    let omega = sim.osc.omega;
+    let period = 2.0 * std::f64::consts::PI / omega;
+    // Fourth order, T = 20 periods: after 50 T the start is forgotten (below 1e-15) and
+    // the ripple at 2Ω is (1 + (2ΩT)²)^(−2) ≈ 2.5e-10 of A.
+    let mut lockin = LockIn::new(4, 20.0 * period, omega).unwrap();
+    sim.march(&mut phase, 1000, &mut lockin).unwrap();
+    let (a, phi) = (lockin.amplitude(), lockin.phase_deg());
+    eprintln!(
+        "lock-in A {a} (tap {}, rel {:e}), φ {phi} (tap {}, {:e}°)",
+        o.amplitude_ratio,
+        a / o.amplitude_ratio - 1.0,
+        o.phase_deg,
+        phi - o.phase_deg
+    );
+    assert!(
+        (a - o.amplitude_ratio).abs() < 1e-6 * o.amplitude_ratio,
+        "A {a} vs {}",
+        o.amplitude_ratio
+    );
+    assert!(
+        (phi - o.phase_deg).abs() < 1e-4,
+        "φ {phi} vs {}",
+        o.phase_deg
+    );
+}
