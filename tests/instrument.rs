@@ -70,3 +70,41 @@ fn the_lock_in_reads_a_settled_orbit_as_tap_does() {
         o.phase_deg
     );
 }
+
+/// The z feedback on a flat homogeneous sample (the defaults), approached from the free
+/// oscillation at 1.2 A₀ with the loop closed at A/A₀ = 0.8: the error settles below
+/// 1e-4 of the setpoint, and the piezo rests at the rest separation the setpoint solver
+/// finds on the branch a falling setpoint stays on (continuation and root-finding, no
+/// marching in time) within 0.01 nm.
+#[test]
+fn the_z_feedback_rests_where_the_setpoint_solver_puts_the_state() {
+    use tapsim::instrument::feedback::{PiController, hold};
+    use tapsim::setpoint::{PhaseBranch, states_at_setpoint};
+    let setup = default_setup();
+    let numerics = Numerics::default();
+    let p = Prepared::new(&setup, &numerics).unwrap();
+    let omega = p.simulation().osc.omega;
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let mut lockin = LockIn::new(4, 2.0 * period, omega).unwrap();
+    let mut controller = PiController::new(0.8, 0.0, 0.002).unwrap();
+    let a0 = setup.cantilever.free_amplitude_m;
+    let samples = hold(&p, 1.2 * a0, &mut lockin, &mut controller, 8000).unwrap();
+    // It starts free, far from the sample.
+    assert!((samples[0].amplitude_ratio - 1.0).abs() < 1e-4);
+    let tail = &samples[7500..];
+    for s in tail {
+        assert!(s.error.abs() < 1e-4 * 0.8, "{s:?}");
+    }
+    let z = tail.last().unwrap().separation_m;
+    let solved = states_at_setpoint(&setup, &numerics, 0.8, Some(PhaseBranch::Attractive)).unwrap();
+    let want = solved[0].separation_m;
+    assert!(
+        (z - want).abs() < 0.01e-9,
+        "piezo at {z:e} m, solver {want:e} m"
+    );
+    eprintln!("feedback rests at {z:e} m, the solver's state at {want:e} m");
+    // Refused: a setpoint outside (0, 1), a negative gain, both gains zero.
+    assert!(PiController::new(1.2, 0.0, 0.002).is_err());
+    assert!(PiController::new(0.8, -1.0, 0.002).is_err());
+    assert!(PiController::new(0.8, 0.0, 0.0).is_err());
+}

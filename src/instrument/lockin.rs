@@ -79,6 +79,16 @@ impl LockIn {
         })
     }
 
+    /// The filter order n.
+    pub fn order(&self) -> usize {
+        self.order
+    }
+
+    /// The filter time constant T·ω₀.
+    pub fn time_constant_hat(&self) -> f64 {
+        self.time_constant
+    }
+
     /// The filtered (in-phase, quadrature) pair: (A cos φ, A sin φ) once settled.
     pub fn output(&self) -> (f64, f64) {
         (

@@ -2,4 +2,5 @@
 //! as an AFM's electronics do, each a value of its own that watches the integration
 //! ([`crate::dynamics::numeric::StepObserver`]) beside the steady-state solver.
 
+pub mod feedback;
 pub mod lockin;

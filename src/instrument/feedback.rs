@@ -1,0 +1,115 @@
+//! The z feedback of amplitude-modulation AFM: a PI controller that moves the rest
+//! separation z_c (the z piezo) to hold the lock-in amplitude at the setpoint, and the
+//! loop that runs it on the marched cantilever.
+//!
+//! Once per drive period the controller reads the lock-in's amplitude ratio A/A₀,
+//! forms the error e = A/A₀ − setpoint and moves the sample by
+//! Δz_c/A₀ = −(K_p·Δe + K_i·e) (the velocity form of u = K_p·e + K_i·Σe, per period):
+//! too large an amplitude brings the sample closer. The piezo position z_c is what the
+//! instrument records as topography.
+
+use super::lockin::LockIn;
+use crate::dynamics::setup::Prepared;
+use crate::error::{Error, Result};
+
+/// A PI controller on the amplitude error, in units of A₀ and drive periods.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PiController {
+    /// The amplitude setpoint A/A₀.
+    pub setpoint: f64,
+    /// Proportional gain K_p (A₀ of z_c per unit of A/A₀ error).
+    pub proportional: f64,
+    /// Integral gain K_i (A₀ of z_c per unit of A/A₀ error and drive period).
+    pub integral: f64,
+    /// The last error (for the velocity form).
+    last_error: Option<f64>,
+}
+
+impl PiController {
+    /// A controller holding `setpoint` (0 < A/A₀ < 1) with gains K_p, K_i ≥ 0 (not both
+    /// zero).
+    pub fn new(setpoint: f64, proportional: f64, integral: f64) -> Result<Self> {
+        crate::setpoint::check_ratio(setpoint)?;
+        for (name, g) in [
+            ("proportional gain", proportional),
+            ("integral gain", integral),
+        ] {
+            if !(g.is_finite() && g >= 0.0) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: g,
+                    reason: "a gain is a finite number ≥ 0",
+                });
+            }
+        }
+        if proportional == 0.0 && integral == 0.0 {
+            return Err(Error::NotApplicable(
+                "a controller with both gains zero does not move the sample".into(),
+            ));
+        }
+        Ok(Self {
+            setpoint,
+            proportional,
+            integral,
+            last_error: None,
+        })
+    }
+
+    /// The move of the rest separation (in units of A₀) after a period whose lock-in
+    /// amplitude ratio was `amplitude_ratio`, and the error it acted on.
+    pub fn update(&mut self, amplitude_ratio: f64) -> (f64, f64) {
+        let e = amplitude_ratio - self.setpoint;
+        let de = self.last_error.map_or(0.0, |last| e - last);
+        self.last_error = Some(e);
+        (-(self.proportional * de + self.integral * e), e)
+    }
+}
+
+/// One drive period of the loop: where the piezo was and what the lock-in read.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct LoopSample {
+    /// The rest separation z_c during the period, in m (the topography signal).
+    pub separation_m: f64,
+    /// The lock-in amplitude at its end, A/A₀.
+    pub amplitude_ratio: f64,
+    /// The lock-in phase at its end, degrees.
+    pub phase_deg: f64,
+    /// The amplitude error A/A₀ − setpoint.
+    pub error: f64,
+}
+
+/// Run the z feedback on `p` for `periods` drive periods from the free oscillation at
+/// rest separation `start_m`: the lock-in first settles there with the loop open, then
+/// each period is marched at the current z_c with `lockin` watching, and `controller`
+/// moves z_c. Every closed-loop period's sample is returned.
+pub fn hold(
+    p: &Prepared,
+    start_m: f64,
+    lockin: &mut LockIn,
+    controller: &mut PiController,
+    periods: usize,
+) -> Result<Vec<LoopSample>> {
+    let a0 = p.setup.cantilever.free_amplitude_m;
+    let mut z = start_m;
+    let mut phase = p.simulation().free_steady_start();
+    // The lock-in settles on the motion at the start before the loop closes (its step
+    // response is within 1e-4 of 1 after 12 + 3n time constants).
+    let settle = (12.0 + 3.0 * lockin.order() as f64) * lockin.time_constant_hat()
+        / p.simulation().osc.period();
+    p.simulation_at(z)?
+        .march(&mut phase, settle.ceil() as usize, lockin)?;
+    let mut out = Vec::with_capacity(periods);
+    for _ in 0..periods {
+        p.simulation_at(z)?.march(&mut phase, 1, lockin)?;
+        let amplitude_ratio = lockin.amplitude();
+        let (dz, error) = controller.update(amplitude_ratio);
+        out.push(LoopSample {
+            separation_m: z,
+            amplitude_ratio,
+            phase_deg: lockin.phase_deg(),
+            error,
+        });
+        z += dz * a0;
+    }
+    Ok(out)
+}
