@@ -10,6 +10,7 @@
 
 use super::lockin::LockIn;
 use crate::dynamics::setup::Prepared;
+use crate::dynamics::steady::Phase;
 use crate::error::{Error, Result};
 
 /// A PI controller on the amplitude error, in units of A₀ and drive periods.
@@ -78,29 +79,29 @@ pub struct LoopSample {
     pub error: f64,
 }
 
-/// Run the z feedback on `p` for `periods` drive periods from the free oscillation at
-/// rest separation `start_m`: the lock-in first settles there with the loop open, then
-/// each period is marched at the current z_c with `lockin` watching, and `controller`
-/// moves z_c. Every closed-loop period's sample is returned.
+/// Run the z feedback on `p` for `periods` drive periods from the oscillator state
+/// `phase` at rest separation `start_m` (the free oscillation, say): the lock-in first
+/// settles there with the loop open, then each period is marched at the current z_c with
+/// `lockin` watching, and `controller` moves z_c. Returns every closed-loop period's
+/// sample and the rest separation the loop has moved to; `phase` is left at the end.
 pub fn hold(
     p: &Prepared,
-    start_m: f64,
+    (start_m, phase): (f64, &mut Phase),
     lockin: &mut LockIn,
     controller: &mut PiController,
     periods: usize,
-) -> Result<Vec<LoopSample>> {
+) -> Result<(Vec<LoopSample>, f64)> {
     let a0 = p.setup.cantilever.free_amplitude_m;
     let mut z = start_m;
-    let mut phase = p.simulation().free_steady_start();
     // The lock-in settles on the motion at the start before the loop closes (its step
     // response is within 1e-4 of 1 after 12 + 3n time constants).
     let settle = (12.0 + 3.0 * lockin.order() as f64) * lockin.time_constant_hat()
         / p.simulation().osc.period();
     p.simulation_at(z)?
-        .march(&mut phase, settle.ceil() as usize, lockin)?;
+        .march(phase, settle.ceil() as usize, lockin)?;
     let mut out = Vec::with_capacity(periods);
     for _ in 0..periods {
-        p.simulation_at(z)?.march(&mut phase, 1, lockin)?;
+        p.simulation_at(z)?.march(phase, 1, lockin)?;
         let amplitude_ratio = lockin.amplitude();
         let (dz, error) = controller.update(amplitude_ratio);
         out.push(LoopSample {
@@ -111,5 +112,5 @@ pub fn hold(
         });
         z += dz * a0;
     }
-    Ok(out)
+    Ok((out, z))
 }

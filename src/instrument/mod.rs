@@ -4,3 +4,4 @@
 
 pub mod feedback;
 pub mod lockin;
+pub mod scan;
