@@ -3,7 +3,8 @@
 //! The physics follows Ciavarella, Greenwood & Barber, "Effect of Tabor parameter on
 //! hysteresis losses during adhesive contact"; equation numbers in the documentation
 //! are that paper's. Data flows one way: [`params`] → [`contact`] (force laws) →
-//! [`law`] → [`dynamics`] / [`quasistatic`] → [`sweep`] / [`setpoint`] → [`identification`] →
+//! [`law`] → [`dynamics`] / [`quasistatic`] → [`instrument`] → [`sweep`] / [`setpoint`] →
+//! [`identification`] →
 //! [`figures`] → [`report`].
 
 #![forbid(unsafe_code)]
@@ -39,6 +40,8 @@ pub mod lj_cache;
 pub mod report;
 #[cfg(feature = "app")]
 pub mod reproduce;
+#[cfg(feature = "app")]
+pub mod sample;
 #[cfg(feature = "app")]
 pub mod units;
 

@@ -3,6 +3,7 @@
 //! RC cascade, and its reading of a settled orbit against `tap`'s amplitude and phase
 //! (integrals over the period carried by the integrator).
 
+mod common;
 use tapsim::dynamics::observables::TapObservables;
 use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};
 use tapsim::instrument::lockin::{LockIn, step_response};
@@ -164,8 +165,10 @@ fn a_slow_scan_images_material_contrast_and_a_height_step() {
             (&mut lockin, &mut controller),
             z,
             &mut phase,
+            |_| {},
         )
         .unwrap()
+        .0
     };
     // (1) Material contrast on a flat sample.
     let pixels = scan(&[
@@ -211,4 +214,186 @@ fn a_slow_scan_images_material_contrast_and_a_height_step() {
         "imaged step {imaged:e} m"
     );
     eprintln!("imaged height step {imaged:e} m");
+}
+
+/// `tapsim scan` on the built-in blend: trace and retrace, each pixel at the setpoint
+/// where the loop has settled, B imaged lower than A (its apparent step) and with the
+/// larger phase lag (the attractive branch); bad samples and settings are refused.
+#[test]
+fn scan_images_the_built_in_blend_and_refuses_bad_samples() {
+    let out = common::tapsim(&[
+        "scan",
+        "--pixels",
+        "4",
+        "--line-rate",
+        "20",
+        "--json",
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let col = |k: &str| -> Vec<f64> {
+        v[k].as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let dirs: Vec<&str> = v["direction"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        dirs,
+        ["trace"; 4]
+            .iter()
+            .chain(["retrace"; 4].iter())
+            .copied()
+            .collect::<Vec<_>>()
+    );
+    let (z, phase, ratio) = (
+        col("topography_m"),
+        col("phase_deg"),
+        col("amplitude_ratio"),
+    );
+    // Settled pixels (the second of each material on the trace) hold the setpoint.
+    for i in [1, 3] {
+        assert!((ratio[i] - 0.8).abs() < 1e-4, "pixel {i}: {}", ratio[i]);
+    }
+    assert!(
+        z[3] < z[1] - 0.5e-9,
+        "B imaged {:e} m against A {:e} m",
+        z[3],
+        z[1]
+    );
+    assert!(
+        phase[3] > phase[1] + 2.0,
+        "φ {} on B, {} on A",
+        phase[3],
+        phase[1]
+    );
+    // The retrace meets B first, at the x it left it.
+    let x = col("x_m");
+    assert_eq!(x[4], x[3]);
+    let dir = common::scratch("scan");
+    let sample = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let material = "[[material]]\nname = \"A\"\n";
+    let region = "[[region]]\nuntil = \"1um\"\nmaterial = \"A\"\n";
+    for (args, says) in [
+        (vec!["--pixels", "0"], "--pixels is from 1 to 4096"),
+        (vec!["--line-rate", "0"], "line rate"),
+        (vec!["--line-rate", "1e-3"], "drive periods a pixel"),
+        (
+            vec!["--separation", "16nm"],
+            "the feedback sets the separation",
+        ),
+        (vec!["--lockin-order", "5"], "lock-in filter order"),
+        (
+            vec![
+                "--sample",
+                &sample(
+                    "a.toml",
+                    &format!("length = \"1um\"\nwidth = 3\n{material}{region}"),
+                ),
+            ],
+            "unknown key width",
+        ),
+        (
+            vec![
+                "--sample",
+                &sample(
+                    "b.toml",
+                    &format!(
+                        "length = \"1um\"\n{material}[[region]]\nuntil = \"1um\"\nmaterial = \"C\"\n"
+                    ),
+                ),
+            ],
+            "names material C, which is not given",
+        ),
+        (
+            vec![
+                "--sample",
+                &sample("c.toml", &format!("length = \"2um\"\n{material}{region}")),
+            ],
+            "short of the line",
+        ),
+        (
+            vec![
+                "--sample",
+                &sample(
+                    "d.toml",
+                    &format!("length = \"1um\"\n{material}separation = \"10nm\"\n{region}"),
+                ),
+            ],
+            "is the instrument's, not a material's",
+        ),
+        (
+            vec![
+                "--sample",
+                &sample(
+                    "e.toml",
+                    &format!(
+                        "length = \"1um\"\n{material}[[material]]\nname = \"B\"\nstiffness = \"2N/m\"\n{region}"
+                    ),
+                ),
+            ],
+            "differ in the cantilever",
+        ),
+    ] {
+        let mut all = vec!["scan", "--quiet"];
+        all.extend(args.iter().copied());
+        let out = common::tapsim(&all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{all:?}: {err}");
+        assert!(err.contains(says), "{all:?}: {err}");
+    }
+}
+
+/// Scanned fast over a 2 nm step (94 drive periods a pixel, a stiffer loop), the known
+/// artefacts of the z feedback appear: the topography overshoots the step up, and after
+/// the step down (on the retrace) the amplitude runs above the setpoint while the tip
+/// loses the sample.
+#[test]
+fn a_fast_scan_shows_the_feedback_artefacts() {
+    let out = common::tapsim(&[
+        "scan",
+        "--sample",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/examples/samples/step.toml"),
+        "--line-rate",
+        "100",
+        "--integral-gain",
+        "0.01",
+        "--json",
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let col = |k: &str| -> Vec<f64> {
+        v[k].as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let (z, ratio) = (col("topography_m"), col("amplitude_ratio"));
+    let (trace, retrace) = (&z[..32], &ratio[32..]);
+    let settled = trace[31];
+    let peak = trace[16..].iter().copied().fold(f64::MIN, f64::max);
+    assert!(peak > settled + 0.1e-9, "overshoot {:e} m", peak - settled);
+    let high = retrace.iter().copied().fold(f64::MIN, f64::max);
+    assert!(high > 0.85, "highest amplitude on the retrace {high}");
 }

@@ -28,6 +28,7 @@ mod lj;
 mod map;
 mod merge;
 mod reproduce;
+mod scan;
 mod shard;
 mod tap;
 
@@ -56,6 +57,7 @@ enum Command {
     Bifurcation(bifurcation::BifurcationArgs),
     Contrast(contrast::ContrastArgs),
     Map(map::MapArgs),
+    Scan(scan::ScanArgs),
     Batch(batch::BatchArgs),
     Merge(merge::MergeArgs),
     Hysteresis(hysteresis::HysteresisArgs),
@@ -308,6 +310,7 @@ pub fn main() -> ExitCode {
         Command::Bifurcation(args) => bifurcation::run(args),
         Command::Contrast(args) => contrast::run(args),
         Command::Map(args) => map::run(args),
+        Command::Scan(args) => scan::run(args),
         Command::Batch(args) => batch::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),

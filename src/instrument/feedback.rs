@@ -30,7 +30,13 @@ impl PiController {
     /// A controller holding `setpoint` (0 < A/A₀ < 1) with gains K_p, K_i ≥ 0 (not both
     /// zero).
     pub fn new(setpoint: f64, proportional: f64, integral: f64) -> Result<Self> {
-        crate::setpoint::check_ratio(setpoint)?;
+        if !(setpoint > 0.0 && setpoint < 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "amplitude setpoint A/A0",
+                value: setpoint,
+                reason: "the amplitude of a tip that touches lies between 0 and A₀",
+            });
+        }
         for (name, g) in [
             ("proportional gain", proportional),
             ("integral gain", integral),

@@ -35,7 +35,7 @@ pub struct Pixel {
     pub topography_m: f64,
     /// The lock-in amplitude ratio A/A₀.
     pub amplitude_ratio: f64,
-    /// The amplitude error A/A₀ − setpoint.
+    /// The amplitude error A/A₀ − setpoint (0 where below 1e-12: round-off).
     pub error: f64,
     /// The lock-in phase, degrees.
     pub phase_deg: f64,
@@ -46,7 +46,8 @@ pub struct Pixel {
 /// loop already holding the setpoint from the piezo position `start_z_m` and the
 /// oscillator state `phase` (as [`super::feedback::hold`] leaves them over the first
 /// region, say). All
-/// materials must share the cantilever (its drive period sets the time).
+/// materials must share the cantilever (its drive period sets the time). `progress` is
+/// told each pixel done. Returns the pixels and the piezo position at the end.
 pub fn line(
     materials: &[Prepared],
     regions: &[Region],
@@ -54,7 +55,8 @@ pub fn line(
     (lockin, controller): (&mut LockIn, &mut PiController),
     start_z_m: f64,
     phase: &mut Phase,
-) -> Result<Vec<Pixel>> {
+    mut progress: impl FnMut(usize),
+) -> Result<(Vec<Pixel>, f64)> {
     if regions.is_empty() || regions.iter().any(|r| r.material >= materials.len()) {
         return Err(Error::NotApplicable(
             "a scanned sample needs regions, each naming one of its materials".into(),
@@ -99,9 +101,28 @@ pub fn line(
             x_m: step * periods_per_pixel as f64 * (i as f64 + 0.5),
             topography_m: sum[0] / n,
             amplitude_ratio: sum[1] / n,
-            error: sum[2] / n,
+            // (A mean error below 1e-12 is the round-off of a loop that holds.)
+            error: if (sum[2] / n).abs() < 1e-12 {
+                0.0
+            } else {
+                sum[2] / n
+            },
             phase_deg: sum[3] / n,
         });
+        progress(i + 1);
     }
-    Ok(out)
+    Ok((out, z))
+}
+
+/// `regions` of a line of length `length_m` as the retrace meets them: x mirrored.
+pub fn mirrored(regions: &[Region], length_m: f64) -> Vec<Region> {
+    let mut out = Vec::with_capacity(regions.len());
+    for (i, r) in regions.iter().enumerate().rev() {
+        let start = if i == 0 { 0.0 } else { regions[i - 1].until_m };
+        out.push(Region {
+            until_m: length_m - start,
+            ..*r
+        });
+    }
+    out
 }

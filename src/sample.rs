@@ -1,0 +1,224 @@
+//! A sample to scan, read from a TOML file: its materials (each any of `tap`'s sample
+//! and law parameters over the run's own) and their layout along the scan line.
+//!
+//! ```toml
+//! length = "1um"               # the scan line
+//! [[material]]
+//! name = "A"
+//! sample-modulus = "0.5GPa"
+//! work-of-adhesion = 0.1
+//! [[material]]
+//! name = "B"
+//! sample-modulus = "1GPa"
+//! [[region]]                   # from the end of the last region (or 0)
+//! until = "0.5um"              # to here,
+//! material = "A"               # this material,
+//! height = "0nm"               # its surface this high (default 0)
+//! [[region]]
+//! until = "1um"
+//! material = "B"
+//! ```
+
+use crate::config::{MAX_CONFIG_BYTES, TapInputs, read_text};
+use crate::dynamics::setup::TapSetup;
+use crate::error::{Error, Result};
+use crate::instrument::scan::Region;
+use std::path::Path;
+
+/// The most materials and regions a sample holds.
+pub const MAX_MATERIALS: usize = 64;
+/// The most regions along a line.
+pub const MAX_REGIONS: usize = 10_000;
+
+/// A sample: named materials over a common cantilever, and their layout.
+#[derive(Debug, Clone)]
+pub struct Sample {
+    /// The line's length in m.
+    pub length_m: f64,
+    /// Each material's name and setup.
+    pub materials: Vec<(String, TapSetup)>,
+    /// The layout along x.
+    pub regions: Vec<Region>,
+}
+
+/// The built-in sample: a flat blend of the two polymers `contrast` compares, A
+/// (E = 0.5 GPa, Δγ = 0.1 J/m², the defaults) on the first half of a 1 µm line and B
+/// (E = 1 GPa, Δγ = 0.08 J/m²) on the second.
+pub const BLEND: &str = r#"
+length = "1um"
+[[material]]
+name = "A"
+sample-modulus = "0.5GPa"
+work-of-adhesion = 0.1
+[[material]]
+name = "B"
+sample-modulus = "1GPa"
+work-of-adhesion = 0.08
+[[region]]
+until = "0.5um"
+material = "A"
+[[region]]
+until = "1um"
+material = "B"
+"#;
+
+impl Sample {
+    /// Read a sample file (at most [`MAX_CONFIG_BYTES`]), each material over `base`.
+    pub fn from_file(path: &Path, base: &TapInputs) -> Result<Self> {
+        let refuse = |reason: String| Error::Parse {
+            name: "sample",
+            text: path.display().to_string(),
+            reason,
+        };
+        let text = read_text(path, MAX_CONFIG_BYTES, refuse)?;
+        Self::from_toml(&text, base).map_err(|e| match e {
+            Error::Parse { name, text, reason } => Error::Parse {
+                name,
+                text,
+                reason: format!("{reason} (in {})", path.display()),
+            },
+            other => other,
+        })
+    }
+
+    /// Parse a sample description, each material over `base`.
+    pub fn from_toml(text: &str, base: &TapInputs) -> Result<Self> {
+        let bad = |reason: String| Error::Parse {
+            name: "sample",
+            text: String::new(),
+            reason,
+        };
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+            bad(format!("not valid TOML: {}", e.to_string().trim_end()))
+        })?;
+        for key in table.keys() {
+            if !["length", "material", "region"].contains(&key.as_str()) {
+                return Err(bad(format!(
+                    "unknown key {key}; a sample has length, [[material]] and [[region]]"
+                )));
+            }
+        }
+        let length_m = match table.get("length") {
+            Some(v) => crate::config::length(&value_text(v, "length")?).map_err(bad)?,
+            None => return Err(bad("the line's length is missing (length = \"1um\")".into())),
+        };
+        crate::error::positive("sample length", length_m)?;
+        let list = |key: &str| -> Result<Vec<toml::Table>> {
+            match table.get(key) {
+                Some(toml::Value::Array(items)) => items
+                    .iter()
+                    .map(|v| match v {
+                        toml::Value::Table(t) => Ok(t.clone()),
+                        _ => Err(bad(format!("each {key} is a table ([[{key}]])"))),
+                    })
+                    .collect(),
+                Some(_) => Err(bad(format!("{key} is a list of tables ([[{key}]])"))),
+                None => Err(bad(format!("no [[{key}]] given"))),
+            }
+        };
+        let mut materials: Vec<(String, TapSetup)> = Vec::new();
+        for m in list("material")? {
+            let Some(toml::Value::String(name)) = m.get("name") else {
+                return Err(bad("every [[material]] has a name (name = \"A\")".into()));
+            };
+            if materials.iter().any(|(n, _)| n == name) {
+                return Err(bad(format!("material {name} is given twice")));
+            }
+            let mut inputs = TapInputs::default();
+            for (key, value) in m.iter().filter(|(k, _)| *k != "name") {
+                if ["separation", "setpoint", "amplitude-setpoint", "branch"]
+                    .contains(&key.as_str())
+                {
+                    return Err(bad(format!(
+                        "material {name}: {key} is the instrument's, not a material's"
+                    )));
+                }
+                inputs.set(key, &value_text(value, key)?)?;
+            }
+            let (setup, _) = inputs.or(base.clone()).resolve()?;
+            setup.check_plausible()?;
+            if let Some((first, s)) = materials.first()
+                && s.cantilever != setup.cantilever
+            {
+                return Err(bad(format!(
+                    "materials {first} and {name} differ in the cantilever: one tip scans them all"
+                )));
+            }
+            materials.push((name.clone(), setup));
+        }
+        if materials.len() > MAX_MATERIALS {
+            return Err(bad(format!("more than {MAX_MATERIALS} materials")));
+        }
+        let mut regions: Vec<Region> = Vec::new();
+        for r in list("region")? {
+            for key in r.keys() {
+                if !["until", "material", "height"].contains(&key.as_str()) {
+                    return Err(bad(format!(
+                        "unknown key {key} in a region (until, material, height)"
+                    )));
+                }
+            }
+            let until_m = match r.get("until") {
+                Some(v) => crate::config::length(&value_text(v, "until")?).map_err(bad)?,
+                None => return Err(bad("every [[region]] says where it ends (until)".into())),
+            };
+            let Some(toml::Value::String(name)) = r.get("material") else {
+                return Err(bad("every [[region]] names its material".into()));
+            };
+            let Some(material) = materials.iter().position(|(n, _)| n == name) else {
+                return Err(bad(format!(
+                    "region names material {name}, which is not given"
+                )));
+            };
+            let height_m = match r.get("height") {
+                Some(v) => crate::config::length(&value_text(v, "height")?).map_err(bad)?,
+                None => 0.0,
+            };
+            let start = regions.last().map_or(0.0, |r| r.until_m);
+            if !(until_m > start && until_m <= length_m * (1.0 + 1e-12)) {
+                return Err(bad(format!(
+                    "region ends ({until_m:e} m) must rise from {start:e} m and stay within \
+                     the line ({length_m:e} m)"
+                )));
+            }
+            if height_m.is_nan() || height_m.abs() > 1e-6 {
+                return Err(bad(format!(
+                    "a region's height ({height_m:e} m) is at most 1 µm either way"
+                )));
+            }
+            regions.push(Region {
+                until_m,
+                material,
+                height_m,
+            });
+            if regions.len() > MAX_REGIONS {
+                return Err(bad(format!("more than {MAX_REGIONS} regions")));
+            }
+        }
+        let end = regions.last().expect("a list is never empty").until_m;
+        if end < length_m * (1.0 - 1e-12) {
+            return Err(bad(format!(
+                "the regions end at {end:e} m, short of the line ({length_m:e} m)"
+            )));
+        }
+        Ok(Self {
+            length_m,
+            materials,
+            regions,
+        })
+    }
+}
+
+/// A TOML value as the text a quantity is parsed from.
+fn value_text(value: &toml::Value, key: &str) -> Result<String> {
+    match value {
+        toml::Value::Float(f) => Ok(f.to_string()),
+        toml::Value::Integer(i) => Ok(i.to_string()),
+        toml::Value::String(s) => Ok(s.clone()),
+        other => Err(Error::Parse {
+            name: "sample value",
+            text: other.to_string(),
+            reason: format!("{key} must be a number or a string with a unit"),
+        }),
+    }
+}
