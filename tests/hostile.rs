@@ -134,6 +134,19 @@ fn flag(command: &'static str) -> impl Strategy<Value = Vec<String>> {
             "--csv",
         ],
         "bifurcation" => &["--points", "--samples", "--from", "--to", "--csv", "--json"],
+        "scan" => &[
+            "--setpoint",
+            "--pixels",
+            "--line-rate",
+            "--integral-gain",
+            "--proportional-gain",
+            "--lockin-order",
+            "--lockin-periods",
+            "--sample",
+            "--no-retrace",
+            "--json",
+            "--csv",
+        ],
         "contrast" => &["--setpoints", "--points", "--laws", "--material", "--csv"],
         "map" => &[
             "--adhesion-from",
@@ -159,14 +172,25 @@ fn flag(command: &'static str) -> impl Strategy<Value = Vec<String>> {
             "magic",
         ];
         let value = match name {
-            "--json" | "--no-retract" => return vec![name.to_string()],
+            "--json" | "--no-retract" | "--no-retrace" => return vec![name.to_string()],
+            "--sample" => ["no-such.toml", ".", "cfg.toml"][pick % 3].to_string(),
+            // (A valid slow scan runs long, with a progress bar: rates that are fast or
+            // refused.)
+            "--line-rate" => {
+                ["1e4", "0", "-1", "1e300", "x", "5e3", "NaN", "2e4"][pick].to_string()
+            }
+            "--lockin-periods" => {
+                ["0", "1", "2", "1e9", "-1", "x", "0.5", "1000"][pick].to_string()
+            }
             "--law" => law[pick % law.len()].to_string(),
             "--laws" => format!("{},{}", law[pick % law.len()], law[(pick + 3) % law.len()]),
             "--material" => format!("M{pick}:sample-modulus={value}"),
             "--csv" | "--trajectory" => format!("out{pick}.csv"),
             "--plot" => ["p.png", "p.svg", "p.pdf", "no/such/dir/p.png", "."][pick % 5].to_string(),
             "--points" | "--steps" | "--samples" | "--record-cycles" | "--threads"
-            | "--overlay" => ["0", "1", "2", "3", "-1", "1e9", "100000000", "x"][pick].to_string(),
+            | "--overlay" | "--pixels" | "--lockin-order" => {
+                ["0", "1", "2", "3", "-1", "1e9", "100000000", "x"][pick].to_string()
+            }
             _ => value,
         };
         vec![format!("{name}={value}")]
@@ -197,6 +221,10 @@ fn command_line(command: &'static str) -> impl Strategy<Value = Vec<String>> {
                 default("--setpoints", "0.5");
             }
             "map" => default("--steps", "2"),
+            "scan" => {
+                default("--pixels", "2");
+                default("--line-rate", "1e4");
+            }
             _ => {}
         }
         if command != "tap" {
@@ -425,6 +453,7 @@ fn hostile_sweep_command_lines() {
         command_line("bifurcation"),
         command_line("contrast"),
         command_line("map"),
+        command_line("scan"),
     ];
     runner()
         .run(&lines, |args| check(args, None, &dir))

@@ -62,7 +62,7 @@ pub struct ScanArgs {
     /// Lock-in filter order (1–4).
     #[arg(long, allow_hyphen_values = true, default_value_t = 4)]
     lockin_order: usize,
-    /// Lock-in time constant, in drive periods.
+    /// Lock-in time constant, in drive periods (at most 1000).
     #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 2.0)]
     lockin_periods: f64,
     /// Trace only.
@@ -104,6 +104,12 @@ pub fn run(args: ScanArgs) -> Result<()> {
         )));
     }
     crate::error::positive("line rate", args.line_rate)?;
+    if !(args.lockin_periods > 0.0 && args.lockin_periods <= 1000.0) {
+        return Err(Error::OutOfRange(format!(
+            "--lockin-periods is from above 0 to 1000 drive periods, not {}",
+            args.lockin_periods
+        )));
+    }
     let (_, numerics) = base.resolve()?;
     let prepared = sample
         .materials
@@ -120,9 +126,14 @@ pub fn run(args: ScanArgs) -> Result<()> {
     let total = per_pixel * args.pixels as f64 * directions;
     if !(per_pixel >= 1.0 && total <= MAX_PERIODS) {
         return Err(Error::OutOfRange(format!(
-            "{} pixels at {} lines/s is {per_pixel} drive periods a pixel, {total:.3e} in all: \
-             from 1 a pixel to {MAX_PERIODS:e} in all",
-            args.pixels, args.line_rate
+            "{} pixels at {} lines/s is {per_pixel:e} drive periods a pixel, {total:.3e} in \
+             all: from 1 a pixel to {MAX_PERIODS:e} in all",
+            args.pixels,
+            if (1e-3..1e6).contains(&args.line_rate) {
+                args.line_rate.to_string()
+            } else {
+                format!("{:e}", args.line_rate)
+            }
         )));
     }
     let per_pixel = per_pixel as usize;

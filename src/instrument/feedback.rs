@@ -13,6 +13,11 @@ use crate::dynamics::setup::Prepared;
 use crate::dynamics::steady::Phase;
 use crate::error::{Error, Result};
 
+/// The largest proportional gain K_p (A₀ per unit of A/A₀ error).
+pub const MAX_PROPORTIONAL: f64 = 10.0;
+/// The largest integral gain K_i (A₀ per unit of A/A₀ error and drive period).
+pub const MAX_INTEGRAL: f64 = 1.0;
+
 /// A PI controller on the amplitude error, in units of A₀ and drive periods.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PiController {
@@ -37,15 +42,17 @@ impl PiController {
                 reason: "the amplitude of a tip that touches lies between 0 and A₀",
             });
         }
-        for (name, g) in [
-            ("proportional gain", proportional),
-            ("integral gain", integral),
+        for (name, g, most) in [
+            ("proportional gain", proportional, MAX_PROPORTIONAL),
+            ("integral gain", integral, MAX_INTEGRAL),
         ] {
-            if !(g.is_finite() && g >= 0.0) {
+            if !(g >= 0.0 && g <= most) {
                 return Err(Error::InvalidParameter {
                     name,
                     value: g,
-                    reason: "a gain is a finite number ≥ 0",
+                    reason: "a gain lies from 0 to its most (10 for K_p, 1 for K_i): a \
+                             loop that moves the sample by A₀ and more per period on a \
+                             small error only throws the tip about",
                 });
             }
         }
