@@ -589,6 +589,29 @@ impl TapInputs {
         )
     }
 
+    /// These inputs holding the tip at the setpoint of a command's own flags (`tap`'s
+    /// and `map`'s --setpoint, --amplitude-setpoint, --branch), over the `--config`
+    /// file ([`Self::with_config`]).
+    pub fn holding(
+        self,
+        setpoint: Option<f64>,
+        amplitude_setpoint: Option<f64>,
+        branch: Option<BranchChoice>,
+    ) -> Result<Self> {
+        Self {
+            setpoint,
+            amplitude_setpoint,
+            branch,
+            ..self
+        }
+        .with_config()
+    }
+
+    /// Whether the tip is held at an amplitude setpoint (as A/A₀ or an amplitude).
+    pub fn holds_setpoint(&self) -> bool {
+        self.setpoint.is_some() || self.amplitude_setpoint.is_some()
+    }
+
     /// Flags over the `--config` file, if one was given.
     pub fn with_config(self) -> Result<Self> {
         Ok(match self.config.clone() {

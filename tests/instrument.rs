@@ -221,7 +221,7 @@ fn a_slow_scan_images_material_contrast_and_a_height_step() {
 /// larger phase lag (the attractive branch); bad samples and settings are refused.
 #[test]
 fn scan_images_the_built_in_blend_and_refuses_bad_samples() {
-    let out = common::tapsim(&[
+    let v = common::json(&[
         "scan",
         "--pixels",
         "4",
@@ -230,19 +230,7 @@ fn scan_images_the_built_in_blend_and_refuses_bad_samples() {
         "--json",
         "--quiet",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let col = |k: &str| -> Vec<f64> {
-        v[k].as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect()
-    };
+    let col = |k: &str| column(&v, k);
     let dirs: Vec<&str> = v["direction"]
         .as_array()
         .unwrap()
@@ -365,7 +353,7 @@ fn scan_images_the_built_in_blend_and_refuses_bad_samples() {
 /// loses the sample.
 #[test]
 fn a_fast_scan_shows_the_feedback_artefacts() {
-    let out = common::tapsim(&[
+    let v = common::json(&[
         "scan",
         "--sample",
         concat!(env!("CARGO_MANIFEST_DIR"), "/examples/samples/step.toml"),
@@ -376,19 +364,7 @@ fn a_fast_scan_shows_the_feedback_artefacts() {
         "--json",
         "--quiet",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let col = |k: &str| -> Vec<f64> {
-        v[k].as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect()
-    };
+    let col = |k: &str| column(&v, k);
     let (z, ratio) = (col("topography_m"), col("amplitude_ratio"));
     let (trace, retrace) = (&z[..32], &ratio[32..]);
     let settled = trace[31];
@@ -396,4 +372,14 @@ fn a_fast_scan_shows_the_feedback_artefacts() {
     assert!(peak > settled + 0.1e-9, "overshoot {:e} m", peak - settled);
     let high = retrace.iter().copied().fold(f64::MIN, f64::max);
     assert!(high > 0.85, "highest amplitude on the retrace {high}");
+}
+
+/// A column of numbers of a command's JSON (an object of arrays).
+fn column(v: &serde_json::Value, key: &str) -> Vec<f64> {
+    v[key]
+        .as_array()
+        .unwrap_or_else(|| panic!("no column {key}"))
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
 }

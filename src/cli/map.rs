@@ -70,15 +70,11 @@ pub struct MapArgs {
 
 /// Run the subcommand.
 pub fn run(args: MapArgs) -> Result<()> {
-    let inputs = TapInputs {
-        setpoint: args.setpoint,
-        amplitude_setpoint: args.amplitude_setpoint,
-        branch: args.branch,
-        ..args.inputs.clone()
-    }
-    .with_config()?;
-    let held = inputs.setpoint.is_some() || inputs.amplitude_setpoint.is_some();
-    if held && inputs.separation.is_some() {
+    let inputs =
+        args.inputs
+            .clone()
+            .holding(args.setpoint, args.amplitude_setpoint, args.branch)?;
+    if inputs.holds_setpoint() && inputs.separation.is_some() {
         return Err(super::separation_and_setpoint());
     }
     let (setup, numerics) = inputs.resolve()?;

@@ -106,14 +106,11 @@ pub struct TapArgs {
 
 /// Run the subcommand.
 pub fn run(args: TapArgs) -> Result<()> {
-    let inputs = TapInputs {
-        setpoint: args.setpoint,
-        amplitude_setpoint: args.amplitude_setpoint,
-        branch: args.branch,
-        ..args.inputs.clone()
-    }
-    .with_config()?;
-    if inputs.setpoint.is_some() || inputs.amplitude_setpoint.is_some() {
+    let inputs =
+        args.inputs
+            .clone()
+            .holding(args.setpoint, args.amplitude_setpoint, args.branch)?;
+    if inputs.holds_setpoint() {
         return at_setpoint(&args, inputs);
     }
     let (setup, numerics) = inputs.resolve()?;
