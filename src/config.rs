@@ -335,6 +335,21 @@ impl BranchChoice {
     }
 }
 
+/// A TOML value of `key` as the text a quantity is parsed from (a number, or a string
+/// with a unit); anything else is refused as a `what` (the file's kind of value).
+pub fn value_text(value: &toml::Value, key: &str, what: &'static str) -> Result<String> {
+    match value {
+        toml::Value::Float(f) => Ok(f.to_string()),
+        toml::Value::Integer(i) => Ok(i.to_string()),
+        toml::Value::String(s) => Ok(s.clone()),
+        other => Err(Error::Parse {
+            name: what,
+            text: other.to_string(),
+            reason: format!("{key} must be a number or a string with a unit"),
+        }),
+    }
+}
+
 /// The largest parameter file read, in bytes.
 pub const MAX_CONFIG_BYTES: u64 = 64 * 1024;
 
@@ -493,19 +508,7 @@ impl TapInputs {
                 })?);
                 continue;
             }
-            let text = match value {
-                toml::Value::Float(f) => f.to_string(),
-                toml::Value::Integer(i) => i.to_string(),
-                toml::Value::String(s) => s.clone(),
-                other => {
-                    return Err(Error::Parse {
-                        name: "config value",
-                        text: other.to_string(),
-                        reason: format!("{key} must be a number or a string with a unit"),
-                    });
-                }
-            };
-            inputs.set(key, &text)?;
+            inputs.set(key, &value_text(value, key, "config value")?)?;
         }
         let held = [
             ("separation", inputs.separation),
@@ -605,6 +608,13 @@ impl TapInputs {
             ..self
         }
         .with_config()
+    }
+
+    /// The amplitude setpoint A/A₀ these inputs hold the tip at, if any: `setpoint`, or
+    /// `amplitude-setpoint` over the free amplitude `free_amplitude_m`.
+    pub fn setpoint_ratio(&self, free_amplitude_m: f64) -> Option<f64> {
+        self.setpoint
+            .or(self.amplitude_setpoint.map(|a| a / free_amplitude_m))
     }
 
     /// Whether the tip is held at an amplitude setpoint (as A/A₀ or an amplitude).

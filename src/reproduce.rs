@@ -407,18 +407,15 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         amplitude_ratio: MAP_SETPOINT,
         branch: crate::setpoint::PhaseBranch::Repulsive,
     };
-    let solve = |s: &TapSetup| {
-        let states = crate::setpoint::states_at_setpoint(
-            s,
-            &map_numerics,
-            setpoint.amplitude_ratio,
-            Some(setpoint.branch),
-        )?;
-        let first = states.into_iter().next().expect("a list is never empty");
-        Ok((first.observables, Some(first.separation_m)))
-    };
-    let at_setpoint =
-        sweep::map_cells_with(&map_setup, (&works, &moduli), &cells, 0, || {}, &solve)?;
+    let at_setpoint = crate::setpoint::map_cells(
+        &map_setup,
+        &map_numerics,
+        (&works, &moduli),
+        &cells,
+        0,
+        || {},
+        (setpoint.amplitude_ratio, setpoint.branch),
+    )?;
     for (stem, cells, caption, what) in [
         (
             "tap_map_separation",

@@ -20,6 +20,11 @@
 //! ```
 
 use crate::config::{MAX_CONFIG_BYTES, TapInputs, read_text};
+
+/// A TOML value of a sample file as text ([`crate::config::value_text`]).
+fn value_text(value: &toml::Value, key: &str) -> Result<String> {
+    crate::config::value_text(value, key, "sample value")
+}
 use crate::dynamics::setup::TapSetup;
 use crate::error::{Error, Result};
 use crate::instrument::scan::Region;
@@ -206,19 +211,5 @@ impl Sample {
             materials,
             regions,
         })
-    }
-}
-
-/// A TOML value as the text a quantity is parsed from.
-fn value_text(value: &toml::Value, key: &str) -> Result<String> {
-    match value {
-        toml::Value::Float(f) => Ok(f.to_string()),
-        toml::Value::Integer(i) => Ok(i.to_string()),
-        toml::Value::String(s) => Ok(s.clone()),
-        other => Err(Error::Parse {
-            name: "sample value",
-            text: other.to_string(),
-            reason: format!("{key} must be a number or a string with a unit"),
-        }),
     }
 }

@@ -206,13 +206,19 @@ fn far_from_the_sample(p: &Prepared) -> Result<BranchRecord> {
 /// The steady state at rest separation `z_m` started from `phase` (left on it).
 fn settled(p: &Prepared, z_m: f64, phase: &mut Phase) -> Result<BranchRecord> {
     let state = p.simulation_at(z_m)?.steady_state(phase, &p.steady)?;
-    Ok(BranchRecord {
-        separation_m: z_m,
+    Ok(record(z_m, TapObservables::new(p, &state)?, *phase))
+}
+
+/// A state found by settling or solving at `separation_m`, as an orbit of a family
+/// (one piece, a regular point) for the bracketing and refining that follow.
+fn record(separation_m: f64, observables: TapObservables, phase: Phase) -> BranchRecord {
+    BranchRecord {
+        separation_m,
         segment: 0,
         point: sweep::BranchPointKind::Regular,
-        observables: TapObservables::new(p, &state)?,
-        phase: *phase,
-    })
+        observables,
+        phase,
+    }
 }
 
 /// Walk the rest separation from the state `here` to the setpoint `ratio`, as a z
@@ -266,13 +272,7 @@ fn hold(
     if held(&a) && held(&b) && other == side {
         if let Some(s) = refine(p, (&a, &b), ratio, side, free)? {
             // Carry on from the state at the setpoint.
-            *here = BranchRecord {
-                separation_m: s.separation_m,
-                segment: 0,
-                point: sweep::BranchPointKind::Regular,
-                observables: s.observables.clone(),
-                phase: s.phase,
-            };
+            *here = record(s.separation_m, s.observables.clone(), s.phase);
             return Ok(Ok(s));
         }
     }
@@ -431,13 +431,7 @@ fn seed_at(
             let Ok(state) = sim.steady_state(&mut phase, &p.steady) else {
                 return Ok(None);
             };
-            BranchRecord {
-                separation_m: q * a0,
-                segment: 0,
-                point: sweep::BranchPointKind::Regular,
-                observables: TapObservables::new(p, &state)?,
-                phase,
-            }
+            record(q * a0, TapObservables::new(p, &state)?, phase)
         }
     };
     let o = &seed.observables;

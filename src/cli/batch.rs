@@ -235,9 +235,7 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
     let (setup, numerics) = inputs.resolve().map_err(at)?;
     // A value `tap` refuses refuses the batch here, before any case runs.
     setup.check_plausible().map_err(at)?;
-    let setpoint = inputs.setpoint.or(inputs
-        .amplitude_setpoint
-        .map(|a| a / setup.cantilever.free_amplitude_m));
+    let setpoint = inputs.setpoint_ratio(setup.cantilever.free_amplitude_m);
     let branch = inputs
         .branch
         .unwrap_or(crate::config::BranchChoice::All)

@@ -78,10 +78,7 @@ pub fn run(args: MapArgs) -> Result<()> {
         return Err(super::separation_and_setpoint());
     }
     let (setup, numerics) = inputs.resolve()?;
-    let ratio = inputs.setpoint.or(inputs
-        .amplitude_setpoint
-        .map(|a| a / setup.cantilever.free_amplitude_m));
-    let setpoint = match ratio {
+    let setpoint = match inputs.setpoint_ratio(setup.cantilever.free_amplitude_m) {
         None => None,
         Some(amplitude_ratio) => {
             crate::setpoint::check_ratio(amplitude_ratio)?;

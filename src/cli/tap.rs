@@ -170,11 +170,9 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
         ));
     }
     let (setup, numerics) = inputs.resolve()?;
-    let ratio = match (inputs.setpoint, inputs.amplitude_setpoint) {
-        (Some(r), _) => r,
-        (None, Some(a)) => a / setup.cantilever.free_amplitude_m,
-        (None, None) => unreachable!("called with a setpoint"),
-    };
+    let ratio = inputs
+        .setpoint_ratio(setup.cantilever.free_amplitude_m)
+        .expect("called with a setpoint");
     let branch = inputs.branch.unwrap_or(BranchChoice::All).only();
     let spinner = spinner("following the period-1 families to the setpoint");
     let states = states_at_setpoint(&setup, &numerics, ratio, branch);

@@ -70,19 +70,18 @@ pub fn line(
     }
     let a0 = materials[0].setup.cantilever.free_amplitude_m;
     let step = length_m / (pixels * periods_per_pixel) as f64;
-    let at = |x: f64| {
-        regions
-            .iter()
-            .find(|r| x < r.until_m)
-            .unwrap_or(regions.last().expect("regions is not empty"))
-    };
+    // The region under the tip: x only grows, so the index only moves on.
+    let mut under = 0;
     let mut z = start_z_m;
     let mut out = Vec::with_capacity(pixels);
     for i in 0..pixels {
         let mut sum = [0.0; 4];
         for j in 0..periods_per_pixel {
             let x = step * (i * periods_per_pixel + j) as f64;
-            let region = at(x);
+            while under + 1 < regions.len() && x >= regions[under].until_m {
+                under += 1;
+            }
+            let region = &regions[under];
             let p = &materials[region.material];
             p.simulation_at(z - region.height_m)?
                 .march(phase, 1, lockin)?;

@@ -76,10 +76,13 @@ impl MapRecord for Box<RawValue> {
 /// topography image shows over a flat sample of the cells' materials. `None` where a
 /// cell has no rest separation.
 pub fn apparent_heights<T: MapRecord>(cells: &[T]) -> Vec<Option<f64>> {
-    let z: Vec<Option<f64>> = cells
-        .iter()
-        .map(|c| c.plotted().and_then(|p| p.1))
-        .collect();
+    let plotted: Vec<Plotted> = cells.iter().map(MapRecord::plotted).collect();
+    heights_of(&plotted)
+}
+
+/// [`apparent_heights`] from the cells' plotted values.
+fn heights_of(plotted: &[Plotted]) -> Vec<Option<f64>> {
+    let z: Vec<Option<f64>> = plotted.iter().map(|p| p.and_then(|p| p.1)).collect();
     let reference = z.iter().flatten().next().copied();
     z.iter()
         .map(|z| z.zip(reference).map(|(z, r)| z - r))
@@ -100,7 +103,7 @@ pub fn heat_maps<T: MapRecord>(
     cells: &[T],
 ) -> Vec<HeatMap> {
     let plotted: Vec<Plotted> = cells.iter().map(MapRecord::plotted).collect();
-    let heights = apparent_heights(cells);
+    let heights = heights_of(&plotted);
     let at = setpoint.map_or(String::new(), |s| format!(" at {s}"));
     let map = |title: &str, value_label: &str, value: &dyn Fn(usize, &[f64; 4]) -> f64| HeatMap {
         title: format!("{law} law{at}: {title}"),
