@@ -383,3 +383,50 @@ fn column(v: &serde_json::Value, key: &str) -> Vec<f64> {
         .map(|x| x.as_f64().unwrap())
         .collect()
 }
+
+/// A sample whose first region is raised: the loop engages there and the line starts
+/// with the piezo that much higher (rest separation of the defaults at 0.8 plus the
+/// height), holding the setpoint from the first pixel on.
+#[test]
+fn a_scan_over_a_raised_first_region_starts_at_its_height() {
+    use tapsim::setpoint::{PhaseBranch, states_at_setpoint};
+    let dir = common::scratch("raised");
+    let path = dir.join("raised.toml");
+    std::fs::write(
+        &path,
+        "length = \"1um\"\n[[material]]\nname = \"A\"\n[[region]]\nuntil = \"1um\"\n\
+         material = \"A\"\nheight = \"1nm\"\n",
+    )
+    .unwrap();
+    let v = common::json(&[
+        "scan",
+        "--sample",
+        path.to_str().unwrap(),
+        "--pixels",
+        "2",
+        "--line-rate",
+        "1e3",
+        "--no-retrace",
+        "--json",
+        "--quiet",
+    ]);
+    let rest = states_at_setpoint(
+        &default_setup(),
+        &Numerics::default(),
+        0.8,
+        Some(PhaseBranch::Attractive),
+    )
+    .unwrap()[0]
+        .separation_m;
+    for (z, ratio) in column(&v, "topography_m")
+        .into_iter()
+        .zip(column(&v, "amplitude_ratio"))
+    {
+        assert!(
+            (z - (rest + 1e-9)).abs() < 0.01e-9,
+            "piezo {z:e} m, want {:e}",
+            rest + 1e-9
+        );
+        assert!((ratio - 0.8).abs() < 1e-4, "A/A₀ {ratio}");
+    }
+}

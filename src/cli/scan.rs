@@ -143,13 +143,15 @@ pub fn run(args: ScanArgs) -> Result<()> {
     let a0 = first.setup.cantilever.free_amplitude_m;
     let bar = args.out.progress_bar(args.pixels * directions as usize + 1);
     let mut phase = sim.free_steady_start();
-    let (_, mut z) = hold(
+    // The loop holds the rest separation; the piezo stands that much above the surface.
+    let (_, rest) = hold(
         first,
-        (1.2 * a0 + sample.regions[0].height_m, &mut phase),
+        (1.2 * a0, &mut phase),
         &mut lockin,
         &mut controller,
         ENGAGE_PERIODS,
     )?;
+    let mut z = rest + sample.regions[0].height_m;
     bar.inc(1);
     let mut rows = Vec::new();
     let mut layouts = vec![("trace", sample.regions.clone())];
