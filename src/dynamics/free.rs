@@ -111,7 +111,7 @@ impl FreeFlight {
 
     /// (x, x') at τ_a + k·h for k = 0, 1, 2, …, by rotating the phasors of both parts
     /// instead of calling sin, cos and exp at every sample.
-    fn samples(&self, tau_a: f64, h: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
+    pub(crate) fn samples(&self, tau_a: f64, h: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
         let t = tau_a - self.tau0;
         let (mut s, mut c) = (self.omega * tau_a).sin_cos();
         let (mut sd, mut cd) = (self.omega_d * t).sin_cos();
