@@ -10,9 +10,9 @@
 //! where its phase lag lies above the free oscillator's (90° at resonance), repulsive
 //! below (García & San Paulo, PRB 60, 4961, 1999).
 
+use crate::dynamics::march::Phase;
 use crate::dynamics::observables::TapObservables;
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
-use crate::dynamics::steady::Phase;
 use crate::error::{Error, Result};
 use crate::sweep::{self, BranchRecord};
 use serde::Serialize;

@@ -345,7 +345,7 @@ pub struct BranchRecord {
     /// The oscillator's state on the orbit at the drive phase (to start a neighbouring
     /// steady state from; not written out).
     #[serde(skip)]
-    pub phase: crate::dynamics::steady::Phase,
+    pub phase: crate::dynamics::march::Phase,
 }
 
 impl BranchRecord {
@@ -356,7 +356,8 @@ impl BranchRecord {
         segment: usize,
     ) -> Result<Self> {
         use crate::dynamics::continuation::PointKind;
-        use crate::dynamics::steady::{Motion, StdErr, SteadyState};
+        use crate::dynamics::steady::{Motion, SteadyState};
+        use crate::dynamics::window::StdErr;
         let state = SteadyState {
             window: b.integrals,
             cycles: 1,

@@ -7,7 +7,7 @@ use tapsim::dynamics::continuation::{
 };
 use tapsim::dynamics::numeric::Ignore;
 use tapsim::dynamics::setup::{Numerics, Prepared, TapSetup, default_setup};
-use tapsim::dynamics::steady::Multipliers;
+use tapsim::dynamics::shooting::Multipliers;
 use tapsim::law::LawKind;
 use tapsim::sweep::{self, Direction};
 

@@ -4,11 +4,12 @@
 use std::f64::consts::PI;
 use tapsim::contact::hybrid::JumpIn;
 use tapsim::dynamics::base_drive::{self, BaseDriveOptions};
+use tapsim::dynamics::march::{Phase, Simulation};
 use tapsim::dynamics::model::{Coupling, Drive, Oscillator};
 use tapsim::dynamics::numeric::Tolerances;
 use tapsim::dynamics::observables::{Observe, TapObservables, tap};
 use tapsim::dynamics::setup::{Numerics, TapSetup, default_setup};
-use tapsim::dynamics::steady::{Phase, Simulation, SteadyOptions};
+use tapsim::dynamics::steady::SteadyOptions;
 use tapsim::law::{Branch, ForceLaw, LawKind, LawSpec, NoForce};
 
 /// The observables of `law` on the defaults at rest separation `separation_nm`.

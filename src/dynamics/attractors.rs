@@ -6,9 +6,9 @@
 //! reached from a set of documented starts, at the production tolerance and 100× below
 //! it, with how many starts reached each.
 
+use super::march::{Phase, Simulation};
 use super::observables::TapObservables;
 use super::setup::{Numerics, Prepared, TapSetup};
-use super::steady::{Phase, Simulation};
 use crate::error::Result;
 use crate::law::AnyLaw;
 use rayon::prelude::*;

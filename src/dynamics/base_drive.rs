@@ -2,9 +2,9 @@
 //! enough damping that the ringing after each jump dies out, so the cantilever behaves
 //! quasi-statically and must lose per cycle the finite-stiffness hysteresis (26).
 
+use super::march::{Phase, Simulation};
 use super::model::{Coupling, Drive, Oscillator};
 use super::numeric::{Ignore, Tolerances};
-use super::steady::{Phase, Simulation};
 use crate::contact::hybrid::JumpIn;
 use crate::contact::spring;
 use crate::error::{Error, Result, positive};

@@ -16,7 +16,8 @@
 //! for an orbit that grazes a switch it shrinks to nothing, and the answer is what
 //! marching reaches.
 
-use super::steady::{Phase, Simulation, SteadyState};
+use super::march::{Phase, Simulation};
+use super::steady::SteadyState;
 use crate::law::{Branch, ForceLaw};
 use nalgebra::{DMatrix, DVector};
 

@@ -16,7 +16,8 @@
 //! an orbit grazes a switch (it just starts to touch, or a hysteretic law's tip stalls at
 //! a fold) it is not, and the continuation may stop there; [`Stop`] says why.
 
-use super::steady::{CycleIntegrals, Multipliers, Phase, Simulation, eigenvalues};
+use super::march::{CycleIntegrals, Phase, Simulation};
+use super::shooting::{Multipliers, eigenvalues};
 use crate::error::{Error, Result};
 use crate::law::ForceLaw;
 use nalgebra::{Complex, DMatrix, DVector, Vector3};

@@ -4,10 +4,11 @@ use super::attractors::{Attractor, DEFAULT_STARTS, MAX_STARTS, Start, attractors
 use super::budget;
 use super::free::FreeFlight;
 use super::harmonics::{Harmonic, HarmonicsObserver};
+use super::march::CycleIntegrals;
 use super::model::{Coupling, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver, hermite, internal_at};
 use super::setup::{Numerics, Prepared, TapSetup};
-use super::steady::{CycleIntegrals, Motion, SteadyState};
+use super::steady::{Motion, SteadyState};
 use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw, Internal};
 use crate::params::ELECTRONVOLT_J;

@@ -3,9 +3,10 @@
 
 use super::budget;
 use super::grazing::{ROOM_TEMPERATURE_K, thermal_rms_m};
+use super::march::Simulation;
 use super::model::{Coupling, Drive, Oscillator};
 use super::numeric::Tolerances;
-use super::steady::{MARCHING_TOLERANCE, MIN_CYCLES, Simulation, SteadyOptions};
+use super::steady::{MARCHING_TOLERANCE, MIN_CYCLES, SteadyOptions};
 use crate::error::{Error, Result, finite, positive};
 use crate::law::{AnyLaw, LawKind, LawSpec};
 use crate::params::{Contact, composite_modulus};

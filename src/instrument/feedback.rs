@@ -9,8 +9,8 @@
 //! instrument records as topography.
 
 use super::lockin::LockIn;
+use crate::dynamics::march::Phase;
 use crate::dynamics::setup::Prepared;
-use crate::dynamics::steady::Phase;
 use crate::error::{Error, Result};
 
 /// The largest proportional gain K_p (A₀ per unit of A/A₀ error).

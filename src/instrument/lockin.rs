@@ -270,10 +270,11 @@ mod tests {
     fn the_clock_follows_tau_moved_back_by_whole_periods() {
         let mut l = LockIn::new(1, 10.0, 1.0).unwrap();
         let period = 2.0 * std::f64::consts::PI;
-        assert_eq!(l.samples_in(0.0, 0.5 * period), 0..17);
-        assert_eq!(l.samples_in(0.5 * period, period), 17..33);
+        let s = SAMPLES_PER_PERIOD as i64;
+        assert_eq!(l.samples_in(0.0, 0.5 * period), 0..s / 2 + 1);
+        assert_eq!(l.samples_in(0.5 * period, period), s / 2 + 1..s + 1);
         // The marcher moves τ back by a period: the same instant, the sample at τ = T
-        // (index 32) not taken again as index 0.
-        assert_eq!(l.samples_in(0.0, 0.25 * period), 1..9);
+        // (index S) not taken again as index 0.
+        assert_eq!(l.samples_in(0.0, 0.25 * period), 1..s / 4 + 1);
     }
 }

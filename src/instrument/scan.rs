@@ -12,7 +12,7 @@
 use super::feedback::PiController;
 use super::lockin::LockIn;
 use crate::dynamics::setup::Prepared;
-use crate::dynamics::steady::Phase;
+use crate::dynamics::march::Phase;
 use crate::error::{Error, Result};
 
 /// A stretch of the sample along x.

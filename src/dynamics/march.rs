@@ -1,0 +1,691 @@
+//! The marcher: the cantilever integrated in time, one drive period after another, as
+//! a chain of segments, one per branch: closed-form free flight where the law is
+//! force-free out of contact (and the oscillator is force-driven and underdamped),
+//! Dopri5 otherwise; every branch switch is located and the next segment restarts from
+//! the located state. The carried integrals give the energies, Fourier projections, mean
+//! force and virial of each period; with the variational equations (and a saltation
+//! matrix at every switch) a period also gives the exact derivative of the period map.
+//!
+//! The steady-state solver ([`super::steady`]) and the instrument
+//! ([`crate::instrument`]) both march with it: the solver period by period, the
+//! instrument watching every step ([`StepObserver`]).
+
+use super::budget;
+use super::free::FreeFlight;
+use super::grazing::{Margins, SwitchLevels};
+use super::model::{
+    BASE, Carried, Coupling, MEMORY, MEMORY_TANGENT, MODES, Oscillator, RATE, RATE_TANGENT, State,
+    TANGENT, V, X, dissipative_work_index, has_tangent, internal, internal_count, phi, phi_column,
+    relax_internal, reset_phi, section_dim, set_internal,
+};
+use super::numeric::{
+    self, Crossing, Events, StepEnd, StepObserver, Tolerances, hermite, internal_at,
+};
+use crate::error::Result;
+use crate::law::{Branch, Exits, ForceLaw, Internal, MAX_INTERNAL};
+use nalgebra::{DMatrix, DVector};
+
+/// The most dimensions a section state has: each mode's x and x', and the law's
+/// internal state.
+pub const MAX_SECTION: usize = 2 * MODES + MAX_INTERNAL;
+
+/// Where the oscillator is: time, deflection, velocity, the law's internal state and
+/// the contact branch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Phase {
+    /// τ.
+    pub tau: f64,
+    /// Deflection x.
+    pub x: f64,
+    /// Velocity x'.
+    pub v: f64,
+    /// The law's internal state ([`ForceLaw::internal_states`]; zeros for a law without).
+    pub internal: Internal,
+    /// Contact branch.
+    pub branch: Branch,
+    /// First trial step for the next numerical segment on each branch (free, contact,
+    /// necked; 0: the solver's choice).
+    pub h_next: [f64; Branch::COUNT],
+}
+
+impl Phase {
+    /// At rest at τ = 0 out of contact.
+    pub fn at_rest() -> Self {
+        Self {
+            tau: 0.0,
+            x: 0.0,
+            v: 0.0,
+            internal: Internal::default(),
+            branch: Branch::Free,
+            h_next: [0.0; Branch::COUNT],
+        }
+    }
+
+    /// The section state z of dimension `d`: (x, x'), then the first d − 2 internal
+    /// variables times `scale`.
+    fn section(&self, d: usize, scale: f64) -> DVector<f64> {
+        DVector::from_fn(d, |i, _| match i {
+            0 => self.x,
+            1 => self.v,
+            k => scale * self.internal[k - 2 * MODES],
+        })
+    }
+
+    /// This phase moved to the section state `z` ([`Phase::section`]).
+    fn with_section(&self, z: &DVector<f64>, scale: f64) -> Self {
+        let mut internal = self.internal;
+        for (k, s) in internal.iter_mut().enumerate().take(z.len() - 2 * MODES) {
+            *s = z[2 * MODES + k] / scale;
+        }
+        Self {
+            x: z[0],
+            v: z[1],
+            internal,
+            ..*self
+        }
+    }
+}
+
+/// The integrals and extremes of a whole number of drive periods (dimensionless): one
+/// period from [`Simulation::cycle`], or the window a steady state is averaged over.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CycleIntegrals {
+    /// Drive periods covered.
+    pub periods: u32,
+    /// Length of the span in τ (`periods` drive periods).
+    pub period: f64,
+    /// Energy dissipated in the contact, ∮ −f_ts dα: the elastic part summed from the
+    /// branch work functions between the located switches (exact for the computed path),
+    /// a rate-dependent part from its carried integral.
+    pub e_ts: f64,
+    /// The part of `e_ts` done against a rate-dependent force (a viscous sample's loss),
+    /// from its carried integral; zero for an elastic law.
+    pub e_viscous: f64,
+    /// The part of `e_ts` a capillary neck lost, from its share of the branch work
+    /// functions ([`ForceLaw::capillary_work_hat`]); zero without a neck.
+    pub e_capillary: f64,
+    /// Energy dissipated by damping.
+    pub e_damp: f64,
+    /// Energy put in by the drive ([`Oscillator::drive_work`]).
+    pub e_drive: f64,
+    /// Change of the oscillator's energy ½(x² + x'²) over the span.
+    pub delta_mechanical: f64,
+    /// ∫ x cos Ωτ dτ.
+    pub sc: f64,
+    /// ∫ x sin Ωτ dτ.
+    pub ss: f64,
+    /// ∫ f_ts dτ.
+    pub f_int: f64,
+    /// ∫ f_ts x dτ.
+    pub virial_int: f64,
+    /// Time spent on the contact branch.
+    pub contact_time: f64,
+    /// Smallest separation α̂ met.
+    pub min_alpha_hat: f64,
+    /// Largest (most repulsive) f_ts met.
+    pub max_force: f64,
+    /// Smallest (most attractive) f_ts met.
+    pub min_force: f64,
+    /// The grazing margins ([`super::grazing`]): the smallest distance in α̂ from a
+    /// turning point of the separation to a switch level that matters on its branch,
+    /// and to one where the force jumps (∞: no turning point near such a level).
+    pub grazing: Margins,
+    /// Number of jumps into contact.
+    pub jumps_in: u32,
+    /// Number of jumps out of contact.
+    pub jumps_out: u32,
+}
+
+impl CycleIntegrals {
+    /// Amplitude of the fundamental over the span (units of L): what a lock-in reads.
+    pub fn amplitude(&self) -> f64 {
+        2.0 / self.period * self.sc.hypot(self.ss)
+    }
+
+    /// Phase lag φ of the fundamental over the span, z ≈ A cos(ωt − φ), in radians.
+    pub fn phase(&self) -> f64 {
+        self.ss.atan2(self.sc)
+    }
+
+    /// Energy dissipated in the contact per drive period.
+    pub fn e_ts_per_period(&self) -> f64 {
+        self.e_ts / f64::from(self.periods)
+    }
+
+    /// Energy put in by the drive per drive period.
+    pub fn e_drive_per_period(&self) -> f64 {
+        self.e_drive / f64::from(self.periods)
+    }
+
+    /// The integrals of this span followed by `next` (sums; extremes over both).
+    pub fn then(&self, next: &CycleIntegrals) -> CycleIntegrals {
+        CycleIntegrals {
+            periods: self.periods + next.periods,
+            period: self.period + next.period,
+            e_ts: self.e_ts + next.e_ts,
+            e_viscous: self.e_viscous + next.e_viscous,
+            e_capillary: self.e_capillary + next.e_capillary,
+            e_damp: self.e_damp + next.e_damp,
+            e_drive: self.e_drive + next.e_drive,
+            delta_mechanical: self.delta_mechanical + next.delta_mechanical,
+            sc: self.sc + next.sc,
+            ss: self.ss + next.ss,
+            f_int: self.f_int + next.f_int,
+            virial_int: self.virial_int + next.virial_int,
+            contact_time: self.contact_time + next.contact_time,
+            min_alpha_hat: self.min_alpha_hat.min(next.min_alpha_hat),
+            max_force: self.max_force.max(next.max_force),
+            min_force: self.min_force.min(next.min_force),
+            grazing: self.grazing.min(next.grazing),
+            jumps_in: self.jumps_in + next.jumps_in,
+            jumps_out: self.jumps_out + next.jumps_out,
+        }
+    }
+}
+
+/// Tracks extremes of the separation and force over accepted steps, then passes each
+/// step on.
+struct Tracker<'a, L: ForceLaw, O: StepObserver> {
+    law: &'a L,
+    osc: &'a Oscillator,
+    cpl: &'a Coupling,
+    inner: &'a mut O,
+    min_alpha: f64,
+    max_f: f64,
+    min_f: f64,
+    levels: SwitchLevels,
+    /// The grazing margins so far.
+    margins: Margins,
+}
+
+impl<L: ForceLaw, O: StepObserver> Tracker<'_, L, O> {
+    /// Take a turning point of the separation at `alpha_hat` on `branch` into the
+    /// grazing margin.
+    #[inline]
+    fn turn(&mut self, branch: Branch, alpha_hat: f64) {
+        self.margins = self.margins.min(self.levels.margins(branch, alpha_hat));
+    }
+}
+
+impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
+    fn step<const N: usize>(&mut self, a: &StepEnd<N>, b: &StepEnd<N>, branch: Branch) {
+        let alpha = |tau: f64, x: f64| self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
+        let mut lowest = alpha(b.tau, b.y[X]);
+        // A turning point inside the step: the minimum of the Hermite cubic, where its
+        // derivative (a quadratic in the step fraction) vanishes.
+        // The force there is an extreme too when the law is monotonic on the branch, as
+        // every contact branch is: sampling step ends alone would miss the peak.
+        self.max_f = self.max_f.max(b.dy[Carried::Force]);
+        self.min_f = self.min_f.min(b.dy[Carried::Force]);
+        if a.y[V] > 0.0 && b.y[V] < 0.0 {
+            let tau = a.tau + hermite_turn(a, b, false) * (b.tau - a.tau);
+            let top = alpha(tau, hermite(a, b, X, tau));
+            self.turn(branch, top);
+        }
+        if a.y[V] < 0.0 && b.y[V] > 0.0 {
+            let t = hermite_turn(a, b, true);
+            let tau = a.tau + t * (b.tau - a.tau);
+            // (The tip is at rest there; the support may not be.)
+            let turn = self.cpl.contact_state(
+                (hermite(a, b, X, tau), 0.0),
+                self.osc.base_at(tau),
+                branch,
+                internal_at(a, b, tau),
+            );
+            lowest = lowest.min(turn.alpha_hat);
+            self.turn(branch, turn.alpha_hat);
+            let f = -self.cpl.f_scale * self.law.force_hat(&turn);
+            self.max_f = self.max_f.max(f);
+            self.min_f = self.min_f.min(f);
+        }
+        self.min_alpha = self.min_alpha.min(lowest);
+        self.inner.step(a, b, branch);
+    }
+
+    fn free_flight(&mut self, flight: &FreeFlight, from: f64, to: f64) {
+        self.max_f = self.max_f.max(0.0);
+        self.min_f = self.min_f.min(0.0);
+        self.inner.free_flight(flight, from, to);
+    }
+}
+
+/// Step fraction in [0, 1] of the turning point of the deflection's Hermite cubic on a
+/// step where the velocity changes sign: its minimum (`rising`: from negative to
+/// positive) or its maximum.
+fn hermite_turn<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, rising: bool) -> f64 {
+    let h = b.tau - a.tau;
+    let (p0, p1, m0, m1) = (a.y[X], b.y[X], h * a.y[V], h * b.y[V]);
+    // The cubic is p0 + m0 t + c2 t² + c3 t³; its derivative 3c3 t² + 2c2 t + m0.
+    let c3 = 2.0 * p0 + m0 - 2.0 * p1 + m1;
+    let c2 = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1;
+    let (qa, qb, qc) = (3.0 * c3, 2.0 * c2, m0);
+    let t = if qa.abs() <= 1e-14 * (qb.abs() + qc.abs()) {
+        -qc / qb
+    } else {
+        let disc = (qb * qb - 4.0 * qa * qc).max(0.0).sqrt();
+        let (r1, r2) = ((-qb - disc) / (2.0 * qa), (-qb + disc) / (2.0 * qa));
+        // The root where the derivative rises (falls) through zero.
+        if (2.0 * qa * r1 + qb > 0.0) == rising {
+            r1
+        } else {
+            r2
+        }
+    };
+    if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.5
+    }
+}
+
+/// A law, an oscillator, its coupling to the contact and the integrator settings.
+#[derive(Debug)]
+pub struct Simulation<'a, L: ForceLaw> {
+    /// Tip–sample force law.
+    pub law: &'a L,
+    /// The oscillator.
+    pub osc: Oscillator,
+    /// Coupling to the contact.
+    pub cpl: Coupling,
+    /// Integrator settings.
+    pub tol: Tolerances,
+}
+
+// By hand: derived, they would ask the law itself to be Copy.
+impl<L: ForceLaw> Clone for Simulation<'_, L> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<L: ForceLaw> Copy for Simulation<'_, L> {}
+
+/// The loosest relative tolerance any integration runs at.
+pub(crate) const LOOSEST_RTOL: f64 = 1e-5;
+
+impl<L: ForceLaw> Simulation<'_, L> {
+    /// Dimension of the section state: x, x' and the law's internal state.
+    pub fn section_dim(&self) -> usize {
+        2 * MODES + self.law.internal_states().min(MAX_INTERNAL)
+    }
+
+    /// The section state of `phase`: (x, x') and the law's internal variables (forces
+    /// in the contact's units, [`ForceLaw::internal_states`]) as forces in units of kL,
+    /// so that every component is a length in units of L and one norm and tolerance
+    /// serve them all.
+    pub fn z(&self, phase: &Phase) -> DVector<f64> {
+        phase.section(self.section_dim(), self.cpl.f_scale)
+    }
+
+    /// `phase` moved to the section state `z` ([`Simulation::z`]).
+    pub fn at_z(&self, phase: &Phase, z: &DVector<f64>) -> Phase {
+        phase.with_section(z, self.cpl.f_scale)
+    }
+
+    /// The branch a state at rest separation α̂ starts on: in contact if the tip is already
+    /// below the jump-in separation.
+    pub(crate) fn branch_at(&self, tau: f64, x: f64) -> Branch {
+        let alpha = self.cpl.alpha_hat(x, self.osc.base_at(tau).0);
+        if alpha <= self.law.jump_in_alpha_hat() {
+            Branch::Contact
+        } else {
+            Branch::Free
+        }
+    }
+
+    /// The force-driven free steady state at τ = 0 (or rest for a base drive).
+    pub fn free_steady_start(&self) -> Phase {
+        let (x, v) = FreeFlight::steady(&self.osc)
+            .map(|(a, b)| (a, b * self.osc.omega))
+            .unwrap_or((0.0, 0.0));
+        Phase {
+            tau: 0.0,
+            x,
+            v,
+            internal: Internal::default(),
+            branch: self.branch_at(0.0, x),
+            h_next: [0.0; Branch::COUNT],
+        }
+    }
+
+    /// Integrate one drive period from `phase`, updating it.
+    pub fn cycle<O: StepObserver>(
+        &self,
+        phase: &mut Phase,
+        observer: &mut O,
+    ) -> Result<CycleIntegrals> {
+        Ok(if self.law.internal_states() > 0 {
+            self.cycle_in::<MEMORY, O>(phase, observer)?.0
+        } else if self.law.is_rate_dependent() {
+            self.cycle_in::<RATE, O>(phase, observer)?.0
+        } else {
+            self.cycle_in::<BASE, O>(phase, observer)?.0
+        })
+    }
+
+    /// March `periods` drive periods from `phase` (left at their end, its τ kept within
+    /// one period of the drive's origin), every integrator step and free flight shown
+    /// to `observer`: the motion in time, as an instrument watching it sees it (a
+    /// [`crate::instrument::lockin::LockIn`], say).
+    pub fn march<O: StepObserver>(
+        &self,
+        phase: &mut Phase,
+        periods: usize,
+        observer: &mut O,
+    ) -> Result<()> {
+        for _ in 0..periods {
+            self.rewind(phase);
+            self.cycle(phase, observer)?;
+        }
+        Ok(())
+    }
+
+    /// Integrate one drive period from `phase`, updating it, with the derivative of the
+    /// period map, ∂z(τ + T)/∂(z, q)(τ), z the section state ([`Simulation::z`]: x, x'
+    /// and the law's internal state, in its units), q = z_c/L: the variational equations along every segment, the
+    /// free flight's transition matrix in closed form, and at every branch switch the
+    /// saltation matrix: where the force jumps by Δf_ts as α̂ crosses its level, δx'
+    /// gains Δf_ts(δx + δq)/(x' + x_b') (and an internal variable whose rate jumps, its
+    /// jump times the same).
+    pub fn cycle_with_derivative(
+        &self,
+        phase: &mut Phase,
+    ) -> Result<(CycleIntegrals, DMatrix<f64>)> {
+        let (integrals, derivative) = if self.law.internal_states() > 0 {
+            self.cycle_in::<MEMORY_TANGENT, _>(phase, &mut numeric::Ignore)
+        } else if self.law.is_rate_dependent() {
+            self.cycle_in::<RATE_TANGENT, _>(phase, &mut numeric::Ignore)
+        } else {
+            self.cycle_in::<TANGENT, _>(phase, &mut numeric::Ignore)
+        }?;
+        let mut derivative = derivative.expect("a tangent layout carries Φ");
+        // In the section's units (`Simulation::z`): internal rows times f_scale, internal
+        // columns divided by it.
+        let d = derivative.nrows();
+        for row in 2 * MODES..d {
+            for col in 0..=d {
+                derivative[(row, col)] *= self.cpl.f_scale;
+                if col < d {
+                    derivative[(col, row)] /= self.cpl.f_scale;
+                }
+            }
+        }
+        Ok((integrals, derivative))
+    }
+
+    /// Move `phase` back by whole drive periods to τ in [0, T): the drive is periodic,
+    /// and a τ that grows through a long run costs the integrator its precision (at
+    /// τ ≈ 10⁷ Dopri5's steps underflow).
+    pub(crate) fn rewind(&self, phase: &mut Phase) {
+        let period = self.osc.period();
+        if phase.tau >= period {
+            phase.tau -= (phase.tau / period).floor() * period;
+        }
+    }
+
+    /// The branch a state can be on: its own, unless it sits on the wrong side of a
+    /// switch (a state carried over from another setpoint or moved by Newton's method:
+    /// the tip cannot be out of contact below the jump-in separation, nor in contact
+    /// above the jump-out one).
+    pub(crate) fn consistent_branch(&self, phase: &Phase) -> Branch {
+        let alpha = self.cpl.alpha_hat(phase.x, self.osc.base_at(phase.tau).0);
+        match self.law.exits(phase.branch) {
+            Exits {
+                below: Some((level, next)),
+                ..
+            } if alpha <= level => next,
+            Exits {
+                above: Some((level, next)),
+                ..
+            } if alpha >= level => next,
+            _ => phase.branch,
+        }
+    }
+
+    /// Apply the saltation matrix of a switch `from` → `to` in state `y` at τ.
+    fn saltation<const N: usize>(&self, tau: f64, y: &mut State<N>, from: Branch, to: Branch) {
+        if !has_tangent(N) {
+            return;
+        }
+        let (x_b, v_b) = self.osc.base_at(tau);
+        let at = |branch| {
+            self.cpl
+                .contact_state((y[X], y[V]), (x_b, v_b), branch, internal(y))
+        };
+        let jump =
+            -self.cpl.f_scale * (self.law.force_hat(&at(to)) - self.law.force_hat(&at(from)));
+        let kinds = internal_count(N);
+        let (rates_to, rates_from) = if kinds > 0 {
+            (
+                self.law.internal_rates_hat(&at(to)),
+                self.law.internal_rates_hat(&at(from)),
+            )
+        } else {
+            ([0.0; MAX_INTERNAL], [0.0; MAX_INTERNAL])
+        };
+        let rate_jumps = (0..kinds).any(|k| rates_to[k] != rates_from[k]);
+        if jump == 0.0 && !rate_jumps {
+            return;
+        }
+        let dim = section_dim(N);
+        let speed = y[V] + v_b;
+        let k = jump / speed;
+        for col in 0..=dim {
+            let at = phi_column(N, col);
+            // δx + δq of this column: how far the switch moves.
+            let shift = y[at] + if col == dim { 1.0 } else { 0.0 };
+            y[at + 1] += k * shift;
+            for i in 0..kinds {
+                y[at + 2 * MODES + i] += (rates_to[i] - rates_from[i]) / speed * shift;
+            }
+        }
+    }
+
+    fn cycle_in<const N: usize, O: StepObserver>(
+        &self,
+        phase: &mut Phase,
+        observer: &mut O,
+    ) -> Result<(CycleIntegrals, Option<DMatrix<f64>>)> {
+        budget::spend(1)?;
+        let period = self.osc.period();
+        let tau_end = phase.tau + period;
+        phase.branch = self.consistent_branch(phase);
+        let mut y = State::<N>::zeros();
+        y[X] = phase.x;
+        y[V] = phase.v;
+        set_internal(&mut y, &phase.internal);
+        if has_tangent(N) {
+            reset_phi(&mut y);
+        }
+        let mechanical = |y: &State<N>| 0.5 * (y[X] * y[X] + y[V] * y[V]);
+        let e0 = mechanical(&y);
+        let start = (phase.tau, phase.x, phase.v);
+        let mut tracker = Tracker {
+            law: self.law,
+            osc: &self.osc,
+            cpl: &self.cpl,
+            inner: observer,
+            min_alpha: f64::INFINITY,
+            max_f: f64::NEG_INFINITY,
+            min_f: f64::INFINITY,
+            levels: SwitchLevels::of(self.law),
+            margins: Margins::NONE,
+        };
+        let (mut contact_time, mut jumps_in, mut jumps_out) = (0.0, 0, 0);
+        // E_ts = (RΔγ/(kL))/(L/(με)) ∫ T̂ dα̂ in units of kL².
+        let work_scale = self.cpl.f_scale / self.cpl.a1;
+        let (mut e_ts, mut e_capillary) = (0.0, 0.0);
+        let mut tau = phase.tau;
+        // An internal state evolves in free flight too: in closed form if the law says
+        // how it relaxes there, else integrated with the motion.
+        let relaxation = self.law.free_relaxation_rates();
+        // (Closed-form free flight ends only falling to the jump-in, into contact.)
+        let (jump_in, closed_form) = match self.law.exits(Branch::Free) {
+            Exits {
+                below: Some((level, Branch::Contact)),
+                above: None,
+            } => (
+                level,
+                self.law.free_branch_is_force_free()
+                    && (internal_count(N) == 0 || relaxation.is_some()),
+            ),
+            _ => (f64::NAN, false),
+        };
+        // Stop when the remaining time is round-off.
+        while tau_end - tau > 1e-12 * period {
+            let flight = (phase.branch == Branch::Free && closed_form)
+                .then(|| FreeFlight::new(&self.osc, tau, y[X], y[V]))
+                .flatten();
+            if let Some(flight) = flight {
+                let level = self.cpl.x_at(jump_in);
+                let fall = flight.first_fall_to(level, tau, tau_end, period / 8.0);
+                let (hit, min_x) = (fall.hit, fall.min_x);
+                let stop = hit.unwrap_or(tau_end);
+                for turn in [fall.lowest_turn, fall.highest_turn] {
+                    if turn.is_finite() {
+                        tracker.turn(Branch::Free, self.cpl.alpha_hat(turn, 0.0));
+                    }
+                }
+                flight.advance(&mut y, tau, stop);
+                if let Some(rates) = &relaxation {
+                    relax_internal(&mut y, rates, stop - tau);
+                }
+                tracker.free_flight(&flight, tau, stop);
+                tracker.min_alpha = tracker.min_alpha.min(self.cpl.alpha_hat(min_x, 0.0));
+                tau = stop;
+                if hit.is_some() {
+                    self.saltation(tau, &mut y, Branch::Free, Branch::Contact);
+                    phase.branch = Branch::Contact;
+                    jumps_in += 1;
+                }
+                continue;
+            }
+            let exits = self.law.exits(phase.branch);
+            let level = |exit: Option<(f64, Branch)>| exit.map(|e| e.0).filter(|l| l.is_finite());
+            let events = Events {
+                below: level(exits.below),
+                above: level(exits.above),
+            };
+            let alpha_at =
+                |tau: f64, y: &State<N>| self.cpl.alpha_hat(y[X], self.osc.base_at(tau).0);
+            let alpha_start = alpha_at(tau, &y);
+            let work_start = self.law.work_hat(alpha_start, phase.branch);
+            let capillary_start = self.law.capillary_work_hat(alpha_start, phase.branch);
+            let end = numeric::integrate(
+                self.law,
+                &self.osc,
+                &self.cpl,
+                phase.branch,
+                events,
+                tau,
+                y,
+                tau_end,
+                phase.h_next[phase.branch as usize],
+                &self.tol,
+                &mut tracker,
+            )?;
+            let alpha_end = alpha_at(end.tau, &end.y);
+            e_ts += work_scale * (self.law.work_hat(alpha_end, phase.branch) - work_start);
+            e_capillary += work_scale
+                * (self.law.capillary_work_hat(alpha_end, phase.branch) - capillary_start);
+            if phase.branch == Branch::Contact {
+                contact_time += end.tau - tau;
+            }
+            if end.h_first > 0.0 {
+                phase.h_next[phase.branch as usize] = end.h_first;
+            }
+            tau = end.tau;
+            y = end.y;
+            if let Some(crossing) = end.switched {
+                let exit = match crossing {
+                    Crossing::Down => exits.below,
+                    Crossing::Up => exits.above,
+                };
+                let next = exit.expect("a switch happens at an exit").1;
+                jumps_in += u32::from(next == Branch::Contact);
+                jumps_out += u32::from(phase.branch == Branch::Contact);
+                self.saltation(tau, &mut y, phase.branch, next);
+                phase.branch = next;
+            }
+        }
+        // A rate-dependent force's work, carried along (zero for every other law).
+        let e_viscous = dissipative_work_index(N).map_or(0.0, |i| work_scale * y[i]);
+        e_ts += e_viscous;
+        phase.tau = tau_end;
+        phase.x = y[X];
+        phase.v = y[V];
+        phase.internal = internal(&y);
+        let integrals = CycleIntegrals {
+            periods: 1,
+            period,
+            e_ts,
+            e_viscous,
+            e_capillary,
+            e_damp: y[Carried::Damping],
+            e_drive: self.osc.drive_work(
+                start,
+                (tau, y[X], y[V]),
+                y[Carried::CosProjection],
+                y[Carried::SinProjection],
+            ),
+            delta_mechanical: mechanical(&y) - e0,
+            sc: y[Carried::CosProjection],
+            ss: y[Carried::SinProjection],
+            f_int: y[Carried::Force],
+            virial_int: y[Carried::Virial],
+            contact_time,
+            min_alpha_hat: tracker.min_alpha,
+            max_force: tracker.max_f,
+            min_force: tracker.min_f,
+            grazing: tracker.margins,
+            jumps_in,
+            jumps_out,
+        };
+        Ok((integrals, has_tangent(N).then(|| phi(&y))))
+    }
+
+    /// This simulation with the integrator's relative tolerance raised to `rtol` (at most
+    /// [`LOOSEST_RTOL`]; never lowered), the absolute one in proportion.
+    pub(crate) fn loosened(&self, rtol: f64) -> Self {
+        let rtol = self.tol.rtol.max(rtol.min(LOOSEST_RTOL));
+        Self {
+            tol: Tolerances {
+                rtol,
+                atol: self.tol.atol * rtol / self.tol.rtol,
+                ..self.tol
+            },
+            ..*self
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hermite_turn_finds_the_turning_points_of_parabolas() {
+        // x = (τ − 0.3)², sampled at τ = 0 and 1 with exact slopes: the cubic is exact.
+        let end = |tau: f64| {
+            let mut y = State::<BASE>::zeros();
+            y[X] = (tau - 0.3) * (tau - 0.3);
+            y[V] = 2.0 * (tau - 0.3);
+            StepEnd {
+                tau,
+                y,
+                dy: State::<BASE>::zeros(),
+            }
+        };
+        let t = hermite_turn(&end(0.0), &end(1.0), true);
+        assert!((t - 0.3).abs() < 1e-12, "{t}");
+        // And the top of x = −(τ − 0.6)².
+        let top = |tau: f64| {
+            let mut e = end(tau + 0.3 - 0.6);
+            e.tau = tau;
+            e.y[X] = -e.y[X];
+            e.y[V] = -e.y[V];
+            e
+        };
+        let t = hermite_turn(&top(0.0), &top(1.0), false);
+        assert!((t - 0.6).abs() < 1e-12, "{t}");
+    }
+}
