@@ -192,5 +192,52 @@ fn setpoint(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, settle, map, setpoint);
+/// The marcher as the instrument drives it (`Simulation::march`), a thousand drive periods
+/// on the defaults with the hybrid and the Hertz law at (rtol, atol) = (2e-7, 2e-9), the
+/// loosest pair whose energy balance stays below 1e-6 (checked first on the settled
+/// state): bare, and watched by a fourth-order lock-in (T = 2 periods), as `scan`
+/// marches.
+fn march(c: &mut Criterion) {
+    use tapsim::instrument::lockin::LockIn;
+    use tapsim::law::LawKind;
+    const PERIODS: u64 = 1000;
+    let mut group = c.benchmark_group("march");
+    group.throughput(Throughput::Elements(PERIODS));
+    group.sample_size(20);
+    for (name, kind) in [("hybrid", LawKind::Hybrid), ("hertz", LawKind::Hertz)] {
+        let mut setup = default_setup();
+        setup.law.kind = kind;
+        let numerics = Numerics {
+            rtol: 2e-7,
+            atol: 2e-9,
+            ..Numerics::default()
+        };
+        let p = Prepared::new(&setup, &numerics).expect("defaults are valid");
+        let sim = p.simulation();
+        let mut phase = sim.free_steady_start();
+        let state = sim
+            .steady_state(&mut phase, &p.steady)
+            .expect("steady state");
+        let o = TapObservables::new(&p, &state).unwrap();
+        assert!(o.energy_balance_rel < 1e-6, "{name}: {o:?}");
+        eprintln!("{name}: energy balance {:.1e}", o.energy_balance_rel);
+        group.bench_function(format!("{name}, bare"), |b| {
+            b.iter(|| {
+                sim.march(&mut phase, PERIODS as usize, &mut Ignore)
+                    .unwrap()
+            })
+        });
+        let omega = sim.osc.omega;
+        let mut lockin = LockIn::new(4, 2.0 * sim.osc.period(), omega).unwrap();
+        group.bench_function(format!("{name}, with the lock-in"), |b| {
+            b.iter(|| {
+                sim.march(&mut phase, PERIODS as usize, &mut lockin)
+                    .unwrap()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, settle, map, setpoint, march);
 criterion_main!(benches);

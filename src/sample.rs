@@ -1,8 +1,10 @@
 //! A sample to scan, read from a TOML file: its materials (each any of `tap`'s sample
-//! and law parameters over the run's own) and their layout along the scan line.
+//! and law parameters over the run's own) and their layout: stripes along the scan line
+//! (x) that run across the image (y), and discs laid over them.
 //!
 //! ```toml
 //! length = "1um"               # the scan line
+//! width = "1um"                # the image's extent in y (default: the length)
 //! [[material]]
 //! name = "A"
 //! sample-modulus = "0.5GPa"
@@ -17,6 +19,12 @@
 //! [[region]]
 //! until = "1um"
 //! material = "B"
+//! [[disc]]                     # over the stripes
+//! x = "250nm"                  # centre,
+//! y = "500nm"
+//! radius = "150nm"
+//! material = "B"
+//! height = "0nm"               # (default 0)
 //! ```
 
 use crate::config::{MAX_CONFIG_BYTES, TapInputs, read_text};
@@ -27,23 +35,27 @@ fn value_text(value: &toml::Value, key: &str) -> Result<String> {
 }
 use crate::dynamics::setup::TapSetup;
 use crate::error::{Error, Result};
-use crate::instrument::scan::Region;
+use crate::instrument::scan::{Disc, Layout, Region};
 use std::path::Path;
 
 /// The most materials and regions a sample holds.
 pub const MAX_MATERIALS: usize = 64;
 /// The most regions along a line.
 pub const MAX_REGIONS: usize = 10_000;
+/// The most discs.
+pub const MAX_DISCS: usize = 1_000;
 
 /// A sample: named materials over a common cantilever, and their layout.
 #[derive(Debug, Clone)]
 pub struct Sample {
     /// The line's length in m.
     pub length_m: f64,
+    /// The image's extent across the lines (y) in m.
+    pub width_m: f64,
     /// Each material's name and setup.
     pub materials: Vec<(String, TapSetup)>,
-    /// The layout along x.
-    pub regions: Vec<Region>,
+    /// The layout in the plane.
+    pub layout: Layout,
 }
 
 /// The built-in sample: a flat blend of the two polymers `contrast` compares, A
@@ -97,9 +109,10 @@ impl Sample {
             bad(format!("not valid TOML: {}", e.to_string().trim_end()))
         })?;
         for key in table.keys() {
-            if !["length", "material", "region"].contains(&key.as_str()) {
+            if !["length", "width", "material", "region", "disc"].contains(&key.as_str()) {
                 return Err(bad(format!(
-                    "unknown key {key}; a sample has length, [[material]] and [[region]]"
+                    "unknown key {key}; a sample has length, width, [[material]], \
+                     [[region]] and [[disc]]"
                 )));
             }
         }
@@ -108,8 +121,14 @@ impl Sample {
             None => return Err(bad("the line's length is missing (length = \"1um\")".into())),
         };
         crate::error::positive("sample length", length_m)?;
+        let width_m = match table.get("width") {
+            Some(v) => crate::config::length(&value_text(v, "width")?).map_err(bad)?,
+            None => length_m,
+        };
+        crate::error::positive("sample width", width_m)?;
         let list = |key: &str| -> Result<Vec<toml::Table>> {
             match table.get(key) {
+                None if key == "disc" => Ok(Vec::new()),
                 Some(toml::Value::Array(items)) => items
                     .iter()
                     .map(|v| match v {
@@ -167,14 +186,8 @@ impl Sample {
                 Some(v) => crate::config::length(&value_text(v, "until")?).map_err(bad)?,
                 None => return Err(bad("every [[region]] says where it ends (until)".into())),
             };
-            let Some(toml::Value::String(name)) = r.get("material") else {
-                return Err(bad("every [[region]] names its material".into()));
-            };
-            let Some(material) = materials.iter().position(|(n, _)| n == name) else {
-                return Err(bad(format!(
-                    "region names material {name}, which is not given"
-                )));
-            };
+            let material =
+                material_index(&materials, r.get("material"), "[[region]]").map_err(bad)?;
             let height_m = match r.get("height") {
                 Some(v) => crate::config::length(&value_text(v, "height")?).map_err(bad)?,
                 None => 0.0,
@@ -186,11 +199,7 @@ impl Sample {
                      the line ({length_m:e} m)"
                 )));
             }
-            if height_m.is_nan() || height_m.abs() > 1e-6 {
-                return Err(bad(format!(
-                    "a region's height ({height_m:e} m) is at most 1 µm either way"
-                )));
-            }
+            check_height(height_m).map_err(bad)?;
             regions.push(Region {
                 until_m,
                 material,
@@ -206,10 +215,78 @@ impl Sample {
                 "the regions end at {end:e} m, short of the line ({length_m:e} m)"
             )));
         }
+        let mut discs = Vec::new();
+        for d in list("disc")? {
+            for key in d.keys() {
+                if !["x", "y", "radius", "material", "height"].contains(&key.as_str()) {
+                    return Err(bad(format!(
+                        "unknown key {key} in a disc (x, y, radius, material, height)"
+                    )));
+                }
+            }
+            let at = |key: &str| -> Result<f64> {
+                match d.get(key) {
+                    Some(v) => crate::config::length(&value_text(v, key)?).map_err(bad),
+                    None => Err(bad(format!("every [[disc]] gives its {key}"))),
+                }
+            };
+            let (x, y, radius_m) = (at("x")?, at("y")?, at("radius")?);
+            if !(x.is_finite() && y.is_finite() && radius_m > 0.0 && radius_m.is_finite()) {
+                return Err(bad(format!(
+                    "a disc's centre ({x:e}, {y:e}) m is finite and its radius ({radius_m:e} m) \
+                     positive"
+                )));
+            }
+            let height_m = match d.get("height") {
+                Some(_) => at("height")?,
+                None => 0.0,
+            };
+            check_height(height_m).map_err(bad)?;
+            discs.push(Disc {
+                centre_m: (x, y),
+                radius_m,
+                material: material_index(&materials, d.get("material"), "[[disc]]").map_err(bad)?,
+                height_m,
+            });
+            if discs.len() > MAX_DISCS {
+                return Err(bad(format!("more than {MAX_DISCS} discs")));
+            }
+        }
         Ok(Self {
             length_m,
+            width_m,
             materials,
-            regions,
+            layout: Layout {
+                stripes: regions,
+                discs,
+            },
         })
     }
+}
+
+/// The index of the material a region or disc names (`what`: which of them).
+fn material_index(
+    materials: &[(String, TapSetup)],
+    name: Option<&toml::Value>,
+    what: &str,
+) -> std::result::Result<usize, String> {
+    let Some(toml::Value::String(name)) = name else {
+        return Err(format!(
+            "every {what} names its material (material = \"A\")"
+        ));
+    };
+    materials
+        .iter()
+        .position(|(n, _)| n == name)
+        .ok_or_else(|| format!("{what} names material {name}, which is not given"))
+}
+
+/// A surface height is finite and at most 1 µm either way.
+fn check_height(height_m: f64) -> std::result::Result<(), String> {
+    if height_m.is_nan() || height_m.abs() > 1e-6 {
+        return Err(format!(
+            "a surface height ({height_m:e} m) is at most 1 µm either way"
+        ));
+    }
+    Ok(())
 }

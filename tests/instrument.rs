@@ -276,7 +276,18 @@ fn scan_images_the_built_in_blend_and_refuses_bad_samples() {
     let material = "[[material]]\nname = \"A\"\n";
     let region = "[[region]]\nuntil = \"1um\"\nmaterial = \"A\"\n";
     for (args, says) in [
-        (vec!["--pixels", "0"], "--pixels is from 1 to 4096"),
+        (
+            vec!["--pixels", "0"],
+            "--pixels and --lines are from 1 to 4096",
+        ),
+        (
+            vec!["--lines", "5000"],
+            "--pixels and --lines are from 1 to 4096",
+        ),
+        (
+            vec!["--lines", "2048", "--pixels", "1024"],
+            "an image holds at most 1048576 pixels",
+        ),
         (vec!["--line-rate", "0"], "line rate"),
         (vec!["--line-rate", "1e-3"], "drive periods a pixel"),
         (
@@ -289,10 +300,10 @@ fn scan_images_the_built_in_blend_and_refuses_bad_samples() {
                 "--sample",
                 &sample(
                     "a.toml",
-                    &format!("length = \"1um\"\nwidth = 3\n{material}{region}"),
+                    &format!("length = \"1um\"\ndepth = 3\n{material}{region}"),
                 ),
             ],
-            "unknown key width",
+            "unknown key depth",
         ),
         (
             vec![
@@ -334,6 +345,30 @@ fn scan_images_the_built_in_blend_and_refuses_bad_samples() {
                 ),
             ],
             "differ in the cantilever",
+        ),
+        (
+            vec![
+                "--sample",
+                &sample(
+                    "f.toml",
+                    &format!(
+                        "length = \"1um\"\n{material}{region}[[disc]]\nx = \"1nm\"\ny = \"1nm\"\nradius = \"-5nm\"\nmaterial = \"A\"\n"
+                    ),
+                ),
+            ],
+            "its radius (-5e-9 m) positive",
+        ),
+        (
+            vec![
+                "--sample",
+                &sample(
+                    "g.toml",
+                    &format!(
+                        "length = \"1um\"\n{material}{region}[[disc]]\nx = \"1nm\"\ny = \"1nm\"\nmaterial = \"A\"\n"
+                    ),
+                ),
+            ],
+            "every [[disc]] gives its radius",
         ),
     ] {
         let mut all = vec!["scan", "--quiet"];
@@ -426,5 +461,114 @@ fn a_scan_over_a_raised_first_region_starts_at_its_height() {
             rest + 1e-9
         );
         assert!((ratio - 0.8).abs() < 1e-4, "A/A₀ {ratio}");
+    }
+}
+
+/// An image of a disc of B in A: every line engaged and scanned on its own, so the same
+/// bytes on one thread and on two; pixels well inside the disc read B's phase, those
+/// well outside A's (as a one-line scan over each material reads them), and the
+/// topography steps down over the disc as over B in the blend.
+#[test]
+fn an_image_of_a_disc_shows_it_where_it_lies_on_any_number_of_threads() {
+    let dir = common::scratch("scan_image");
+    let sample = dir.join("disc.toml");
+    std::fs::write(
+        &sample,
+        r#"
+length = "1um"
+[[material]]
+name = "A"
+sample-modulus = "0.5GPa"
+work-of-adhesion = 0.1
+[[material]]
+name = "B"
+sample-modulus = "1GPa"
+work-of-adhesion = 0.08
+[[region]]
+until = "1um"
+material = "A"
+[[disc]]
+x = "500nm"
+y = "500nm"
+radius = "300nm"
+material = "B"
+"#,
+    )
+    .unwrap();
+    let image = |threads: &str, csv: &str| {
+        let path = dir.join(csv);
+        let out = common::tapsim(&[
+            "scan",
+            "--sample",
+            sample.to_str().unwrap(),
+            "--lines",
+            "4",
+            "--pixels",
+            "8",
+            "--line-rate",
+            "20",
+            "--no-retrace",
+            "--threads",
+            threads,
+            "--csv",
+            path.to_str().unwrap(),
+            "--quiet",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read_to_string(path).unwrap()
+    };
+    let (one, two) = (image("1", "one.csv"), image("2", "two.csv"));
+    assert_eq!(one, two, "the image depends on the thread count");
+    let mut reader = csv::Reader::from_reader(one.as_bytes());
+    let head = reader.headers().unwrap().clone();
+    let at = |k: &str| head.iter().position(|h| h == k).unwrap();
+    let (x, y, phase, z) = (at("x_m"), at("y_m"), at("phase_deg"), at("topography_m"));
+    let (mut inside, mut outside) = (Vec::new(), Vec::new());
+    for rec in reader.records() {
+        let rec = rec.unwrap();
+        let v = |i: usize| rec[i].parse::<f64>().unwrap();
+        let r = (v(x) - 500e-9).hypot(v(y) - 500e-9);
+        // Well inside, and past the first pixel of the disc (the loop settles there).
+        if r < 200e-9 && v(x) > 400e-9 {
+            inside.push((v(phase), v(z)));
+        } else if r > 400e-9 && v(x) < 500e-9 {
+            outside.push((v(phase), v(z)));
+        }
+    }
+    assert!(
+        inside.len() >= 2 && outside.len() >= 4,
+        "{inside:?} {outside:?}"
+    );
+    // Each material's one-line reading (the blend's halves, trace).
+    let blend = common::json(&[
+        "scan",
+        "--pixels",
+        "4",
+        "--line-rate",
+        "20",
+        "--no-retrace",
+        "--json",
+        "--quiet",
+    ]);
+    let (bp, bz) = (column(&blend, "phase_deg"), column(&blend, "topography_m"));
+    for &(p, h) in &inside {
+        assert!((p - bp[3]).abs() < 0.05, "inside: φ {p} vs B {}", bp[3]);
+        assert!(
+            (h - bz[3]).abs() < 0.01e-9,
+            "inside: z {h:e} vs B {:e}",
+            bz[3]
+        );
+    }
+    for &(p, h) in &outside {
+        assert!((p - bp[1]).abs() < 0.05, "outside: φ {p} vs A {}", bp[1]);
+        assert!(
+            (h - bz[1]).abs() < 0.01e-9,
+            "outside: z {h:e} vs A {:e}",
+            bz[1]
+        );
     }
 }

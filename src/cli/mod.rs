@@ -176,12 +176,24 @@ impl SweepOutput {
         records: &[T],
         charts: impl FnOnce() -> Vec<crate::report::chart::Chart>,
     ) -> crate::Result<()> {
-        use crate::report::{output, plot, records};
+        self.write_files_drawn(records, |path| {
+            crate::report::plot::render_stack(&charts(), path)
+        })
+    }
+
+    /// [`SweepOutput::write_files`] with the plot drawn by `draw` into the file it is
+    /// given.
+    pub fn write_files_drawn<T: serde::Serialize>(
+        &self,
+        records: &[T],
+        draw: impl FnOnce(&std::path::Path) -> crate::Result<()>,
+    ) -> crate::Result<()> {
+        use crate::report::{output, records};
         if let Some(path) = &self.csv {
             output::write_bytes(path, &records::records_csv(records)?)?;
         }
         if let Some(path) = &self.plot {
-            plot::render_stack(&charts(), path)?;
+            draw(path)?;
         }
         Ok(())
     }

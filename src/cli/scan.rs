@@ -3,10 +3,11 @@
 use crate::config::{TapInputs, number};
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
-use crate::instrument::feedback::{PiController, hold};
+use crate::instrument::feedback::PiController;
 use crate::instrument::lockin::LockIn;
-use crate::instrument::scan::{Pixel, line, mirrored};
+use crate::instrument::scan::{Pixel, row};
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
+use crate::report::heatmap::{Cell, HeatMap};
 use crate::sample::{BLEND, Sample};
 use clap::Args;
 
@@ -20,9 +21,13 @@ use clap::Args;
 /// Δγ = 0.1 J/m², the defaults, on the first half; B: E = 1 GPa, Δγ = 0.08 J/m²): the
 /// image shows a step that is not there (the two materials hold the setpoint at
 /// different rest separations) and the phase contrast between them. --sample FILE.toml
-/// describes another: its materials (any of tap's sample and law parameters) and their
-/// layout along the line, each region with a surface height (see examples/samples/).
+/// describes another: its materials (any of tap's sample and law parameters), their
+/// layout along the line, each region with a surface height, and discs laid over it
+/// (see examples/samples/).
 ///
+/// --lines N records an image: N lines across the sample's width, each engaged and
+/// scanned on its own (in parallel, --threads; the same result on any number of
+/// threads), drawn by --plot as heat maps of topography and phase side by side.
 /// The loop is engaged over the first region from the free oscillation at 1.2 A₀ (10 000
 /// drive periods), so it sits on the branch a falling setpoint stays on (attractive on
 /// the defaults). A slow scan (the default: 4 lines/s, 32 pixels, about 2 300 drive
@@ -30,9 +35,9 @@ use clap::Args;
 /// pixel; a fast one shows the feedback's artefacts: overshoot after a step up, the
 /// amplitude running away after a step down (the tip loses the sample).
 ///
-/// Output: a table, --json (arrays per pixel: x_m, direction, topography_m,
-/// amplitude_ratio, error, phase_deg), --csv, --plot (topography and phase profiles,
-/// trace and retrace).
+/// Output: a table, --json (a record per pixel: direction, line, y_m, x_m,
+/// topography_m, amplitude_ratio, error, phase_deg), --csv, --plot (one line: topography
+/// and phase profiles, trace and retrace; an image: heat maps of the trace).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct ScanArgs {
@@ -50,6 +55,12 @@ pub struct ScanArgs {
     /// Pixels along the line.
     #[arg(long, allow_hyphen_values = true, default_value_t = 32)]
     pixels: usize,
+    /// Lines across the sample (an image when more than one).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1)]
+    lines: usize,
+    /// Worker threads for the lines of an image (0: all cores).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
+    threads: usize,
     /// Lines per second (each direction).
     #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 4.0)]
     line_rate: f64,
@@ -70,16 +81,22 @@ pub struct ScanArgs {
     no_retrace: bool,
 }
 
-/// A pixel with its direction.
+/// A pixel with its direction and line.
 #[derive(serde::Serialize)]
 struct Row {
     direction: &'static str,
+    /// The line's index (0 first) and its position across the sample, in m.
+    line: usize,
+    y_m: f64,
     #[serde(flatten)]
     pixel: Pixel,
 }
 
-/// The most drive periods one scan marches (both directions).
-const MAX_PERIODS: f64 = 2e7;
+/// The most drive periods one scan marches (every line, both directions).
+const MAX_PERIODS: f64 = 2e8;
+
+/// The most pixels of an image (lines × pixels): its records stay within memory.
+const MAX_IMAGE_PIXELS: usize = 1 << 20;
 
 /// The loop's engagement over the first region, in drive periods.
 const ENGAGE_PERIODS: usize = 10_000;
@@ -97,10 +114,16 @@ pub fn run(args: ScanArgs) -> Result<()> {
         Some(path) => Sample::from_file(path, &base)?,
         None => Sample::from_toml(BLEND, &base)?,
     };
-    if !(1..=4096).contains(&args.pixels) {
+    if !(1..=4096).contains(&args.pixels) || !(1..=4096).contains(&args.lines) {
         return Err(Error::OutOfRange(format!(
-            "--pixels is from 1 to 4096, not {}",
-            args.pixels
+            "--pixels and --lines are from 1 to 4096, not {} and {}",
+            args.pixels, args.lines
+        )));
+    }
+    if args.pixels * args.lines > MAX_IMAGE_PIXELS {
+        return Err(Error::OutOfRange(format!(
+            "an image holds at most {MAX_IMAGE_PIXELS} pixels, not {} × {}",
+            args.lines, args.pixels
         )));
     }
     crate::error::positive("line rate", args.line_rate)?;
@@ -116,18 +139,25 @@ pub fn run(args: ScanArgs) -> Result<()> {
         .iter()
         .map(|(_, s)| Prepared::new(s, &numerics))
         .collect::<Result<Vec<_>>>()?;
-    let first = &prepared[sample.regions[0].material];
+    let lines: Vec<(f64, Vec<crate::instrument::scan::Region>)> = (0..args.lines)
+        .map(|j| {
+            let y = sample.width_m * (j as f64 + 0.5) / args.lines as f64;
+            (y, sample.layout.line_at(y, sample.length_m))
+        })
+        .collect();
+    let first = &prepared[lines[0].1[0].material];
     let sim = first.simulation();
     let omega = sim.osc.omega;
     let period_hat = sim.osc.period();
     let drive_hz = first.setup.cantilever.drive_frequency_hz;
     let per_pixel = (drive_hz / (args.pixels as f64 * args.line_rate)).round();
-    let directions = if args.no_retrace { 1.0 } else { 2.0 };
-    let total = per_pixel * args.pixels as f64 * directions;
+    let directions = if args.no_retrace { 1 } else { 2 };
+    let total = per_pixel * (args.pixels * args.lines * directions) as f64;
     if !(per_pixel >= 1.0 && total <= MAX_PERIODS) {
         return Err(Error::OutOfRange(format!(
-            "{} pixels at {} lines/s is {per_pixel:e} drive periods a pixel, {total:.3e} in \
-             all: from 1 a pixel to {MAX_PERIODS:e} in all",
+            "{} lines of {} pixels at {} lines/s is {per_pixel:e} drive periods a pixel, \
+             {total:.3e} in all: from 1 a pixel to {MAX_PERIODS:e} in all",
+            args.lines,
             args.pixels,
             if (1e-3..1e6).contains(&args.line_rate) {
                 args.line_rate.to_string()
@@ -137,57 +167,70 @@ pub fn run(args: ScanArgs) -> Result<()> {
         )));
     }
     let per_pixel = per_pixel as usize;
-    let mut lockin = LockIn::new(args.lockin_order, args.lockin_periods * period_hat, omega)?;
-    let mut controller =
-        PiController::new(args.setpoint, args.proportional_gain, args.integral_gain)?;
-    let a0 = first.setup.cantilever.free_amplitude_m;
-    let bar = args.out.progress_bar(args.pixels * directions as usize + 1);
-    let mut phase = sim.free_steady_start();
-    // The loop holds the rest separation; the piezo stands that much above the surface.
-    let (_, rest) = hold(
-        first,
-        (1.2 * a0, &mut phase),
-        &mut lockin,
-        &mut controller,
-        ENGAGE_PERIODS,
-    )?;
-    let mut z = rest + sample.regions[0].height_m;
-    bar.inc(1);
-    let mut rows = Vec::new();
-    let mut layouts = vec![("trace", sample.regions.clone())];
-    if !args.no_retrace {
-        layouts.push(("retrace", mirrored(&sample.regions, sample.length_m)));
-    }
-    for (direction, regions) in layouts {
-        let (pixels, end) = line(
-            &prepared,
-            &regions,
-            (sample.length_m, args.pixels, per_pixel),
-            (&mut lockin, &mut controller),
-            z,
-            &mut phase,
-            |_| bar.inc(1),
-        )?;
-        z = end;
-        rows.extend(pixels.into_iter().map(|mut pixel| {
-            if direction == "retrace" {
-                pixel.x_m = sample.length_m - pixel.x_m;
-            }
-            Row { direction, pixel }
-        }));
+    let lockin = LockIn::new(args.lockin_order, args.lockin_periods * period_hat, omega)?;
+    let controller = PiController::new(args.setpoint, args.proportional_gain, args.integral_gain)?;
+    let bar = args
+        .out
+        .progress_bar(args.lines * (args.pixels * directions + 1));
+    let shape = (sample.length_m, args.pixels, per_pixel);
+    let scanned = {
+        use rayon::prelude::*;
+        crate::sweep::thread_pool(args.threads)?.install(|| {
+            lines
+                .par_iter()
+                .map(|(_, regions)| {
+                    bar.inc(1);
+                    row(
+                        &prepared,
+                        regions,
+                        shape,
+                        (lockin, controller),
+                        ENGAGE_PERIODS,
+                        !args.no_retrace,
+                        |_| bar.inc(1),
+                    )
+                })
+                .collect::<Result<Vec<_>>>()
+        })?
+    };
+    let mut rows = Vec::with_capacity(args.lines * args.pixels * directions);
+    for (line, ((y_m, _), (trace, retrace))) in lines.iter().zip(scanned).enumerate() {
+        let tagged = |direction, pixels: Vec<Pixel>| {
+            pixels.into_iter().map(move |pixel| Row {
+                direction,
+                line,
+                y_m: *y_m,
+                pixel,
+            })
+        };
+        rows.extend(tagged("trace", trace));
+        rows.extend(retrace.into_iter().flat_map(|r| tagged("retrace", r)));
     }
     bar.finish_and_clear();
-    args.out.write_files(&rows, || charts(&rows))?;
+    if args.lines > 1 {
+        args.out.write_files_drawn(&rows, |path| {
+            let maps = images(&rows, args.lines, args.pixels, args.setpoint);
+            crate::report::plot::render_side_by_side(&maps, path)
+        })?;
+    } else {
+        args.out.write_files(&rows, || charts(&rows))?;
+    }
     if args.out.json {
         return args.out.print_json(&rows);
     }
     outln!(
-        "line scan at A/A₀ = {}: {} pixels, {per_pixel} drive periods each",
+        "{} at A/A₀ = {}: {} pixels a line, {per_pixel} drive periods each",
+        if args.lines > 1 {
+            format!("image of {} lines", args.lines)
+        } else {
+            "line scan".into()
+        },
         args.setpoint,
         args.pixels
     );
     outln!(
-        "{:>10} {:>8} {:>12} {:>10} {:>10} {:>10}",
+        "{:>10} {:>10} {:>8} {:>12} {:>10} {:>10} {:>10}",
+        "y (nm)",
         "x (nm)",
         "dir",
         "height (nm)",
@@ -198,7 +241,8 @@ pub fn run(args: ScanArgs) -> Result<()> {
     for r in &rows {
         let p = &r.pixel;
         outln!(
-            "{:>10.2} {:>8} {:>12.4} {:>10.6} {:>10.2e} {:>10.4}",
+            "{:>10.2} {:>10.2} {:>8} {:>12.4} {:>10.6} {:>10.2e} {:>10.4}",
+            r.y_m * 1e9,
             p.x_m * 1e9,
             r.direction,
             p.topography_m * 1e9,
@@ -244,5 +288,41 @@ fn charts(rows: &[Row]) -> Vec<Chart> {
         profile("phase_deg", "lock-in phase", "phase lag φ (deg)", |p| {
             p.phase_deg
         }),
+    ]
+}
+
+/// Heat maps of the trace's topography and phase over the image, side by side.
+fn images(rows: &[Row], lines: usize, pixels: usize, setpoint: f64) -> Vec<HeatMap> {
+    let trace: Vec<&Row> = rows.iter().filter(|r| r.direction == "trace").collect();
+    let x: Vec<f64> = trace[..pixels].iter().map(|r| r.pixel.x_m * 1e9).collect();
+    let y: Vec<f64> = trace.iter().step_by(pixels).map(|r| r.y_m * 1e9).collect();
+    let map = |title: &str, label: &str, pick: fn(&Pixel) -> f64| HeatMap {
+        title: format!("{title} at A/A₀ = {setpoint} (trace)"),
+        x_label: "x along the line (nm)".into(),
+        y_label: "y across the lines (nm)".into(),
+        value_label: label.into(),
+        x: x.clone(),
+        y: y.clone(),
+        cells: trace
+            .chunks(pixels)
+            .take(lines)
+            .map(|line| {
+                line.iter()
+                    .map(|r| Cell::Value {
+                        value: pick(&r.pixel),
+                        period_one: true,
+                        grazing: false,
+                    })
+                    .collect()
+            })
+            .collect(),
+        empty_label: String::new(),
+        log_axes: false,
+    };
+    vec![
+        map("topography", "z piezo height (nm)", |p| {
+            p.topography_m * 1e9
+        }),
+        map("phase", "lock-in phase φ (deg)", |p| p.phase_deg),
     ]
 }

@@ -11,8 +11,8 @@
 
 use super::feedback::PiController;
 use super::lockin::LockIn;
-use crate::dynamics::setup::Prepared;
 use crate::dynamics::march::Phase;
+use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
 
 /// A stretch of the sample along x.
@@ -124,4 +124,197 @@ pub fn mirrored(regions: &[Region], length_m: f64) -> Vec<Region> {
         });
     }
     out
+}
+
+/// A disc of one material laid over the stripes of a [`Layout`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Disc {
+    /// Its centre (x, y), in m.
+    pub centre_m: (f64, f64),
+    /// Its radius, in m.
+    pub radius_m: f64,
+    /// Its material: an index into the sample's materials.
+    pub material: usize,
+    /// Its surface height, in m.
+    pub height_m: f64,
+}
+
+/// A sample's layout in the plane: stripes along x that run across the whole width
+/// (as [`Region`]s), with discs laid over them (a later disc over an earlier one).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    /// The stripes, sorted by `until_m`, the last reaching the end of the line.
+    pub stripes: Vec<Region>,
+    /// The discs.
+    pub discs: Vec<Disc>,
+}
+
+impl Layout {
+    /// The regions a line at `y_m` crosses: the stripes, cut where a disc's chord at
+    /// that y begins and ends, neighbours of the same material and height merged.
+    pub fn line_at(&self, y_m: f64, length_m: f64) -> Vec<Region> {
+        let chords: Vec<(f64, f64, &Disc)> = self
+            .discs
+            .iter()
+            .filter_map(|d| {
+                let dy = y_m - d.centre_m.1;
+                let half = (d.radius_m * d.radius_m - dy * dy).sqrt();
+                (half > 0.0).then_some((d.centre_m.0 - half, d.centre_m.0 + half, d))
+            })
+            .collect();
+        let mut cuts: Vec<f64> = self.stripes.iter().map(|r| r.until_m).collect();
+        cuts.extend(chords.iter().flat_map(|&(a, b, _)| [a, b]));
+        cuts.retain(|&c| c > 0.0 && c < length_m);
+        cuts.push(length_m);
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let mut out: Vec<Region> = Vec::with_capacity(cuts.len());
+        let mut start = 0.0;
+        for until_m in cuts {
+            let mid = 0.5 * (start + until_m);
+            let stripe = self
+                .stripes
+                .iter()
+                .find(|r| mid < r.until_m)
+                .or(self.stripes.last())
+                .expect("a layout has stripes");
+            let (material, height_m) = chords
+                .iter()
+                .rev()
+                .find(|&&(a, b, _)| a <= mid && mid < b)
+                .map_or((stripe.material, stripe.height_m), |&(_, _, d)| {
+                    (d.material, d.height_m)
+                });
+            match out.last_mut() {
+                Some(last) if last.material == material && last.height_m == height_m => {
+                    last.until_m = until_m;
+                }
+                _ => out.push(Region {
+                    until_m,
+                    material,
+                    height_m,
+                }),
+            }
+            start = until_m;
+        }
+        out
+    }
+}
+
+/// One line of an image as an AFM records it: the loop engaged over the line's first
+/// region from the free oscillation at 1.2 A₀ ([`super::feedback::hold`] for
+/// `engage_periods`), then trace and (if `retrace`) retrace, each by [`line`]. The
+/// lock-in and the controller start from the given ones, so every line is independent
+/// of the others (computed in any order, on any thread, with the same result).
+/// Returns the trace and the retrace (x as the trace's, not mirrored).
+#[allow(clippy::too_many_arguments)]
+pub fn row(
+    materials: &[Prepared],
+    regions: &[Region],
+    (length_m, pixels, periods_per_pixel): (f64, usize, usize),
+    (lockin, controller): (LockIn, PiController),
+    engage_periods: usize,
+    retrace: bool,
+    mut progress: impl FnMut(usize),
+) -> Result<(Vec<Pixel>, Option<Vec<Pixel>>)> {
+    let (mut lockin, mut controller) = (lockin, controller);
+    let Some(first) = regions.first().and_then(|r| materials.get(r.material)) else {
+        return Err(Error::NotApplicable(
+            "a scanned sample needs regions, each naming one of its materials".into(),
+        ));
+    };
+    let a0 = first.setup.cantilever.free_amplitude_m;
+    let mut phase = first.simulation().free_steady_start();
+    let (_, rest) = super::feedback::hold(
+        first,
+        (1.2 * a0, &mut phase),
+        &mut lockin,
+        &mut controller,
+        engage_periods,
+    )?;
+    // The loop holds the rest separation; the piezo stands that much above the surface.
+    let z = rest + regions[0].height_m;
+    let shape = (length_m, pixels, periods_per_pixel);
+    let loop_state = (&mut lockin, &mut controller);
+    let (trace, end) = line(
+        materials,
+        regions,
+        shape,
+        loop_state,
+        z,
+        &mut phase,
+        &mut progress,
+    )?;
+    if !retrace {
+        return Ok((trace, None));
+    }
+    let back = mirrored(regions, length_m);
+    let loop_state = (&mut lockin, &mut controller);
+    let (mut retrace, _) = line(
+        materials, &back, shape, loop_state, end, &mut phase, progress,
+    )?;
+    for p in &mut retrace {
+        p.x_m = length_m - p.x_m;
+    }
+    Ok((trace, Some(retrace)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_line_crosses_the_material_under_each_point_of_the_plane() {
+        let layout = Layout {
+            stripes: vec![
+                Region {
+                    until_m: 0.4,
+                    material: 0,
+                    height_m: 0.0,
+                },
+                Region {
+                    until_m: 1.0,
+                    material: 1,
+                    height_m: 0.1,
+                },
+            ],
+            discs: vec![
+                Disc {
+                    centre_m: (0.35, 0.5),
+                    radius_m: 0.2,
+                    material: 2,
+                    height_m: 0.2,
+                },
+                Disc {
+                    centre_m: (0.5, 0.45),
+                    radius_m: 0.1,
+                    material: 3,
+                    height_m: -0.1,
+                },
+            ],
+        };
+        // Point by point: the last disc holding it, else its stripe.
+        let under = |x: f64, y: f64| {
+            layout
+                .discs
+                .iter()
+                .rev()
+                .find(|d| (x - d.centre_m.0).hypot(y - d.centre_m.1) < d.radius_m)
+                .map(|d| (d.material, d.height_m))
+                .unwrap_or_else(|| {
+                    let s = layout.stripes.iter().find(|r| x < r.until_m).unwrap();
+                    (s.material, s.height_m)
+                })
+        };
+        for y in [0.0, 0.31, 0.4, 0.45, 0.52, 0.69, 0.9] {
+            let regions = layout.line_at(y, 1.0);
+            assert!(regions.windows(2).all(|w| w[0].until_m < w[1].until_m));
+            assert_eq!(regions.last().unwrap().until_m, 1.0);
+            for i in 0..2000 {
+                let x = (i as f64 + 0.5) / 2000.0;
+                let r = regions.iter().find(|r| x < r.until_m).unwrap();
+                assert_eq!((r.material, r.height_m), under(x, y), "x {x}, y {y}");
+            }
+        }
+    }
 }

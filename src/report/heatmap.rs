@@ -20,7 +20,7 @@ pub enum Cell {
     NotApplicable,
 }
 
-/// A heat map over log-spaced axes.
+/// A heat map over log-spaced (a parameter grid) or evenly spaced (an image) axes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeatMap {
     /// Title above the panel.
@@ -37,8 +37,11 @@ pub struct HeatMap {
     pub y: Vec<f64>,
     /// Cells, `cells[j][i]` at `(x[i], y[j])`.
     pub cells: Vec<Vec<Cell>>,
-    /// What a grey (empty) cell means, as the key says it ("law n/a").
+    /// What a grey (empty) cell means, as the key says it ("law n/a"); nothing: no
+    /// key (no cell is empty or marked).
     pub empty_label: String,
+    /// Log axes (a parameter grid); else linear (an image in nm).
+    pub log_axes: bool,
 }
 
 impl HeatMap {
@@ -52,6 +55,33 @@ impl HeatMap {
             None => Some((v, v)),
             Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
         })
+    }
+
+    /// Cell edges along x and y ([`HeatMap::edges`], [`HeatMap::linear_edges`]).
+    pub fn cell_edges(&self) -> (Vec<f64>, Vec<f64>) {
+        let edges = if self.log_axes {
+            Self::edges
+        } else {
+            Self::linear_edges
+        };
+        (edges(&self.x), edges(&self.y))
+    }
+
+    /// Cell edges along an evenly spaced axis: midpoints between the values, and half a
+    /// step beyond the first and the last (a single value: ±1 around it).
+    pub fn linear_edges(values: &[f64]) -> Vec<f64> {
+        match values {
+            [] => Vec::new(),
+            [v] => vec![v - 1.0, v + 1.0],
+            _ => {
+                let n = values.len();
+                let mut e = Vec::with_capacity(n + 1);
+                e.push(values[0] - 0.5 * (values[1] - values[0]));
+                e.extend(values.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+                e.push(values[n - 1] + 0.5 * (values[n - 1] - values[n - 2]));
+                e
+            }
+        }
     }
 
     /// Cell edges along a log-spaced axis: geometric midpoints between the values, and

@@ -117,6 +117,7 @@ pub fn heat_maps<T: MapRecord>(
         },
         x: works.to_vec(),
         y: moduli.iter().map(|e| e * 1e-9).collect(),
+        log_axes: true,
         cells: plotted
             .iter()
             .enumerate()

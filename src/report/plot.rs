@@ -40,12 +40,12 @@ fn register_font() {
 
 /// Render `chart` to a PNG file at `path` (written atomically).
 pub fn render_png(chart: &Chart, path: &Path) -> Result<()> {
-    render_stack_png(std::slice::from_ref(chart), path)
+    render_stack_png(std::slice::from_ref(chart), path, Arrange::Stack)
 }
 
 /// Render `chart` to an SVG file at `path` (written atomically).
 pub fn render_svg(chart: &Chart, path: &Path) -> Result<()> {
-    render_stack_svg(std::slice::from_ref(chart), path)
+    render_stack_svg(std::slice::from_ref(chart), path, Arrange::Stack)
 }
 
 /// Where a panel was drawn: its plotting area (backend pixels, x and y ranges) and how
@@ -88,28 +88,33 @@ impl Panel for HeatMap {
 fn draw_stack<DB: DrawingBackend, P: Panel>(
     panels: &[P],
     root: &DrawingArea<DB, Shift>,
+    arrange: Arrange,
 ) -> std::result::Result<Vec<Drawn>, String> {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     panels
         .iter()
-        .zip(root.split_evenly(grid(panels.len())))
+        .zip(root.split_evenly(grid(panels.len(), arrange)))
         .map(|(panel, area)| panel.draw_panel(&area))
         .collect()
 }
 
 /// Rows and columns of a figure of `n` charts.
-fn grid(n: usize) -> (usize, usize) {
-    if n <= 3 {
+fn grid(n: usize, arrange: Arrange) -> (usize, usize) {
+    if arrange == Arrange::SideBySide {
+        (1, n.max(1))
+    } else if n <= 3 {
         (n.max(1), 1)
     } else {
         (n.div_ceil(2), 2)
     }
 }
 
-fn stack_size(n: usize) -> (u32, u32) {
-    let (rows, columns) = grid(n);
+fn stack_size(n: usize, arrange: Arrange) -> (u32, u32) {
+    let (rows, columns) = grid(n, arrange);
     if n <= 1 {
         SIZE
+    } else if arrange == Arrange::SideBySide {
+        (SIZE.0 * columns as u32 * 3 / 4, SIZE.1 * 3 / 4)
     } else {
         (SIZE.0 * columns as u32, (SIZE.1 * 2 / 3) * rows as u32)
     }
@@ -117,9 +122,10 @@ fn stack_size(n: usize) -> (u32, u32) {
 
 /// Drawn into memory and encoded there, then written like any other output: file
 /// errors are told as such, and a PNG can go to a device or a FIFO like a CSV.
-fn render_stack_png<P: Panel>(panels: &[P], path: &Path) -> Result<()> {
+fn render_stack_png<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
     use image::ImageEncoder;
-    let (pixels, (width, height), _) = rasterize(panels).map_err(|reason| fail(path, reason))?;
+    let (pixels, (width, height), _) =
+        rasterize(panels, arrange).map_err(|reason| fail(path, reason))?;
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(&pixels, width, height, image::ColorType::Rgb8)
@@ -131,25 +137,26 @@ fn render_stack_png<P: Panel>(panels: &[P], path: &Path) -> Result<()> {
 type Raster = (Vec<u8>, (u32, u32), Vec<Drawn>);
 
 /// `panels` drawn into RGB pixels ([`draw_stack`]).
-fn rasterize<P: Panel>(panels: &[P]) -> std::result::Result<Raster, String> {
+fn rasterize<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<Raster, String> {
     register_font();
-    let (width, height) = stack_size(panels.len());
+    let (width, height) = stack_size(panels.len(), arrange);
     let mut pixels = vec![0u8; 3 * width as usize * height as usize];
     let drawn = {
         let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
-        let drawn = draw_stack(panels, &root)?;
+        let drawn = draw_stack(panels, &root, arrange)?;
         root.present().map_err(|e| e.to_string())?;
         drawn
     };
     Ok((pixels, (width, height), drawn))
 }
 
-fn render_stack_svg<P: Panel>(panels: &[P], path: &Path) -> Result<()> {
+fn render_stack_svg<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
     register_font();
     let mut text = String::new();
     {
-        let root = SVGBackend::with_string(&mut text, stack_size(panels.len())).into_drawing_area();
-        draw_stack(panels, &root).map_err(|reason| fail(path, reason))?;
+        let root = SVGBackend::with_string(&mut text, stack_size(panels.len(), arrange))
+            .into_drawing_area();
+        draw_stack(panels, &root, arrange).map_err(|reason| fail(path, reason))?;
         root.present().map_err(|e| fail(path, e.to_string()))?;
     }
     output::write_bytes(path, text.as_bytes())
@@ -157,24 +164,39 @@ fn render_stack_svg<P: Panel>(panels: &[P], path: &Path) -> Result<()> {
 
 /// Render `charts` one above the other into `path`, PNG or SVG by its extension.
 pub fn render_stack(charts: &[Chart], path: &Path) -> Result<()> {
-    render(charts, path)
+    render(charts, path, Arrange::Stack)
 }
 
 /// Render heat maps one above the other into `path`, PNG or SVG by its extension.
 pub fn render_heatmaps(maps: &[HeatMap], path: &Path) -> Result<()> {
-    render(maps, path)
+    render(maps, path, Arrange::Stack)
+}
+
+/// Render heat maps side by side into `path` (an image's channels), PNG or SVG by its
+/// extension.
+pub fn render_side_by_side(maps: &[HeatMap], path: &Path) -> Result<()> {
+    render(maps, path, Arrange::SideBySide)
+}
+
+/// How the panels of a figure are laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Arrange {
+    /// One above the other up to three, else row by row in two columns.
+    Stack,
+    /// In one row.
+    SideBySide,
 }
 
 /// `panels` into `path`, PNG or SVG by its extension.
-fn render<P: Panel>(panels: &[P], path: &Path) -> Result<()> {
+fn render<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
     match path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .as_deref()
     {
-        Some("png") => render_stack_png(panels, path),
-        Some("svg") => render_stack_svg(panels, path),
+        Some("png") => render_stack_png(panels, path, arrange),
+        Some("svg") => render_stack_svg(panels, path, arrange),
         _ => Err(fail(path, "the plot file must end in .png or .svg".into())),
     }
 }
@@ -212,8 +234,9 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     ticks
 }
 
-/// One heat map: the cells on log axes, and beside them the colour bar with a key to
-/// the grey (the law does not apply) and the marked (not period-1) cells.
+/// One heat map: the cells on log axes (a parameter grid) or linear ones (an image), and
+/// beside them the colour bar with a key to the grey (the law does not apply) and the
+/// marked (not period-1) cells, where there is such a key ([`HeatMap::empty_label`]).
 fn draw_heatmap<DB: DrawingBackend>(
     map: &HeatMap,
     area: &DrawingArea<DB, Shift>,
@@ -221,35 +244,10 @@ fn draw_heatmap<DB: DrawingBackend>(
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let (width, _) = area.dim_in_pixel();
     let (main, side) = area.split_horizontally(width as i32 * 4 / 5);
-    let (xe, ye) = (HeatMap::edges(&map.x), HeatMap::edges(&map.y));
+    let (xe, ye) = map.cell_edges();
     if xe.len() < 2 || ye.len() < 2 {
         return Err("a heat map needs at least one cell".into());
     }
-    let mut ctx = ChartBuilder::on(&main)
-        .caption(&map.title, ("sans-serif", 26))
-        .margin(18)
-        .x_label_area_size(60)
-        .y_label_area_size(80)
-        .build_cartesian_2d(
-            (xe[0]..xe[xe.len() - 1])
-                .log_scale()
-                .with_key_points(log_ticks(xe[0], xe[xe.len() - 1])),
-            (ye[0]..ye[ye.len() - 1])
-                .log_scale()
-                .with_key_points(log_ticks(ye[0], ye[ye.len() - 1])),
-        )
-        .map_err(|e| err(&e))?;
-    let log = |v: &f64| tick_label(*v, Scale::Log);
-    ctx.configure_mesh()
-        .disable_mesh()
-        .x_label_formatter(&log)
-        .y_label_formatter(&log)
-        .x_desc(map.x_label.as_str())
-        .y_desc(map.y_label.as_str())
-        .axis_desc_style(("sans-serif", 22))
-        .label_style(("sans-serif", 17))
-        .draw()
-        .map_err(|e| err(&e))?;
     let (lo, hi) = map.value_range().unwrap_or((0.0, 1.0));
     let span = if hi > lo { hi - lo } else { 1.0 };
     let colour = |v: f64| {
@@ -257,35 +255,27 @@ fn draw_heatmap<DB: DrawingBackend>(
         RGBColor(r, g, b)
     };
     let grey = RGBColor(225, 225, 225);
-    for (j, row) in map.cells.iter().enumerate() {
-        for (i, cell) in row.iter().enumerate() {
-            let corners = [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])];
-            let fill = match *cell {
-                Cell::Value { value, .. } => colour(value),
-                Cell::NotApplicable => grey,
-            };
-            ctx.draw_series(std::iter::once(Rectangle::new(corners, fill.filled())))
-                .map_err(|e| err(&e))?;
-            let centre = (map.x[i], map.y[j]);
-            if let Cell::Value {
-                period_one: false, ..
-            } = cell
-            {
-                ctx.draw_series([
-                    Circle::new(centre, 6, WHITE.filled()),
-                    Circle::new(centre, 6, BLACK.stroke_width(2)),
-                ])
-                .map_err(|e| err(&e))?;
-            }
-            if let Cell::Value { grazing: true, .. } = cell {
-                ctx.draw_series([Circle::new(centre, 3, BLACK.filled())])
-                    .map_err(|e| err(&e))?;
-            }
-        }
-    }
+    let (x_range, y_range) = (xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1]);
+    let cells: (&[f64], &[f64], &dyn Fn(f64) -> RGBColor, RGBColor) = (&xe, &ye, &colour, grey);
+    let plotted = if map.log_axes {
+        let x_ticks = log_ticks(x_range.start, x_range.end);
+        let y_ticks = log_ticks(y_range.start, y_range.end);
+        draw_cells(
+            map,
+            &main,
+            (
+                x_range.log_scale().with_key_points(x_ticks),
+                y_range.log_scale().with_key_points(y_ticks),
+            ),
+            Scale::Log,
+            cells,
+        )?
+    } else {
+        draw_cells(map, &main, (x_range, y_range), Scale::Linear, cells)?
+    };
     // The colour bar, level with the plotting area, and the key below it.
-    let top = ctx.plotting_area().get_pixel_range().1.start - area.get_base_pixel().1;
-    let bottom = ctx.plotting_area().get_pixel_range().1.end - area.get_base_pixel().1;
+    let top = plotted.1.start - area.get_base_pixel().1;
+    let bottom = plotted.1.end - area.get_base_pixel().1;
     let (_, side_height) = side.dim_in_pixel();
     let mut bar = ChartBuilder::on(&side)
         .margin_top(top.max(0) as u32)
@@ -313,6 +303,12 @@ fn draw_heatmap<DB: DrawingBackend>(
         )
     }))
     .map_err(|e| err(&e))?;
+    if map.empty_label.is_empty() {
+        return Ok(Drawn {
+            area: plotted,
+            legend_covers: 0,
+        });
+    }
     let key = ("sans-serif", 16).into_font().color(&BLACK);
     let at = |dy: i32| (10, bottom + 14 + dy);
     side.draw(&Circle::new(at(8), 6, BLACK.stroke_width(2)))
@@ -343,9 +339,73 @@ fn draw_heatmap<DB: DrawingBackend>(
     ))
     .map_err(|e| err(&e))?;
     Ok(Drawn {
-        area: ctx.plotting_area().get_pixel_range(),
+        area: plotted,
         legend_covers: 0,
     })
+}
+
+/// A heat map's axes and cells on `main` (`cells`: the edges along x and y, the colour
+/// of a value, the grey of an empty cell); where the plotting area went.
+fn draw_cells<DB, X, Y>(
+    map: &HeatMap,
+    main: &DrawingArea<DB, Shift>,
+    (x, y): (X, Y),
+    scale: Scale,
+    (xe, ye, colour, grey): (&[f64], &[f64], &dyn Fn(f64) -> RGBColor, RGBColor),
+) -> std::result::Result<(std::ops::Range<i32>, std::ops::Range<i32>), String>
+where
+    DB: DrawingBackend,
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let mut ctx = ChartBuilder::on(main)
+        .caption(&map.title, ("sans-serif", 26))
+        .margin(18)
+        .x_label_area_size(60)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x, y)
+        .map_err(|e| err(&e))?;
+    let label = |v: &f64| tick_label(*v, scale);
+    ctx.configure_mesh()
+        .disable_mesh()
+        .x_label_formatter(&label)
+        .y_label_formatter(&label)
+        .x_desc(map.x_label.as_str())
+        .y_desc(map.y_label.as_str())
+        .axis_desc_style(("sans-serif", 22))
+        .label_style(("sans-serif", 17))
+        .draw()
+        .map_err(|e| err(&e))?;
+    for (j, row) in map.cells.iter().enumerate() {
+        for (i, cell) in row.iter().enumerate() {
+            let corners = [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])];
+            let fill = match *cell {
+                Cell::Value { value, .. } => colour(value),
+                Cell::NotApplicable => grey,
+            };
+            ctx.draw_series(std::iter::once(Rectangle::new(corners, fill.filled())))
+                .map_err(|e| err(&e))?;
+            let centre = (map.x[i], map.y[j]);
+            if let Cell::Value {
+                period_one: false, ..
+            } = cell
+            {
+                ctx.draw_series([
+                    Circle::new(centre, 6, WHITE.filled()),
+                    Circle::new(centre, 6, BLACK.stroke_width(2)),
+                ])
+                .map_err(|e| err(&e))?;
+            }
+            if let Cell::Value { grazing: true, .. } = cell {
+                ctx.draw_series([Circle::new(centre, 3, BLACK.filled())])
+                    .map_err(|e| err(&e))?;
+            }
+        }
+    }
+    Ok(ctx.plotting_area().get_pixel_range())
 }
 
 fn fail(path: &Path, reason: String) -> Error {
@@ -818,7 +878,7 @@ mod tests {
     /// Pixels of exactly `color` outside the drawn charts' plotting areas (grown by a
     /// pixel for a line's half width).
     fn strays(charts: &[Chart], color: RGBColor) -> usize {
-        let (pixels, (width, _), drawn) = rasterize(charts).unwrap();
+        let (pixels, (width, _), drawn) = rasterize(charts, Arrange::Stack).unwrap();
         pixels
             .chunks(3)
             .enumerate()
@@ -860,7 +920,7 @@ mod tests {
         assert!(strays(std::slice::from_ref(&linear), color) == 0);
         assert!(strays(&[linear.clone(), log.clone(), linear], color) == 0);
         // (Not vacuous: the series is drawn, in that colour.)
-        let (pixels, _, _) = rasterize(&[log]).unwrap();
+        let (pixels, _, _) = rasterize(&[log], Arrange::Stack).unwrap();
         assert!(
             pixels
                 .chunks(3)
@@ -886,12 +946,12 @@ mod tests {
             ],
             Corner::UpperRight,
         );
-        let (_, _, drawn) = rasterize(&[busy]).unwrap();
+        let (_, _, drawn) = rasterize(&[busy], Arrange::Stack).unwrap();
         assert_eq!(drawn[0].legend_covers, 0);
         // The paper's figures that need no Lennard-Jones solution: clear legends too.
         for n in [1, 5] {
             let c = crate::figures::figure(n, &Default::default()).unwrap();
-            let (_, _, drawn) = rasterize(&[c]).unwrap();
+            let (_, _, drawn) = rasterize(&[c], Arrange::Stack).unwrap();
             assert_eq!(drawn[0].legend_covers, 0, "figure {n}");
         }
     }
@@ -935,6 +995,7 @@ mod tests {
             empty_label: "law n/a".into(),
             x: vec![1.0, 10.0],
             y: vec![1.0, 10.0],
+            log_axes: true,
             cells: vec![
                 vec![
                     Cell::Value {
@@ -958,7 +1019,7 @@ mod tests {
                 ],
             ],
         };
-        let (pixels, _, _) = rasterize(&[map]).unwrap();
+        let (pixels, _, _) = rasterize(&[map], Arrange::Stack).unwrap();
         let count = |c: (u8, u8, u8)| pixels.chunks(3).filter(|p| (p[0], p[1], p[2]) == c).count();
         // A quarter of a ~600 x 500 plot each, and the ends of the colour bar.
         assert!(count(viridis(0.0)) > 20_000, "{}", count(viridis(0.0)));
