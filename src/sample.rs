@@ -26,6 +26,11 @@
 //! material = "B"
 //! height = "0nm"               # (default 0)
 //! ```
+//!
+//! `mask = "mask.csv"` (beside the sample file) lays a grid of cells over the stripes
+//! and under the discs: a CSV of material names, the first row the top of the image,
+//! cells spanning length/columns × width/rows, each `B` or `B@1nm` (with a surface
+//! height), an empty cell showing what lies beneath.
 
 use crate::config::{MAX_CONFIG_BYTES, TapInputs, read_text};
 
@@ -35,7 +40,7 @@ fn value_text(value: &toml::Value, key: &str) -> Result<String> {
 }
 use crate::dynamics::setup::TapSetup;
 use crate::error::{Error, Result};
-use crate::instrument::scan::{Disc, Layout, Region};
+use crate::instrument::scan::{Disc, Layout, Mask, Region};
 use std::path::Path;
 
 /// The most materials and regions a sample holds.
@@ -80,7 +85,8 @@ material = "B"
 "#;
 
 impl Sample {
-    /// Read a sample file (at most [`MAX_CONFIG_BYTES`]), each material over `base`.
+    /// Read a sample file (at most [`MAX_CONFIG_BYTES`]), each material over `base`; a
+    /// mask it names is read from beside it.
     pub fn from_file(path: &Path, base: &TapInputs) -> Result<Self> {
         let refuse = |reason: String| Error::Parse {
             name: "sample",
@@ -88,7 +94,7 @@ impl Sample {
             reason,
         };
         let text = read_text(path, MAX_CONFIG_BYTES, refuse)?;
-        Self::from_toml(&text, base).map_err(|e| match e {
+        Self::from_toml_in(&text, base, path.parent()).map_err(|e| match e {
             Error::Parse { name, text, reason } => Error::Parse {
                 name,
                 text,
@@ -98,8 +104,14 @@ impl Sample {
         })
     }
 
-    /// Parse a sample description, each material over `base`.
+    /// Parse a sample description, each material over `base` (it cannot name a mask
+    /// file: [`Sample::from_file`]).
     pub fn from_toml(text: &str, base: &TapInputs) -> Result<Self> {
+        Self::from_toml_in(text, base, None)
+    }
+
+    /// Parse a sample description, each material over `base`, a mask read from `dir`.
+    fn from_toml_in(text: &str, base: &TapInputs, dir: Option<&Path>) -> Result<Self> {
         let bad = |reason: String| Error::Parse {
             name: "sample",
             text: String::new(),
@@ -109,10 +121,10 @@ impl Sample {
             bad(format!("not valid TOML: {}", e.to_string().trim_end()))
         })?;
         for key in table.keys() {
-            if !["length", "width", "material", "region", "disc"].contains(&key.as_str()) {
+            if !["length", "width", "material", "region", "mask", "disc"].contains(&key.as_str()) {
                 return Err(bad(format!(
                     "unknown key {key}; a sample has length, width, [[material]], \
-                     [[region]] and [[disc]]"
+                     [[region]], mask and [[disc]]"
                 )));
             }
         }
@@ -215,6 +227,16 @@ impl Sample {
                 "the regions end at {end:e} m, short of the line ({length_m:e} m)"
             )));
         }
+        let mask = match table.get("mask") {
+            None => None,
+            Some(toml::Value::String(file)) => {
+                let Some(dir) = dir else {
+                    return Err(bad("a mask is read from beside a sample file".into()));
+                };
+                Some(read_mask(&dir.join(file), &materials, (length_m, width_m))?)
+            }
+            Some(_) => return Err(bad("mask names a CSV file (mask = \"mask.csv\")".into())),
+        };
         let mut discs = Vec::new();
         for d in list("disc")? {
             for key in d.keys() {
@@ -258,6 +280,7 @@ impl Sample {
             materials,
             layout: Layout {
                 stripes: regions,
+                mask,
                 discs,
             },
         })
@@ -289,4 +312,67 @@ fn check_height(height_m: f64) -> std::result::Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// The most cells of a mask.
+pub const MAX_MASK_CELLS: usize = 1 << 20;
+
+/// Read a mask CSV ([`Mask`]): rows of material names (`B`, or `B@1nm` with a surface
+/// height; empty: what lies beneath), the first row the top of the image, every row as
+/// long as the first, covering `size_m` (length, width).
+fn read_mask(path: &Path, materials: &[(String, TapSetup)], size_m: (f64, f64)) -> Result<Mask> {
+    let refuse = |reason: String| Error::Parse {
+        name: "sample mask",
+        text: path.display().to_string(),
+        reason,
+    };
+    let text = read_text(path, MAX_CONFIG_BYTES, refuse)?;
+    let mut cells: Vec<Vec<Option<(usize, f64)>>> = Vec::new();
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(text.as_bytes());
+    for (r, record) in reader.records().enumerate() {
+        let record = record.map_err(|e| refuse(format!("not CSV: {e}")))?;
+        let row = record
+            .iter()
+            .enumerate()
+            .map(|(c, cell)| {
+                let cell = cell.trim();
+                if cell.is_empty() {
+                    return Ok(None);
+                }
+                let (name, height) = cell.split_once('@').unwrap_or((cell, "0"));
+                let at =
+                    |reason: String| refuse(format!("row {}, column {}: {reason}", r + 1, c + 1));
+                let height_m = crate::config::length(height.trim()).map_err(at)?;
+                check_height(height_m).map_err(at)?;
+                let value = toml::Value::String(name.trim().into());
+                let material = material_index(materials, Some(&value), "mask cell").map_err(at)?;
+                Ok(Some((material, height_m)))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        if let Some(first) = cells.first()
+            && first.len() != row.len()
+        {
+            return Err(refuse(format!(
+                "row {} has {} cells, the first {}",
+                r + 1,
+                row.len(),
+                first.len()
+            )));
+        }
+        cells.push(row);
+        if cells.len() * cells[0].len() > MAX_MASK_CELLS {
+            return Err(refuse(format!("more than {MAX_MASK_CELLS} cells")));
+        }
+    }
+    if cells.is_empty() || cells[0].is_empty() {
+        return Err(refuse("no cells".into()));
+    }
+    Ok(Mask {
+        columns: cells[0].len(),
+        cells,
+        size_m,
+    })
 }

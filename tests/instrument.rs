@@ -572,3 +572,73 @@ material = "B"
         );
     }
 }
+
+/// A mask CSV beside the sample file: its cells lay materials over the stripes, the first
+/// row at the top of the image; a ragged row, an unknown material or a bad height is
+/// refused with where it is.
+#[test]
+fn a_mask_lays_its_materials_where_its_cells_say() {
+    let dir = common::scratch("scan_mask");
+    let sample = dir.join("masked.toml");
+    std::fs::write(
+        &sample,
+        r#"
+length = "1um"
+mask = "mask.csv"
+[[material]]
+name = "A"
+sample-modulus = "0.5GPa"
+work-of-adhesion = 0.1
+[[material]]
+name = "B"
+sample-modulus = "1GPa"
+work-of-adhesion = 0.08
+[[region]]
+until = "1um"
+material = "A"
+"#,
+    )
+    .unwrap();
+    let scan = |mask: &str| {
+        std::fs::write(dir.join("mask.csv"), mask).unwrap();
+        common::tapsim(&[
+            "scan",
+            "--sample",
+            sample.to_str().unwrap(),
+            "--lines",
+            "2",
+            "--pixels",
+            "4",
+            "--line-rate",
+            "20",
+            "--no-retrace",
+            "--json",
+            "--quiet",
+        ])
+    };
+    // Top row (line 1, y = 750 nm): A then B; bottom row (line 0): B then A.
+    let out = scan("A,B\nB,\n");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let phase = column(&v, "phase_deg");
+    let (line0, line1) = (&phase[..4], &phase[4..]);
+    // Settled pixels: the second of each half.
+    assert!((line0[1] - line1[3]).abs() < 0.05, "B: {line0:?} {line1:?}");
+    assert!((line0[3] - line1[1]).abs() < 0.05, "A: {line0:?} {line1:?}");
+    assert!((line0[1] - line0[3]).abs() > 1.0, "no contrast: {line0:?}");
+    for (mask, says) in [
+        ("A,B\nB\n", "row 2 has 1 cells, the first 2"),
+        ("A,C\n", "row 1, column 2: mask cell names material C"),
+        ("A,B@2um\n", "row 1, column 2: a surface height"),
+        ("", "no cells"),
+    ] {
+        let out = scan(mask);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{mask:?}: {err}");
+        assert!(err.contains(says), "{mask:?}: {err}");
+    }
+}

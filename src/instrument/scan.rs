@@ -139,20 +139,43 @@ pub struct Disc {
     pub height_m: f64,
 }
 
+/// A grid of cells over the whole sample, each a material and a surface height or
+/// nothing (what lies beneath shows), as a mask image gives them: `rows` rows of `columns`
+/// cells, the first row the top of the image (the largest y).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mask {
+    /// Cells per row.
+    pub columns: usize,
+    /// Rows, top first, each `columns` cells: (material, height in m) or nothing.
+    pub cells: Vec<Vec<Option<(usize, f64)>>>,
+    /// The extent it covers: the line's length and the image's width, in m.
+    pub size_m: (f64, f64),
+}
+
 /// A sample's layout in the plane: stripes along x that run across the whole width
-/// (as [`Region`]s), with discs laid over them (a later disc over an earlier one).
+/// (as [`Region`]s), a mask laid over them where its cells say so, and discs over both
+/// (a later disc over an earlier one).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Layout {
     /// The stripes, sorted by `until_m`, the last reaching the end of the line.
     pub stripes: Vec<Region>,
+    /// The mask.
+    pub mask: Option<Mask>,
     /// The discs.
     pub discs: Vec<Disc>,
 }
 
 impl Layout {
-    /// The regions a line at `y_m` crosses: the stripes, cut where a disc's chord at
-    /// that y begins and ends, neighbours of the same material and height merged.
+    /// The regions a line at `y_m` crosses: the stripes, cut where the mask's cells in
+    /// that row and a disc's chord at that y begin and end, neighbours of the same
+    /// material and height merged.
     pub fn line_at(&self, y_m: f64, length_m: f64) -> Vec<Region> {
+        let row = self.mask.as_ref().map(|m| {
+            let rows = m.cells.len();
+            let from_top = ((m.size_m.1 - y_m) / m.size_m.1 * rows as f64).floor();
+            let cell_m = m.size_m.0 / m.columns as f64;
+            (&m.cells[(from_top.max(0.0) as usize).min(rows - 1)], cell_m)
+        });
         let chords: Vec<(f64, f64, &Disc)> = self
             .discs
             .iter()
@@ -164,6 +187,9 @@ impl Layout {
             .collect();
         let mut cuts: Vec<f64> = self.stripes.iter().map(|r| r.until_m).collect();
         cuts.extend(chords.iter().flat_map(|&(a, b, _)| [a, b]));
+        if let Some((cells, cell_m)) = row {
+            cuts.extend((1..cells.len()).map(|i| i as f64 * cell_m));
+        }
         cuts.retain(|&c| c > 0.0 && c < length_m);
         cuts.push(length_m);
         cuts.sort_by(f64::total_cmp);
@@ -178,13 +204,14 @@ impl Layout {
                 .find(|r| mid < r.until_m)
                 .or(self.stripes.last())
                 .expect("a layout has stripes");
+            let masked = row
+                .and_then(|(cells, cell_m)| cells[((mid / cell_m) as usize).min(cells.len() - 1)]);
+            let beneath = masked.unwrap_or((stripe.material, stripe.height_m));
             let (material, height_m) = chords
                 .iter()
                 .rev()
                 .find(|&&(a, b, _)| a <= mid && mid < b)
-                .map_or((stripe.material, stripe.height_m), |&(_, _, d)| {
-                    (d.material, d.height_m)
-                });
+                .map_or(beneath, |&(_, _, d)| (d.material, d.height_m));
             match out.last_mut() {
                 Some(last) if last.material == material && last.height_m == height_m => {
                     last.until_m = until_m;
@@ -203,7 +230,7 @@ impl Layout {
 
 /// One line of an image as an AFM records it: the loop engaged over the line's first
 /// region from the free oscillation at 1.2 A₀ ([`super::feedback::hold`] for
-/// `engage_periods`), then trace and (if `retrace`) retrace, each by [`line`]. The
+/// `engage_periods`), then trace and (if `retrace`) retrace, each by [`line()`]. The
 /// lock-in and the controller start from the given ones, so every line is independent
 /// of the others (computed in any order, on any thread, with the same result).
 /// Returns the trace and the retrace (x as the trace's, not mirrored).
@@ -278,6 +305,15 @@ mod tests {
                     height_m: 0.1,
                 },
             ],
+            mask: Some(Mask {
+                columns: 4,
+                // Top row first: y in (0.5, 1] is row 0, [0, 0.5] row 1.
+                cells: vec![
+                    vec![None, Some((4, 0.3)), None, Some((5, 0.0))],
+                    vec![Some((5, 0.0)), None, None, None],
+                ],
+                size_m: (1.0, 1.0),
+            }),
             discs: vec![
                 Disc {
                     centre_m: (0.35, 0.5),
@@ -293,20 +329,26 @@ mod tests {
                 },
             ],
         };
-        // Point by point: the last disc holding it, else its stripe.
+        // Point by point: the last disc holding it, else the mask's cell, else its stripe.
         let under = |x: f64, y: f64| {
+            let cell = if y > 0.5 {
+                [None, Some((4, 0.3)), None, Some((5, 0.0))][(x * 4.0) as usize]
+            } else {
+                [Some((5, 0.0)), None, None, None][(x * 4.0) as usize]
+            };
             layout
                 .discs
                 .iter()
                 .rev()
                 .find(|d| (x - d.centre_m.0).hypot(y - d.centre_m.1) < d.radius_m)
                 .map(|d| (d.material, d.height_m))
+                .or(cell)
                 .unwrap_or_else(|| {
                     let s = layout.stripes.iter().find(|r| x < r.until_m).unwrap();
                     (s.material, s.height_m)
                 })
         };
-        for y in [0.0, 0.31, 0.4, 0.45, 0.52, 0.69, 0.9] {
+        for y in [0.0, 0.31, 0.4, 0.45, 0.49, 0.52, 0.69, 0.9] {
             let regions = layout.line_at(y, 1.0);
             assert!(regions.windows(2).all(|w| w[0].until_m < w[1].until_m));
             assert_eq!(regions.last().unwrap().until_m, 1.0);
