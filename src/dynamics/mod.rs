@@ -7,6 +7,7 @@ pub mod base_drive;
 pub mod budget;
 mod capture;
 pub mod continuation;
+mod dopri5;
 pub mod free;
 pub mod grazing;
 pub mod harmonics;

@@ -1,5 +1,5 @@
-//! Numerical integration of one branch with ode_solvers' Dopri5, stopping at the first
-//! branch switch. Dopri5 has no event location, so each accepted step is checked here:
+//! Numerical integration of one branch with Dopri5 (`dynamics::dopri5`), stopping at the
+//! first branch switch. Dopri5 has no event location, so each accepted step is checked here:
 //! the switching function α̂ − level is evaluated on the step's cubic Hermite interpolant
 //! (from the states and derivatives at both ends), the crossing is located on it, and
 //! the state at the crossing is obtained by integrating again from the start of that
@@ -13,14 +13,13 @@
 //! three smooth steps instead of a cascade of shrinking ones onto the cusp.
 
 use super::budget;
+use super::dopri5::{self, Settings, StepError, System};
 use super::model::{
     BASE, Coupling, Oscillator, Part, State, V, X, has_tangent, internal_count, rhs, set_phasor,
 };
 use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw, Internal};
 use crate::numeric::bracketed_root;
-use ode_solvers::dop_shared::{OutputType, System};
-use ode_solvers::dopri5::Dopri5;
 use std::cell::Cell;
 use std::ops::Index;
 
@@ -261,7 +260,7 @@ fn approach_rate(
     (s * (level - cpl.alpha_hat(x, x_b)), s * cpl.a1 * (v + v_b))
 }
 
-impl<L: ForceLaw, O: StepObserver, const N: usize> System<f64, State<N>> for Segment<'_, L, O, N> {
+impl<L: ForceLaw, O: StepObserver, const N: usize> System<N> for Segment<'_, L, O, N> {
     #[inline]
     fn system(&self, tau: f64, y: &State<N>, dy: &mut State<N>) {
         rhs(self.law, self.osc, self.cpl, self.branch, tau, y, dy);
@@ -344,7 +343,7 @@ impl<L: ForceLaw, const N: usize> Approach<'_, L, N> {
     }
 }
 
-impl<L: ForceLaw, const N: usize> System<f64, State<N>> for Approach<'_, L, N> {
+impl<L: ForceLaw, const N: usize> System<N> for Approach<'_, L, N> {
     #[inline]
     fn system(&self, w: f64, y: &State<N>, dy: &mut State<N>) {
         let (tau, z) = self.tau_form(w, y);
@@ -447,37 +446,6 @@ pub(crate) struct SegmentEnd<const N: usize = BASE> {
     pub h_first: f64,
 }
 
-fn dopri<S: System<f64, State<N>>, const N: usize>(
-    system: S,
-    tau0: f64,
-    tau1: f64,
-    y0: State<N>,
-    h0: f64,
-    tol: &Tolerances,
-    max_steps: u32,
-) -> Dopri5<f64, State<N>, S> {
-    Dopri5::from_param(
-        system,
-        tau0,
-        tau1,
-        0.0,
-        y0,
-        tol.rtol,
-        tol.atol,
-        0.9,
-        0.04,
-        0.2,
-        10.0,
-        tol.h_max,
-        h0,
-        max_steps,
-        // No stiffness test: slow base-driven cycles run Dopri5 at its stability limit
-        // on purpose (the problem is only mildly stiff there).
-        u32::MAX,
-        OutputType::Sparse,
-    )
-}
-
 /// Most steps of one segment with the variational equations. A segment normally takes
 /// a hundred or so; where the tip lingers next to a fold of the force law the variational
 /// equations grow stiff (the slope there is ∝ 1/√distance) and Dopri5 would crawl. The
@@ -485,9 +453,9 @@ fn dopri<S: System<f64, State<N>>, const N: usize>(
 /// the shooting takes as "no orbit here".
 const MAX_TANGENT_STEPS: u32 = 4000;
 
-/// Most steps of any segment (a segment lasts at most a drive period). Dopri5 keeps every
-/// step of a segment, 8(N + 1) bytes each: this bounds that to 80 MB, and a period that
-/// needs more steps than this is unresolvable in practice.
+/// Most steps of any segment (a segment lasts at most a drive period): a period that
+/// needs more steps than this is unresolvable in practice (and its run is bounded in
+/// time by it).
 const MAX_SEGMENT_STEPS: u32 = 1_000_000;
 
 /// Whether [from, to] is too short for Dopri5 to step at this τ (its step-size underflow
@@ -505,8 +473,8 @@ fn interpolate<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, tau: f64) -> Stat
     y
 }
 
-fn run<S: System<f64, State<N>>, const N: usize>(
-    system: S,
+fn run<S: System<N>, const N: usize>(
+    mut system: S,
     from: f64,
     to: f64,
     y: State<N>,
@@ -514,7 +482,7 @@ fn run<S: System<f64, State<N>>, const N: usize>(
     tol: &Tolerances,
     branch: Branch,
 ) -> Result<()> {
-    use ode_solvers::dop_shared::IntegrationError as E;
+    use StepError as E;
     let branch = match branch {
         Branch::Free => "out-of-contact",
         Branch::Contact => "contact",
@@ -530,7 +498,14 @@ fn run<S: System<f64, State<N>>, const N: usize>(
     let left = budget::left();
     let max_steps = u32::try_from(left).map_or(segment_cap, |l| l.min(segment_cap));
     let limited_by_budget = u64::from(max_steps) == left && max_steps < segment_cap;
-    match dopri(system, from, to, y, h, tol, max_steps).integrate() {
+    let settings = Settings {
+        rtol: tol.rtol,
+        atol: tol.atol,
+        h_max: tol.h_max,
+        h0: h,
+        max_steps,
+    };
+    match dopri5::integrate(&mut system, from, to, y, &settings) {
         Ok(stats) => budget::spend(u64::from(stats.accepted_steps + stats.rejected_steps)),
         Err(E::MaxNumStepReached { .. }) if limited_by_budget => Err(budget::exhausted()),
         Err(e) => Err({
@@ -548,9 +523,6 @@ fn run<S: System<f64, State<N>>, const N: usize>(
                      resolve (a cantilever far softer than the contact, or a drive far \
                      below resonance)"
                 ),
-                E::StiffnessDetected { x } => {
-                    format!("the motion on the {branch} branch became stiff at τ = {x:.6e} (ω₀t)")
-                }
             })
         }),
     }
@@ -898,7 +870,7 @@ mod tests {
     fn an_integration_failure_is_told_in_words() {
         // x' = 1/(1 − τ)²: the step must shrink to nothing at τ = 1.
         struct Blows;
-        impl System<f64, State> for Blows {
+        impl System<BASE> for Blows {
             fn system(&self, tau: f64, _: &State, dy: &mut State) {
                 *dy = State::zeros();
                 dy[X] = 1.0 / ((1.0 - tau) * (1.0 - tau));
