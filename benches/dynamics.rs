@@ -239,5 +239,50 @@ fn march(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, settle, map, setpoint, march);
+/// The line: 256 pixels over the built-in two-polymer blend at 1 line/s on the
+/// default 300 kHz cantilever (1 172 drive periods a pixel, 300 032 in the trace), the
+/// loop engaged first (10 000 periods), as `tapsim scan --pixels 256 --line-rate 1
+/// --no-retrace` runs it.
+fn scan_line(c: &mut Criterion) {
+    use tapsim::config::TapInputs;
+    use tapsim::instrument::feedback::PiController;
+    use tapsim::instrument::lockin::LockIn;
+    use tapsim::instrument::scan::row;
+    use tapsim::sample::{BLEND, Sample};
+    let sample = Sample::from_toml(BLEND, &TapInputs::default()).unwrap();
+    let numerics = Numerics {
+        rtol: tapsim::instrument::MARCH_RTOL,
+        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
+        ..Numerics::default()
+    };
+    let prepared: Vec<Prepared> = sample
+        .materials
+        .iter()
+        .map(|(_, s)| Prepared::new(s, &numerics).unwrap())
+        .collect();
+    let sim = prepared[0].simulation();
+    let lockin = LockIn::new(4, 2.0 * sim.osc.period(), sim.osc.omega).unwrap();
+    let controller = PiController::new(0.8, 0.0, 0.002).unwrap();
+    let regions = sample.layout.line_at(0.5 * sample.width_m, sample.length_m);
+    let per_pixel = (300e3_f64 / 256.0).round() as usize;
+    let mut group = c.benchmark_group("scan");
+    group.sample_size(10);
+    group.bench_function("256-pixel line at 1 line/s", |b| {
+        b.iter(|| {
+            row(
+                &prepared,
+                &regions,
+                (sample.length_m, 256, per_pixel),
+                (lockin, controller),
+                10_000,
+                false,
+                |_| {},
+            )
+            .unwrap()
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, settle, map, setpoint, march, scan_line);
 criterion_main!(benches);

@@ -642,3 +642,69 @@ material = "A"
         assert!(err.contains(says), "{mask:?}: {err}");
     }
 }
+
+/// An image sharded over three runs and merged is byte for byte the image one run
+/// writes (CSV and heat maps); a part missing, or one whose pixels were moved to another
+/// line, is refused.
+#[test]
+fn a_sharded_image_merges_into_the_whole_run_byte_for_byte() {
+    let dir = common::scratch("scan_shards");
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let sample = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/samples/discs.toml");
+    let scan = |extra: &[&str]| {
+        let mut args = vec![
+            "scan",
+            "--sample",
+            sample,
+            "--lines",
+            "3",
+            "--pixels",
+            "4",
+            "--line-rate",
+            "40",
+            "--no-retrace",
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        let out = common::tapsim(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let (whole_csv, whole_png) = (path("whole.csv"), path("whole.png"));
+    scan(&["--csv", &whole_csv, "--plot", &whole_png]);
+    let parts: Vec<String> = (0..3).map(|i| path(&format!("part{i}.json"))).collect();
+    for (i, part) in parts.iter().enumerate() {
+        scan(&["--shard", &format!("{i}/3"), "--part", part]);
+    }
+    let (csv, png) = (path("merged.csv"), path("merged.png"));
+    let out = common::tapsim(&[
+        "merge", &parts[0], &parts[1], &parts[2], "--out", &csv, "--out", &png,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(&csv).unwrap(),
+        std::fs::read(&whole_csv).unwrap()
+    );
+    assert_eq!(
+        std::fs::read(&png).unwrap(),
+        std::fs::read(&whole_png).unwrap()
+    );
+    let out = common::tapsim(&["merge", &parts[0], &parts[2], "--out", &csv]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("1 of 3 parts missing: 1"));
+    // Part 1 holds line 1; its pixels relabelled as line 0 are refused.
+    let text = std::fs::read_to_string(&parts[1]).unwrap();
+    let moved = path("moved.json");
+    std::fs::write(&moved, text.replace("\"line\":1", "\"line\":0")).unwrap();
+    let out = common::tapsim(&["merge", &parts[0], &moved, &parts[2], "--out", &csv]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("hold for line 1 a pixel of line 0"), "{err}");
+}

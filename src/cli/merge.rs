@@ -1,4 +1,4 @@
-//! `tapsim merge`: the parts of a sharded map, checked and joined into the outputs one
+//! `tapsim merge`: the parts of a sharded map, batch or image, checked and joined into the outputs one
 //! whole run writes.
 
 use crate::error::{Error, Result};
@@ -6,9 +6,10 @@ use crate::report::part::{self, Job, Part};
 use clap::Args;
 use std::path::PathBuf;
 
-/// Join the part files of a sharded `tapsim map` or `tapsim batch` (--shard I/N, or a
-/// Slurm job array) into exactly the outputs the whole run writes: the CSV, the JSON and
-/// a map's heat maps are byte for byte those of one unsharded run.
+/// Join the part files of a sharded `tapsim map`, `tapsim batch` or `tapsim scan --lines
+/// N` (--shard I/N, or a Slurm job array) into exactly the outputs the whole run writes:
+/// the CSV, the JSON and a map's or an image's heat maps are byte for byte those of one
+/// unsharded run.
 ///
 /// A part file is checked like any input before anything is drawn from it: written by
 /// this tapsim, its job one `map` or `batch` would run, its configuration hash recomputed
@@ -83,5 +84,8 @@ pub fn run(args: MergeArgs) -> Result<()> {
             &merged.records,
         ),
         Job::Batch { .. } => super::batch::emit(&args.output, &args.out, &merged.records),
+        Job::Scan { .. } => {
+            super::scan::emit(&args.output, &args.out, &merged.job, &merged.records)
+        }
     }
 }

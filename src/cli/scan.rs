@@ -5,11 +5,14 @@ use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
 use crate::instrument::feedback::PiController;
 use crate::instrument::lockin::LockIn;
-use crate::instrument::scan::{Pixel, row};
+use crate::instrument::scan::{MAX_IMAGE_PIXELS, MAX_PIXELS, Pixel, row};
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::report::heatmap::{Cell, HeatMap};
+use crate::report::part::{self, Job};
 use crate::sample::{BLEND, Sample};
+use crate::sweep::Shard;
 use clap::Args;
+use serde_json::value::RawValue;
 
 /// Scan one line over a sample as an AFM images it: a lock-in reads the amplitude and
 /// phase at the drive frequency, a PI controller moves the z piezo to hold the amplitude
@@ -28,6 +31,8 @@ use clap::Args;
 /// --lines N records an image: N lines across the sample's width, each engaged and
 /// scanned on its own (in parallel, --threads; the same result on any number of
 /// threads), drawn by --plot as heat maps of topography and phase side by side.
+/// --shard I/N (or a Slurm job array) scans every N-th line into a part file; `tapsim
+/// merge` joins the parts into the outputs one whole run writes.
 /// The loop is engaged over the first region from the free oscillation at 1.2 A₀ (10 000
 /// drive periods), so it sits on the branch a falling setpoint stays on (attractive on
 /// the defaults). A slow scan (the default: 4 lines/s, 32 pixels, about 2 300 drive
@@ -82,12 +87,14 @@ pub struct ScanArgs {
     /// Trace only.
     #[arg(long)]
     no_retrace: bool,
+    #[command(flatten)]
+    split: super::shard::ShardArgs,
 }
 
 /// A pixel with its direction and line.
-#[derive(serde::Serialize)]
+#[derive(serde::Serialize, serde::Deserialize)]
 struct Row {
-    direction: &'static str,
+    direction: String,
     /// The line's index (0 first) and its position across the sample, in m.
     line: usize,
     y_m: f64,
@@ -97,9 +104,6 @@ struct Row {
 
 /// The most drive periods one scan marches (every line, both directions).
 const MAX_PERIODS: f64 = 2e8;
-
-/// The most pixels of an image (lines × pixels): its records stay within memory.
-const MAX_IMAGE_PIXELS: usize = 1 << 20;
 
 /// The loop's engagement over the first region, in drive periods.
 const ENGAGE_PERIODS: usize = 10_000;
@@ -117,9 +121,9 @@ pub fn run(args: ScanArgs) -> Result<()> {
         Some(path) => Sample::from_file(path, &base)?,
         None => Sample::from_toml(BLEND, &base)?,
     };
-    if !(1..=4096).contains(&args.pixels) || !(1..=4096).contains(&args.lines) {
+    if !(1..=MAX_PIXELS).contains(&args.pixels) || !(1..=MAX_PIXELS).contains(&args.lines) {
         return Err(Error::OutOfRange(format!(
-            "--pixels and --lines are from 1 to 4096, not {} and {}",
+            "--pixels and --lines are from 1 to {MAX_PIXELS}, not {} and {}",
             args.pixels, args.lines
         )));
     }
@@ -146,6 +150,9 @@ pub fn run(args: ScanArgs) -> Result<()> {
         .iter()
         .map(|(_, s)| Prepared::new(s, &numerics))
         .collect::<Result<Vec<_>>>()?;
+    let whole_outputs = args.out.csv.is_some() || args.out.plot.is_some() || args.out.json;
+    let shard = args.split.resolve("scan", whole_outputs)?;
+    let mine = shard.unwrap_or(Shard::WHOLE).items(args.lines);
     let lines: Vec<(f64, Vec<crate::instrument::scan::Region>)> = (0..args.lines)
         .map(|j| {
             let y = sample.width_m * (j as f64 + 0.5) / args.lines as f64;
@@ -178,18 +185,17 @@ pub fn run(args: ScanArgs) -> Result<()> {
     let controller = PiController::new(args.setpoint, args.proportional_gain, args.integral_gain)?;
     let bar = args
         .out
-        .progress_bar(args.lines * (args.pixels * directions + 1));
+        .progress_bar(mine.len() * (args.pixels * directions + 1));
     let shape = (sample.length_m, args.pixels, per_pixel);
     let scanned = {
         use rayon::prelude::*;
         crate::sweep::thread_pool(args.threads)?.install(|| {
-            lines
-                .par_iter()
-                .map(|(_, regions)| {
+            mine.par_iter()
+                .map(|&j| {
                     bar.inc(1);
                     row(
                         &prepared,
-                        regions,
+                        &lines[j].1,
                         shape,
                         (lockin, controller),
                         ENGAGE_PERIODS,
@@ -200,28 +206,57 @@ pub fn run(args: ScanArgs) -> Result<()> {
                 .collect::<Result<Vec<_>>>()
         })?
     };
-    let mut rows = Vec::with_capacity(args.lines * args.pixels * directions);
-    for (line, ((y_m, _), (trace, retrace))) in lines.iter().zip(scanned).enumerate() {
-        let tagged = |direction, pixels: Vec<Pixel>| {
-            pixels.into_iter().map(move |pixel| Row {
-                direction,
-                line,
-                y_m: *y_m,
-                pixel,
-            })
-        };
-        rows.extend(tagged("trace", trace));
-        rows.extend(retrace.into_iter().flat_map(|r| tagged("retrace", r)));
-    }
+    // Each line's rows, trace then retrace.
+    let per_line: Vec<Vec<Row>> = mine
+        .iter()
+        .zip(scanned)
+        .map(|(&line, (trace, retrace))| {
+            let y_m = lines[line].0;
+            let tagged = move |direction: &str, pixels: Vec<Pixel>| {
+                let direction = direction.to_string();
+                pixels.into_iter().map(move |pixel| Row {
+                    direction: direction.clone(),
+                    line,
+                    y_m,
+                    pixel,
+                })
+            };
+            tagged("trace", trace)
+                .chain(retrace.into_iter().flat_map(|r| tagged("retrace", r)))
+                .collect()
+        })
+        .collect();
     bar.finish_and_clear();
-    if args.lines > 1 {
-        args.out.write_files_drawn(&rows, |path| {
-            let maps = images(&rows, args.lines, args.pixels, args.setpoint);
-            crate::report::plot::render_side_by_side(&maps, path)
-        })?;
-    } else {
-        args.out.write_files(&rows, || charts(&rows))?;
+    let job = Job::Scan {
+        lines: args.lines,
+        pixels: args.pixels,
+        retrace: !args.no_retrace,
+        setpoint: args.setpoint,
+    };
+    if let Some(shard) = shard {
+        let config = serde_json::to_value((
+            &sample.materials,
+            &sample.layout,
+            (sample.length_m, sample.width_m),
+            &numerics,
+            (per_pixel, args.lockin_order, args.lockin_periods),
+            (args.proportional_gain, args.integral_gain),
+        ))
+        .expect("a configuration serialises");
+        return args.split.write(
+            ("scan", shard, args.out.quiet),
+            job,
+            &part::Config::Whole(config),
+            mine,
+            per_line
+                .iter()
+                .map(|rows| part::raw_records(rows))
+                .collect::<Result<_>>()?,
+        );
     }
+    let rows: Vec<Row> = per_line.into_iter().flatten().collect();
+    args.out
+        .write_files_drawn(&rows, |path| draw(&job, &rows, path))?;
     if args.out.json {
         return args.out.print_json(&rows);
     }
@@ -251,7 +286,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
             "{:>10.2} {:>10.2} {:>8} {:>12.4} {:>10.6} {:>10.2e} {:>10.4}",
             r.y_m * 1e9,
             p.x_m * 1e9,
-            r.direction,
+            r.direction.as_str(),
             p.topography_m * 1e9,
             p.amplitude_ratio,
             p.error,
@@ -261,16 +296,78 @@ pub fn run(args: ScanArgs) -> Result<()> {
     Ok(())
 }
 
+/// What a plot shows of a pixel's record: its direction (trace?), position (y, x in m),
+/// topography (m) and phase (deg).
+type Point = (bool, f64, f64, f64, f64);
+
+/// A pixel's record, as computed or as read back from a part file.
+pub(super) trait ScanRecord: serde::Serialize {
+    /// What a plot shows of it.
+    fn point(&self) -> Option<Point>;
+}
+
+impl ScanRecord for Row {
+    fn point(&self) -> Option<Point> {
+        let p = &self.pixel;
+        Some((
+            self.direction == "trace",
+            self.y_m,
+            p.x_m,
+            p.topography_m,
+            p.phase_deg,
+        ))
+    }
+}
+
+impl ScanRecord for Box<RawValue> {
+    fn point(&self) -> Option<Point> {
+        serde_json::from_str::<Row>(self.get()).ok()?.point()
+    }
+}
+
+/// Write a whole scan's outputs from its records: `tapsim merge` writes a sharded
+/// image's through this ([`super::SweepOutput::emit`]).
+pub(super) fn emit<T: ScanRecord>(
+    out: &super::SweepOutput,
+    extra: &[std::path::PathBuf],
+    job: &Job,
+    records: &[T],
+) -> Result<()> {
+    out.emit(
+        ("scan", extra),
+        records,
+        || crate::report::records::columns_json(records),
+        Some(&|path| draw(job, records, path)),
+    )
+}
+
+/// The plot of a scan: profiles of one line, heat maps of an image.
+fn draw<T: ScanRecord>(job: &Job, records: &[T], path: &std::path::Path) -> Result<()> {
+    let points: Vec<Point> = records.iter().filter_map(ScanRecord::point).collect();
+    match *job {
+        Job::Scan {
+            lines,
+            pixels,
+            setpoint,
+            ..
+        } if lines > 1 => crate::report::plot::render_side_by_side(
+            &images(&points, lines, pixels, setpoint),
+            path,
+        ),
+        _ => crate::report::plot::render_stack(&charts(&points), path),
+    }
+}
+
 /// Topography and phase profiles, trace and retrace.
-fn charts(rows: &[Row]) -> Vec<Chart> {
-    let profile = |name: &str, title: &str, label: &str, pick: fn(&Pixel) -> f64| {
+fn charts(rows: &[Point]) -> Vec<Chart> {
+    let profile = |name: &str, title: &str, label: &str, pick: fn(&Point) -> f64| {
         let series: Vec<Series> = [("trace", Style::Line, 1), ("retrace", Style::Dashed, 2)]
             .into_iter()
             .filter_map(|(dir, style, color)| {
                 let points: Vec<(f64, f64)> = rows
                     .iter()
-                    .filter(|r| r.direction == dir)
-                    .map(|r| (r.pixel.x_m * 1e9, pick(&r.pixel)))
+                    .filter(|r| r.0 == (dir == "trace"))
+                    .map(|r| (r.2 * 1e9, pick(r)))
                     .collect();
                 (!points.is_empty()).then(|| Series::new(dir, points, style, color))
             })
@@ -290,20 +387,18 @@ fn charts(rows: &[Row]) -> Vec<Chart> {
             "topography_nm",
             "topography (z piezo)",
             "height (nm)",
-            |p| p.topography_m * 1e9,
+            |p| p.3 * 1e9,
         ),
-        profile("phase_deg", "lock-in phase", "phase lag φ (deg)", |p| {
-            p.phase_deg
-        }),
+        profile("phase_deg", "lock-in phase", "phase lag φ (deg)", |p| p.4),
     ]
 }
 
 /// Heat maps of the trace's topography and phase over the image, side by side.
-fn images(rows: &[Row], lines: usize, pixels: usize, setpoint: f64) -> Vec<HeatMap> {
-    let trace: Vec<&Row> = rows.iter().filter(|r| r.direction == "trace").collect();
-    let x: Vec<f64> = trace[..pixels].iter().map(|r| r.pixel.x_m * 1e9).collect();
-    let y: Vec<f64> = trace.iter().step_by(pixels).map(|r| r.y_m * 1e9).collect();
-    let map = |title: &str, label: &str, pick: fn(&Pixel) -> f64| HeatMap {
+fn images(rows: &[Point], lines: usize, pixels: usize, setpoint: f64) -> Vec<HeatMap> {
+    let trace: Vec<&Point> = rows.iter().filter(|r| r.0).collect();
+    let x: Vec<f64> = trace.iter().take(pixels).map(|r| r.2 * 1e9).collect();
+    let y: Vec<f64> = trace.iter().step_by(pixels).map(|r| r.1 * 1e9).collect();
+    let map = |title: &str, label: &str, pick: fn(&Point) -> f64| HeatMap {
         title: format!("{title} at A/A₀ = {setpoint} (trace)"),
         x_label: "x along the line (nm)".into(),
         y_label: "y across the lines (nm)".into(),
@@ -316,7 +411,7 @@ fn images(rows: &[Row], lines: usize, pixels: usize, setpoint: f64) -> Vec<HeatM
             .map(|line| {
                 line.iter()
                     .map(|r| Cell::Value {
-                        value: pick(&r.pixel),
+                        value: pick(r),
                         period_one: true,
                         grazing: false,
                     })
@@ -327,9 +422,7 @@ fn images(rows: &[Row], lines: usize, pixels: usize, setpoint: f64) -> Vec<HeatM
         log_axes: false,
     };
     vec![
-        map("topography", "z piezo height (nm)", |p| {
-            p.topography_m * 1e9
-        }),
-        map("phase", "lock-in phase φ (deg)", |p| p.phase_deg),
+        map("topography", "z piezo height (nm)", |p| p.3 * 1e9),
+        map("phase", "lock-in phase φ (deg)", |p| p.4),
     ]
 }

@@ -1,4 +1,5 @@
-//! Splitting a job over machines, for the commands that can (`map`, `batch`): which part
+//! Splitting a job over machines, for the commands that can (`map`, `batch`, `scan
+//! --lines N`): which part
 //! a run computes, and its part file.
 
 use crate::error::{Error, Result};
@@ -12,8 +13,8 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct ShardArgs {
     /// Compute only part I (from 0) of N: the items (a map's cells, row by row as the
-    /// CSV lists them; a batch's cases) whose number is I mod N, written to a part file
-    /// (--part) for `tapsim merge`. Inside a Slurm array task, I and N default to the
+    /// CSV lists them; a batch's cases; an image's lines) whose number is I mod N, written
+    /// to a part file (--part) for `tapsim merge`. Inside a Slurm array task, I and N default to the
     /// task's SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN and SLURM_ARRAY_TASK_COUNT.
     #[arg(long, value_name = "I/N")]
     shard: Option<String>,

@@ -15,8 +15,13 @@ use crate::dynamics::march::Phase;
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
 
+/// The most pixels along a line, and the most lines of an image.
+pub const MAX_PIXELS: usize = 4096;
+/// The most pixels of an image (lines × pixels): its records stay within memory.
+pub const MAX_IMAGE_PIXELS: usize = 1 << 20;
+
 /// A stretch of the sample along x.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Region {
     /// Where the stretch ends, in m (the last region runs to the end of the line).
     pub until_m: f64,
@@ -27,7 +32,7 @@ pub struct Region {
 }
 
 /// What is recorded over one pixel: means over its drive periods.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Pixel {
     /// The pixel's centre, in m.
     pub x_m: f64,
@@ -127,7 +132,7 @@ pub fn mirrored(regions: &[Region], length_m: f64) -> Vec<Region> {
 }
 
 /// A disc of one material laid over the stripes of a [`Layout`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Disc {
     /// Its centre (x, y), in m.
     pub centre_m: (f64, f64),
@@ -142,7 +147,7 @@ pub struct Disc {
 /// A grid of cells over the whole sample, each a material and a surface height or
 /// nothing (what lies beneath shows), as a mask image gives them: `rows` rows of `columns`
 /// cells, the first row the top of the image (the largest y).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Mask {
     /// Cells per row.
     pub columns: usize,
@@ -155,7 +160,7 @@ pub struct Mask {
 /// A sample's layout in the plane: stripes along x that run across the whole width
 /// (as [`Region`]s), a mask laid over them where its cells say so, and discs over both
 /// (a later disc over an earlier one).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Layout {
     /// The stripes, sorted by `until_m`, the last reaching the end of the line.
     pub stripes: Vec<Region>,

@@ -1,7 +1,8 @@
 //! Part files of a job split over machines (`tapsim map --shard I/N`, `tapsim batch
-//! --shard I/N`) and their merge (`tapsim merge`). A part file is one JSON object: a
-//! header (format, tapsim version, a hash of the whole configuration, N, I, what the job
-//! is, the numbers of the part's items: a map's cells, a batch's cases) and each item's
+//! --shard I/N`, `tapsim scan --lines N --shard I/N`) and their merge (`tapsim merge`). A
+//! part file is one JSON object: a header (format, tapsim version, a hash of the whole
+//! configuration, N, I, what the job is, the numbers of the part's items: a map's cells,
+//! a batch's cases, an image's lines) and each item's
 //! records, floats written so they read back bit for bit. Merging checks that the parts
 //! belong together and cover every item exactly once, and gives the records in the
 //! order one whole run gives them.
@@ -64,6 +65,17 @@ pub enum Job {
         /// The number of cases.
         cases: usize,
     },
+    /// `tapsim scan --lines N`: one record per pixel, each line an item.
+    Scan {
+        /// Lines of the image.
+        lines: usize,
+        /// Pixels a line.
+        pixels: usize,
+        /// Whether each line is scanned back too.
+        retrace: bool,
+        /// The amplitude setpoint A/A₀.
+        setpoint: f64,
+    },
 }
 
 impl Job {
@@ -76,6 +88,7 @@ impl Job {
                 ..
             } => work_of_adhesion_j_m2.len().saturating_mul(modulus_pa.len()),
             Job::Batch { cases } => *cases,
+            Job::Scan { lines, .. } => *lines,
         }
     }
 
@@ -140,6 +153,54 @@ impl Job {
                 }
                 Ok(())
             }
+            Job::Scan {
+                lines,
+                pixels,
+                setpoint,
+                ..
+            } => {
+                use crate::instrument::scan::{MAX_IMAGE_PIXELS, MAX_PIXELS};
+                if !(1..=MAX_PIXELS).contains(lines)
+                    || !(1..=MAX_PIXELS).contains(pixels)
+                    || lines * pixels > MAX_IMAGE_PIXELS
+                {
+                    return Err(refuse(
+                        "lines",
+                        format!(
+                            "and pixels are {lines} and {pixels}: from 1 to {MAX_PIXELS} each, \
+                             at most {MAX_IMAGE_PIXELS} in all"
+                        ),
+                    ));
+                }
+                if !(*setpoint > 0.0 && *setpoint < 1.0) {
+                    return Err(refuse(
+                        "setpoint",
+                        "is not an amplitude setpoint between 0 and 1".into(),
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// What an item is called: a map's cell, a batch's case, an image's line.
+    fn item_name(&self) -> &'static str {
+        match self {
+            Job::Map { .. } => "cell",
+            Job::Batch { .. } => "case",
+            Job::Scan { .. } => "line",
+        }
+    }
+
+    /// The records one item has: a map cell's one, a scan line's pixels, trace (and
+    /// retrace); `None` where it varies (a batch case).
+    fn records_per_item(&self) -> Option<usize> {
+        match self {
+            Job::Map { .. } => Some(1),
+            Job::Batch { .. } => None,
+            Job::Scan {
+                pixels, retrace, ..
+            } => Some(pixels * if *retrace { 2 } else { 1 }),
         }
     }
 }
@@ -341,29 +402,45 @@ fn check(name: &str, p: &Part) -> Result<Shard> {
             ),
         ));
     }
+    if !matches!(p.job, Job::Batch { .. }) {
+        if !p.item_configs.is_empty() || !p.config.is_array() {
+            return Err(refuse(
+                "config",
+                "is not a whole job's configuration".into(),
+            ));
+        }
+        if job_hash(&p.job, &Config::Whole(p.config.clone())) != p.config_hash {
+            return Err(refuse(
+                "config_hash",
+                "does not match the job and configuration the part holds: it was changed after tapsim wrote it"
+                    .into(),
+            ));
+        }
+    }
+    if let Some(each) = p.job.records_per_item()
+        && let Some((k, item)) = p
+            .items
+            .iter()
+            .zip(&p.records)
+            .find(|(_, r)| r.len() != each)
+    {
+        let name = p.job.item_name();
+        return Err(refuse(
+            "records",
+            format!(
+                "hold {} records for {name} {k}; a {name} has {each}",
+                item.len()
+            ),
+        ));
+    }
     match &p.job {
         Job::Map {
             work_of_adhesion_j_m2: works,
             modulus_pa: moduli,
             ..
         } => {
-            if !p.item_configs.is_empty() || !p.config.is_array() {
-                return Err(refuse("config", "is not a map's configuration".into()));
-            }
-            if job_hash(&p.job, &Config::Whole(p.config.clone())) != p.config_hash {
-                return Err(refuse(
-                    "config_hash",
-                    "does not match the job and configuration the part holds: it was changed after tapsim wrote it"
-                        .into(),
-                ));
-            }
             for (&k, item) in p.items.iter().zip(&p.records) {
-                let [record] = item.as_slice() else {
-                    return Err(refuse(
-                        "records",
-                        format!("hold {} records for cell {k}; a cell has one", item.len()),
-                    ));
-                };
+                let record = &item[0];
                 #[derive(Deserialize)]
                 struct At {
                     work_of_adhesion_j_m2: f64,
@@ -406,6 +483,25 @@ fn check(name: &str, p: &Part) -> Result<Shard> {
                         "records",
                         format!("hold {} records for case {k}: from 1 to {most}", item.len()),
                     ));
+                }
+            }
+        }
+        Job::Scan { .. } => {
+            for (&k, item) in p.items.iter().zip(&p.records) {
+                #[derive(Deserialize)]
+                struct On {
+                    line: usize,
+                }
+                for record in item {
+                    let on: On = serde_json::from_str(record.get()).map_err(|e| {
+                        refuse("records", format!("hold line {k} as no scan record: {e}"))
+                    })?;
+                    if on.line != k {
+                        return Err(refuse(
+                            "records",
+                            format!("hold for line {k} a pixel of line {}", on.line),
+                        ));
+                    }
                 }
             }
         }
