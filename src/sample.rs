@@ -31,8 +31,19 @@
 //! and under the discs: a CSV of material names, the first row the top of the image,
 //! cells spanning length/columns × width/rows, each `B` or `B@1nm` (with a surface
 //! height), an empty cell showing what lies beneath.
+//!
+//! `mask = "mask.png"` gives the grid as an image instead, one cell a pixel, its colours
+//! named in a table (a pixel of any other colour, or partly transparent, is refused;
+//! a transparent one shows what lies beneath):
+//!
+//! ```toml
+//! mask = "mask.png"
+//! [mask-colours]
+//! "#000000" = "A"
+//! "#ff0000" = "B@1nm"
+//! ```
 
-use crate::config::{MAX_CONFIG_BYTES, TapInputs, read_text};
+use crate::config::{MAX_CONFIG_BYTES, TapInputs, read_input, read_text};
 
 /// A TOML value of a sample file as text ([`crate::config::value_text`]).
 fn value_text(value: &toml::Value, key: &str) -> Result<String> {
@@ -121,10 +132,20 @@ impl Sample {
             bad(format!("not valid TOML: {}", e.to_string().trim_end()))
         })?;
         for key in table.keys() {
-            if !["length", "width", "material", "region", "mask", "disc"].contains(&key.as_str()) {
+            if ![
+                "length",
+                "width",
+                "material",
+                "region",
+                "mask",
+                "mask-colours",
+                "disc",
+            ]
+            .contains(&key.as_str())
+            {
                 return Err(bad(format!(
                     "unknown key {key}; a sample has length, width, [[material]], \
-                     [[region]], mask and [[disc]]"
+                     [[region]], mask, [mask-colours] and [[disc]]"
                 )));
             }
         }
@@ -227,15 +248,56 @@ impl Sample {
                 "the regions end at {end:e} m, short of the line ({length_m:e} m)"
             )));
         }
+        let colours = match table.get("mask-colours") {
+            None => None,
+            Some(toml::Value::Table(t)) => Some(t),
+            Some(_) => {
+                return Err(bad(
+                    "mask-colours is a table of colours ([mask-colours] \"#ff0000\" = \"B\")"
+                        .into(),
+                ));
+            }
+        };
         let mask = match table.get("mask") {
+            None if colours.is_some() => {
+                return Err(bad(
+                    "[mask-colours] names the colours of a mask image, but no \
+                     mask = \"mask.png\" is given"
+                        .into(),
+                ));
+            }
             None => None,
             Some(toml::Value::String(file)) => {
                 let Some(dir) = dir else {
                     return Err(bad("a mask is read from beside a sample file".into()));
                 };
-                Some(read_mask(&dir.join(file), &materials, (length_m, width_m))?)
+                let path = dir.join(file);
+                let size_m = (length_m, width_m);
+                let is_png = path
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+                Some(match (is_png, colours) {
+                    (true, Some(colours)) => read_png_mask(&path, colours, &materials, size_m)?,
+                    (true, None) => {
+                        return Err(bad(format!(
+                            "the mask image {file} needs its colours named: [mask-colours] \
+                             \"#ff0000\" = \"B\" (or \"B@1nm\"), one line per colour"
+                        )));
+                    }
+                    (false, None) => read_mask(&path, &materials, size_m)?,
+                    (false, Some(_)) => {
+                        return Err(bad(format!(
+                            "[mask-colours] is for a mask image (.png); {file} is read as CSV \
+                             of material names"
+                        )));
+                    }
+                })
             }
-            Some(_) => return Err(bad("mask names a CSV file (mask = \"mask.csv\")".into())),
+            Some(_) => {
+                return Err(bad(
+                    "mask names a CSV or PNG file (mask = \"mask.csv\")".into()
+                ));
+            }
         };
         let mut discs = Vec::new();
         for d in list("disc")? {
@@ -327,7 +389,7 @@ fn read_mask(path: &Path, materials: &[(String, TapSetup)], size_m: (f64, f64)) 
         reason,
     };
     let text = read_text(path, MAX_CONFIG_BYTES, refuse)?;
-    let mut cells: Vec<Vec<Option<(usize, f64)>>> = Vec::new();
+    let mut cells: Vec<Vec<MaskCell>> = Vec::new();
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
@@ -338,18 +400,8 @@ fn read_mask(path: &Path, materials: &[(String, TapSetup)], size_m: (f64, f64)) 
             .iter()
             .enumerate()
             .map(|(c, cell)| {
-                let cell = cell.trim();
-                if cell.is_empty() {
-                    return Ok(None);
-                }
-                let (name, height) = cell.split_once('@').unwrap_or((cell, "0"));
-                let at =
-                    |reason: String| refuse(format!("row {}, column {}: {reason}", r + 1, c + 1));
-                let height_m = crate::config::length(height.trim()).map_err(at)?;
-                check_height(height_m).map_err(at)?;
-                let value = toml::Value::String(name.trim().into());
-                let material = material_index(materials, Some(&value), "mask cell").map_err(at)?;
-                Ok(Some((material, height_m)))
+                mask_cell(materials, cell)
+                    .map_err(|e| refuse(format!("row {}, column {}: {e}", r + 1, c + 1)))
             })
             .collect::<Result<Vec<_>>>()?;
         if let Some(first) = cells.first()
@@ -375,4 +427,127 @@ fn read_mask(path: &Path, materials: &[(String, TapSetup)], size_m: (f64, f64)) 
         cells,
         size_m,
     })
+}
+
+/// A mask cell: its material and surface height in m, or nothing ([`Mask::cells`]).
+type MaskCell = Option<(usize, f64)>;
+
+/// A mask cell's text: `B`, `B@1nm` (material and surface height), or empty (nothing).
+fn mask_cell(
+    materials: &[(String, TapSetup)],
+    cell: &str,
+) -> std::result::Result<MaskCell, String> {
+    let cell = cell.trim();
+    if cell.is_empty() {
+        return Ok(None);
+    }
+    let (name, height) = cell.split_once('@').unwrap_or((cell, "0"));
+    let height_m = crate::config::length(height.trim())?;
+    check_height(height_m)?;
+    let value = toml::Value::String(name.trim().into());
+    let material = material_index(materials, Some(&value), "mask cell")?;
+    Ok(Some((material, height_m)))
+}
+
+/// The most bytes of a mask image read.
+pub const MAX_MASK_PNG_BYTES: u64 = 16 << 20;
+
+/// Read a mask image ([`Mask`]): a PNG, one cell a pixel, the top row the top of the
+/// image; each opaque pixel's colour named in `colours` (`"#rrggbb" = "B"` or `"B@1nm"`),
+/// a transparent pixel nothing. Its size is checked before it is decoded.
+fn read_png_mask(
+    path: &Path,
+    colours: &toml::Table,
+    materials: &[(String, TapSetup)],
+    size_m: (f64, f64),
+) -> Result<Mask> {
+    let refuse = |reason: String| Error::Parse {
+        name: "sample mask image",
+        text: path.display().to_string(),
+        reason,
+    };
+    let mut named: Vec<([u8; 3], MaskCell)> = Vec::new();
+    for (key, value) in colours {
+        let rgb = parse_colour(key).map_err(|e| refuse(format!("[mask-colours]: {e}")))?;
+        let toml::Value::String(cell) = value else {
+            return Err(refuse(format!(
+                "[mask-colours] \"{key}\" names a material as text (\"B\" or \"B@1nm\")"
+            )));
+        };
+        let cell = mask_cell(materials, cell)
+            .map_err(|e| refuse(format!("[mask-colours] \"{key}\": {e}")))?
+            .ok_or_else(|| {
+                refuse(format!(
+                    "[mask-colours] \"{key}\" is empty (a transparent pixel shows what lies \
+                     beneath)"
+                ))
+            })?;
+        if named.iter().any(|(c, _)| *c == rgb) {
+            return Err(refuse(format!("[mask-colours] names {key} twice")));
+        }
+        named.push((rgb, Some(cell)));
+    }
+    let bytes = read_input(path, MAX_MASK_PNG_BYTES, refuse)?;
+    let mut reader =
+        image::io::Reader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
+    let mut limits = image::io::Limits::default();
+    limits.max_image_width = Some(MAX_MASK_SIDE);
+    limits.max_image_height = Some(MAX_MASK_SIDE);
+    limits.max_alloc = Some(16 * MAX_MASK_CELLS as u64);
+    reader.limits(limits);
+    let decoded = reader.decode().map_err(|e| {
+        refuse(format!(
+            "not a PNG image within {MAX_MASK_SIDE} pixels a side: {e}"
+        ))
+    })?;
+    let (columns, rows) = (decoded.width() as usize, decoded.height() as usize);
+    if columns * rows > MAX_MASK_CELLS {
+        return Err(refuse(format!("more than {MAX_MASK_CELLS} pixels")));
+    }
+    let rgba = decoded.into_rgba8();
+    let mut cells = vec![vec![None; columns]; rows];
+    for (c, r, pixel) in rgba.enumerate_pixels() {
+        let [red, green, blue, alpha] = pixel.0;
+        let at = |reason: String| {
+            refuse(format!(
+                "row {}, column {} (#{red:02x}{green:02x}{blue:02x}): {reason}",
+                r + 1,
+                c + 1
+            ))
+        };
+        cells[r as usize][c as usize] = match alpha {
+            0 => None,
+            255 => {
+                named
+                    .iter()
+                    .find(|(rgb, _)| *rgb == [red, green, blue])
+                    .ok_or_else(|| at("a colour [mask-colours] does not name".into()))?
+                    .1
+            }
+            _ => {
+                return Err(at(format!(
+                    "partly transparent (alpha {alpha}); a mask's pixels are opaque or \
+                     transparent (an antialiased edge?)"
+                )));
+            }
+        };
+    }
+    Ok(Mask {
+        columns,
+        cells,
+        size_m,
+    })
+}
+
+/// The most pixels a side of a mask image.
+pub const MAX_MASK_SIDE: u32 = 4096;
+
+/// A colour `#rrggbb`.
+fn parse_colour(text: &str) -> std::result::Result<[u8; 3], String> {
+    let hex = text
+        .strip_prefix('#')
+        .filter(|h| h.len() == 6 && h.bytes().all(|b| b.is_ascii_hexdigit()))
+        .ok_or_else(|| format!("{text} is not a colour #rrggbb"))?;
+    let byte = |i: usize| u8::from_str_radix(&hex[i..i + 2], 16).expect("checked hex digits");
+    Ok([byte(0), byte(2), byte(4)])
 }

@@ -643,6 +643,129 @@ material = "A"
     }
 }
 
+/// A mask image is the same grid as a mask CSV: the PNG of the CSV above (its colours
+/// named in [mask-colours], a transparent pixel for the empty cell) scans to the same
+/// bytes; a colour not named, a partly transparent pixel, an image without its colours,
+/// colours for a CSV and a file that is not a PNG are refused with what is wrong.
+#[test]
+fn a_mask_image_lays_the_same_grid_as_its_csv() {
+    let dir = common::scratch("scan_mask_png");
+    let materials = r#"
+[[material]]
+name = "A"
+sample-modulus = "0.5GPa"
+work-of-adhesion = 0.1
+[[material]]
+name = "B"
+sample-modulus = "1GPa"
+work-of-adhesion = 0.08
+[[region]]
+until = "1um"
+material = "A"
+"#;
+    let scan = |head: &str| {
+        let sample = dir.join("masked.toml");
+        std::fs::write(&sample, format!("length = \"1um\"\n{head}\n{materials}")).unwrap();
+        common::tapsim(&[
+            "scan",
+            "--sample",
+            sample.to_str().unwrap(),
+            "--lines",
+            "2",
+            "--pixels",
+            "4",
+            "--line-rate",
+            "20",
+            "--no-retrace",
+            "--json",
+            "--quiet",
+        ])
+    };
+    std::fs::write(dir.join("mask.csv"), "A,B\nB,\n").unwrap();
+    let png = |pixels: [[u8; 4]; 4]| {
+        let image =
+            image::RgbaImage::from_fn(2, 2, |c, r| image::Rgba(pixels[(2 * r + c) as usize]));
+        image.save(dir.join("mask.png")).unwrap();
+    };
+    let (black, red, clear) = ([0, 0, 0, 255], [255, 0, 0, 255], [0, 0, 0, 0]);
+    png([black, red, red, clear]);
+    let colours = "mask = \"mask.png\"\n[mask-colours]\n\"#000000\" = \"A\"\n\"#FF0000\" = \"B\"\n";
+    let from_csv = scan("mask = \"mask.csv\"");
+    let from_png = scan(colours);
+    for out in [&from_csv, &from_png] {
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    assert_eq!(
+        String::from_utf8_lossy(&from_csv.stdout),
+        String::from_utf8_lossy(&from_png.stdout)
+    );
+    let refused = |head: &str, says: &str| {
+        let out = scan(head);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{head:?}: {err}");
+        assert!(err.contains(says), "{head:?}: {err}");
+    };
+    png([black, red, [0, 255, 0, 255], clear]);
+    refused(
+        colours,
+        "row 2, column 1 (#00ff00): a colour [mask-colours] does not name",
+    );
+    png([black, red, [255, 0, 0, 128], clear]);
+    refused(
+        colours,
+        "row 2, column 1 (#ff0000): partly transparent (alpha 128)",
+    );
+    refused("mask = \"mask.png\"", "needs its colours named");
+    refused(
+        "mask = \"mask.csv\"\n[mask-colours]\n\"#000000\" = \"A\"",
+        "[mask-colours] is for a mask image",
+    );
+    refused(
+        "mask = \"mask.png\"\n[mask-colours]\n\"black\" = \"A\"",
+        "black is not a colour #rrggbb",
+    );
+    refused(
+        "mask = \"mask.png\"\n[mask-colours]\n\"#000000\" = \"C\"",
+        "mask cell names material C",
+    );
+    std::fs::write(dir.join("mask.png"), "A,B\n").unwrap();
+    refused(colours, "not a PNG image");
+    // Too wide a mask is refused before it is decoded.
+    image::RgbaImage::new(4097, 1)
+        .save(dir.join("mask.png"))
+        .unwrap();
+    refused(colours, "within 4096 pixels a side");
+    // The shipped examples: the T of mask.csv and of mask.png image alike.
+    let shipped = |name: &str| {
+        let sample = format!("{}/examples/samples/{name}", env!("CARGO_MANIFEST_DIR"));
+        let out = common::tapsim(&[
+            "scan",
+            "--sample",
+            &sample,
+            "--lines",
+            "3",
+            "--pixels",
+            "8",
+            "--line-rate",
+            "20",
+            "--no-retrace",
+            "--json",
+            "--quiet",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out.stdout
+    };
+    assert_eq!(shipped("mask.toml"), shipped("mask_png.toml"));
+}
+
 /// An image sharded over three runs and merged is byte for byte the image one run
 /// writes (CSV and heat maps); a part missing, or one whose pixels were moved to another
 /// line, is refused.

@@ -25,8 +25,9 @@ use serde_json::value::RawValue;
 /// image shows a step that is not there (the two materials hold the setpoint at
 /// different rest separations) and the phase contrast between them. --sample FILE.toml
 /// describes another: its materials (any of tap's sample and law parameters), their
-/// layout along the line, each region with a surface height, and discs laid over it
-/// (see examples/samples/).
+/// layout along the line, each region with a surface height, a mask of cells over it
+/// (a CSV of material names, or a PNG whose colours the file names) and discs laid over
+/// both (see examples/samples/).
 ///
 /// --lines N records an image: N lines across the sample's width, each engaged and
 /// scanned on its own (in parallel, --threads; the same result on any number of
