@@ -46,6 +46,8 @@ unit_parser!(/// A viscosity (Pa·s).
     viscosity, "viscosity", Dimension::Viscosity);
 unit_parser!(/// A time (s).
     time, "time", Dimension::Time);
+unit_parser!(/// A temperature (K).
+    temperature, "temperature", Dimension::Temperature);
 unit_parser!(/// A plain number.
     number, "value", Dimension::Dimensionless);
 

@@ -1,5 +1,5 @@
 //! Reading physical quantities from text: a number with an optional SI unit, such as
-//! `10e-9`, `10nm`, `50 MPa`, `0.05J/m^2`, `40 N/m` or `300kHz`. A bare number is
+//! `10e-9`, `10nm`, `50 MPa`, `0.05J/m^2`, `40 N/m`, `300kHz` or `300K`. A bare number is
 //! taken in the base SI unit of the quantity.
 
 use crate::error::{Error, Result};
@@ -23,6 +23,8 @@ pub enum Dimension {
     Viscosity,
     /// Seconds.
     Time,
+    /// Kelvins.
+    Temperature,
     /// A plain number.
     Dimensionless,
 }
@@ -38,6 +40,7 @@ impl Dimension {
             Dimension::Energy => &[("J", 1.0), ("eV", crate::params::ELECTRONVOLT_J)],
             Dimension::Viscosity => &[("Pa·s", 1.0), ("Pa*s", 1.0), ("Pa s", 1.0), ("Pas", 1.0)],
             Dimension::Time => &[("s", 1.0)],
+            Dimension::Temperature => &[("K", 1.0)],
             Dimension::Dimensionless => &[],
         }
     }

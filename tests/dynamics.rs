@@ -63,6 +63,7 @@ fn free_response<L: ForceLaw>(law: &L, omega: f64, q: f64) -> (f64, f64) {
         gamma: 0.5 / q,
         omega,
         drive: Drive::Force { amplitude: f0 },
+        bias: 0.0,
     };
     let sim = Simulation {
         law,

@@ -31,6 +31,7 @@ mod reproduce;
 mod scan;
 mod shard;
 mod tap;
+mod thermal;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -58,6 +59,7 @@ enum Command {
     Contrast(contrast::ContrastArgs),
     Map(map::MapArgs),
     Scan(scan::ScanArgs),
+    Thermal(thermal::ThermalArgs),
     Batch(batch::BatchArgs),
     Merge(merge::MergeArgs),
     Hysteresis(hysteresis::HysteresisArgs),
@@ -323,6 +325,7 @@ pub fn main() -> ExitCode {
         Command::Contrast(args) => contrast::run(args),
         Command::Map(args) => map::run(args),
         Command::Scan(args) => scan::run(args),
+        Command::Thermal(args) => thermal::run(args),
         Command::Batch(args) => batch::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),

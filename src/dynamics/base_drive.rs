@@ -85,6 +85,7 @@ pub fn hybrid_cycle(
         gamma: 0.5 / opts.quality,
         omega: opts.frequency_ratio,
         drive: Drive::Base { amplitude },
+        bias: 0.0,
     };
     let cpl = Coupling {
         a0: mid,

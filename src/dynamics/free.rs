@@ -1,6 +1,7 @@
 //! Closed-form motion of the force-driven, underdamped oscillator while the tip feels no
-//! force: x'' + 2γx' + x = f₀ cos Ωτ. Exact, so free flight costs no integration steps,
-//! and so are the carried integrals.
+//! force: x'' + 2γx' + x = f₀ cos Ωτ + b, b a constant force (the thermal force over
+//! one of its steps; usually 0). Exact, so free flight costs no integration steps, and
+//! so are the carried integrals.
 
 use super::model::{Carried, Drive, Oscillator, State, V, X, has_tangent, phi_column, section_dim};
 use crate::numeric::newton_bracketed;
@@ -23,9 +24,10 @@ pub(crate) struct Fall {
 #[derive(Debug, Clone, Copy)]
 pub struct FreeFlight {
     tau0: f64,
-    /// Particular solution a cos Ωτ + b sin Ωτ.
+    /// Particular solution a cos Ωτ + b sin Ωτ + bias.
     a: f64,
     b: f64,
+    bias: f64,
     /// Transient e^{−γs}(c1 cos ω_d s + c2 sin ω_d s), s = τ − τ₀.
     c1: f64,
     c2: f64,
@@ -63,12 +65,13 @@ impl FreeFlight {
         let xp = a * c + b * s;
         let vp = w * (-a * s + b * c);
         let omega_d = (1.0 - osc.gamma * osc.gamma).sqrt();
-        let c1 = x0 - xp;
+        let c1 = x0 - xp - osc.bias;
         let c2 = (v0 - vp + osc.gamma * c1) / omega_d;
         Some(Self {
             tau0,
             a,
             b,
+            bias: osc.bias,
             c1,
             c2,
             gamma: osc.gamma,
@@ -99,7 +102,7 @@ impl FreeFlight {
     #[inline]
     fn combine(&self, (s, c): (f64, f64), (sd, cd): (f64, f64), e: f64) -> (f64, f64) {
         let (x_p, v_p) = (
-            self.a * c + self.b * s,
+            self.a * c + self.b * s + self.bias,
             self.omega * (-self.a * s + self.b * c),
         );
         let x_h = e * (self.c1 * cd + self.c2 * sd);
@@ -134,15 +137,15 @@ impl FreeFlight {
         let (x, v) = self.at(tau);
         (
             v,
-            self.f0 * (self.omega * tau).cos() - 2.0 * self.gamma * v - x,
+            self.f0 * (self.omega * tau).cos() + self.bias - 2.0 * self.gamma * v - x,
         )
     }
 
     /// Advance `y` (deflection, velocity and the carried integrals) from `tau_a` to
     /// `tau_b`, all in closed form: the Fourier projections are integrals of exponentials,
     /// the drive's work follows from them by parts, ∫ f₀ cos Ωτ x' dτ =
-    /// f₀([x cos Ωτ] + Ω ∫ x sin Ωτ dτ), and damping takes the rest of the energy balance
-    /// (the tip feels no force). The tip–sample integrals do not change. The variational
+    /// f₀([x cos Ωτ] + Ω ∫ x sin Ωτ dτ), a constant force's is b[x], and damping takes the
+    /// rest of the energy balance (the tip feels no force). The tip–sample integrals do not change. The variational
     /// matrix of a state with a tangent ([`super::model::has_tangent`]) is carried by
     /// [`FreeFlight::transition`].
     pub(crate) fn advance<const N: usize>(&self, y: &mut State<N>, tau_a: f64, tau_b: f64) {
@@ -155,7 +158,7 @@ impl FreeFlight {
         let mechanical = 0.5 * (x_b * x_b + v_b * v_b) - 0.5 * (x_a * x_a + v_a * v_a);
         y[X] = x_b;
         y[V] = v_b;
-        y[Carried::Damping] += drive - mechanical;
+        y[Carried::Damping] += drive + self.bias * (x_b - x_a) - mechanical;
         y[Carried::CosProjection] += sc;
         y[Carried::SinProjection] += ss;
         if has_tangent(N) {
@@ -188,7 +191,7 @@ impl FreeFlight {
     }
 
     /// (∫ x cos Ωτ dτ, ∫ x sin Ωτ dτ) over [a, b], exactly: with x = Re[P e^{iΩτ}] +
-    /// Re[C e^{λ(τ−τ₀)}], P = a − ib, C = c₁ − ic₂, λ = −γ + iω_d, the integral of
+    /// Re[C e^{λ(τ−τ₀)}] + bias, P = a − ib, C = c₁ − ic₂, λ = −γ + iω_d, the integral of
     /// x e^{iΩτ} is a sum of integrals of complex exponentials.
     pub(crate) fn fourier(&self, tau_a: f64, tau_b: f64) -> (f64, f64) {
         let w = self.omega;
@@ -203,7 +206,13 @@ impl FreeFlight {
         let homogeneous = Complex::from_polar(0.5, w * self.tau0)
             * (c * span(lam + Complex::new(0.0, w))
                 + c.conj() * span(lam.conj() + Complex::new(0.0, w)));
-        let total = particular + homogeneous;
+        let constant = if self.bias == 0.0 {
+            Complex::new(0.0, 0.0)
+        } else {
+            self.bias * (Complex::from_polar(1.0, w * tau_b) - Complex::from_polar(1.0, w * tau_a))
+                / Complex::new(0.0, w)
+        };
+        let total = particular + homogeneous + constant;
         (total.re, total.im)
     }
 
@@ -277,70 +286,78 @@ mod tests {
             gamma: 1.0 / 40.0,
             omega: 0.97,
             drive: Drive::Force { amplitude: 0.05 },
+            bias: 0.0,
         }
+    }
+
+    /// With and without a constant force (the thermal force's step).
+    fn oscs() -> [Oscillator; 2] {
+        [osc(), Oscillator { bias: 0.3, ..osc() }]
     }
 
     #[test]
     fn closed_form_solves_the_ode() {
-        let osc = osc();
-        let f = FreeFlight::new(&osc, 0.3, 0.2, -0.4).unwrap();
-        let cpl = Coupling {
-            a0: 0.0,
-            a1: 1.0,
-            f_scale: 0.0,
-        };
-        for i in 0..50 {
-            let t = 0.3 + 0.37 * i as f64;
-            let (x, v) = f.at(t);
-            let h = 1e-4;
-            let (xp, vp) = f.at(t + h);
-            let (xm, vm) = f.at(t - h);
-            let acc = (vp - vm) / (2.0 * h);
-            let mut y = State::<BASE>::zeros();
-            y[X] = x;
-            y[V] = v;
-            crate::dynamics::model::set_phasor(&osc, t, &mut y);
-            let mut dy = State::<BASE>::zeros();
-            rhs(&NoForce, &osc, &cpl, Branch::Free, t, &y, &mut dy);
-            assert!((acc - dy[V]).abs() < 1e-7, "{acc} vs {}", dy[V]);
-            assert!(((xp - xm) / (2.0 * h) - v).abs() < 1e-7);
+        for osc in oscs() {
+            let f = FreeFlight::new(&osc, 0.3, 0.2, -0.4).unwrap();
+            let cpl = Coupling {
+                a0: 0.0,
+                a1: 1.0,
+                f_scale: 0.0,
+            };
+            for i in 0..50 {
+                let t = 0.3 + 0.37 * i as f64;
+                let (x, v) = f.at(t);
+                let h = 1e-4;
+                let (xp, vp) = f.at(t + h);
+                let (xm, vm) = f.at(t - h);
+                let acc = (vp - vm) / (2.0 * h);
+                let mut y = State::<BASE>::zeros();
+                y[X] = x;
+                y[V] = v;
+                crate::dynamics::model::set_phasor(&osc, t, &mut y);
+                let mut dy = State::<BASE>::zeros();
+                rhs(&NoForce, &osc, &cpl, Branch::Free, t, &y, &mut dy);
+                assert!((acc - dy[V]).abs() < 1e-7, "{acc} vs {}", dy[V]);
+                assert!(((xp - xm) / (2.0 * h) - v).abs() < 1e-7);
+            }
+            let (x0, v0) = f.at(0.3);
+            assert!((x0 - 0.2).abs() < 1e-14 && (v0 + 0.4).abs() < 1e-14);
         }
-        let (x0, v0) = f.at(0.3);
-        assert!((x0 - 0.2).abs() < 1e-14 && (v0 + 0.4).abs() < 1e-14);
     }
 
     #[test]
     fn closed_form_integrals_match_quadrature() {
-        let osc = osc();
-        let f = FreeFlight::new(&osc, 0.3, 0.2, -0.4).unwrap();
-        let (a, b) = (0.7, 9.1);
-        let n = 200_000;
-        let h = (b - a) / n as f64;
-        let (mut sc, mut ss, mut damp) = (0.0, 0.0, 0.0);
-        for i in 0..n {
-            let t = a + h * (i as f64 + 0.5);
-            let (x, v) = f.at(t);
-            sc += h * x * (osc.omega * t).cos();
-            ss += h * x * (osc.omega * t).sin();
-            damp += h * 2.0 * osc.gamma * v * v;
+        for osc in oscs() {
+            let f = FreeFlight::new(&osc, 0.3, 0.2, -0.4).unwrap();
+            let (a, b) = (0.7, 9.1);
+            let n = 200_000;
+            let h = (b - a) / n as f64;
+            let (mut sc, mut ss, mut damp) = (0.0, 0.0, 0.0);
+            for i in 0..n {
+                let t = a + h * (i as f64 + 0.5);
+                let (x, v) = f.at(t);
+                sc += h * x * (osc.omega * t).cos();
+                ss += h * x * (osc.omega * t).sin();
+                damp += h * 2.0 * osc.gamma * v * v;
+            }
+            let mut y = State::<BASE>::zeros();
+            f.advance(&mut y, a, b);
+            assert!(
+                (y[Carried::CosProjection] - sc).abs() < 1e-9,
+                "{} {sc}",
+                y[Carried::CosProjection]
+            );
+            assert!(
+                (y[Carried::SinProjection] - ss).abs() < 1e-9,
+                "{} {ss}",
+                y[Carried::SinProjection]
+            );
+            assert!(
+                (y[Carried::Damping] - damp).abs() < 1e-9,
+                "{} {damp}",
+                y[Carried::Damping]
+            );
         }
-        let mut y = State::<BASE>::zeros();
-        f.advance(&mut y, a, b);
-        assert!(
-            (y[Carried::CosProjection] - sc).abs() < 1e-9,
-            "{} {sc}",
-            y[Carried::CosProjection]
-        );
-        assert!(
-            (y[Carried::SinProjection] - ss).abs() < 1e-9,
-            "{} {ss}",
-            y[Carried::SinProjection]
-        );
-        assert!(
-            (y[Carried::Damping] - damp).abs() < 1e-9,
-            "{} {damp}",
-            y[Carried::Damping]
-        );
     }
 
     #[test]

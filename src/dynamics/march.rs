@@ -90,9 +90,9 @@ impl Phase {
 /// period from [`Simulation::cycle`], or the window a steady state is averaged over.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CycleIntegrals {
-    /// Drive periods covered.
+    /// Drive periods covered (0 for a part of one: [`Simulation::advance`]).
     pub periods: u32,
-    /// Length of the span in τ (`periods` drive periods).
+    /// Length of the span in τ (`periods` drive periods, or the part of one).
     pub period: f64,
     /// Energy dissipated in the contact, ∮ −f_ts dα: the elastic part summed from the
     /// branch work functions between the located switches (exact for the computed path),
@@ -353,12 +353,34 @@ impl<L: ForceLaw> Simulation<'_, L> {
         phase: &mut Phase,
         observer: &mut O,
     ) -> Result<CycleIntegrals> {
+        self.span(phase, self.osc.period(), observer)
+    }
+
+    /// Integrate the part `span` (0 < span ≤ one drive period, in τ) of a drive period
+    /// from `phase`, updating it: what a force that changes between parts of a period
+    /// needs (the thermal force, [`crate::instrument::thermal`]). The integrals cover
+    /// the span (`periods` 0 unless it is a whole period).
+    pub fn advance<O: StepObserver>(
+        &self,
+        phase: &mut Phase,
+        span: f64,
+        observer: &mut O,
+    ) -> Result<CycleIntegrals> {
+        self.span(phase, span.min(self.osc.period()), observer)
+    }
+
+    fn span<O: StepObserver>(
+        &self,
+        phase: &mut Phase,
+        span: f64,
+        observer: &mut O,
+    ) -> Result<CycleIntegrals> {
         Ok(if self.law.internal_states() > 0 {
-            self.cycle_in::<MEMORY, O>(phase, observer)?.0
+            self.cycle_in::<MEMORY, O>(phase, span, observer)?.0
         } else if self.law.is_rate_dependent() {
-            self.cycle_in::<RATE, O>(phase, observer)?.0
+            self.cycle_in::<RATE, O>(phase, span, observer)?.0
         } else {
-            self.cycle_in::<BASE, O>(phase, observer)?.0
+            self.cycle_in::<BASE, O>(phase, span, observer)?.0
         })
     }
 
@@ -390,12 +412,13 @@ impl<L: ForceLaw> Simulation<'_, L> {
         &self,
         phase: &mut Phase,
     ) -> Result<(CycleIntegrals, DMatrix<f64>)> {
+        let period = self.osc.period();
         let (integrals, derivative) = if self.law.internal_states() > 0 {
-            self.cycle_in::<MEMORY_TANGENT, _>(phase, &mut numeric::Ignore)
+            self.cycle_in::<MEMORY_TANGENT, _>(phase, period, &mut numeric::Ignore)
         } else if self.law.is_rate_dependent() {
-            self.cycle_in::<RATE_TANGENT, _>(phase, &mut numeric::Ignore)
+            self.cycle_in::<RATE_TANGENT, _>(phase, period, &mut numeric::Ignore)
         } else {
-            self.cycle_in::<TANGENT, _>(phase, &mut numeric::Ignore)
+            self.cycle_in::<TANGENT, _>(phase, period, &mut numeric::Ignore)
         }?;
         let mut derivative = derivative.expect("a tangent layout carries Φ");
         // In the section's units (`Simulation::z`): internal rows times f_scale, internal
@@ -480,14 +503,16 @@ impl<L: ForceLaw> Simulation<'_, L> {
         }
     }
 
+    /// Integrate `span` (at most a drive period) from `phase`.
     fn cycle_in<const N: usize, O: StepObserver>(
         &self,
         phase: &mut Phase,
+        span: f64,
         observer: &mut O,
     ) -> Result<(CycleIntegrals, Option<DMatrix<f64>>)> {
         budget::spend(1)?;
         let period = self.osc.period();
-        let tau_end = phase.tau + period;
+        let tau_end = phase.tau + span;
         phase.branch = self.consistent_branch(phase);
         let mut y = State::<N>::zeros();
         y[X] = phase.x;
@@ -615,8 +640,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
         phase.v = y[V];
         phase.internal = internal(&y);
         let integrals = CycleIntegrals {
-            periods: 1,
-            period,
+            periods: u32::from(span == period),
+            period: span,
             e_ts,
             e_viscous,
             e_capillary,

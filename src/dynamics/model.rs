@@ -303,6 +303,9 @@ pub struct Oscillator {
     pub omega: f64,
     /// The drive.
     pub drive: Drive,
+    /// A constant force on the tip, in units of kL: the thermal force over one of its
+    /// steps ([`crate::instrument::thermal`]); 0 otherwise.
+    pub bias: f64,
 }
 
 impl Oscillator {
@@ -503,7 +506,7 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
         }
     }
     dy[X] = v;
-    dy[V] = -2.0 * osc.gamma * v - x + f + drive;
+    dy[V] = -2.0 * osc.gamma * v - x + f + drive + osc.bias;
     dy[Carried::Damping] = 2.0 * osc.gamma * v * v;
     dy[Carried::CosProjection] = x * c;
     dy[Carried::SinProjection] = x * s;
@@ -551,6 +554,7 @@ mod tests {
                 gamma: 0.05,
                 omega: 1.3,
                 drive,
+                bias: 0.0,
             };
             let w = osc.omega;
             let sc = simpson(|t| x(t) * (w * t).cos(), t0, t1, n);

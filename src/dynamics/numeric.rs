@@ -772,6 +772,7 @@ mod tests {
             gamma: 0.01,
             omega: 1.0,
             drive: Drive::Force { amplitude: 0.02 },
+            bias: 0.0,
         };
         let cpl = Coupling {
             a0: 0.0,

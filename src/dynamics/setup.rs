@@ -418,6 +418,7 @@ impl Prepared {
             drive: Drive::Force {
                 amplitude: cantilever.drive_over_k_a0(),
             },
+            bias: 0.0,
         };
         let a0_m = cantilever.free_amplitude_m;
         let cpl = Coupling {

@@ -5,6 +5,8 @@
 pub mod feedback;
 pub mod lockin;
 pub mod scan;
+pub mod spectrum;
+pub mod thermal;
 
 /// The integrator's relative tolerance an instrument marches at unless told otherwise
 /// (absolute: 1e-2 of it): the loosest at which the energy balance of the default

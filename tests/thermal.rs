@@ -1,0 +1,250 @@
+//! The thermal force (issue 28): equipartition of the free cantilever's motion, the
+//! marcher's noisy free flight against the exact step recursion, reproducible streams,
+//! no noise at T = 0, and the energy balance of a noisy tapping march.
+
+mod common;
+
+use tapsim::dynamics::free::FreeFlight;
+use tapsim::dynamics::grazing::{BOLTZMANN_J_K, ROOM_TEMPERATURE_K};
+use tapsim::dynamics::march::Simulation;
+use tapsim::dynamics::model::{Coupling, Drive, Oscillator};
+use tapsim::dynamics::numeric::{StepEnd, StepObserver, Tolerances};
+use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};
+use tapsim::instrument::thermal::{
+    FreeThermal, STEPS_PER_PERIOD, ThermalForce, free_variance_hat, intensity_hat,
+};
+use tapsim::law::{Branch, NoForce};
+
+/// The mean of `x²` and its standard error from the means of 50 batches (each far longer
+/// than the motion's correlation time when the record is).
+fn mean_square(x: &[f64]) -> (f64, f64) {
+    const BATCHES: usize = 50;
+    let per = x.len() / BATCHES;
+    let means: Vec<f64> = x
+        .chunks_exact(per)
+        .map(|c| c.iter().map(|v| v * v).sum::<f64>() / per as f64)
+        .collect();
+    let m = means.iter().sum::<f64>() / means.len() as f64;
+    let var = means.iter().map(|b| (b - m).powi(2)).sum::<f64>() / (means.len() - 1) as f64;
+    (m, (var / means.len() as f64).sqrt())
+}
+
+/// Equipartition: the free cantilever's ⟨z²⟩ is k_BT/k (10.18 pm rms at 40 N/m and
+/// 300 K), within its standard error, at three stiffnesses. The record: Q = 20, 64 force
+/// steps a period, 40 000 periods (about 2 000 correlation times of the amplitude).
+#[test]
+fn the_free_cantilever_holds_equipartition() {
+    let (q, length_m) = (20.0, 1e-9);
+    let step = 2.0 * std::f64::consts::PI / STEPS_PER_PERIOD as f64;
+    for (k, seed) in [(40.0, 1), (2.0, 2), (0.1, 3)] {
+        let d = intensity_hat(ROOM_TEMPERATURE_K, k, q, length_m);
+        let mut force = ThermalForce::new(d, STEPS_PER_PERIOD, seed, 0).unwrap();
+        let x = FreeThermal::new(q, step).record(40_000 * STEPS_PER_PERIOD, 1, &mut force);
+        let (m, se) = mean_square(&x);
+        let (m_m2, se_m2) = (m * length_m * length_m, se * length_m * length_m);
+        let kt_over_k = BOLTZMANN_J_K * ROOM_TEMPERATURE_K / k;
+        // The force held over steps falls short of white by (π/64)²/3 = 8e-4.
+        let exact = free_variance_hat(q, step, d) * length_m * length_m;
+        assert!((exact / kt_over_k - 1.0).abs() < 1e-3);
+        // The rms's standard error (half the mean square's, relative) under 1 %.
+        assert!(se_m2 < 0.02 * m_m2, "k = {k}: error {se_m2:e} too large");
+        assert!(
+            (m_m2 - kt_over_k).abs() < 3.0 * se_m2,
+            "k = {k}: <z²> = {m_m2:e} ± {se_m2:e} vs k_BT/k = {kt_over_k:e}"
+        );
+        eprintln!(
+            "k = {k} N/m: rms {:.4} pm ± {:.2} % (k_BT/k: {:.4} pm)",
+            m_m2.sqrt() * 1e12,
+            50.0 * se_m2 / m_m2,
+            kt_over_k.sqrt() * 1e12
+        );
+        if k == 40.0 {
+            assert_eq!(format!("{:.2}", kt_over_k.sqrt() * 1e12), "10.18");
+        }
+    }
+}
+
+/// Records the deflection at the end of each free flight.
+struct Ends(Vec<f64>);
+impl StepObserver for Ends {
+    fn step<const N: usize>(&mut self, _: &StepEnd<N>, _: &StepEnd<N>, _: Branch) {
+        panic!("a free cantilever far from the sample takes no integrator step");
+    }
+    fn free_flight(&mut self, flight: &FreeFlight, _from: f64, to: f64) {
+        self.0.push(flight.at(to).0);
+    }
+}
+
+/// The marcher under the thermal force (each step's force held, the free flight in
+/// closed form) moves the free cantilever as the exact step recursion does, force for
+/// force, to round-off: two independent routes to the same motion.
+#[test]
+fn the_noisy_marcher_moves_the_free_cantilever_as_the_step_recursion_does() {
+    let q = 20.0;
+    let sim = Simulation {
+        law: &NoForce,
+        osc: Oscillator {
+            gamma: 0.5 / q,
+            omega: 1.0,
+            drive: Drive::Force { amplitude: 0.0 },
+            bias: 0.0,
+        },
+        cpl: Coupling {
+            a0: 1e3,
+            a1: 1.0,
+            f_scale: 1.0,
+        },
+        tol: Tolerances {
+            rtol: 1e-9,
+            atol: 1e-11,
+            h_max: 0.1,
+        },
+    };
+    let d = intensity_hat(ROOM_TEMPERATURE_K, 2.0, q, 1e-9);
+    let periods = 50;
+    let mut ends = Ends(Vec::new());
+    let mut phase = sim.free_steady_start();
+    let mut force = ThermalForce::new(d, STEPS_PER_PERIOD, 7, 3).unwrap();
+    force.march(&sim, &mut phase, periods, &mut ends).unwrap();
+    let step = sim.osc.period() / STEPS_PER_PERIOD as f64;
+    let mut again = ThermalForce::new(d, STEPS_PER_PERIOD, 7, 3).unwrap();
+    let record = FreeThermal::new(q, step).record(periods * STEPS_PER_PERIOD, 1, &mut again);
+    assert_eq!(ends.0.len(), record.len());
+    let scale = record.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    assert!(scale > 0.0);
+    for (i, (a, b)) in ends.0.iter().zip(&record).enumerate() {
+        assert!((a - b).abs() < 1e-9 * scale, "step {i}: {a:e} vs {b:e}");
+    }
+}
+
+/// The same seed and stream draw the same forces; another stream others; D̂ = 0 marches
+/// exactly as the noise-free marcher does.
+#[test]
+fn streams_are_reproducible_and_zero_temperature_is_noise_free() {
+    let draw = |seed, stream| {
+        let mut f = ThermalForce::new(1.0, 64, seed, stream).unwrap();
+        (0..5).map(|_| f.draw(0.1)).collect::<Vec<_>>()
+    };
+    assert_eq!(draw(1, 0), draw(1, 0));
+    assert_ne!(draw(1, 0), draw(1, 1));
+    assert_ne!(draw(1, 0), draw(2, 0));
+    let p = Prepared::new(&default_setup(), &Numerics::default()).unwrap();
+    let sim = p.simulation();
+    let mut plain = sim.free_steady_start();
+    sim.march(&mut plain, 30, &mut tapsim::dynamics::numeric::Ignore)
+        .unwrap();
+    let mut noisy = sim.free_steady_start();
+    let mut cold = ThermalForce::new(0.0, 64, 1, 0).unwrap();
+    let (_, work) = cold
+        .march(&sim, &mut noisy, 30, &mut tapsim::dynamics::numeric::Ignore)
+        .unwrap();
+    assert_eq!(plain, noisy);
+    assert_eq!(work, 0.0);
+}
+
+/// A tapping march at 300 K on the defaults keeps its books: the drive's and the thermal
+/// force's work less damping and the contact's loss is the change of the oscillator's
+/// energy, to 1e-6 of the drive's work — the held forces are integrated exactly through
+/// free flight and contact alike.
+#[test]
+fn a_noisy_tapping_march_balances_its_energy() {
+    let p = Prepared::new(&default_setup(), &Numerics::default()).unwrap();
+    let sim = p.simulation();
+    let mut phase = sim.free_steady_start();
+    sim.march(&mut phase, 200, &mut tapsim::dynamics::numeric::Ignore)
+        .unwrap();
+    let c = &p.setup.cantilever;
+    let d = intensity_hat(
+        ROOM_TEMPERATURE_K,
+        c.stiffness_n_m,
+        c.quality,
+        c.free_amplitude_m,
+    );
+    let mut force = ThermalForce::new(d, STEPS_PER_PERIOD, 11, 0).unwrap();
+    let (total, work) = force
+        .march(&sim, &mut phase, 20, &mut tapsim::dynamics::numeric::Ignore)
+        .unwrap();
+    let t = total.unwrap();
+    assert_eq!(t.periods, 20);
+    assert!(
+        t.jumps_in == 20,
+        "the tip taps every period: {}",
+        t.jumps_in
+    );
+    assert!(work != 0.0);
+    let residual = t.e_drive + work - t.e_damp - t.e_ts - t.delta_mechanical;
+    eprintln!(
+        "E_drive {:e}, thermal work {work:e}, residual {residual:e}",
+        t.e_drive
+    );
+    assert!(
+        residual.abs() < 1e-6 * t.e_drive,
+        "residual {residual:e} of {:e}",
+        t.e_drive
+    );
+}
+
+/// `tapsim thermal` recovers the cantilever it records (the defaults' 300 kHz and
+/// 40 N/m at Q = 30, 10⁶ periods): f₀ and Q within 1 %, k within 2 %, over three seeds;
+/// the record's rms is equipartition's; the CSV holds the spectrum and the plot is
+/// drawn; bad settings are refused.
+#[test]
+fn thermal_calibrates_the_cantilever_it_records() {
+    let dir = common::scratch("thermal");
+    for seed in ["1", "2", "3"] {
+        let csv = dir.join("spectrum.csv");
+        let png = dir.join("spectrum.png");
+        let out = common::tapsim(&[
+            "thermal",
+            "--quality",
+            "30",
+            "--duration",
+            "3.3333333s",
+            "--seed",
+            seed,
+            "--json",
+            "--quiet",
+            "--csv",
+            csv.to_str().unwrap(),
+            "--plot",
+            png.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let off =
+            |fit: &str, truth: &str| v[fit].as_f64().unwrap() / v[truth].as_f64().unwrap() - 1.0;
+        assert_eq!(v["periods"].as_u64(), Some(1_000_000));
+        eprintln!(
+            "seed {seed}: f0 {:+.4} %, Q {:+.3} %, k {:+.3} %, rms {:+.3} %",
+            100.0 * off("fit_resonance_hz", "resonance_hz"),
+            100.0 * off("fit_quality", "quality"),
+            100.0 * off("fit_stiffness_n_m", "stiffness_n_m"),
+            100.0 * off("rms_m", "equipartition_rms_m")
+        );
+        assert!(off("fit_resonance_hz", "resonance_hz").abs() < 0.01);
+        assert!(off("fit_quality", "quality").abs() < 0.01);
+        assert!(off("fit_stiffness_n_m", "stiffness_n_m").abs() < 0.02);
+        assert!(off("rms_m", "equipartition_rms_m").abs() < 0.01);
+        let text = std::fs::read_to_string(&csv).unwrap();
+        assert!(text.starts_with("freq_hz,welch_m2_hz,sho_m2_hz,fit_m2_hz\n"));
+        assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
+    }
+    for (args, says) in [
+        (&["--quality", "5"][..], "Q from 10"),
+        (&["--steps", "12"], "multiple of 8"),
+        (&["--temperature", "-1K"], "temperature"),
+        (&["--duration", "1us"], "spans"),
+        (&["--duration", "1e9s"], "beyond reach"),
+    ] {
+        let mut all = vec!["thermal", "--quiet"];
+        all.extend_from_slice(args);
+        let out = common::tapsim(&all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+}
