@@ -284,5 +284,53 @@ fn scan_line(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, settle, map, setpoint, march, scan_line);
+/// Thermal noise on the defaults at 300 K: the linear theory's σ_A and σ_φ through a
+/// fourth-order lock-in of ENBW 1 kHz about the settled orbit (256 parts of the period;
+/// the target 5 ms), and a thousand drive periods of the marcher under the
+/// thermal force (64 steps a period) watched by that lock-in, at rtol 2e-7.
+fn noise(c: &mut Criterion) {
+    use tapsim::instrument::lockin::LockIn;
+    use tapsim::instrument::noise::{PARTS_PER_PERIOD, linear_noise, time_constant_for_enbw};
+    use tapsim::instrument::thermal::{STEPS_PER_PERIOD, ThermalForce, intensity_hat};
+    let numerics = Numerics {
+        rtol: tapsim::instrument::MARCH_RTOL,
+        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
+        ..Numerics::default()
+    };
+    let p = Prepared::new(&default_setup(), &numerics).expect("defaults are valid");
+    let sim = p.simulation();
+    let mut phase = sim.free_steady_start();
+    sim.steady_state(&mut phase, &p.steady)
+        .expect("steady state");
+    let cant = p.setup.cantilever;
+    let d = intensity_hat(
+        300.0,
+        cant.stiffness_n_m,
+        cant.quality,
+        cant.free_amplitude_m,
+    );
+    let tau_hat =
+        time_constant_for_enbw(4, 1000.0) * 2.0 * std::f64::consts::PI * cant.resonance_hz;
+    let mut group = c.benchmark_group("noise");
+    group.sample_size(20);
+    group.bench_function("linear theory, defaults, 1 kHz", |b| {
+        b.iter(|| linear_noise(&sim, &phase, d, (4, tau_hat), PARTS_PER_PERIOD).unwrap())
+    });
+    const PERIODS: u64 = 1000;
+    group.throughput(Throughput::Elements(PERIODS));
+    let mut force = ThermalForce::new(d, STEPS_PER_PERIOD, 1, 0).unwrap();
+    let mut lockin = LockIn::new(4, tau_hat, sim.osc.omega).unwrap();
+    group.bench_function("noisy march with the lock-in", |b| {
+        b.iter(|| {
+            force
+                .march(&sim, &mut phase, PERIODS as usize, &mut lockin)
+                .unwrap()
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches, bench, settle, map, setpoint, march, scan_line, noise
+);
 criterion_main!(benches);

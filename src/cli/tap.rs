@@ -1,8 +1,9 @@
 //! `tapsim tap`: one tapping-mode simulation to its steady state.
 
-use crate::config::{BranchChoice, TapInputs, length, number};
+use crate::config::{BranchChoice, TapInputs, frequency, length, number, temperature};
 use crate::dynamics::observables::{Observe, Starts, tap};
 use crate::error::{Error, Result};
+use crate::instrument::noise::thermal_noise_at;
 use crate::report::{output, plot, tap as report};
 use crate::setpoint::states_at_setpoint;
 use clap::Args;
@@ -99,10 +100,26 @@ pub struct TapArgs {
     /// force; repulsive: below it.
     #[arg(long, value_enum)]
     branch: Option<BranchChoice>,
+    /// Temperature [K]: report the thermal noise a lock-in reads on the orbit — the
+    /// standard deviations of its amplitude and phase from the linear theory about the
+    /// periodic orbit (the thermal force of the cantilever's damping, S_F =
+    /// 4k_BT·k/(ω₀Q), through the variational equations and the lock-in's filter).
+    /// A stable period-1 orbit only. Off unless given (300K is room temperature).
+    #[arg(long, allow_hyphen_values = true, value_parser = temperature)]
+    temperature: Option<f64>,
+    /// The lock-in's equivalent noise bandwidth for --temperature [Hz; default 1kHz].
+    #[arg(long, allow_hyphen_values = true, value_parser = frequency)]
+    enbw: Option<f64>,
+    /// The lock-in's filter order (1–4) for --temperature [default 4].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=4))]
+    lockin_order: Option<u8>,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
 }
+
+/// The lock-in bandwidth `--temperature` reads through unless told otherwise, Hz.
+const DEFAULT_ENBW_HZ: f64 = 1000.0;
 
 /// Run the subcommand.
 pub fn run(args: TapArgs) -> Result<()> {
@@ -141,6 +158,18 @@ pub fn run(args: TapArgs) -> Result<()> {
     let coexisting = crate::setpoint::coexisting(&setup, &numerics, &run.observables);
     spinner.finish_and_clear();
     let coexisting = coexisting?;
+    let noise = match args.temperature {
+        Some(t) => Some(thermal_noise_at(
+            &setup,
+            &numerics,
+            t,
+            (
+                args.lockin_order.map_or(4, usize::from),
+                args.enbw.unwrap_or(DEFAULT_ENBW_HZ),
+            ),
+        )?),
+        None => None,
+    };
     if args.json {
         let mut v = serde_json::to_value(&run).expect("observables serialise");
         if let serde_json::Value::Object(m) = &mut v {
@@ -148,11 +177,34 @@ pub fn run(args: TapArgs) -> Result<()> {
                 "coexisting".into(),
                 serde_json::to_value(&coexisting).expect("states serialise"),
             );
+            if let Some(noise) = &noise {
+                m.insert(
+                    "thermal_noise".into(),
+                    serde_json::to_value(noise).expect("noise serialises"),
+                );
+            }
         }
         outln!("{}", serde_json::to_string_pretty(&v).expect("serialises"));
     } else {
         out!("{}", report::to_text(&setup, &run));
         out!("{}", report::coexisting_text(&coexisting));
+        match noise {
+            Some(Some(n)) => outln!(
+                "thermal noise at {} K through a lock-in of order {}, ENBW {} Hz (T_f = \
+                 {:.4} µs), linear theory about the orbit: σ_A = {:.4} pm, σ_φ = {:.5}°",
+                n.temperature_k,
+                n.lockin_order,
+                n.enbw_hz,
+                n.time_constant_s * 1e6,
+                n.sigma_amplitude_m * 1e12,
+                n.sigma_phase_deg
+            ),
+            Some(None) => outln!(
+                "thermal noise: not computed — the linear theory needs a stable period-1 \
+                 orbit, and this state is not one"
+            ),
+            None => {}
+        }
     }
     Ok(())
 }
@@ -166,6 +218,13 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
         return Err(Error::NotApplicable(
             "--trajectory and --plot draw one state: run `tapsim tap --separation <z_c>` \
              with the separation_m of the state at the setpoint you want"
+                .into(),
+        ));
+    }
+    if args.temperature.is_some() {
+        return Err(Error::NotApplicable(
+            "--temperature reads the noise of one state: run `tapsim tap --separation \
+             <z_c> --temperature T` with the separation_m of the state at the setpoint"
                 .into(),
         ));
     }

@@ -412,13 +412,23 @@ impl<L: ForceLaw> Simulation<'_, L> {
         &self,
         phase: &mut Phase,
     ) -> Result<(CycleIntegrals, DMatrix<f64>)> {
-        let period = self.osc.period();
+        self.advance_with_derivative(phase, self.osc.period())
+    }
+
+    /// [`Simulation::cycle_with_derivative`] over the part `span` (0 < span ≤ one drive
+    /// period) of a period: ∂z(τ + span)/∂(z, q)(τ).
+    pub fn advance_with_derivative(
+        &self,
+        phase: &mut Phase,
+        span: f64,
+    ) -> Result<(CycleIntegrals, DMatrix<f64>)> {
+        let span = span.min(self.osc.period());
         let (integrals, derivative) = if self.law.internal_states() > 0 {
-            self.cycle_in::<MEMORY_TANGENT, _>(phase, period, &mut numeric::Ignore)
+            self.cycle_in::<MEMORY_TANGENT, _>(phase, span, &mut numeric::Ignore)
         } else if self.law.is_rate_dependent() {
-            self.cycle_in::<RATE_TANGENT, _>(phase, period, &mut numeric::Ignore)
+            self.cycle_in::<RATE_TANGENT, _>(phase, span, &mut numeric::Ignore)
         } else {
-            self.cycle_in::<TANGENT, _>(phase, period, &mut numeric::Ignore)
+            self.cycle_in::<TANGENT, _>(phase, span, &mut numeric::Ignore)
         }?;
         let mut derivative = derivative.expect("a tangent layout carries Φ");
         // In the section's units (`Simulation::z`): internal rows times f_scale, internal

@@ -4,6 +4,7 @@
 
 pub mod feedback;
 pub mod lockin;
+pub mod noise;
 pub mod scan;
 pub mod spectrum;
 pub mod thermal;
