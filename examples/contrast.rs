@@ -16,8 +16,8 @@ fn main() -> tapsim::Result<()> {
     let (rows, _) = contrast(
         &materials,
         &[LawKind::Jkr, LawKind::Hybrid],
-        &[0.9, 0.8, 0.7],
-        30,
+        (&[0.9, 0.8, 0.7], 30),
+        None,
         |what| eprintln!("approach curve: {what}"),
     )?;
     // Materials are compared only on the same branch (attractive or repulsive).

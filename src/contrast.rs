@@ -5,6 +5,7 @@
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
 use crate::identification::Mechanism;
+use crate::instrument::noise::NoiseRequest;
 use crate::law::LawKind;
 use crate::setpoint;
 use crate::sweep::{self, Direction, SweepPoint};
@@ -66,6 +67,15 @@ pub struct ContrastRow {
     pub e_ts_viscous_j: Vec<Option<f64>>,
     /// Its capillary share (J).
     pub e_ts_capillary_j: Vec<Option<f64>>,
+    /// The thermal noise asked for (null: none).
+    pub noise: Option<NoiseRequest>,
+    /// The standard deviation of each material's lock-in phase at that noise (degrees;
+    /// the linear theory about its stable period-1 orbit), null where none was asked
+    /// for or its φ does not come from such an orbit.
+    pub sigma_phase_deg: Vec<Option<f64>>,
+    /// |Δφ|/√(σ_first² + σ_last²): the contrast over the noise of the difference of one
+    /// reading on each material; null where either σ is.
+    pub contrast_to_noise: Option<f64>,
 }
 
 /// One steady state at an amplitude setpoint.
@@ -79,6 +89,8 @@ struct AtSetpoint {
     regime: String,
     converged: bool,
     grazing: bool,
+    /// σ_φ (degrees) at the noise asked for, on a stable period-1 orbit.
+    sigma_phase_deg: Option<f64>,
 }
 
 /// z_c, φ and E_ts per mechanism interpolated linearly in A/A₀ at A/A₀ = `r` between
@@ -101,12 +113,24 @@ fn crossing(pa: &SweepPoint, pb: &SweepPoint, r: f64) -> Option<(f64, f64, [f64;
 /// period-1 orbit of its families there, solved exactly ([`setpoint::states_on`]), and,
 /// on a branch with none, the approach curve's states (orbits of higher period or
 /// irregular motion) interpolated there.
-fn states_at(p: &Prepared, curve: &LawCurve, r: f64) -> Result<Vec<AtSetpoint>> {
+fn states_at(
+    p: &Prepared,
+    curve: &LawCurve,
+    r: f64,
+    noise: Option<&NoiseRequest>,
+) -> Result<Vec<AtSetpoint>> {
     let mut out: Vec<AtSetpoint> = setpoint::states_on(p, &curve.family, r, None)?
         .into_iter()
         .map(|s| {
             let o = &s.observables;
-            AtSetpoint {
+            let sigma_phase_deg = match noise {
+                Some(n) => Some(
+                    n.on_orbit(p, &p.simulation_at(s.separation_m)?, &s.phase)?
+                        .sigma_phase_deg,
+                ),
+                None => None,
+            };
+            Ok(AtSetpoint {
                 branch: s.branch,
                 separation_m: s.separation_m,
                 phase_deg: o.phase_deg,
@@ -114,9 +138,10 @@ fn states_at(p: &Prepared, curve: &LawCurve, r: f64) -> Result<Vec<AtSetpoint>> 
                 regime: o.regime.clone(),
                 converged: o.converged,
                 grazing: o.grazing,
-            }
+                sigma_phase_deg,
+            })
         })
-        .collect();
+        .collect::<Result<_>>()?;
     let approach: Vec<&SweepPoint> = curve
         .points
         .iter()
@@ -143,6 +168,7 @@ fn states_at(p: &Prepared, curve: &LawCurve, r: f64) -> Result<Vec<AtSetpoint>> 
                     regime: nearer.regime.clone(),
                     converged: a.converged && b.converged,
                     grazing: a.grazing || b.grazing,
+                    sigma_phase_deg: None,
                 });
             }
         }
@@ -171,12 +197,13 @@ pub struct LawCurve {
 /// Approach curves and period-1 orbit families of every material under every law, and
 /// the contrast table at the amplitude setpoints `ratios`: at each, every branch
 /// (attractive, repulsive) on which some material has a steady state, with Δφ between
-/// materials on the same branch. `progress` is told what is being computed.
+/// materials on the same branch, and with `noise` each phase's thermal noise and the
+/// contrast over it. `progress` is told what is being computed.
 pub fn contrast(
     materials: &[Material],
     laws: &[LawKind],
-    ratios: &[f64],
-    points: usize,
+    (ratios, points): (&[f64], usize),
+    noise: Option<&NoiseRequest>,
     mut progress: impl FnMut(&str),
 ) -> Result<(Vec<ContrastRow>, Vec<LawCurve>)> {
     if materials.len() < 2 {
@@ -240,7 +267,7 @@ pub fn contrast(
             let states: Vec<Vec<AtSetpoint>> = of_law
                 .iter()
                 .zip(&prepared)
-                .map(|(c, p)| states_at(p, c, r))
+                .map(|(c, p)| states_at(p, c, r, noise))
                 .collect::<Result<_>>()?;
             for branch in [PhaseBranch::Attractive, PhaseBranch::Repulsive] {
                 let on: Vec<Option<&AtSetpoint>> = states
@@ -257,6 +284,11 @@ pub fn contrast(
                 let share = |i: usize| -> Vec<Option<f64>> {
                     on.iter().map(|s| s.map(|a| a.e_ts_j[i])).collect()
                 };
+                let sigma_phase_deg: Vec<Option<f64>> = on
+                    .iter()
+                    .map(|s| s.and_then(|a| a.sigma_phase_deg))
+                    .collect();
+                let last = phase_deg.len() - 1;
                 rows.push(ContrastRow {
                     law: law.to_string(),
                     materials: of_law.iter().map(|c| c.material.clone()).collect(),
@@ -279,6 +311,19 @@ pub fn contrast(
                     e_ts_capillary_j: share(3),
                     converged: on.iter().map(|s| s.map(|a| a.converged)).collect(),
                     grazing: on.iter().map(|s| s.map(|a| a.grazing)).collect(),
+                    contrast_to_noise: match (
+                        phase_deg[0],
+                        phase_deg[last],
+                        sigma_phase_deg[0],
+                        sigma_phase_deg[last],
+                    ) {
+                        (Some(a), Some(b), Some(sa), Some(sb)) if sa.hypot(sb) > 0.0 => {
+                            Some((b - a).abs() / sa.hypot(sb))
+                        }
+                        _ => None,
+                    },
+                    noise: noise.copied(),
+                    sigma_phase_deg,
                     phase_deg,
                 });
             }

@@ -223,8 +223,8 @@ fn tap_reports_the_thermal_noise_of_its_orbit() {
             "noise of one state",
         ),
         (
-            &["--temperature", "300K", "--enbw", "100kHz"],
-            "a tenth of the drive",
+            &["--temperature", "300K", "--enbw", "20kHz"],
+            "a thirtieth of the drive",
         ),
         (&["--temperature", "-3K"], "not negative"),
     ] {
@@ -235,4 +235,82 @@ fn tap_reports_the_thermal_noise_of_its_orbit() {
         assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
         assert!(err.contains(says), "{args:?}: {err}");
     }
+}
+
+/// `contrast --temperature`: each phase on a stable period-1 orbit carries its thermal
+/// noise, each row |Δφ|/√(σ_first² + σ_last²); a phase from a long mode lock none. The
+/// README's answer: on the defaults (polymers A and B at A/A₀ = 0.8, repulsive branch)
+/// the hybrid's contrast is 99, 24 and 13 times its noise at ENBW 100 Hz, 1 kHz and
+/// 10 kHz, and JKR's Δφ lies 190, 46 and 25 σ_Δ from the hybrid's.
+#[test]
+fn contrast_weighs_each_phase_difference_against_its_thermal_noise() {
+    let mut answers = Vec::new();
+    for enbw in ["100Hz", "1kHz", "10kHz"] {
+        let out = common::tapsim(&[
+            "contrast",
+            "--setpoints",
+            "0.8",
+            "--laws",
+            "jkr,hybrid",
+            "--temperature",
+            "300K",
+            "--enbw",
+            enbw,
+            "--json",
+            "--quiet",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let row = |law: &str, branch: &str| {
+            rows.as_array()
+                .unwrap()
+                .iter()
+                .find(|r| r["law"] == law && r["branch"] == branch)
+                .unwrap()
+                .clone()
+        };
+        for r in rows.as_array().unwrap() {
+            let sigma: Vec<Option<f64>> = r["sigma_phase_deg"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64())
+                .collect();
+            let regimes: Vec<Option<&str>> = r["regime"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_str())
+                .collect();
+            for (s, g) in sigma.iter().zip(&regimes) {
+                // A σ exactly where the phase comes from a period-1 orbit.
+                assert_eq!(s.is_some(), *g == Some("period-1"), "{r}");
+            }
+            match (r["delta_phase_deg"].as_f64(), sigma[0], sigma[1]) {
+                (Some(d), Some(a), Some(b)) => {
+                    let c = r["contrast_to_noise"].as_f64().unwrap();
+                    assert!((c - d.abs() / a.hypot(b)).abs() < 1e-9 * c);
+                }
+                _ => assert!(r["contrast_to_noise"].is_null()),
+            }
+        }
+        let hybrid = row("hybrid", "repulsive");
+        let jkr = row("jkr", "repulsive");
+        let sigma = |r: &serde_json::Value, i: usize| r["sigma_phase_deg"][i].as_f64().unwrap();
+        let gap = (jkr["delta_phase_deg"].as_f64().unwrap()
+            - hybrid["delta_phase_deg"].as_f64().unwrap())
+        .abs();
+        answers.push(format!(
+            "{:.0} {:.0}",
+            hybrid["contrast_to_noise"].as_f64().unwrap(),
+            gap / sigma(&hybrid, 0).hypot(sigma(&hybrid, 1))
+        ));
+        // The attractive JKR state of A is a long mode lock: no σ.
+        assert!(row("jkr", "attractive")["sigma_phase_deg"][0].is_null());
+    }
+    assert_eq!(answers, ["99 190", "24 46", "13 25"]);
 }

@@ -31,11 +31,20 @@ use clap::Args;
 /// setpoint. The table names the motion behind every φ and compares JKR's contrast with
 /// the other laws', branch by branch.
 ///
+/// Can a contrast be seen? With --temperature (and --enbw, --lockin-order) each φ on a
+/// stable period-1 orbit gets its thermal noise σ_φ, the standard deviation a lock-in
+/// of that bandwidth reads (the linear theory about the orbit, as `tap --temperature`),
+/// and each row the contrast over the noise of one reading on each material,
+/// |Δφ|/√(σ_first² + σ_last²): above a few, one pixel on each tells them apart. A φ
+/// from other motion (a long mode lock, irregular) has no σ: its noise is not that of a
+/// small perturbation.
+///
 /// JSON (--json): one object per law, setpoint and branch with law, materials,
 /// amplitude_ratio, branch, phase_deg, regime, converged, grazing, separation_m, e_ts_j,
 /// e_ts_adhesion_j, e_ts_viscous_j and e_ts_capillary_j (one entry per material, null
 /// where it has no steady state on that branch), delta_phase_deg and
-/// apparent_height_m. --csv has the same, a column per material. --plot: φ and E_ts (and
+/// apparent_height_m; with --temperature also noise (temperature_k, lockin_order,
+/// enbw_hz), sigma_phase_deg (per material) and contrast_to_noise. --csv has the same, a column per material. --plot: φ and E_ts (and
 /// a viscous sample's share) against A/A₀ per law, and Δφ against the setpoint.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
@@ -57,6 +66,8 @@ pub struct ContrastArgs {
     /// Setpoints on each approach curve.
     #[arg(long, allow_hyphen_values = true, default_value_t = 50)]
     points: usize,
+    #[command(flatten)]
+    noise: super::NoiseArgs,
 }
 
 /// Run the subcommand.
@@ -76,11 +87,15 @@ pub fn run(args: ContrastArgs) -> Result<()> {
         .iter()
         .map(|m| m.resolve(&base))
         .collect::<Result<Vec<_>>>()?;
+    let request = args.noise.request();
+    if let Some(request) = &request {
+        request.check(materials[0].setup.cantilever.drive_frequency_hz)?;
+    }
     let (rows, curves) = contrast::contrast(
         &materials,
         &args.laws,
-        &args.setpoints,
-        args.points,
+        (&args.setpoints, args.points),
+        request.as_ref(),
         |what| {
             if !quiet {
                 eprintln!("approach curve: {what}");

@@ -145,6 +145,37 @@ pub struct SweepOutput {
     pub quiet: bool,
 }
 
+/// The thermal noise flags of the commands that read it through a lock-in (tap,
+/// contrast).
+#[derive(Debug, Clone, clap::Args)]
+pub struct NoiseArgs {
+    /// Temperature [K; off unless given, 300K is room temperature]: report the thermal
+    /// noise a lock-in reads on each stable period-1 orbit — the standard deviations of
+    /// its amplitude and phase from the linear theory about the orbit (the thermal
+    /// force of the cantilever's damping, S_F = 4k_BT·k/(ω₀Q), through the variational
+    /// equations and the lock-in's filter).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::config::temperature, help_heading = "Thermal noise")]
+    pub temperature: Option<f64>,
+    /// The lock-in's equivalent noise bandwidth for --temperature [Hz; default 1kHz].
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::config::frequency, help_heading = "Thermal noise")]
+    pub enbw: Option<f64>,
+    /// The lock-in's filter order (1–4) for --temperature [default 4].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=4), help_heading = "Thermal noise")]
+    pub lockin_order: Option<u8>,
+}
+
+impl NoiseArgs {
+    /// The noise asked for (none without --temperature).
+    pub fn request(&self) -> Option<crate::instrument::noise::NoiseRequest> {
+        self.temperature
+            .map(|temperature_k| crate::instrument::noise::NoiseRequest {
+                temperature_k,
+                lockin_order: self.lockin_order.map_or(4, usize::from),
+                enbw_hz: self.enbw.unwrap_or(1000.0),
+            })
+    }
+}
+
 /// The refusal of a rest separation beside an amplitude setpoint (tap, map, a batch
 /// row): at a setpoint the separation is what is solved for.
 pub(crate) fn separation_and_setpoint() -> crate::Error {

@@ -1,6 +1,6 @@
 //! `tapsim tap`: one tapping-mode simulation to its steady state.
 
-use crate::config::{BranchChoice, TapInputs, frequency, length, number, temperature};
+use crate::config::{BranchChoice, TapInputs, length, number};
 use crate::dynamics::observables::{Observe, Starts, tap};
 use crate::error::{Error, Result};
 use crate::instrument::noise::thermal_noise_at;
@@ -100,26 +100,12 @@ pub struct TapArgs {
     /// force; repulsive: below it.
     #[arg(long, value_enum)]
     branch: Option<BranchChoice>,
-    /// Temperature [K]: report the thermal noise a lock-in reads on the orbit — the
-    /// standard deviations of its amplitude and phase from the linear theory about the
-    /// periodic orbit (the thermal force of the cantilever's damping, S_F =
-    /// 4k_BT·k/(ω₀Q), through the variational equations and the lock-in's filter).
-    /// A stable period-1 orbit only. Off unless given (300K is room temperature).
-    #[arg(long, allow_hyphen_values = true, value_parser = temperature)]
-    temperature: Option<f64>,
-    /// The lock-in's equivalent noise bandwidth for --temperature [Hz; default 1kHz].
-    #[arg(long, allow_hyphen_values = true, value_parser = frequency)]
-    enbw: Option<f64>,
-    /// The lock-in's filter order (1–4) for --temperature [default 4].
-    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=4))]
-    lockin_order: Option<u8>,
+    #[command(flatten)]
+    noise: super::NoiseArgs,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
 }
-
-/// The lock-in bandwidth `--temperature` reads through unless told otherwise, Hz.
-const DEFAULT_ENBW_HZ: f64 = 1000.0;
 
 /// Run the subcommand.
 pub fn run(args: TapArgs) -> Result<()> {
@@ -158,16 +144,8 @@ pub fn run(args: TapArgs) -> Result<()> {
     let coexisting = crate::setpoint::coexisting(&setup, &numerics, &run.observables);
     spinner.finish_and_clear();
     let coexisting = coexisting?;
-    let noise = match args.temperature {
-        Some(t) => Some(thermal_noise_at(
-            &setup,
-            &numerics,
-            t,
-            (
-                args.lockin_order.map_or(4, usize::from),
-                args.enbw.unwrap_or(DEFAULT_ENBW_HZ),
-            ),
-        )?),
+    let noise = match args.noise.request() {
+        Some(request) => Some(thermal_noise_at(&setup, &numerics, &request)?),
         None => None,
     };
     if args.json {
@@ -221,7 +199,7 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
                 .into(),
         ));
     }
-    if args.temperature.is_some() {
+    if args.noise.temperature.is_some() {
         return Err(Error::NotApplicable(
             "--temperature reads the noise of one state: run `tapsim tap --separation \
              <z_c> --temperature T` with the separation_m of the state at the setpoint"

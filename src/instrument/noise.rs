@@ -304,8 +304,87 @@ pub fn monte_carlo_noise<L: ForceLaw + Sync>(
     })
 }
 
-/// The thermal noise `tap --temperature` reports: the linear theory's σ of the
-/// lock-in's amplitude and phase on a stable period-1 orbit, in SI units.
+/// What thermal noise to read, and through what lock-in: the temperature, the filter's
+/// order and its equivalent noise bandwidth.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct NoiseRequest {
+    /// Temperature, K.
+    pub temperature_k: f64,
+    /// The lock-in's filter order (1–4).
+    pub lockin_order: usize,
+    /// Its equivalent noise bandwidth, Hz.
+    pub enbw_hz: f64,
+}
+
+impl NoiseRequest {
+    /// Refuse a negative temperature, an order outside 1–4, and a bandwidth above a
+    /// thirtieth of the drive frequency `drive_hz` (the linear theory feeds the filter
+    /// period averages: its time constant must span periods — two at 10 kHz on 300 kHz,
+    /// fourth order, where the theory still equals a free cantilever's spectrum to 1e-4).
+    pub fn check(&self, drive_hz: f64) -> Result<()> {
+        if !(self.temperature_k >= 0.0 && self.temperature_k.is_finite()) {
+            return Err(Error::OutOfRange(format!(
+                "a temperature is finite and not negative, not {} K",
+                self.temperature_k
+            )));
+        }
+        if !(1..=super::lockin::MAX_ORDER).contains(&self.lockin_order) {
+            return Err(Error::OutOfRange(format!(
+                "a lock-in filter has order 1 to 4, not {}",
+                self.lockin_order
+            )));
+        }
+        crate::error::positive("lock-in bandwidth (ENBW)", self.enbw_hz)?;
+        if self.enbw_hz > drive_hz / 30.0 {
+            return Err(Error::OutOfRange(format!(
+                "the lock-in's bandwidth ({} Hz) is at most a thirtieth of the drive \
+                 frequency ({drive_hz} Hz): the linear theory takes its filter to average \
+                 over periods",
+                self.enbw_hz
+            )));
+        }
+        Ok(())
+    }
+
+    /// The lock-in's time constant, s.
+    pub fn time_constant_s(&self) -> f64 {
+        time_constant_for_enbw(self.lockin_order, self.enbw_hz)
+    }
+
+    /// [`linear_noise`] in SI units on the stable period-1 orbit of `sim` through
+    /// `phase`, the simulation of `prepared` (its cantilever).
+    pub fn on_orbit<L: ForceLaw>(
+        &self,
+        prepared: &Prepared,
+        sim: &Simulation<'_, L>,
+        phase: &Phase,
+    ) -> Result<ThermalNoise> {
+        let c = prepared.setup.cantilever;
+        self.check(c.drive_frequency_hz)?;
+        let a0 = c.free_amplitude_m;
+        let noise = linear_noise(
+            sim,
+            phase,
+            super::thermal::intensity_hat(self.temperature_k, c.stiffness_n_m, c.quality, a0),
+            (
+                self.lockin_order,
+                self.time_constant_s() * 2.0 * std::f64::consts::PI * c.resonance_hz,
+            ),
+            PARTS_PER_PERIOD,
+        )?;
+        Ok(ThermalNoise {
+            temperature_k: self.temperature_k,
+            lockin_order: self.lockin_order,
+            enbw_hz: self.enbw_hz,
+            time_constant_s: self.time_constant_s(),
+            sigma_amplitude_m: noise.sigma_amplitude_hat * a0,
+            sigma_phase_deg: noise.sigma_phase_rad.to_degrees(),
+        })
+    }
+}
+
+/// The thermal noise a lock-in reads on a stable period-1 orbit: the linear theory's σ
+/// of its amplitude and phase, in SI units.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ThermalNoise {
     /// Temperature, K.
@@ -322,55 +401,21 @@ pub struct ThermalNoise {
     pub sigma_phase_deg: f64,
 }
 
-/// [`linear_noise`] on the steady state `setup` settles on from the free oscillation, at
-/// `temperature_k`, through a lock-in of order `order` and equivalent noise bandwidth
-/// `enbw_hz`. `None` where that state is not a stable period-1 orbit (the linear theory
-/// needs one).
+/// [`NoiseRequest::on_orbit`] on the steady state `setup` settles on from the free
+/// oscillation. `None` where that state is not a stable period-1 orbit (the linear
+/// theory needs one).
 pub fn thermal_noise_at(
     setup: &TapSetup,
     numerics: &Numerics,
-    temperature_k: f64,
-    (order, enbw_hz): (usize, f64),
+    request: &NoiseRequest,
 ) -> Result<Option<ThermalNoise>> {
-    if !(temperature_k >= 0.0 && temperature_k.is_finite()) {
-        return Err(Error::OutOfRange(format!(
-            "a temperature is finite and not negative, not {temperature_k} K"
-        )));
-    }
-    crate::error::positive("lock-in bandwidth (ENBW)", enbw_hz)?;
     let p = Prepared::new(setup, numerics)?;
-    let c = p.setup.cantilever;
-    if enbw_hz > 0.1 * c.drive_frequency_hz {
-        return Err(Error::OutOfRange(format!(
-            "the lock-in's bandwidth ({enbw_hz} Hz) is at most a tenth of the drive \
-             frequency ({} Hz): its filter averages over many periods",
-            c.drive_frequency_hz
-        )));
-    }
+    request.check(p.setup.cantilever.drive_frequency_hz)?;
     let sim = p.simulation();
     let mut phase = sim.free_steady_start();
     let state = sim.steady_state(&mut phase, &p.steady)?;
     if state.motion.period() != Some(1) || state.motion.stable() != Some(true) {
         return Ok(None);
     }
-    let time_constant_s = time_constant_for_enbw(order, enbw_hz);
-    let a0 = c.free_amplitude_m;
-    let noise = linear_noise(
-        &sim,
-        &phase,
-        super::thermal::intensity_hat(temperature_k, c.stiffness_n_m, c.quality, a0),
-        (
-            order,
-            time_constant_s * 2.0 * std::f64::consts::PI * c.resonance_hz,
-        ),
-        PARTS_PER_PERIOD,
-    )?;
-    Ok(Some(ThermalNoise {
-        temperature_k,
-        lockin_order: order,
-        enbw_hz,
-        time_constant_s,
-        sigma_amplitude_m: noise.sigma_amplitude_hat * a0,
-        sigma_phase_deg: noise.sigma_phase_rad.to_degrees(),
-    }))
+    request.on_orbit(&p, &sim, &phase).map(Some)
 }

@@ -32,6 +32,15 @@ pub fn contrast_csv(
     header.push("delta_phase_deg".into());
     header.extend(materials.iter().map(|m| format!("separation_m_{}", m.name)));
     header.push("apparent_height_m".into());
+    let noisy = rows.iter().any(|r| r.noise.is_some());
+    if noisy {
+        header.extend(
+            materials
+                .iter()
+                .map(|m| format!("sigma_phase_deg_{}", m.name)),
+        );
+        header.push("contrast_to_noise".into());
+    }
     for column in [
         "e_ts_j",
         "e_ts_adhesion_j",
@@ -60,6 +69,10 @@ pub fn contrast_csv(
         rec.push(cell(r.delta_phase_deg));
         rec.extend(r.separation_m.iter().map(|&z| cell(z)));
         rec.push(cell(r.apparent_height_m));
+        if noisy {
+            rec.extend(r.sigma_phase_deg.iter().map(|&p| cell(p)));
+            rec.push(cell(r.contrast_to_noise));
+        }
         for shares in [
             &r.e_ts_j,
             &r.e_ts_adhesion_j,
@@ -181,11 +194,24 @@ pub fn contrast_charts(
 /// by branch (only materials on the same branch are compared).
 pub fn contrast_text(laws: &[LawKind], rows: &[ContrastRow]) -> String {
     let mut s = String::new();
-    let _ = writeln!(
+    let noise = rows.iter().find_map(|r| r.noise);
+    if let Some(n) = noise {
+        let _ = writeln!(
+            s,
+            "thermal noise at {} K through a lock-in of order {}, ENBW {} Hz: σ_φ of each \
+             material (first/last), and Δφ/σ = |Δφ|/√(σ_first² + σ_last²)",
+            n.temperature_k, n.lockin_order, n.enbw_hz
+        );
+    }
+    let _ = write!(
         s,
-        "{:>18} {:>8} {:>11} {:>10} {:>10}  motion",
+        "{:>18} {:>8} {:>11} {:>10} {:>10}",
         "law", "A/A0", "branch", "Δφ (deg)", "Δz_c (nm)"
     );
+    if noise.is_some() {
+        let _ = write!(s, " {:>17} {:>8}", "σ_φ (deg)", "Δφ/σ");
+    }
+    let _ = writeln!(s, "  motion");
     for r in rows {
         let regimes: Vec<String> = r
             .regime
@@ -200,17 +226,31 @@ pub fn contrast_text(laws: &[LawKind], rows: &[ContrastRow]) -> String {
                 format!("{}{mark}", g.as_deref().unwrap_or("none"))
             })
             .collect();
-        let _ = writeln!(
+        let _ = write!(
             s,
-            "{:>18} {:>8.3} {:>11} {:>10} {:>10}  {}",
+            "{:>18} {:>8.3} {:>11} {:>10} {:>10}",
             r.law,
             r.amplitude_ratio,
             branch_name(r.branch),
             r.delta_phase_deg.map_or("—".into(), |d| format!("{d:.3}")),
             r.apparent_height_m
                 .map_or("—".into(), |h| format!("{:.3}", h * 1e9)),
-            regimes.join(", ")
         );
+        if noise.is_some() {
+            let sigma = |p: Option<f64>| p.map_or("—".into(), |p| format!("{p:.4}"));
+            let pair = format!(
+                "{}/{}",
+                sigma(r.sigma_phase_deg[0]),
+                sigma(r.sigma_phase_deg[r.sigma_phase_deg.len() - 1])
+            );
+            let _ = write!(
+                s,
+                " {pair:>17} {:>8}",
+                r.contrast_to_noise
+                    .map_or("—".into(), |c| format!("{c:.1}"))
+            );
+        }
+        let _ = writeln!(s, "  {}", regimes.join(", "));
     }
     for other in laws.iter().filter(|l| **l != LawKind::Jkr) {
         for r in rows.iter().filter(|r| r.law == "jkr") {
