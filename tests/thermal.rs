@@ -248,3 +248,131 @@ fn thermal_calibrates_the_cantilever_it_records() {
         assert!(err.contains(says), "{args:?}: {err}");
     }
 }
+
+/// Near grazing (the hybrid defaults at z_c = 20 nm, where the deterministic answer is a
+/// period-41 lock whose touches a perturbation below the thermal motion decides), the
+/// thermal average — what an instrument reads — does not depend on the integrator's
+/// tolerance (rtol 1e-9 and 1e-11) nor on the seed, within its standard errors; at 0 K
+/// it is the deterministic lock's.
+#[test]
+fn the_thermal_average_near_grazing_is_independent_of_the_tolerance() {
+    use tapsim::instrument::thermal::thermal_average;
+    let mut setup = default_setup();
+    setup.separation_m = 20e-9;
+    let numerics = |rtol: f64| Numerics {
+        rtol,
+        atol: 1e-2 * rtol,
+        ..Numerics::default()
+    };
+    let run = |rtol: f64, seed: u64, t: f64| {
+        thermal_average(&setup, &numerics(rtol), t, (20_000, seed)).unwrap()
+    };
+    let base = run(1e-9, 1, ROOM_TEMPERATURE_K);
+    let ev = 1.602_176_634e-19;
+    for (what, other) in [
+        ("rtol 1e-11", run(1e-11, 1, ROOM_TEMPERATURE_K)),
+        ("seed 2", run(1e-9, 2, ROOM_TEMPERATURE_K)),
+    ] {
+        eprintln!(
+            "{what}: E_ts {:.3} ± {:.3} eV vs {:.3} ± {:.3}; φ {:.3} ± {:.3}° vs {:.3} ± {:.3}",
+            other.e_ts_j / ev,
+            other.e_ts_std_err_j / ev,
+            base.e_ts_j / ev,
+            base.e_ts_std_err_j / ev,
+            other.phase_deg,
+            other.phase_std_err_deg,
+            base.phase_deg,
+            base.phase_std_err_deg
+        );
+        let within = |a: f64, b: f64, sa: f64, sb: f64| (a - b).abs() <= 3.0 * sa.hypot(sb);
+        assert!(within(
+            other.e_ts_j,
+            base.e_ts_j,
+            other.e_ts_std_err_j,
+            base.e_ts_std_err_j
+        ));
+        assert!(within(
+            other.phase_deg,
+            base.phase_deg,
+            other.phase_std_err_deg,
+            base.phase_std_err_deg
+        ));
+        assert!(other.e_ts_std_err_j < 0.01 * other.e_ts_j);
+    }
+    // Some periods touch, some do not: the thermal motion decides.
+    assert!(base.touch_fraction > 0.1 && base.touch_fraction < 0.95);
+    // At 0 K the deterministic lock, averaged over the same record.
+    let cold = run(1e-9, 1, 0.0);
+    let state = tapsim::tap(&setup, &numerics(1e-9), Default::default()).unwrap();
+    assert!(
+        (cold.e_ts_j / state.observables.e_ts_j - 1.0).abs() < 1e-3,
+        "{} vs {}",
+        cold.e_ts_j,
+        state.observables.e_ts_j
+    );
+}
+
+/// The thermal average's standard errors are the spread of independent records: over
+/// six seeds the means of E_ts and φ scatter by their quoted standard error (the ratio
+/// of the seeds' standard deviation to the mean standard error within 0.4–2).
+#[test]
+fn the_thermal_averages_errors_are_the_spread_of_seeds() {
+    use tapsim::instrument::thermal::thermal_average;
+    let mut setup = default_setup();
+    setup.separation_m = 20e-9;
+    let numerics = Numerics::default();
+    let runs: Vec<_> = (10..16)
+        .map(|seed| thermal_average(&setup, &numerics, ROOM_TEMPERATURE_K, (8_000, seed)).unwrap())
+        .collect();
+    let check = |value: &dyn Fn(&tapsim::instrument::thermal::ThermalAverage) -> (f64, f64)| {
+        let v: Vec<(f64, f64)> = runs.iter().map(value).collect();
+        let n = v.len() as f64;
+        let m = v.iter().map(|x| x.0).sum::<f64>() / n;
+        let sd = (v.iter().map(|x| (x.0 - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        let se = (v.iter().map(|x| x.1 * x.1).sum::<f64>() / n).sqrt();
+        eprintln!("spread {sd:e}, quoted {se:e}");
+        assert!(sd / se > 0.4 && sd / se < 2.0, "{sd:e} vs {se:e}");
+    };
+    check(&|a| (a.e_ts_j, a.e_ts_std_err_j));
+    check(&|a| (a.phase_deg, a.phase_std_err_deg));
+}
+
+/// `tap --temperature` averages over the thermal motion where the deterministic state
+/// grazes a switch (README: the hybrid defaults at 20 nm), and not on a stable period-1
+/// orbit away from every switch (the defaults, where the linear noise theory speaks).
+#[test]
+fn tap_averages_a_grazing_state_over_the_thermal_motion() {
+    let json = |args: &[&str]| {
+        let mut all = vec!["tap", "--json", "--temperature", "300K"];
+        all.extend_from_slice(args);
+        let out = common::tapsim(&all);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let v = json(&["--separation", "20nm"]);
+    assert_eq!(v["grazing"], true);
+    let a = &v["thermal_average"];
+    let ev = 1.602_176_634e-19;
+    let f = |key: &str| a[key].as_f64().unwrap();
+    assert_eq!(
+        format!(
+            "{} {:.3} {:.3} | {:.3} ± {:.3} {:.3} ± {:.3} {:.1} %",
+            v["regime"].as_str().unwrap(),
+            v["e_ts_ev"].as_f64().unwrap(),
+            v["phase_deg"].as_f64().unwrap(),
+            f("e_ts_j") / ev,
+            f("e_ts_std_err_j") / ev,
+            f("phase_deg"),
+            f("phase_std_err_deg"),
+            100.0 * f("touch_fraction")
+        ),
+        "period-41 15.471 102.976 | 15.359 ± 0.012 102.993 ± 0.009 75.1 %"
+    );
+    assert_eq!(a["records"].as_u64(), Some(8));
+    assert_eq!(a["periods"].as_u64(), Some(20_000));
+    assert!(json(&[]).get("thermal_average").is_none());
+}

@@ -4,6 +4,7 @@ use crate::config::{BranchChoice, TapInputs, length, number};
 use crate::dynamics::observables::{Observe, Starts, tap};
 use crate::error::{Error, Result};
 use crate::instrument::noise::thermal_noise_at;
+use crate::instrument::thermal::thermal_average;
 use crate::report::{output, plot, tap as report};
 use crate::setpoint::states_at_setpoint;
 use clap::Args;
@@ -102,6 +103,12 @@ pub struct TapArgs {
     branch: Option<BranchChoice>,
     #[command(flatten)]
     noise: super::NoiseArgs,
+    /// Drive periods a --temperature run averages over where the deterministic state
+    /// grazes a switch or is not a stable period-1 orbit: eight independent records of
+    /// an eighth each (after ten decay times of settling), whose spread gives the
+    /// standard errors.
+    #[arg(long, default_value_t = 20_000, help_heading = "Thermal noise")]
+    thermal_periods: usize,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
@@ -140,13 +147,24 @@ pub fn run(args: TapArgs) -> Result<()> {
     }
     // Another stable period-1 state at this z_c (a bistable setpoint: the free
     // oscillation settles on one, an approach or a retract may sit on the other).
-    let spinner = spinner("looking for other stable states at this z_c");
+    let searching = spinner("looking for other stable states at this z_c");
     let coexisting = crate::setpoint::coexisting(&setup, &numerics, &run.observables);
-    spinner.finish_and_clear();
+    searching.finish_and_clear();
     let coexisting = coexisting?;
     let noise = match args.noise.request() {
         Some(request) => Some(thermal_noise_at(&setup, &numerics, &request)?),
         None => None,
+    };
+    // Where the deterministic answer is not a stable period-1 orbit away from every
+    // switch, what an instrument reads is the average over the thermal motion.
+    let average = match (&noise, args.noise.temperature) {
+        (Some(n), Some(t)) if run.observables.grazing || n.is_none() => {
+            let busy = spinner("averaging the state over a thermal record");
+            let average = thermal_average(&setup, &numerics, t, (args.thermal_periods, 1));
+            busy.finish_and_clear();
+            Some(average?)
+        }
+        _ => None,
     };
     if args.json {
         let mut v = serde_json::to_value(&run).expect("observables serialise");
@@ -159,6 +177,12 @@ pub fn run(args: TapArgs) -> Result<()> {
                 m.insert(
                     "thermal_noise".into(),
                     serde_json::to_value(noise).expect("noise serialises"),
+                );
+            }
+            if let Some(average) = &average {
+                m.insert(
+                    "thermal_average".into(),
+                    serde_json::to_value(average).expect("average serialises"),
                 );
             }
         }
@@ -182,6 +206,31 @@ pub fn run(args: TapArgs) -> Result<()> {
                  orbit, and this state is not one"
             ),
             None => {}
+        }
+        if let Some(a) = average {
+            let ev = crate::params::ELECTRONVOLT_J;
+            outln!(
+                "thermal average at {} K over {} periods (what an instrument reads here: \
+                 the deterministic state {}): E_ts = {:.3} ± {:.3} eV, φ = {:.3} ± {:.3}°, \
+                 A/A₀ = {:.6} ± {:.1e}, touches in {:.2} ± {:.2} % of periods (standard \
+                 errors from {} independent records)",
+                a.temperature_k,
+                a.periods,
+                if run.observables.grazing {
+                    "grazes a switch"
+                } else {
+                    "is not a stable period-1 orbit"
+                },
+                a.e_ts_j / ev,
+                a.e_ts_std_err_j / ev,
+                a.phase_deg,
+                a.phase_std_err_deg,
+                a.amplitude_ratio,
+                a.amplitude_ratio_std_err,
+                100.0 * a.touch_fraction,
+                100.0 * a.touch_fraction_std_err,
+                a.records
+            );
         }
     }
     Ok(())
