@@ -68,6 +68,21 @@ pub struct SetpointState {
     pub phase: Phase,
 }
 
+impl SetpointState {
+    /// The thermal noise a lock-in reads on this state's orbit
+    /// ([`crate::instrument::noise::NoiseRequest::on_orbit`]), `setup` and `numerics`
+    /// those it was found with.
+    pub fn thermal_noise(
+        &self,
+        setup: &TapSetup,
+        numerics: &Numerics,
+        request: &crate::instrument::noise::NoiseRequest,
+    ) -> Result<crate::instrument::noise::ThermalNoise> {
+        let p = Prepared::new(setup, numerics)?;
+        request.on_orbit(&p, &p.simulation_at(self.separation_m)?, &self.phase)
+    }
+}
+
 /// The free oscillator's phase lag in degrees, atan2(Ω/Q, 1 − Ω²) (the border between
 /// the attractive and the repulsive branch).
 pub fn free_phase_deg(setup: &TapSetup) -> f64 {

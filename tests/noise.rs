@@ -314,3 +314,39 @@ fn contrast_weighs_each_phase_difference_against_its_thermal_noise() {
     }
     assert_eq!(answers, ["99 190", "24 46", "13 25"]);
 }
+
+/// `tap --setpoint --temperature` reads the noise of every state it lists: the repulsive
+/// state at A/A₀ = 0.8 has the σ `tap --separation` reads at its z_c (the free
+/// oscillation settles on the same orbit there).
+#[test]
+fn tap_at_a_setpoint_reads_each_states_noise() {
+    let json = |args: &[&str]| {
+        let mut all = vec!["tap", "--json", "--temperature", "300K"];
+        all.extend_from_slice(args);
+        let out = common::tapsim(&all);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let listed = json(&["--setpoint", "0.8"]);
+    let states = listed["states"].as_array().unwrap();
+    assert_eq!(states.len(), 2);
+    let repulsive = states.iter().find(|s| s["branch"] == "repulsive").unwrap();
+    let z = format!("{:e}", repulsive["separation_m"].as_f64().unwrap());
+    let direct = json(&["--separation", &z]);
+    assert!(
+        (direct["phase_deg"].as_f64().unwrap() - repulsive["phase_deg"].as_f64().unwrap()).abs()
+            < 1e-4
+    );
+    let sigma = |v: &serde_json::Value| v["thermal_noise"]["sigma_phase_deg"].as_f64().unwrap();
+    assert!(
+        (sigma(&direct) / sigma(repulsive) - 1.0).abs() < 1e-4,
+        "{} vs {}",
+        sigma(&direct),
+        sigma(repulsive)
+    );
+    assert!(states.iter().all(|s| sigma(s) > 0.0));
+}

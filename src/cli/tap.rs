@@ -248,13 +248,6 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
                 .into(),
         ));
     }
-    if args.noise.temperature.is_some() {
-        return Err(Error::NotApplicable(
-            "--temperature reads the noise of one state: run `tapsim tap --separation \
-             <z_c> --temperature T` with the separation_m of the state at the setpoint"
-                .into(),
-        ));
-    }
     let (setup, numerics) = inputs.resolve()?;
     let ratio = inputs
         .setpoint_ratio(setup.cantilever.free_amplitude_m)
@@ -272,14 +265,30 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
         }
         e => e,
     })?;
+    // Each state is a stable period-1 orbit: the linear theory reads its noise.
+    let noise = match args.noise.request() {
+        Some(request) => states
+            .iter()
+            .map(|s| s.thermal_noise(&setup, &numerics, &request).map(Some))
+            .collect::<Result<Vec<_>>>()?,
+        None => vec![None; states.len()],
+    };
     if args.json {
-        let mut top = serde_json::to_value(&states[0]).expect("a state serialises");
+        let mut listed = serde_json::to_value(&states).expect("states serialise");
+        if let serde_json::Value::Array(list) = &mut listed {
+            for (state, noise) in list.iter_mut().zip(&noise) {
+                if let (serde_json::Value::Object(m), Some(noise)) = (state, noise) {
+                    m.insert(
+                        "thermal_noise".into(),
+                        serde_json::to_value(noise).expect("noise serialises"),
+                    );
+                }
+            }
+        }
+        let mut top = listed[0].clone();
         if let serde_json::Value::Object(m) = &mut top {
             m.insert("setpoint".into(), ratio.into());
-            m.insert(
-                "states".into(),
-                serde_json::to_value(&states).expect("states serialise"),
-            );
+            m.insert("states".into(), listed);
         }
         outln!(
             "{}",
@@ -287,6 +296,21 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
         );
     } else {
         out!("{}", report::setpoint_text(&setup, ratio, &states));
+        for (state, noise) in states.iter().zip(&noise) {
+            if let Some(n) = noise {
+                outln!(
+                    "thermal noise on the {} state (z_c = {:.4} nm) at {} K, lock-in order \
+                     {}, ENBW {} Hz: σ_A = {:.4} pm, σ_φ = {:.5}°",
+                    format!("{:?}", state.branch).to_lowercase(),
+                    state.separation_m * 1e9,
+                    n.temperature_k,
+                    n.lockin_order,
+                    n.enbw_hz,
+                    n.sigma_amplitude_m * 1e12,
+                    n.sigma_phase_deg
+                );
+            }
+        }
     }
     Ok(())
 }
