@@ -573,18 +573,8 @@ material = "B"
     }
 }
 
-/// A mask CSV beside the sample file: its cells lay materials over the stripes, the first
-/// row at the top of the image; a ragged row, an unknown material or a bad height is
-/// refused with where it is.
-#[test]
-fn a_mask_lays_its_materials_where_its_cells_say() {
-    let dir = common::scratch("scan_mask");
-    let sample = dir.join("masked.toml");
-    std::fs::write(
-        &sample,
-        r#"
-length = "1um"
-mask = "mask.csv"
+/// Two polymers over a stripe of A, for the mask tests.
+const MASKED_MATERIALS: &str = r#"
 [[material]]
 name = "A"
 sample-modulus = "0.5GPa"
@@ -596,25 +586,42 @@ work-of-adhesion = 0.08
 [[region]]
 until = "1um"
 material = "A"
-"#,
+"#;
+
+/// Scan two lines of four pixels of the sample `head` (its mask lines) over
+/// [`MASKED_MATERIALS`], written into `dir`.
+fn scan_masked(dir: &std::path::Path, head: &str) -> std::process::Output {
+    let sample = dir.join("masked.toml");
+    std::fs::write(
+        &sample,
+        format!("length = \"1um\"\n{head}\n{MASKED_MATERIALS}"),
     )
     .unwrap();
+    common::tapsim(&[
+        "scan",
+        "--sample",
+        sample.to_str().unwrap(),
+        "--lines",
+        "2",
+        "--pixels",
+        "4",
+        "--line-rate",
+        "20",
+        "--no-retrace",
+        "--json",
+        "--quiet",
+    ])
+}
+
+/// A mask CSV beside the sample file: its cells lay materials over the stripes, the first
+/// row at the top of the image; a ragged row, an unknown material or a bad height is
+/// refused with where it is.
+#[test]
+fn a_mask_lays_its_materials_where_its_cells_say() {
+    let dir = common::scratch("scan_mask");
     let scan = |mask: &str| {
         std::fs::write(dir.join("mask.csv"), mask).unwrap();
-        common::tapsim(&[
-            "scan",
-            "--sample",
-            sample.to_str().unwrap(),
-            "--lines",
-            "2",
-            "--pixels",
-            "4",
-            "--line-rate",
-            "20",
-            "--no-retrace",
-            "--json",
-            "--quiet",
-        ])
+        scan_masked(&dir, "mask = \"mask.csv\"")
     };
     // Top row (line 1, y = 750 nm): A then B; bottom row (line 0): B then A.
     let out = scan("A,B\nB,\n");
@@ -650,37 +657,7 @@ material = "A"
 #[test]
 fn a_mask_image_lays_the_same_grid_as_its_csv() {
     let dir = common::scratch("scan_mask_png");
-    let materials = r#"
-[[material]]
-name = "A"
-sample-modulus = "0.5GPa"
-work-of-adhesion = 0.1
-[[material]]
-name = "B"
-sample-modulus = "1GPa"
-work-of-adhesion = 0.08
-[[region]]
-until = "1um"
-material = "A"
-"#;
-    let scan = |head: &str| {
-        let sample = dir.join("masked.toml");
-        std::fs::write(&sample, format!("length = \"1um\"\n{head}\n{materials}")).unwrap();
-        common::tapsim(&[
-            "scan",
-            "--sample",
-            sample.to_str().unwrap(),
-            "--lines",
-            "2",
-            "--pixels",
-            "4",
-            "--line-rate",
-            "20",
-            "--no-retrace",
-            "--json",
-            "--quiet",
-        ])
-    };
+    let scan = |head: &str| scan_masked(&dir, head);
     std::fs::write(dir.join("mask.csv"), "A,B\nB,\n").unwrap();
     let png = |pixels: [[u8; 4]; 4]| {
         let image =

@@ -168,13 +168,7 @@ fn tap_reports_the_thermal_noise_of_its_orbit() {
     let json = |args: &[&str]| {
         let mut all = vec!["tap", "--json"];
         all.extend_from_slice(args);
-        let out = common::tapsim(&all);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+        common::json(&all)
     };
     let v = json(&["--temperature", "300K", "--enbw", "1kHz"]);
     let noise = &v["thermal_noise"];
@@ -230,10 +224,7 @@ fn tap_reports_the_thermal_noise_of_its_orbit() {
     ] {
         let mut all = vec!["tap"];
         all.extend_from_slice(args);
-        let out = common::tapsim(&all);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-        assert!(err.contains(says), "{args:?}: {err}");
+        common::refused(&all, says);
     }
 }
 
@@ -246,7 +237,7 @@ fn tap_reports_the_thermal_noise_of_its_orbit() {
 fn contrast_weighs_each_phase_difference_against_its_thermal_noise() {
     let mut answers = Vec::new();
     for enbw in ["100Hz", "1kHz", "10kHz"] {
-        let out = common::tapsim(&[
+        let rows = common::json(&[
             "contrast",
             "--setpoints",
             "0.8",
@@ -259,12 +250,6 @@ fn contrast_weighs_each_phase_difference_against_its_thermal_noise() {
             "--json",
             "--quiet",
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         let row = |law: &str, branch: &str| {
             rows.as_array()
                 .unwrap()
@@ -323,13 +308,7 @@ fn tap_at_a_setpoint_reads_each_states_noise() {
     let json = |args: &[&str]| {
         let mut all = vec!["tap", "--json", "--temperature", "300K"];
         all.extend_from_slice(args);
-        let out = common::tapsim(&all);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+        common::json(&all)
     };
     let listed = json(&["--setpoint", "0.8"]);
     let states = listed["states"].as_array().unwrap();

@@ -242,10 +242,7 @@ fn thermal_calibrates_the_cantilever_it_records() {
     ] {
         let mut all = vec!["thermal", "--quiet"];
         all.extend_from_slice(args);
-        let out = common::tapsim(&all);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-        assert!(err.contains(says), "{args:?}: {err}");
+        common::refused(&all, says);
     }
 }
 
@@ -345,13 +342,7 @@ fn tap_averages_a_grazing_state_over_the_thermal_motion() {
     let json = |args: &[&str]| {
         let mut all = vec!["tap", "--json", "--temperature", "300K"];
         all.extend_from_slice(args);
-        let out = common::tapsim(&all);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+        common::json(&all)
     };
     let v = json(&["--separation", "20nm"]);
     assert_eq!(v["grazing"], true);

@@ -107,3 +107,11 @@ pub fn scratch(name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
+
+/// Run `args`, asserting that it is refused: exit code 1 and `says` in the message.
+pub fn refused(args: &[&str], says: &str) {
+    let out = tapsim(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    assert!(err.contains(says), "{args:?}: {err}");
+}
