@@ -273,7 +273,11 @@ fn scan_line(c: &mut Criterion) {
                 &prepared,
                 &regions,
                 (sample.length_m, 256, per_pixel),
-                (lockin, controller),
+                (
+                    lockin,
+                    controller,
+                    tapsim::instrument::thermal::ThermalForce::none(),
+                ),
                 10_000,
                 false,
                 |_| {},

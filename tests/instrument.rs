@@ -7,6 +7,7 @@ mod common;
 use tapsim::dynamics::observables::TapObservables;
 use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};
 use tapsim::instrument::lockin::{LockIn, step_response};
+use tapsim::instrument::thermal::ThermalForce;
 
 #[test]
 fn the_lock_in_filter_has_the_step_response_of_an_rc_cascade() {
@@ -93,6 +94,7 @@ fn the_z_feedback_rests_where_the_setpoint_solver_puts_the_state() {
         (1.2 * a0, &mut phase),
         &mut lockin,
         &mut controller,
+        &mut ThermalForce::none(),
         8000,
     )
     .unwrap();
@@ -153,6 +155,7 @@ fn a_slow_scan_images_material_contrast_and_a_height_step() {
             (1.2 * a0, &mut phase),
             &mut lockin,
             &mut controller,
+            &mut ThermalForce::none(),
             8000,
         )
         .unwrap();
@@ -160,7 +163,7 @@ fn a_slow_scan_images_material_contrast_and_a_height_step() {
             &prepared,
             regions,
             (1e-6, 4, 6000),
-            (&mut lockin, &mut controller),
+            (&mut lockin, &mut controller, &mut ThermalForce::none()),
             z,
             &mut phase,
             |_| {},

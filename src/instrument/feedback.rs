@@ -9,6 +9,7 @@
 //! instrument records as topography.
 
 use super::lockin::LockIn;
+use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
@@ -95,13 +96,15 @@ pub struct LoopSample {
 /// Run the z feedback on `p` for `periods` drive periods from the oscillator state
 /// `phase` at rest separation `start_m` (the free oscillation, say): the lock-in first
 /// settles there with the loop open, then each period is marched at the current z_c with
-/// `lockin` watching, and `controller` moves z_c. Returns every closed-loop period's
+/// `lockin` watching, under `force` (the thermal force, [`ThermalForce::none`] for
+/// none), and `controller` moves z_c. Returns every closed-loop period's
 /// sample and the rest separation the loop has moved to; `phase` is left at the end.
 pub fn hold(
     p: &Prepared,
     (start_m, phase): (f64, &mut Phase),
     lockin: &mut LockIn,
     controller: &mut PiController,
+    force: &mut ThermalForce,
     periods: usize,
 ) -> Result<(Vec<LoopSample>, f64)> {
     let a0 = p.setup.cantilever.free_amplitude_m;
@@ -110,11 +113,10 @@ pub fn hold(
     // response is within 1e-4 of 1 after 12 + 3n time constants).
     let settle = (12.0 + 3.0 * lockin.order() as f64) * lockin.time_constant_hat()
         / p.simulation().osc.period();
-    p.simulation_at(z)?
-        .march(phase, settle.ceil() as usize, lockin)?;
+    force.march(&p.simulation_at(z)?, phase, settle.ceil() as usize, lockin)?;
     let mut out = Vec::with_capacity(periods);
     for _ in 0..periods {
-        p.simulation_at(z)?.march(phase, 1, lockin)?;
+        force.march(&p.simulation_at(z)?, phase, 1, lockin)?;
         let amplitude_ratio = lockin.amplitude();
         let (dz, error) = controller.update(amplitude_ratio);
         out.push(LoopSample {

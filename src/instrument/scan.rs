@@ -11,6 +11,7 @@
 
 use super::feedback::PiController;
 use super::lockin::LockIn;
+use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
@@ -51,13 +52,14 @@ pub struct Pixel {
 /// loop already holding the setpoint from the piezo position `start_z_m` and the
 /// oscillator state `phase` (as [`super::feedback::hold`] leaves them over the first
 /// region, say). All
-/// materials must share the cantilever (its drive period sets the time). `progress` is
+/// materials must share the cantilever (its drive period sets the time), and the
+/// thermal force `force` shakes it ([`ThermalForce::none`] for none). `progress` is
 /// told each pixel done. Returns the pixels and the piezo position at the end.
 pub fn line(
     materials: &[Prepared],
     regions: &[Region],
     (length_m, pixels, periods_per_pixel): (f64, usize, usize),
-    (lockin, controller): (&mut LockIn, &mut PiController),
+    (lockin, controller, force): (&mut LockIn, &mut PiController, &mut ThermalForce),
     start_z_m: f64,
     phase: &mut Phase,
     mut progress: impl FnMut(usize),
@@ -88,8 +90,7 @@ pub fn line(
             }
             let region = &regions[under];
             let p = &materials[region.material];
-            p.simulation_at(z - region.height_m)?
-                .march(phase, 1, lockin)?;
+            force.march(&p.simulation_at(z - region.height_m)?, phase, 1, lockin)?;
             let amplitude = lockin.amplitude();
             let (dz, error) = controller.update(amplitude);
             for (s, v) in sum
@@ -116,6 +117,33 @@ pub fn line(
         progress(i + 1);
     }
     Ok((out, z))
+}
+
+/// The material under pixel `i` of `pixels` along a line of length `length_m` crossing
+/// `regions`, if the pixel and the one before it lie wholly in one region (the loop has
+/// had a pixel to settle there): what a pixel-to-pixel statistic of a material may use.
+pub fn settled_material(
+    regions: &[Region],
+    length_m: f64,
+    pixels: usize,
+    i: usize,
+) -> Option<usize> {
+    if i == 0 || i >= pixels {
+        return None;
+    }
+    let w = length_m / pixels as f64;
+    let (from, to) = ((i - 1) as f64 * w, (i + 1) as f64 * w);
+    let mut start = 0.0;
+    for r in regions {
+        if from >= start - 1e-12 * length_m && to <= r.until_m + 1e-12 * length_m {
+            return Some(r.material);
+        }
+        if r.until_m > from {
+            return None;
+        }
+        start = r.until_m;
+    }
+    None
 }
 
 /// `regions` of a line of length `length_m` as the retrace meets them: x mirrored.
@@ -236,20 +264,21 @@ impl Layout {
 /// One line of an image as an AFM records it: the loop engaged over the line's first
 /// region from the free oscillation at 1.2 A₀ ([`super::feedback::hold`] for
 /// `engage_periods`), then trace and (if `retrace`) retrace, each by [`line()`]. The
-/// lock-in and the controller start from the given ones, so every line is independent
-/// of the others (computed in any order, on any thread, with the same result).
+/// lock-in, the controller and the thermal force (its own stream for each line) start
+/// from the given ones, so every line is independent of the others (computed in any
+/// order, on any thread, with the same result).
 /// Returns the trace and the retrace (x as the trace's, not mirrored).
 #[allow(clippy::too_many_arguments)]
 pub fn row(
     materials: &[Prepared],
     regions: &[Region],
     (length_m, pixels, periods_per_pixel): (f64, usize, usize),
-    (lockin, controller): (LockIn, PiController),
+    (lockin, controller, force): (LockIn, PiController, ThermalForce),
     engage_periods: usize,
     retrace: bool,
     mut progress: impl FnMut(usize),
 ) -> Result<(Vec<Pixel>, Option<Vec<Pixel>>)> {
-    let (mut lockin, mut controller) = (lockin, controller);
+    let (mut lockin, mut controller, mut force) = (lockin, controller, force);
     let Some(first) = regions.first().and_then(|r| materials.get(r.material)) else {
         return Err(Error::NotApplicable(
             "a scanned sample needs regions, each naming one of its materials".into(),
@@ -262,12 +291,13 @@ pub fn row(
         (1.2 * a0, &mut phase),
         &mut lockin,
         &mut controller,
+        &mut force,
         engage_periods,
     )?;
     // The loop holds the rest separation; the piezo stands that much above the surface.
     let z = rest + regions[0].height_m;
     let shape = (length_m, pixels, periods_per_pixel);
-    let loop_state = (&mut lockin, &mut controller);
+    let loop_state = (&mut lockin, &mut controller, &mut force);
     let (trace, end) = line(
         materials,
         regions,
@@ -281,7 +311,7 @@ pub fn row(
         return Ok((trace, None));
     }
     let back = mirrored(regions, length_m);
-    let loop_state = (&mut lockin, &mut controller);
+    let loop_state = (&mut lockin, &mut controller, &mut force);
     let (mut retrace, _) = line(
         materials, &back, shape, loop_state, end, &mut phase, progress,
     )?;
@@ -294,6 +324,40 @@ pub fn row(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_settled_pixel_and_the_one_before_it_lie_in_one_region() {
+        let regions = [
+            Region {
+                until_m: 0.5,
+                material: 0,
+                height_m: 0.0,
+            },
+            Region {
+                until_m: 1.0,
+                material: 1,
+                height_m: 0.0,
+            },
+        ];
+        // Eight pixels of 0.125: 1–3 settle on 0, 4 straddles nothing but follows 3
+        // (on 0), 5–7 on 1.
+        let got: Vec<Option<usize>> = (0..8)
+            .map(|i| settled_material(&regions, 1.0, 8, i))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                None,
+                Some(0),
+                Some(0),
+                Some(0),
+                None,
+                Some(1),
+                Some(1),
+                Some(1)
+            ]
+        );
+    }
 
     #[test]
     fn a_line_crosses_the_material_under_each_point_of_the_plane() {

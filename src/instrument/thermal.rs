@@ -81,6 +81,12 @@ impl ThermalForce {
         })
     }
 
+    /// No force at all (D̂ = 0): a march under it is [`Simulation::march`]'s, bit for
+    /// bit.
+    pub fn none() -> Self {
+        Self::new(0.0, STEPS_PER_PERIOD, 0, 0).expect("a zero force is valid")
+    }
+
     /// D̂.
     pub fn intensity_hat(&self) -> f64 {
         self.intensity_hat
