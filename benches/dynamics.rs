@@ -181,6 +181,7 @@ fn setpoint(c: &mut Criterion) {
             1,
             || {},
             (0.8, PhaseBranch::Repulsive),
+            None,
         )
     };
     let cells = run().expect("map");

@@ -415,6 +415,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         0,
         || {},
         (setpoint.amplitude_ratio, setpoint.branch),
+        None,
     )?;
     for (stem, cells, caption, what) in [
         (

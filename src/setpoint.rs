@@ -320,8 +320,10 @@ fn hold(
 
 /// The cells numbered `cells` of the adhesion × modulus map ([`sweep::map_cells`]) at the
 /// amplitude setpoint `ratio` on `branch`: each cell's first state there
-/// ([`states_at_setpoint`]) and the rest separation that holds it; a cell whose law does
-/// not apply or whose branch does not reach the setpoint carries the reason as its note.
+/// ([`states_at_setpoint`]) and the rest separation that holds it, with `noise` its
+/// phase's thermal noise ([`SetpointState::thermal_noise`]); a cell whose law does not
+/// apply or whose branch does not reach the setpoint carries the reason as its note.
+#[allow(clippy::too_many_arguments)]
 pub fn map_cells(
     setup: &TapSetup,
     numerics: &Numerics,
@@ -330,12 +332,17 @@ pub fn map_cells(
     threads: usize,
     progress: impl Fn() + Sync,
     (ratio, branch): (f64, PhaseBranch),
+    noise: Option<&crate::instrument::noise::NoiseRequest>,
 ) -> Result<Vec<sweep::MapCell>> {
     check_ratio(ratio)?;
     let solve = |s: &TapSetup| {
         let states = states_at_setpoint(s, numerics, ratio, Some(branch))?;
         let first = states.into_iter().next().expect("a list is never empty");
-        Ok((first.observables, Some(first.separation_m)))
+        let sigma = match noise {
+            Some(request) => Some(first.thermal_noise(s, numerics, request)?.sigma_phase_deg),
+            None => None,
+        };
+        Ok((first.observables, Some(first.separation_m), sigma))
     };
     sweep::map_cells_with(setup, axes, cells, threads, progress, &solve)
 }

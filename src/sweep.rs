@@ -134,6 +134,10 @@ pub struct MapCell {
     /// Why the cell is empty, when it is.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// The thermal noise of the cell's lock-in phase in degrees, where it was asked for
+    /// (a map at an amplitude setpoint: the linear theory about the cell's orbit).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_phase_deg: Option<f64>,
 }
 
 /// `n` values from `lo` to `hi`, evenly spaced on a log scale.
@@ -226,10 +230,12 @@ pub fn adhesion_modulus_map(
     )
 }
 
-/// What a map cell solves: the steady state of a cell's setup, and the rest separation
-/// it was found at where that is solved for (an amplitude setpoint); an
-/// [`Error::NotApplicable`] becomes the cell's note.
-pub type CellSolver<'a> = dyn Fn(&TapSetup) -> Result<(TapObservables, Option<f64>)> + Sync + 'a;
+/// What a map cell solves: the steady state of a cell's setup, the rest separation it
+/// was found at where that is solved for (an amplitude setpoint) and its phase's thermal
+/// noise (degrees) where that was asked for; an [`Error::NotApplicable`] becomes the
+/// cell's note.
+pub type CellSolver<'a> =
+    dyn Fn(&TapSetup) -> Result<(TapObservables, Option<f64>, Option<f64>)> + Sync + 'a;
 
 /// The cells numbered `cells` of the map [`adhesion_modulus_map`] computes (numbered in
 /// its order: cell k has modulus k / (number of works), work k mod (number of works)),
@@ -249,7 +255,7 @@ pub fn map_cells(
             numerics,
             crate::dynamics::observables::Observe::default(),
         )
-        .map(|run| (run.observables, None))
+        .map(|run| (run.observables, None, None))
     };
     map_cells_with(setup, axes, cells, threads, progress, &at_separation)
 }
@@ -292,13 +298,14 @@ pub fn map_cells_with(
                 s.contact.modulus_pa = e;
                 let tabor_mu = s.contact.tabor_mu();
                 let cell = match solve(&s) {
-                    Ok((observables, separation_m)) => MapCell {
+                    Ok((observables, separation_m, sigma_phase_deg)) => MapCell {
                         work_of_adhesion_j_m2: w,
                         modulus_pa: e,
                         tabor_mu,
                         separation_m,
                         observables: Some(observables),
                         note: None,
+                        sigma_phase_deg,
                     },
                     Err(Error::NotApplicable(why)) => MapCell {
                         work_of_adhesion_j_m2: w,
@@ -307,6 +314,7 @@ pub fn map_cells_with(
                         separation_m: None,
                         observables: None,
                         note: Some(why),
+                        sigma_phase_deg: None,
                     },
                     Err(other) => return Err(other),
                 };

@@ -413,3 +413,63 @@ fn a_scan_under_the_thermal_force_scatters_as_the_linear_theory_says() {
         );
     }
 }
+
+/// `map --setpoint --temperature`: every cell that holds the setpoint carries its phase
+/// noise, the one `tap --setpoint` reads for that material; the heat maps are drawn; a
+/// map at a rest separation refuses the temperature.
+#[test]
+fn a_map_at_a_setpoint_reads_each_cells_noise() {
+    let dir = common::scratch("map_noise");
+    let png = dir.join("map.png");
+    let v = common::json(&[
+        "map",
+        "--setpoint",
+        "0.8",
+        "--steps",
+        "3",
+        "--temperature",
+        "300K",
+        "--json",
+        "--quiet",
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    let field = |key: &str| common::cells(&v["grid"][key]);
+    let (phase, sigma_of, works, moduli) = (
+        field("phase_deg"),
+        field("sigma_phase_deg"),
+        field("work_of_adhesion_j_m2"),
+        field("modulus_pa"),
+    );
+    let held: Vec<usize> = (0..phase.len()).filter(|&k| phase[k].is_f64()).collect();
+    assert!(held.len() >= 3);
+    for k in 0..phase.len() {
+        assert_eq!(phase[k].is_f64(), sigma_of[k].is_f64(), "cell {k}");
+    }
+    let k = held[0];
+    let w = format!("{:e}", works[k].as_f64().unwrap());
+    let e = format!("{:e}", moduli[k].as_f64().unwrap());
+    let tap = common::json(&[
+        "tap",
+        "--setpoint",
+        "0.8",
+        "--branch",
+        "repulsive",
+        "--work-of-adhesion",
+        &w,
+        "--modulus",
+        &e,
+        "--temperature",
+        "300K",
+        "--json",
+    ]);
+    let sigma = tap["states"][0]["thermal_noise"]["sigma_phase_deg"]
+        .as_f64()
+        .unwrap();
+    assert!((sigma_of[k].as_f64().unwrap() / sigma - 1.0).abs() < 1e-9);
+    assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
+    common::refused(
+        &["map", "--steps", "3", "--temperature", "300K"],
+        "amplitude setpoint",
+    );
+}

@@ -64,6 +64,12 @@ pub struct MapArgs {
     /// With a setpoint: the branch every cell is solved on [default: repulsive].
     #[arg(long, value_enum)]
     branch: Option<BranchChoice>,
+    /// With a setpoint, --temperature adds each cell's thermal phase noise σ_φ through
+    /// the lock-in (the linear theory about its orbit; column sigma_phase_deg) and heat
+    /// maps of σ_φ and of each cell's phase contrast with the first cell over the noise
+    /// of the two readings, |φ − φ₀|/√(σ² + σ₀²).
+    #[command(flatten)]
+    noise: super::NoiseArgs,
     #[command(flatten)]
     split: super::shard::ShardArgs,
 }
@@ -105,6 +111,17 @@ pub fn run(args: MapArgs) -> Result<()> {
     let whole_outputs = args.out.csv.is_some() || args.out.plot.is_some() || args.out.json;
     let shard = args.split.resolve("map", whole_outputs)?;
     let cells = shard.unwrap_or(Shard::WHOLE).items(total);
+    let noise = args.noise.request();
+    if let Some(request) = &noise {
+        if setpoint.is_none() {
+            return Err(Error::NotApplicable(
+                "a map reads thermal noise at an amplitude setpoint (--setpoint), as an AFM \
+                 images: give one with --temperature"
+                    .into(),
+            ));
+        }
+        request.check(setup.cantilever.drive_frequency_hz)?;
+    }
     let bar = args.out.progress_bar(cells.len());
     let computed = match setpoint {
         None => sweep::map_cells(
@@ -123,6 +140,7 @@ pub fn run(args: MapArgs) -> Result<()> {
             args.threads,
             || bar.inc(1),
             (sp.amplitude_ratio, sp.branch),
+            noise.as_ref(),
         )?,
     };
     bar.finish_and_clear();
@@ -136,7 +154,7 @@ pub fn run(args: MapArgs) -> Result<()> {
                 setpoint,
             },
             &part::Config::Whole(
-                serde_json::to_value((&setup, &numerics, &works, &moduli))
+                serde_json::to_value((&setup, &numerics, &works, &moduli, &noise))
                     .expect("a configuration serialises"),
             ),
             cells,

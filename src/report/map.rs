@@ -12,11 +12,12 @@ use crate::sweep::MapCell;
 use serde::Serialize;
 use serde_json::value::RawValue;
 
-/// What a heat map shows of one cell: E_ts per cycle (eV), the phase (deg), A/A₀ and the
-/// viscous share of E_ts (eV), the rest separation (m) where it was solved for (an
-/// amplitude setpoint), whether the motion is period-1 and whether it grazes a switch;
-/// `None` where the law does not apply.
-pub type Plotted = Option<([f64; 4], Option<f64>, bool, bool)>;
+/// What a heat map shows of one cell: E_ts per cycle (eV), the phase (deg), A/A₀, the
+/// viscous share of E_ts (eV) and the phase's thermal noise (deg; NaN where not asked
+/// for), the rest separation (m) where it was solved for (an amplitude setpoint),
+/// whether the motion is period-1 and whether it grazes a switch; `None` where the law
+/// does not apply.
+pub type Plotted = Option<([f64; 5], Option<f64>, bool, bool)>;
 
 /// A cell as its record serialises, and what its heat maps show.
 pub trait MapRecord: Serialize {
@@ -33,6 +34,7 @@ impl MapRecord for MapCell {
                 o.phase_deg,
                 o.amplitude_ratio,
                 o.e_ts_viscous_j / ELECTRONVOLT_J,
+                self.sigma_phase_deg.unwrap_or(f64::NAN),
             ],
             self.separation_m,
             o.period == Some(1),
@@ -51,6 +53,7 @@ struct PlottedFields {
     separation_m: Option<f64>,
     period: Option<u64>,
     grazing: Option<bool>,
+    sigma_phase_deg: Option<f64>,
 }
 
 impl MapRecord for Box<RawValue> {
@@ -63,6 +66,7 @@ impl MapRecord for Box<RawValue> {
                 f.phase_deg?,
                 f.amplitude_ratio?,
                 f.e_ts_viscous_j? / ELECTRONVOLT_J,
+                f.sigma_phase_deg.unwrap_or(f64::NAN),
             ],
             f.separation_m,
             f.period == Some(1),
@@ -105,7 +109,7 @@ pub fn heat_maps<T: MapRecord>(
     let plotted: Vec<Plotted> = cells.iter().map(MapRecord::plotted).collect();
     let heights = heights_of(&plotted);
     let at = setpoint.map_or(String::new(), |s| format!(" at {s}"));
-    let map = |title: &str, value_label: &str, value: &dyn Fn(usize, &[f64; 4]) -> f64| HeatMap {
+    let map = |title: &str, value_label: &str, value: &dyn Fn(usize, &[f64; 5]) -> f64| HeatMap {
         title: format!("{law} law{at}: {title}"),
         x_label: "work of adhesion Δγ (J/m²)".into(),
         y_label: "composite modulus E* (GPa)".into(),
@@ -155,6 +159,21 @@ pub fn heat_maps<T: MapRecord>(
             "viscous share of the dissipation",
             "E_ts in the viscous sample per cycle (eV)",
             &|_, v| v[3],
+        ));
+    }
+    // The thermal noise, where it was asked for: σ_φ, and the contrast with the first
+    // cell that has one over the noise of the two readings.
+    if let Some(first) = plotted.iter().flatten().find(|p| p.0[4].is_finite()) {
+        let (phase0, sigma0) = (first.0[1], first.0[4]);
+        maps.push(map(
+            "thermal phase noise σ_φ",
+            "σ_φ through the lock-in (deg)",
+            &|_, v| v[4],
+        ));
+        maps.push(map(
+            "contrast over noise",
+            "|φ − φ₀|/√(σ² + σ₀²), first cell",
+            &|_, v| (v[1] - phase0).abs() / v[4].hypot(sigma0),
         ));
     }
     maps
