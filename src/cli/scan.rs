@@ -6,7 +6,9 @@ use crate::error::{Error, Result};
 use crate::instrument::feedback::PiController;
 use crate::instrument::lockin::LockIn;
 use crate::instrument::scan::{MAX_IMAGE_PIXELS, MAX_PIXELS, Pixel, row, settled_material};
-use crate::instrument::thermal::{STEPS_PER_PERIOD, ThermalForce, intensity_hat};
+use crate::instrument::thermal::{
+    STEPS_PER_PERIOD, ThermalForce, check_temperature, intensity_hat,
+};
 use crate::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::report::heatmap::{Cell, HeatMap};
 use crate::report::part::{self, Job};
@@ -195,16 +197,14 @@ pub fn run(args: ScanArgs) -> Result<()> {
     let per_pixel = per_pixel as usize;
     let cantilever = first.setup.cantilever;
     let intensity = match args.temperature {
-        Some(t) if t >= 0.0 && t.is_finite() => intensity_hat(
-            t,
-            cantilever.stiffness_n_m,
-            cantilever.quality,
-            cantilever.free_amplitude_m,
-        ),
         Some(t) => {
-            return Err(Error::OutOfRange(format!(
-                "a temperature is finite and not negative, not {t} K"
-            )));
+            check_temperature(t)?;
+            intensity_hat(
+                t,
+                cantilever.stiffness_n_m,
+                cantilever.quality,
+                cantilever.free_amplitude_m,
+            )
         }
         None => 0.0,
     };

@@ -322,12 +322,7 @@ impl NoiseRequest {
     /// period averages: its time constant must span periods — two at 10 kHz on 300 kHz,
     /// fourth order, where the theory still equals a free cantilever's spectrum to 1e-4).
     pub fn check(&self, drive_hz: f64) -> Result<()> {
-        if !(self.temperature_k >= 0.0 && self.temperature_k.is_finite()) {
-            return Err(Error::OutOfRange(format!(
-                "a temperature is finite and not negative, not {} K",
-                self.temperature_k
-            )));
-        }
+        super::thermal::check_temperature(self.temperature_k)?;
         if !(1..=super::lockin::MAX_ORDER).contains(&self.lockin_order) {
             return Err(Error::OutOfRange(format!(
                 "a lock-in filter has order 1 to 4, not {}",

@@ -34,6 +34,17 @@ pub const STEPS_PER_PERIOD: usize = 64;
 /// The most force steps a drive period.
 pub const MAX_STEPS_PER_PERIOD: usize = 4096;
 
+/// Refuse a temperature that is negative or not finite.
+pub fn check_temperature(temperature_k: f64) -> Result<()> {
+    if temperature_k >= 0.0 && temperature_k.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::OutOfRange(format!(
+            "a temperature is finite and not negative, not {temperature_k} K"
+        )))
+    }
+}
+
 /// D̂ = 2k_BT/(kL²Q): the intensity of the dimensionless thermal force,
 /// ⟨ξ(τ)ξ(τ')⟩ = D̂δ(τ − τ') (from S_F = 4k_BT·k/(ω₀Q), Hutter & Bechhoefer, RSI 64,
 /// 1868, 1993, with F = kLξ and t = τ/ω₀).
@@ -424,11 +435,7 @@ pub fn thermal_average(
     (periods, seed): (usize, u64),
 ) -> Result<ThermalAverage> {
     use rayon::prelude::*;
-    if !(temperature_k >= 0.0 && temperature_k.is_finite()) {
-        return Err(Error::OutOfRange(format!(
-            "a temperature is finite and not negative, not {temperature_k} K"
-        )));
-    }
+    check_temperature(temperature_k)?;
     let per_record = periods / AVERAGE_RECORDS;
     if !(100..=MAX_THERMAL_PERIODS / AVERAGE_RECORDS).contains(&per_record) {
         return Err(Error::OutOfRange(format!(
