@@ -124,10 +124,7 @@ fn states_at(
         .map(|s| {
             let o = &s.observables;
             let sigma_phase_deg = match noise {
-                Some(n) => Some(
-                    n.on_orbit(p, &p.simulation_at(s.separation_m)?, &s.phase)?
-                        .sigma_phase_deg,
-                ),
+                Some(n) => Some(s.thermal_noise(p, n)?.sigma_phase_deg),
                 None => None,
             };
             Ok(AtSetpoint {

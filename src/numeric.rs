@@ -25,6 +25,15 @@ pub(crate) const GAUSS_LEGENDRE_8: [(f64, f64); 8] = [
     (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
 ];
 
+/// The mean of `values` and their sample variance (n − 1 in the denominator; at least
+/// two values for a finite one).
+pub(crate) fn mean_and_variance(values: impl Iterator<Item = f64> + Clone) -> (f64, f64) {
+    let n = values.clone().count() as f64;
+    let mean = values.clone().sum::<f64>() / n;
+    let var = values.map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, var)
+}
+
 /// The polynomial through `points` (distinct abscissae) at `x`, in Lagrange form.
 pub(crate) fn lagrange(points: &[(f64, f64)], x: f64) -> f64 {
     (0..points.len())

@@ -70,16 +70,18 @@ pub struct SetpointState {
 
 impl SetpointState {
     /// The thermal noise a lock-in reads on this state's orbit
-    /// ([`crate::instrument::noise::NoiseRequest::on_orbit`]), `setup` and `numerics`
-    /// those it was found with.
+    /// ([`crate::instrument::noise::NoiseRequest::on_orbit`]), `prepared` the setup and
+    /// numerics it was found with.
     pub fn thermal_noise(
         &self,
-        setup: &TapSetup,
-        numerics: &Numerics,
+        prepared: &Prepared,
         request: &crate::instrument::noise::NoiseRequest,
     ) -> Result<crate::instrument::noise::ThermalNoise> {
-        let p = Prepared::new(setup, numerics)?;
-        request.on_orbit(&p, &p.simulation_at(self.separation_m)?, &self.phase)
+        request.on_orbit(
+            prepared,
+            &prepared.simulation_at(self.separation_m)?,
+            &self.phase,
+        )
     }
 }
 
@@ -339,7 +341,11 @@ pub fn map_cells(
         let states = states_at_setpoint(s, numerics, ratio, Some(branch))?;
         let first = states.into_iter().next().expect("a list is never empty");
         let sigma = match noise {
-            Some(request) => Some(first.thermal_noise(s, numerics, request)?.sigma_phase_deg),
+            Some(request) => Some(
+                first
+                    .thermal_noise(&Prepared::new(s, numerics)?, request)?
+                    .sigma_phase_deg,
+            ),
             None => None,
         };
         Ok((first.observables, Some(first.separation_m), sigma))

@@ -338,8 +338,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
             .map(|v| {
                 let n = v.len();
                 (n >= 3).then(|| {
-                    let m = v.iter().sum::<f64>() / n as f64;
-                    let var = v.iter().map(|p| (p - m).powi(2)).sum::<f64>() / (n - 1) as f64;
+                    let (m, var) = crate::numeric::mean_and_variance(v.iter().copied());
                     (m, var.sqrt(), n)
                 })
             })

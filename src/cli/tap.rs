@@ -267,10 +267,13 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
     })?;
     // Each state is a stable period-1 orbit: the linear theory reads its noise.
     let noise = match args.noise.request() {
-        Some(request) => states
-            .iter()
-            .map(|s| s.thermal_noise(&setup, &numerics, &request).map(Some))
-            .collect::<Result<Vec<_>>>()?,
+        Some(request) => {
+            let prepared = crate::dynamics::setup::Prepared::new(&setup, &numerics)?;
+            states
+                .iter()
+                .map(|s| s.thermal_noise(&prepared, &request).map(Some))
+                .collect::<Result<Vec<_>>>()?
+        }
         None => vec![None; states.len()],
     };
     if args.json {

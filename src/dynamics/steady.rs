@@ -147,12 +147,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let mut stretch = FIRST_STRETCH;
         while spent < search_budget {
             for _ in 0..stretch.min(search_budget - spent) {
-                self.rewind(phase);
-                let c = marching.cycle(phase, &mut numeric::Ignore)?;
-                spent += 1;
-                ring.push(self.z(phase), phase.branch);
-                window.add(&c);
-                if let Some(found) = self.reached(phase, &pending, spent) {
+                let recorded = (&mut ring, &mut window);
+                if let Some(found) =
+                    self.march_recorded(&marching, phase, recorded, &pending, &mut spent)?
+                {
                     return Ok(found);
                 }
                 if !opts.shooting {

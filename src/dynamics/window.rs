@@ -76,6 +76,26 @@ impl<L: ForceLaw> Simulation<'_, L> {
             .clamp(1.0, 1e9) as usize
     }
 
+    /// March one period with `marching` (this simulation at the averages' tolerance),
+    /// record it in the recurrence `ring` and the averaging `window`, count it in
+    /// `spent`, and return the steady state if the motion has reached one of the orbits
+    /// Newton's method found (`pending`).
+    pub(super) fn march_recorded(
+        &self,
+        marching: &Self,
+        phase: &mut Phase,
+        (ring, window): (&mut Recurrence, &mut Window),
+        pending: &[Candidate],
+        spent: &mut usize,
+    ) -> Result<Option<SteadyState>> {
+        self.rewind(phase);
+        let c = marching.cycle(phase, &mut numeric::Ignore)?;
+        *spent += 1;
+        ring.push(self.z(phase), phase.branch);
+        window.add(&c);
+        Ok(self.reached(phase, pending, *spent))
+    }
+
     /// Average irregular motion, marched at the averages' tolerance ([`Self::marching`]),
     /// over a window of 16 batches (begun during the search for an orbit, `window`)
     /// whose length doubles (by merging pairs and integrating as many again) until the
@@ -96,12 +116,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
     ) -> Result<SteadyState> {
         let marching = self.marching(opts);
         loop {
-            self.rewind(phase);
-            let c = marching.cycle(phase, &mut numeric::Ignore)?;
-            spent += 1;
-            ring.push(self.z(phase), phase.branch);
-            window.add(&c);
-            if let Some(found) = self.reached(phase, &pending, spent) {
+            let recorded = (&mut ring, &mut window);
+            if let Some(found) =
+                self.march_recorded(&marching, phase, recorded, &pending, &mut spent)?
+            {
                 return Ok(found);
             }
             // At the end of each batch: has the motion locked onto a long period?
@@ -189,13 +207,7 @@ fn batch_statistics(
     let n = batches.len() as f64;
     let phase = window.phase();
     let std_err_of = |value: &dyn Fn(&CycleIntegrals) -> f64| {
-        let mean = batches.iter().map(value).sum::<f64>() / n;
-        let var = batches
-            .iter()
-            .map(|b| (value(b) - mean).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
-        (var / n).sqrt()
+        (crate::numeric::mean_and_variance(batches.iter().map(value)).1 / n).sqrt()
     };
     let std_err = if batches.len() < 2 {
         StdErr {

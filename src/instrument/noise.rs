@@ -31,6 +31,7 @@ use crate::dynamics::march::{Phase, Simulation};
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
 use crate::law::ForceLaw;
+use crate::numeric::mean_and_variance;
 use nalgebra::DMatrix;
 
 /// Parts of a drive period the linear theory samples the orbit's Φ at unless told
@@ -291,10 +292,7 @@ pub fn monte_carlo_noise<L: ForceLaw + Sync>(
             (p + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
         })
         .collect();
-    let sd = |v: &[f64]| {
-        let m = v.iter().sum::<f64>() / n;
-        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-    };
+    let sd = |v: &[f64]| mean_and_variance(v.iter().copied()).1.sqrt();
     Ok(SampledNoise {
         amplitude_hat: amplitude,
         phase_rad: centre,

@@ -476,8 +476,7 @@ pub fn thermal_average(
         .collect::<Result<_>>()?;
     let n = records.len() as f64;
     let stat = |i: usize| {
-        let m = records.iter().map(|b| b[i]).sum::<f64>() / n;
-        let var = records.iter().map(|b| (b[i] - m).powi(2)).sum::<f64>() / (n - 1.0);
+        let (m, var) = crate::numeric::mean_and_variance(records.iter().map(|b| b[i]));
         (m, (var / n).sqrt())
     };
     let ((e, e_se), (ph, ph_se), (a, a_se), (t, t_se)) = (stat(0), stat(1), stat(2), stat(3));
