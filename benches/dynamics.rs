@@ -193,6 +193,16 @@ fn setpoint(c: &mut Criterion) {
     group.finish();
 }
 
+/// The numerics the instrument marches at: rtol `instrument::MARCH_RTOL` (2e-7), atol
+/// 1e-2 of it.
+fn march_numerics() -> Numerics {
+    Numerics {
+        rtol: tapsim::instrument::MARCH_RTOL,
+        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
+        ..Numerics::default()
+    }
+}
+
 /// The marcher as the instrument drives it (`Simulation::march`), a thousand drive periods
 /// on the defaults with the hybrid and the Hertz law at (rtol, atol) = (2e-7, 2e-9), the
 /// loosest pair whose energy balance stays below 1e-6 (checked first on the settled
@@ -208,11 +218,7 @@ fn march(c: &mut Criterion) {
     for (name, kind) in [("hybrid", LawKind::Hybrid), ("hertz", LawKind::Hertz)] {
         let mut setup = default_setup();
         setup.law.kind = kind;
-        let numerics = Numerics {
-            rtol: 2e-7,
-            atol: 2e-9,
-            ..Numerics::default()
-        };
+        let numerics = march_numerics();
         let p = Prepared::new(&setup, &numerics).expect("defaults are valid");
         let sim = p.simulation();
         let mut phase = sim.free_steady_start();
@@ -251,11 +257,7 @@ fn scan_line(c: &mut Criterion) {
     use tapsim::instrument::scan::row;
     use tapsim::sample::{BLEND, Sample};
     let sample = Sample::from_toml(BLEND, &TapInputs::default()).unwrap();
-    let numerics = Numerics {
-        rtol: tapsim::instrument::MARCH_RTOL,
-        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
-        ..Numerics::default()
-    };
+    let numerics = march_numerics();
     let prepared: Vec<Prepared> = sample
         .materials
         .iter()
@@ -297,11 +299,7 @@ fn noise(c: &mut Criterion) {
     use tapsim::instrument::lockin::LockIn;
     use tapsim::instrument::noise::{PARTS_PER_PERIOD, linear_noise, time_constant_for_enbw};
     use tapsim::instrument::thermal::{STEPS_PER_PERIOD, ThermalForce, intensity_hat};
-    let numerics = Numerics {
-        rtol: tapsim::instrument::MARCH_RTOL,
-        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
-        ..Numerics::default()
-    };
+    let numerics = march_numerics();
     let p = Prepared::new(&default_setup(), &numerics).expect("defaults are valid");
     let sim = p.simulation();
     let mut phase = sim.free_steady_start();

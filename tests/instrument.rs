@@ -477,25 +477,10 @@ fn an_image_of_a_disc_shows_it_where_it_lies_on_any_number_of_threads() {
     let sample = dir.join("disc.toml");
     std::fs::write(
         &sample,
-        r#"
-length = "1um"
-[[material]]
-name = "A"
-sample-modulus = "0.5GPa"
-work-of-adhesion = 0.1
-[[material]]
-name = "B"
-sample-modulus = "1GPa"
-work-of-adhesion = 0.08
-[[region]]
-until = "1um"
-material = "A"
-[[disc]]
-x = "500nm"
-y = "500nm"
-radius = "300nm"
-material = "B"
-"#,
+        format!(
+            "length = \"1um\"\n{TWO_POLYMERS}\n[[disc]]\nx = \"500nm\"\ny = \"500nm\"\n\
+             radius = \"300nm\"\nmaterial = \"B\"\n"
+        ),
     )
     .unwrap();
     let image = |threads: &str, csv: &str| {
@@ -576,8 +561,8 @@ material = "B"
     }
 }
 
-/// Two polymers over a stripe of A, for the mask tests.
-const MASKED_MATERIALS: &str = r#"
+/// Two polymers over a stripe of A, for the image and mask tests.
+const TWO_POLYMERS: &str = r#"
 [[material]]
 name = "A"
 sample-modulus = "0.5GPa"
@@ -592,14 +577,10 @@ material = "A"
 "#;
 
 /// Scan two lines of four pixels of the sample `head` (its mask lines) over
-/// [`MASKED_MATERIALS`], written into `dir`.
+/// [`TWO_POLYMERS`], written into `dir`.
 fn scan_masked(dir: &std::path::Path, head: &str) -> std::process::Output {
     let sample = dir.join("masked.toml");
-    std::fs::write(
-        &sample,
-        format!("length = \"1um\"\n{head}\n{MASKED_MATERIALS}"),
-    )
-    .unwrap();
+    std::fs::write(&sample, format!("length = \"1um\"\n{head}\n{TWO_POLYMERS}")).unwrap();
     common::tapsim(&[
         "scan",
         "--sample",
