@@ -40,12 +40,16 @@ pub(crate) enum StepError {
 }
 
 /// Steps taken.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct Stats {
     /// Accepted steps.
     pub accepted_steps: u32,
     /// Rejected steps (after the first accepted one).
     pub rejected_steps: u32,
+    /// The step the controller proposes after the last accepted one (at least the step
+    /// it had proposed before that one was cut short to end at `x_end`): where an
+    /// integration that goes on from `x_end` should start.
+    pub h_proposed: f64,
 }
 
 /// The settings of one integration.
@@ -130,6 +134,8 @@ pub(crate) fn integrate<S: System<N>, const N: usize>(
     let mut k = [State::<N>::zeros(); 7];
     f.system(x, &y, &mut k[0]);
     let (mut n_step, mut last) = (0u32, false);
+    // The step proposed before the last one was cut to end at x_end.
+    let mut h_uncut = 0.0;
     while !last {
         if n_step > s.max_steps {
             return Err(StepError::MaxNumStepReached { x, n_step });
@@ -138,6 +144,7 @@ pub(crate) fn integrate<S: System<N>, const N: usize>(
             return Err(StepError::StepSizeUnderflow { x });
         }
         if x + 1.01 * h - x_end > 0.0 {
+            h_uncut = h;
             h = x_end - x;
             last = true;
         }
@@ -188,6 +195,7 @@ pub(crate) fn integrate<S: System<N>, const N: usize>(
                 last = true;
             }
             if last {
+                stats.h_proposed = h_new.abs().max(h_uncut.abs()).min(s.h_max);
                 return Ok(stats);
             }
         } else {

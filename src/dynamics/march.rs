@@ -46,6 +46,10 @@ pub struct Phase {
     /// First trial step for the next numerical segment on each branch (free, contact,
     /// necked; 0: the solver's choice).
     pub h_next: [f64; Branch::COUNT],
+    /// First trial step for a numerical segment that goes on from where the last
+    /// [`Simulation::advance`] stopped it (0: none stopped): the integrator's own
+    /// proposal, so that cutting a segment into parts costs no smaller steps.
+    pub h_carry: f64,
 }
 
 impl Phase {
@@ -58,6 +62,7 @@ impl Phase {
             internal: Internal::default(),
             branch: Branch::Free,
             h_next: [0.0; Branch::COUNT],
+            h_carry: 0.0,
         }
     }
 
@@ -193,7 +198,9 @@ struct Tracker<'a, L: ForceLaw, O: StepObserver> {
     min_alpha: f64,
     max_f: f64,
     min_f: f64,
-    levels: SwitchLevels,
+    /// The law's switch levels, found at the first turning point (a part of a period
+    /// often has none, [`Simulation::advance`]).
+    levels: Option<SwitchLevels>,
     /// The grazing margins so far.
     margins: Margins,
 }
@@ -203,7 +210,9 @@ impl<L: ForceLaw, O: StepObserver> Tracker<'_, L, O> {
     /// grazing margin.
     #[inline]
     fn turn(&mut self, branch: Branch, alpha_hat: f64) {
-        self.margins = self.margins.min(self.levels.margins(branch, alpha_hat));
+        let law = self.law;
+        let levels = self.levels.get_or_insert_with(|| SwitchLevels::of(law));
+        self.margins = self.margins.min(levels.margins(branch, alpha_hat));
     }
 }
 
@@ -344,6 +353,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             internal: Internal::default(),
             branch: self.branch_at(0.0, x),
             h_next: [0.0; Branch::COUNT],
+            h_carry: 0.0,
         }
     }
 
@@ -353,34 +363,39 @@ impl<L: ForceLaw> Simulation<'_, L> {
         phase: &mut Phase,
         observer: &mut O,
     ) -> Result<CycleIntegrals> {
-        self.span(phase, self.osc.period(), observer)
+        self.span(phase, self.osc.period(), false, observer)
     }
 
     /// Integrate the part `span` (0 < span ≤ one drive period, in τ) of a drive period
     /// from `phase`, updating it: what a force that changes between parts of a period
     /// needs (the thermal force, [`crate::instrument::thermal`]). The integrals cover
-    /// the span (`periods` 0 unless it is a whole period).
+    /// the span (`periods` 0 unless it is a whole period). A numerical segment the
+    /// span's end cuts goes on in the next call from the step its integrator proposed
+    /// ([`Phase::h_carry`]).
     pub fn advance<O: StepObserver>(
         &self,
         phase: &mut Phase,
         span: f64,
         observer: &mut O,
     ) -> Result<CycleIntegrals> {
-        self.span(phase, span.min(self.osc.period()), observer)
+        self.span(phase, span.min(self.osc.period()), true, observer)
     }
 
+    /// Integrate `span` from `phase`; `carry`: whether a segment cut at the span's end
+    /// leaves its proposed step in [`Phase::h_carry`].
     fn span<O: StepObserver>(
         &self,
         phase: &mut Phase,
         span: f64,
+        carry: bool,
         observer: &mut O,
     ) -> Result<CycleIntegrals> {
         Ok(if self.law.internal_states() > 0 {
-            self.cycle_in::<MEMORY, O>(phase, span, observer)?.0
+            self.cycle_in::<MEMORY, O>(phase, span, carry, observer)?.0
         } else if self.law.is_rate_dependent() {
-            self.cycle_in::<RATE, O>(phase, span, observer)?.0
+            self.cycle_in::<RATE, O>(phase, span, carry, observer)?.0
         } else {
-            self.cycle_in::<BASE, O>(phase, span, observer)?.0
+            self.cycle_in::<BASE, O>(phase, span, carry, observer)?.0
         })
     }
 
@@ -424,11 +439,11 @@ impl<L: ForceLaw> Simulation<'_, L> {
     ) -> Result<(CycleIntegrals, DMatrix<f64>)> {
         let span = span.min(self.osc.period());
         let (integrals, derivative) = if self.law.internal_states() > 0 {
-            self.cycle_in::<MEMORY_TANGENT, _>(phase, span, &mut numeric::Ignore)
+            self.cycle_in::<MEMORY_TANGENT, _>(phase, span, false, &mut numeric::Ignore)
         } else if self.law.is_rate_dependent() {
-            self.cycle_in::<RATE_TANGENT, _>(phase, span, &mut numeric::Ignore)
+            self.cycle_in::<RATE_TANGENT, _>(phase, span, false, &mut numeric::Ignore)
         } else {
-            self.cycle_in::<TANGENT, _>(phase, span, &mut numeric::Ignore)
+            self.cycle_in::<TANGENT, _>(phase, span, false, &mut numeric::Ignore)
         }?;
         let mut derivative = derivative.expect("a tangent layout carries Φ");
         // In the section's units (`Simulation::z`): internal rows times f_scale, internal
@@ -513,11 +528,13 @@ impl<L: ForceLaw> Simulation<'_, L> {
         }
     }
 
-    /// Integrate `span` (at most a drive period) from `phase`.
+    /// Integrate `span` (at most a drive period) from `phase`; `carry` as in
+    /// [`Simulation::span`].
     fn cycle_in<const N: usize, O: StepObserver>(
         &self,
         phase: &mut Phase,
         span: f64,
+        carry: bool,
         observer: &mut O,
     ) -> Result<(CycleIntegrals, Option<DMatrix<f64>>)> {
         budget::spend(1)?;
@@ -542,7 +559,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             min_alpha: f64::INFINITY,
             max_f: f64::NEG_INFINITY,
             min_f: f64::INFINITY,
-            levels: SwitchLevels::of(self.law),
+            levels: None,
             margins: Margins::NONE,
         };
         let (mut contact_time, mut jumps_in, mut jumps_out) = (0.0, 0, 0);
@@ -614,7 +631,11 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 tau,
                 y,
                 tau_end,
-                phase.h_next[phase.branch as usize],
+                if phase.h_carry > 0.0 {
+                    phase.h_carry
+                } else {
+                    phase.h_next[phase.branch as usize]
+                },
                 &self.tol,
                 &mut tracker,
             )?;
@@ -625,9 +646,16 @@ impl<L: ForceLaw> Simulation<'_, L> {
             if phase.branch == Branch::Contact {
                 contact_time += end.tau - tau;
             }
-            if end.h_first > 0.0 {
+            // The first step of a segment entered afresh is how the next entry starts;
+            // one cut at the span's end goes on from its proposed step.
+            if end.h_first > 0.0 && phase.h_carry == 0.0 {
                 phase.h_next[phase.branch as usize] = end.h_first;
             }
+            phase.h_carry = if carry && end.switched.is_none() {
+                end.h_proposed
+            } else {
+                0.0
+            };
             tau = end.tau;
             y = end.y;
             if let Some(crossing) = end.switched {

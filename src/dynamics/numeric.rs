@@ -444,6 +444,9 @@ pub(crate) struct SegmentEnd<const N: usize = BASE> {
     /// Length of the first accepted step (a good first step for the next segment on
     /// the same branch, which starts in the same state of the motion).
     pub h_first: f64,
+    /// The step the controller proposes next, where the segment ended at `tau_end`
+    /// (0 otherwise): where an integration going on from there starts.
+    pub h_proposed: f64,
 }
 
 /// Most steps of one segment with the variational equations. A segment normally takes
@@ -481,7 +484,7 @@ fn run<S: System<N>, const N: usize>(
     h: f64,
     tol: &Tolerances,
     branch: Branch,
-) -> Result<()> {
+) -> Result<f64> {
     use StepError as E;
     let branch = match branch {
         Branch::Free => "out-of-contact",
@@ -506,7 +509,10 @@ fn run<S: System<N>, const N: usize>(
         max_steps,
     };
     match dopri5::integrate(&mut system, from, to, y, &settings) {
-        Ok(stats) => budget::spend(u64::from(stats.accepted_steps + stats.rejected_steps)),
+        Ok(stats) => {
+            budget::spend(u64::from(stats.accepted_steps + stats.rejected_steps))?;
+            Ok(stats.h_proposed)
+        }
         Err(E::MaxNumStepReached { .. }) if limited_by_budget => Err(budget::exhausted()),
         Err(e) => Err({
             if matches!(e, E::MaxNumStepReached { .. }) {
@@ -598,6 +604,7 @@ impl<L: ForceLaw> Span<'_, L> {
                 y: y0 + dy0 * (tau_end - tau0),
                 switched: None,
                 h_first: 0.0,
+                h_proposed: 0.0,
             });
         }
         let mut progress = Progress {
@@ -621,7 +628,7 @@ impl<L: ForceLaw> Span<'_, L> {
             progress: &mut progress,
             observer: &mut *observer,
         };
-        run(segment, tau0, tau_end, y0, h0, tol, branch)?;
+        let h_proposed = run(segment, tau0, tau_end, y0, h0, tol, branch)?;
         if let Some((entry, h, event)) = progress.approach {
             let landed = land(law, osc, cpl, branch, event, entry, tau_end, tol, observer)?;
             let end = match landed {
@@ -630,6 +637,7 @@ impl<L: ForceLaw> Span<'_, L> {
                     y: end.y,
                     switched: Some(event.1),
                     h_first: progress.h,
+                    h_proposed: 0.0,
                 },
                 // Carry on from where the landing started, locating the crossing.
                 None => SegmentEnd {
@@ -646,6 +654,7 @@ impl<L: ForceLaw> Span<'_, L> {
                 y: last.y,
                 switched: None,
                 h_first: progress.h,
+                h_proposed,
             });
         };
         let (tau, y) = self.polish(start, hit_end, t_hit, event)?;
@@ -657,6 +666,7 @@ impl<L: ForceLaw> Span<'_, L> {
             y,
             switched: Some(event.1),
             h_first: progress.h,
+            h_proposed: 0.0,
         })
     }
 
