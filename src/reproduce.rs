@@ -402,6 +402,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         &cells,
         0,
         || {},
+        None,
     )?;
     let setpoint = crate::report::part::MapSetpoint {
         amplitude_ratio: MAP_SETPOINT,

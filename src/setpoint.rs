@@ -206,6 +206,7 @@ pub fn sweep_setpoints(
                 separation_m: s.separation_m,
                 direction,
                 observables: s.observables,
+                thermal_average: None,
             }),
             Err(why) => out.not_held.push((ratio, direction, why)),
         }
@@ -348,7 +349,12 @@ pub fn map_cells(
             ),
             None => None,
         };
-        Ok((first.observables, Some(first.separation_m), sigma))
+        Ok(sweep::CellState {
+            observables: first.observables,
+            separation_m: Some(first.separation_m),
+            sigma_phase_deg: sigma,
+            thermal_average: None,
+        })
     };
     sweep::map_cells_with(setup, axes, cells, threads, progress, &solve)
 }

@@ -5,6 +5,9 @@
 use crate::dynamics::observables::TapObservables;
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result, finite};
+use crate::instrument::average::{
+    AverageRequest, ThermalAverage, reads_as_average, thermal_average, thermal_average_from,
+};
 use serde::Serialize;
 
 /// Default steady-state tolerance per setpoint of a sweep: A, φ and E_ts settled to
@@ -49,6 +52,11 @@ pub struct SweepPoint {
     /// Steady-state observables there.
     #[serde(flatten)]
     pub observables: TapObservables,
+    /// Where a temperature was given and the state is read only as a thermal average
+    /// ([`reads_as_average`]: it grazes a switch, or is not a stable period-1 orbit):
+    /// that average, started from the sweep's state there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thermal_average: Option<ThermalAverage>,
 }
 
 /// Most setpoints of a sweep in each direction (each is a steady state of its own).
@@ -97,18 +105,43 @@ pub fn approach_curve(
     setup: &TapSetup,
     numerics: &Numerics,
     ramp: &[(f64, Direction)],
+    progress: impl FnMut(usize, usize),
+) -> Result<Vec<SweepPoint>> {
+    approach_curve_at(setup, numerics, ramp, None, progress)
+}
+
+/// [`approach_curve`], with each point an instrument reads only as a thermal average
+/// ([`reads_as_average`]) averaged over the thermal motion at `thermal`'s temperature
+/// ([`thermal_average_from`], from the sweep's state there; the sweep itself goes on
+/// from the deterministic state, as without it). `None`: [`approach_curve`].
+pub fn approach_curve_at(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    ramp: &[(f64, Direction)],
+    thermal: Option<&AverageRequest>,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Vec<SweepPoint>> {
+    if let Some(request) = thermal {
+        request.check()?;
+    }
     let p = Prepared::new(setup, numerics)?;
     let mut phase = p.simulation().free_steady_start();
     let mut out = Vec::with_capacity(ramp.len());
     for (i, &(separation_m, direction)) in ramp.iter().enumerate() {
         let sim = p.simulation_at(separation_m)?;
         let state = sim.steady_state(&mut phase, &p.steady)?;
+        let observables = TapObservables::new(&p, &state)?;
+        let thermal_average = match thermal {
+            Some(request) if reads_as_average(&observables) => {
+                Some(thermal_average_from(&p, &sim, &phase, request)?)
+            }
+            _ => None,
+        };
         out.push(SweepPoint {
             separation_m,
             direction,
-            observables: TapObservables::new(&p, &state)?,
+            observables,
+            thermal_average,
         });
         progress(i + 1, ramp.len());
     }
@@ -138,6 +171,10 @@ pub struct MapCell {
     /// (a map at an amplitude setpoint: the linear theory about the cell's orbit).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sigma_phase_deg: Option<f64>,
+    /// Where a temperature was given and the cell's state is read only as a thermal
+    /// average ([`reads_as_average`]): that average (a map at one z_c).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thermal_average: Option<ThermalAverage>,
 }
 
 /// `n` values from `lo` to `hi`, evenly spaced on a log scale.
@@ -227,15 +264,28 @@ pub fn adhesion_modulus_map(
         &all,
         threads,
         progress,
+        None,
     )
 }
 
-/// What a map cell solves: the steady state of a cell's setup, the rest separation it
-/// was found at where that is solved for (an amplitude setpoint) and its phase's thermal
-/// noise (degrees) where that was asked for; an [`Error::NotApplicable`] becomes the
-/// cell's note.
-pub type CellSolver<'a> =
-    dyn Fn(&TapSetup) -> Result<(TapObservables, Option<f64>, Option<f64>)> + Sync + 'a;
+/// What a map cell's solver finds ([`CellSolver`]).
+#[derive(Debug, Clone)]
+pub struct CellState {
+    /// The steady state of the cell's setup.
+    pub observables: TapObservables,
+    /// The rest separation it was found at, m, where that is solved for (an amplitude
+    /// setpoint).
+    pub separation_m: Option<f64>,
+    /// Its phase's thermal noise, degrees, where that was asked for (at a setpoint).
+    pub sigma_phase_deg: Option<f64>,
+    /// Its thermal average, where a temperature was given and the state is read only as
+    /// one ([`reads_as_average`]).
+    pub thermal_average: Option<ThermalAverage>,
+}
+
+/// What a map cell solves: the state of a cell's setup; an [`Error::NotApplicable`]
+/// becomes the cell's note.
+pub type CellSolver<'a> = dyn Fn(&TapSetup) -> Result<CellState> + Sync + 'a;
 
 /// The cells numbered `cells` of the map [`adhesion_modulus_map`] computes (numbered in
 /// its order: cell k has modulus k / (number of works), work k mod (number of works)),
@@ -248,14 +298,29 @@ pub fn map_cells(
     cells: &[usize],
     threads: usize,
     progress: impl Fn() + Sync,
+    thermal: Option<&AverageRequest>,
 ) -> Result<Vec<MapCell>> {
+    if let Some(request) = thermal {
+        request.check()?;
+    }
     let at_separation = |s: &TapSetup| {
-        crate::dynamics::observables::tap(
+        let run = crate::dynamics::observables::tap(
             s,
             numerics,
             crate::dynamics::observables::Observe::default(),
-        )
-        .map(|run| (run.observables, None, None))
+        )?;
+        let thermal_average = match thermal {
+            Some(request) if reads_as_average(&run.observables) => {
+                Some(thermal_average(s, numerics, request)?)
+            }
+            _ => None,
+        };
+        Ok(CellState {
+            observables: run.observables,
+            separation_m: None,
+            sigma_phase_deg: None,
+            thermal_average,
+        })
     };
     map_cells_with(setup, axes, cells, threads, progress, &at_separation)
 }
@@ -298,14 +363,15 @@ pub fn map_cells_with(
                 s.contact.modulus_pa = e;
                 let tabor_mu = s.contact.tabor_mu();
                 let cell = match solve(&s) {
-                    Ok((observables, separation_m, sigma_phase_deg)) => MapCell {
+                    Ok(state) => MapCell {
                         work_of_adhesion_j_m2: w,
                         modulus_pa: e,
                         tabor_mu,
-                        separation_m,
-                        observables: Some(observables),
+                        separation_m: state.separation_m,
+                        observables: Some(state.observables),
                         note: None,
-                        sigma_phase_deg,
+                        sigma_phase_deg: state.sigma_phase_deg,
+                        thermal_average: state.thermal_average,
                     },
                     Err(Error::NotApplicable(why)) => MapCell {
                         work_of_adhesion_j_m2: w,
@@ -315,6 +381,7 @@ pub fn map_cells_with(
                         observables: None,
                         note: Some(why),
                         sigma_phase_deg: None,
+                        thermal_average: None,
                     },
                     Err(other) => return Err(other),
                 };

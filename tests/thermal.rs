@@ -253,7 +253,7 @@ fn thermal_calibrates_the_cantilever_it_records() {
 /// it is the deterministic lock's.
 #[test]
 fn the_thermal_average_near_grazing_is_independent_of_the_tolerance() {
-    use tapsim::instrument::thermal::thermal_average;
+    use tapsim::instrument::average::{AverageRequest, thermal_average};
     let mut setup = default_setup();
     setup.separation_m = 20e-9;
     let numerics = |rtol: f64| Numerics {
@@ -262,7 +262,12 @@ fn the_thermal_average_near_grazing_is_independent_of_the_tolerance() {
         ..Numerics::default()
     };
     let run = |rtol: f64, seed: u64, t: f64| {
-        thermal_average(&setup, &numerics(rtol), t, (20_000, seed)).unwrap()
+        let request = AverageRequest {
+            temperature_k: t,
+            periods: 20_000,
+            seed,
+        };
+        thermal_average(&setup, &numerics(rtol), &request).unwrap()
     };
     let base = run(1e-9, 1, ROOM_TEMPERATURE_K);
     let ev = 1.602_176_634e-19;
@@ -314,14 +319,21 @@ fn the_thermal_average_near_grazing_is_independent_of_the_tolerance() {
 /// of the seeds' standard deviation to the mean standard error within 0.4–2).
 #[test]
 fn the_thermal_averages_errors_are_the_spread_of_seeds() {
-    use tapsim::instrument::thermal::thermal_average;
+    use tapsim::instrument::average::{AverageRequest, thermal_average};
     let mut setup = default_setup();
     setup.separation_m = 20e-9;
     let numerics = Numerics::default();
     let runs: Vec<_> = (10..16)
-        .map(|seed| thermal_average(&setup, &numerics, ROOM_TEMPERATURE_K, (8_000, seed)).unwrap())
+        .map(|seed| {
+            let request = AverageRequest {
+                temperature_k: ROOM_TEMPERATURE_K,
+                periods: 8_000,
+                seed,
+            };
+            thermal_average(&setup, &numerics, &request).unwrap()
+        })
         .collect();
-    let check = |value: &dyn Fn(&tapsim::instrument::thermal::ThermalAverage) -> (f64, f64)| {
+    let check = |value: &dyn Fn(&tapsim::instrument::average::ThermalAverage) -> (f64, f64)| {
         let v: Vec<(f64, f64)> = runs.iter().map(value).collect();
         let n = v.len() as f64;
         let m = v.iter().map(|x| x.0).sum::<f64>() / n;
@@ -366,4 +378,180 @@ fn tap_averages_a_grazing_state_over_the_thermal_motion() {
     assert_eq!(a["records"].as_u64(), Some(8));
     assert_eq!(a["periods"].as_u64(), Some(20_000));
     assert!(json(&[]).get("thermal_average").is_none());
+}
+
+/// `approach --temperature` averages the points that graze a switch over the thermal
+/// motion, started from the sweep's state: the same average, within its statistical
+/// errors, as `tap --temperature` finds at that z_c from the free oscillation (another
+/// start, another route to the same thermal state). Points on a stable period-1 orbit
+/// away from every switch get none, a run without a temperature none at all; the CSV
+/// carries the average as columns; a setpoint sweep refuses the flag.
+#[test]
+fn approach_averages_the_grazing_points_over_the_thermal_motion() {
+    let csv = common::scratch("approach_thermal").join("sweep.csv");
+    let csv_arg = csv.to_str().unwrap();
+    let sweep = |extra: &[&str]| {
+        let mut args = vec![
+            "approach",
+            "--from",
+            "20.6nm",
+            "--to",
+            "17nm",
+            "--points",
+            "2",
+            "--no-retract",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        common::json(&args)
+    };
+    let v = sweep(&[
+        "--temperature",
+        "300K",
+        "--thermal-periods",
+        "4000",
+        "--csv",
+        csv_arg,
+    ]);
+    let averages = v["thermal_average"].as_array().unwrap();
+    assert_eq!(v["grazing"], serde_json::json!([true, false]));
+    assert!(averages[1].is_null(), "{:?}", averages[1]);
+    let a = &averages[0];
+    assert_eq!(a["periods"].as_u64(), Some(4000));
+    let tap = common::json(&[
+        "tap",
+        "--separation",
+        "20.6nm",
+        "--temperature",
+        "300K",
+        "--thermal-periods",
+        "4000",
+        "--json",
+    ]);
+    let t = &tap["thermal_average"];
+    for (value, error) in [
+        ("e_ts_j", "e_ts_std_err_j"),
+        ("phase_deg", "phase_std_err_deg"),
+        ("touch_fraction", "touch_fraction_std_err"),
+    ] {
+        let (x, y) = (common::num(a, value), common::num(t, value));
+        let sigma = common::num(a, error).hypot(common::num(t, error));
+        eprintln!("{value}: approach {x:e}, tap {y:e}, σ {sigma:e}");
+        assert!(sigma > 0.0 && (x - y).abs() <= 4.0 * sigma);
+    }
+    // Some periods touch, some do not.
+    let touches = common::num(a, "touch_fraction");
+    assert!(touches > 0.05 && touches < 0.95, "{touches}");
+    let mut reader = csv::Reader::from_path(&csv).unwrap();
+    let column = reader
+        .headers()
+        .unwrap()
+        .iter()
+        .position(|h| h == "thermal_average_e_ts_j")
+        .expect("the average's columns");
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    assert_eq!(
+        rows[0][column].parse::<f64>().unwrap(),
+        common::num(a, "e_ts_j")
+    );
+    assert_eq!(&rows[1][column], "");
+    assert!(sweep(&[]).get("thermal_average").is_none());
+    common::refused(
+        &["approach", "--sweep", "setpoint", "--temperature", "300K"],
+        "separation sweep",
+    );
+    common::refused(
+        &[
+            "approach",
+            "--temperature",
+            "300K",
+            "--thermal-periods",
+            "10",
+        ],
+        "thermal average spans",
+    );
+}
+
+/// `map --temperature` at one z_c averages exactly the cells an instrument reads only as
+/// a thermal average (grazing or not a stable period-1 orbit), each as `tap
+/// --temperature` does at that cell's parameters (the same records, to the last digit),
+/// and adds the heat maps of E_ts and φ as read; `--enbw` without a setpoint is refused.
+#[test]
+fn map_averages_its_grazing_cells_over_the_thermal_motion() {
+    let grid = [
+        "map",
+        "--separation",
+        "20nm",
+        "--adhesion-from",
+        "0.02",
+        "--adhesion-to",
+        "0.2",
+        "--modulus-from",
+        "0.3GPa",
+        "--modulus-to",
+        "0.5GPa",
+        "--steps",
+        "2",
+        "--temperature",
+        "300K",
+        "--thermal-periods",
+        "1600",
+    ];
+    let v = common::json(&[&grid[..], &["--json"]].concat());
+    // The grid holds a row-by-row array per field: one object per cell from them.
+    let column = |key: &str| common::cells(&v["grid"][key]);
+    let fields = [
+        "grazing",
+        "period",
+        "stable",
+        "work_of_adhesion_j_m2",
+        "modulus_pa",
+        "thermal_average",
+    ];
+    let columns: Vec<Vec<serde_json::Value>> = fields.iter().map(|k| column(k)).collect();
+    let cells: Vec<serde_json::Value> = (0..columns[0].len())
+        .map(|i| {
+            serde_json::Value::Object(
+                fields
+                    .iter()
+                    .zip(&columns)
+                    .map(|(k, c)| (k.to_string(), c[i].clone()))
+                    .collect(),
+            )
+        })
+        .collect();
+    let (mut averaged, mut plain) = (0, 0);
+    for cell in cells.iter().filter(|c| !c["grazing"].is_null()) {
+        let reads_as_average =
+            cell["grazing"] == true || cell["period"].as_u64() != Some(1) || cell["stable"] != true;
+        let average = &cell["thermal_average"];
+        assert_eq!(!average.is_null(), reads_as_average, "{cell}");
+        if average.is_null() {
+            plain += 1;
+            continue;
+        }
+        averaged += 1;
+        let w = format!("{}", common::num(cell, "work_of_adhesion_j_m2"));
+        let e = format!("{}", common::num(cell, "modulus_pa"));
+        let tap = common::json(&[
+            "tap",
+            "--separation",
+            "20nm",
+            "--work-of-adhesion",
+            &w,
+            "--modulus",
+            &e,
+            "--temperature",
+            "300K",
+            "--thermal-periods",
+            "1600",
+            "--json",
+        ]);
+        assert_eq!(&tap["thermal_average"], average);
+    }
+    assert!(
+        averaged > 0 && plain > 0,
+        "{averaged} averaged, {plain} not"
+    );
+    common::refused(&[&grid[..], &["--enbw", "100Hz"]].concat(), "--enbw");
 }

@@ -3,6 +3,7 @@
 use crate::config::TapInputs;
 use crate::error::{Error, Result};
 use crate::identification::{self, Normalized};
+use crate::instrument::average::AverageRequest;
 use crate::report::sweep as report;
 use crate::setpoint;
 use crate::sweep::{self, Direction, SweepPoint};
@@ -14,6 +15,12 @@ use clap::Args;
 /// amplitude setpoint A/A₀ as a z feedback holds it (`tapsim approach --sweep setpoint
 /// --from 0.95 --to 0.4`): each point the state at its setpoint and the z_c that gives
 /// it. Every `tapsim tap` option applies.
+///
+/// With --temperature 300K, each point the deterministic answer does not pin down —
+/// one that grazes a switch (a touch pattern decided by perturbations below the thermal
+/// motion) or is not a stable period-1 orbit — is also averaged over the thermal motion
+/// there, as an instrument reads it (`tapsim tap --temperature` at that z_c, started
+/// from the sweep's state): E_ts, φ, A/A₀ and the touch fraction with standard errors.
 ///
 /// Per point: the steady-state observables of `tapsim tap`. Output: a table on stdout,
 /// or --json (one object of equal-length arrays: separation_m, direction, amplitude_m,
@@ -53,6 +60,17 @@ pub struct ApproachArgs {
     /// held and is listed with why.
     #[arg(long, value_enum, default_value_t = Sweep::Separation)]
     sweep: Sweep,
+    /// Temperature [K; off unless given, 300K is room temperature]: average each point
+    /// that grazes a switch or is not a stable period-1 orbit over the thermal motion
+    /// (the Langevin force of the cantilever's damping), as an instrument reads it;
+    /// reported beside the deterministic state (table, JSON and CSV thermal_average
+    /// fields, triangles on the plot).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::config::temperature, help_heading = "Thermal noise")]
+    temperature: Option<f64>,
+    /// Drive periods of each thermal average: eight independent records of an eighth
+    /// each (after ten decay times of settling), whose spread gives the standard errors.
+    #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
+    thermal_periods: usize,
 }
 
 /// `--sweep`.
@@ -80,17 +98,32 @@ pub(super) const DEFAULT_POINTS: usize = 60;
 pub fn run(args: ApproachArgs) -> Result<()> {
     let start = super::SweepStart::new("approach", args.inputs, &args.range)?;
     let (setup, numerics, (from, to)) = (&start.setup, &start.sweep_numerics, start.range);
+    let thermal = args.temperature.map(|temperature_k| AverageRequest {
+        temperature_k,
+        periods: args.thermal_periods,
+        seed: 1,
+    });
     let (points, not_held) = match args.sweep {
         Sweep::Separation => {
             let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
             let bar = args.out.progress_bar(ramp.len());
-            let points = sweep::approach_curve(setup, numerics, &ramp, |done, _| {
-                bar.set_position(done as u64)
-            })?;
+            let points =
+                sweep::approach_curve_at(setup, numerics, &ramp, thermal.as_ref(), |done, _| {
+                    bar.set_position(done as u64)
+                })?;
             bar.finish_and_clear();
             (points, Vec::new())
         }
         Sweep::Setpoint => {
+            if thermal.is_some() {
+                return Err(Error::NotApplicable(
+                    "--temperature averages the states of a separation sweep that graze a \
+                     switch or are not period-1; a setpoint sweep holds only stable \
+                     period-1 states (`tapsim tap --setpoint S --temperature T` gives their \
+                     thermal noise)"
+                        .into(),
+                ));
+            }
             let from = args.range.from.unwrap_or(0.95);
             let to = args.range.to.unwrap_or(0.4);
             for (flag, r) in [("--from", from), ("--to", to)] {
@@ -116,10 +149,7 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         }
     };
     for (r, direction, why) in &not_held {
-        let dir = match direction {
-            Direction::Approach => "approach",
-            Direction::Retract => "retract",
-        };
+        let dir = direction_name(*direction);
         eprintln!("note: setpoint A/A₀ = {r:.4} ({dir}) not held: {why}");
     }
     let title = format!("{} law", setup.law);
@@ -178,10 +208,7 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         outln!(
             "{:>9.3} {:>9} {:>10} {:>9.5} {:>10.4} {:>11.4} {:>10.4} {:>5} {:>6}{share}",
             p.separation_m * 1e9,
-            match p.direction {
-                Direction::Approach => "approach",
-                Direction::Retract => "retract",
-            },
+            direction_name(p.direction),
             o.regime,
             o.amplitude_ratio,
             o.phase_deg,
@@ -201,5 +228,56 @@ pub fn run(args: ApproachArgs) -> Result<()> {
             points.len()
         );
     }
+    let averaged: Vec<&SweepPoint> = points
+        .iter()
+        .filter(|p| p.thermal_average.is_some())
+        .collect();
+    if let Some(first) = averaged.first().and_then(|p| p.thermal_average) {
+        outln!(
+            "thermal averages at {} K over {} periods each (what an instrument reads where \
+             the deterministic state grazes or is not period-1; standard errors from {} \
+             independent records):",
+            first.temperature_k,
+            first.periods,
+            first.records
+        );
+        outln!(
+            "{:>9} {:>9} {:>22} {:>22} {:>20} {:>15}",
+            "z_c (nm)",
+            "dir",
+            "E_ts (eV)",
+            "phi (deg)",
+            "A/A0",
+            "touches (%)"
+        );
+        let ev = crate::params::ELECTRONVOLT_J;
+        for p in averaged {
+            let a = p.thermal_average.expect("filtered");
+            outln!(
+                "{:>9.3} {:>9} {:>22} {:>22} {:>20} {:>15}",
+                p.separation_m * 1e9,
+                direction_name(p.direction),
+                format!("{:.3} ± {:.3}", a.e_ts_j / ev, a.e_ts_std_err_j / ev),
+                format!("{:.3} ± {:.3}", a.phase_deg, a.phase_std_err_deg),
+                format!(
+                    "{:.6} ± {:.1e}",
+                    a.amplitude_ratio, a.amplitude_ratio_std_err
+                ),
+                format!(
+                    "{:.1} ± {:.1}",
+                    100.0 * a.touch_fraction,
+                    100.0 * a.touch_fraction_std_err
+                )
+            );
+        }
+    }
     Ok(())
+}
+
+/// A ramp direction as the table prints it.
+fn direction_name(direction: Direction) -> &'static str {
+    match direction {
+        Direction::Approach => "approach",
+        Direction::Retract => "retract",
+    }
 }

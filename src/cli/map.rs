@@ -2,6 +2,7 @@
 
 use crate::config::{BranchChoice, TapInputs, number, pressure, surface_energy};
 use crate::error::{Error, Result};
+use crate::instrument::average::AverageRequest;
 use crate::report::part::{self, Job, MapSetpoint};
 use crate::report::{map as report, plot};
 use crate::sweep;
@@ -67,9 +68,16 @@ pub struct MapArgs {
     /// With a setpoint, --temperature adds each cell's thermal phase noise σ_φ through
     /// the lock-in (the linear theory about its orbit; column sigma_phase_deg) and heat
     /// maps of σ_φ and of each cell's phase contrast with the first cell over the noise
-    /// of the two readings, |φ − φ₀|/√(σ² + σ₀²).
+    /// of the two readings, |φ − φ₀|/√(σ² + σ₀²). At one z_c it averages each cell that
+    /// grazes a switch or is not a stable period-1 orbit over the thermal motion, as an
+    /// instrument reads it (thermal_average fields), and adds heat maps of E_ts and φ as
+    /// read: the average where there is one, the steady state elsewhere.
     #[command(flatten)]
     noise: super::NoiseArgs,
+    /// Drive periods of each thermal average (--temperature at one z_c): eight
+    /// independent records of an eighth each, whose spread gives the standard errors.
+    #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
+    thermal_periods: usize,
     #[command(flatten)]
     split: super::shard::ShardArgs,
 }
@@ -111,17 +119,30 @@ pub fn run(args: MapArgs) -> Result<()> {
     let whole_outputs = args.out.csv.is_some() || args.out.plot.is_some() || args.out.json;
     let shard = args.split.resolve("map", whole_outputs)?;
     let cells = shard.unwrap_or(Shard::WHOLE).items(total);
-    let noise = args.noise.request();
+    let noise = args.noise.request().filter(|_| setpoint.is_some());
     if let Some(request) = &noise {
-        if setpoint.is_none() {
-            return Err(Error::NotApplicable(
-                "a map reads thermal noise at an amplitude setpoint (--setpoint), as an AFM \
-                 images: give one with --temperature"
-                    .into(),
-            ));
-        }
         request.check(setup.cantilever.drive_frequency_hz)?;
     }
+    let thermal = match (setpoint, args.noise.temperature) {
+        (None, Some(temperature_k)) => {
+            if args.noise.enbw.is_some() || args.noise.lockin_order.is_some() {
+                return Err(Error::NotApplicable(
+                    "--enbw and --lockin-order set the lock-in that reads σ_φ at an amplitude \
+                     setpoint (--setpoint); a map at one z_c averages its grazing cells over \
+                     the thermal motion and reads no lock-in noise"
+                        .into(),
+                ));
+            }
+            let request = AverageRequest {
+                temperature_k,
+                periods: args.thermal_periods,
+                seed: 1,
+            };
+            request.check()?;
+            Some(request)
+        }
+        _ => None,
+    };
     let bar = args.out.progress_bar(cells.len());
     let computed = match setpoint {
         None => sweep::map_cells(
@@ -131,6 +152,7 @@ pub fn run(args: MapArgs) -> Result<()> {
             &cells,
             args.threads,
             || bar.inc(1),
+            thermal.as_ref(),
         )?,
         Some(sp) => crate::setpoint::map_cells(
             &setup,
@@ -154,7 +176,7 @@ pub fn run(args: MapArgs) -> Result<()> {
                 setpoint,
             },
             &part::Config::Whole(
-                serde_json::to_value((&setup, &numerics, &works, &moduli, &noise))
+                serde_json::to_value((&setup, &numerics, &works, &moduli, &noise, &thermal))
                     .expect("a configuration serialises"),
             ),
             cells,

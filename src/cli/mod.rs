@@ -176,6 +176,9 @@ impl NoiseArgs {
     }
 }
 
+/// Drive periods of a thermal average unless told otherwise (`--thermal-periods`).
+pub(crate) const DEFAULT_THERMAL_PERIODS: usize = 20_000;
+
 /// The refusal of a rest separation beside an amplitude setpoint (tap, map, a batch
 /// row): at a setpoint the separation is what is solved for.
 pub(crate) fn separation_and_setpoint() -> crate::Error {

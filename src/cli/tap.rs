@@ -3,8 +3,8 @@
 use crate::config::{BranchChoice, TapInputs, length, number};
 use crate::dynamics::observables::{Observe, Starts, tap};
 use crate::error::{Error, Result};
+use crate::instrument::average::{AverageRequest, reads_as_average, thermal_average};
 use crate::instrument::noise::thermal_noise_at;
-use crate::instrument::thermal::thermal_average;
 use crate::report::{output, plot, tap as report};
 use crate::setpoint::states_at_setpoint;
 use clap::Args;
@@ -107,7 +107,7 @@ pub struct TapArgs {
     /// grazes a switch or is not a stable period-1 orbit: eight independent records of
     /// an eighth each (after ten decay times of settling), whose spread gives the
     /// standard errors.
-    #[arg(long, default_value_t = 20_000, help_heading = "Thermal noise")]
+    #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
     thermal_periods: usize,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
@@ -157,10 +157,15 @@ pub fn run(args: TapArgs) -> Result<()> {
     };
     // Where the deterministic answer is not a stable period-1 orbit away from every
     // switch, what an instrument reads is the average over the thermal motion.
-    let average = match (&noise, args.noise.temperature) {
-        (Some(n), Some(t)) if run.observables.grazing || n.is_none() => {
+    let average = match args.noise.temperature {
+        Some(temperature_k) if reads_as_average(&run.observables) => {
             let busy = spinner("averaging the state over a thermal record");
-            let average = thermal_average(&setup, &numerics, t, (args.thermal_periods, 1));
+            let request = AverageRequest {
+                temperature_k,
+                periods: args.thermal_periods,
+                seed: 1,
+            };
+            let average = thermal_average(&setup, &numerics, &request);
             busy.finish_and_clear();
             Some(average?)
         }

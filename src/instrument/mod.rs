@@ -2,6 +2,7 @@
 //! as an AFM's electronics do, each a value of its own that watches the integration
 //! ([`crate::dynamics::numeric::StepObserver`]) beside the steady-state solver.
 
+pub mod average;
 pub mod feedback;
 pub mod lockin;
 pub mod noise;

@@ -69,12 +69,18 @@ pub enum Style {
     Squares,
     /// Crosses at the points, no line (a third kind of marker).
     Crosses,
+    /// Filled triangles at the points, no line (a fourth kind: values of another kind
+    /// of calculation, such as thermal averages beside deterministic states).
+    Triangles,
 }
 
 impl Style {
     /// Whether points are marked rather than joined.
     pub fn is_marker(self) -> bool {
-        matches!(self, Style::Markers | Style::Squares | Style::Crosses)
+        matches!(
+            self,
+            Style::Markers | Style::Squares | Style::Crosses | Style::Triangles
+        )
     }
 }
 

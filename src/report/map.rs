@@ -13,11 +13,13 @@ use serde::Serialize;
 use serde_json::value::RawValue;
 
 /// What a heat map shows of one cell: E_ts per cycle (eV), the phase (deg), A/A₀, the
-/// viscous share of E_ts (eV) and the phase's thermal noise (deg; NaN where not asked
-/// for), the rest separation (m) where it was solved for (an amplitude setpoint),
-/// whether the motion is period-1 and whether it grazes a switch; `None` where the law
-/// does not apply.
-pub type Plotted = Option<([f64; 5], Option<f64>, bool, bool)>;
+/// viscous share of E_ts (eV), the phase's thermal noise (deg; NaN where not asked
+/// for), and the thermal average's E_ts (eV), phase (deg) and temperature (K; NaN where
+/// there is none),
+/// the rest separation (m) where it was solved for (an amplitude setpoint), whether the
+/// motion is period-1 and whether it grazes a switch; `None` where the law does not
+/// apply.
+pub type Plotted = Option<([f64; 8], Option<f64>, bool, bool)>;
 
 /// A cell as its record serialises, and what its heat maps show.
 pub trait MapRecord: Serialize {
@@ -35,6 +37,10 @@ impl MapRecord for MapCell {
                 o.amplitude_ratio,
                 o.e_ts_viscous_j / ELECTRONVOLT_J,
                 self.sigma_phase_deg.unwrap_or(f64::NAN),
+                self.thermal_average
+                    .map_or(f64::NAN, |a| a.e_ts_j / ELECTRONVOLT_J),
+                self.thermal_average.map_or(f64::NAN, |a| a.phase_deg),
+                self.thermal_average.map_or(f64::NAN, |a| a.temperature_k),
             ],
             self.separation_m,
             o.period == Some(1),
@@ -54,6 +60,15 @@ struct PlottedFields {
     period: Option<u64>,
     grazing: Option<bool>,
     sigma_phase_deg: Option<f64>,
+    thermal_average: Option<AveragePlotted>,
+}
+
+/// The fields of a cell's thermal average that its heat maps show.
+#[derive(serde::Deserialize)]
+struct AveragePlotted {
+    e_ts_j: f64,
+    phase_deg: f64,
+    temperature_k: f64,
 }
 
 impl MapRecord for Box<RawValue> {
@@ -67,6 +82,13 @@ impl MapRecord for Box<RawValue> {
                 f.amplitude_ratio?,
                 f.e_ts_viscous_j? / ELECTRONVOLT_J,
                 f.sigma_phase_deg.unwrap_or(f64::NAN),
+                f.thermal_average
+                    .as_ref()
+                    .map_or(f64::NAN, |a| a.e_ts_j / ELECTRONVOLT_J),
+                f.thermal_average.as_ref().map_or(f64::NAN, |a| a.phase_deg),
+                f.thermal_average
+                    .as_ref()
+                    .map_or(f64::NAN, |a| a.temperature_k),
             ],
             f.separation_m,
             f.period == Some(1),
@@ -109,7 +131,7 @@ pub fn heat_maps<T: MapRecord>(
     let plotted: Vec<Plotted> = cells.iter().map(MapRecord::plotted).collect();
     let heights = heights_of(&plotted);
     let at = setpoint.map_or(String::new(), |s| format!(" at {s}"));
-    let map = |title: &str, value_label: &str, value: &dyn Fn(usize, &[f64; 5]) -> f64| HeatMap {
+    let map = |title: &str, value_label: &str, value: &dyn Fn(usize, &[f64; 8]) -> f64| HeatMap {
         title: format!("{law} law{at}: {title}"),
         x_label: "work of adhesion Δγ (J/m²)".into(),
         y_label: "composite modulus E* (GPa)".into(),
@@ -174,6 +196,30 @@ pub fn heat_maps<T: MapRecord>(
             "contrast over noise",
             "|φ − φ₀|/√(σ² + σ₀²), first cell",
             &|_, v| (v[1] - phase0).abs() / v[4].hypot(sigma0),
+        ));
+    }
+    // The thermal averages, where some cells have one: E_ts and φ as an instrument reads
+    // them (the average there, the steady state elsewhere).
+    if let Some(first) = plotted.iter().flatten().find(|p| p.0[7].is_finite()) {
+        let kelvin = first.0[7];
+        // The average (index `average`) where there is one, else the steady state's
+        // value (index `steady`).
+        let read = |v: &[f64; 8], average: usize, steady: usize| {
+            if v[average].is_finite() {
+                v[average]
+            } else {
+                v[steady]
+            }
+        };
+        maps.push(map(
+            &format!("dissipation as read at {kelvin} K"),
+            "E_ts per cycle (eV); thermal average at ○ and •",
+            &|_, v| read(v, 5, 0),
+        ));
+        maps.push(map(
+            &format!("phase as read at {kelvin} K"),
+            "phase lag φ (deg); thermal average at ○ and •",
+            &|_, v| read(v, 6, 1),
         ));
     }
     maps

@@ -554,6 +554,17 @@ where
                         .legend(move |(x, y)| Cross::new((x + 10, y), 5, style));
                 }
             }
+            Style::Triangles => {
+                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
+                let filled = color.filled();
+                let anno = ctx
+                    .draw_series(inside.map(|p| TriangleMarker::new(p, 7, filled)))
+                    .map_err(|e| err(&e))?;
+                if !series.name.is_empty() {
+                    anno.label(series.name.as_str())
+                        .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 7, filled));
+                }
+            }
             Style::Line | Style::Dashed | Style::Dotted => {
                 let (dash, gap) = match series.style {
                     Style::Dashed => (12, 8),

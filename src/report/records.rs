@@ -18,6 +18,26 @@ pub fn object<T: Serialize>(record: &T) -> Result<Map<String, Value>> {
     }
 }
 
+/// A record's fields with every nested object's fields brought up beside them, named
+/// `outer_inner` (a sweep point's `thermal_average` becomes `thermal_average_e_ts_j`,
+/// …): one CSV column each.
+fn flat(record: Map<String, Value>) -> Map<String, Value> {
+    let mut out = Map::new();
+    for (key, value) in record {
+        match value {
+            Value::Object(inner) => {
+                for (k, v) in flat(inner) {
+                    out.insert(format!("{key}_{k}"), v);
+                }
+            }
+            v => {
+                out.insert(key, v);
+            }
+        }
+    }
+    out
+}
+
 /// One JSON object whose fields are arrays (one entry per record, null where a record
 /// lacks the field), in record-field order. Records are converted one at a time.
 pub fn columns_json<T: Serialize>(records: &[T]) -> Result<Value> {
@@ -58,7 +78,7 @@ pub fn records_csv<T: Serialize>(records: &[T]) -> Result<Vec<u8>> {
     };
     let mut keys: Vec<String> = Vec::new();
     for r in records {
-        for k in object(r)?.keys() {
+        for k in flat(object(r)?).keys() {
             if !keys.contains(k) {
                 keys.push(k.clone());
             }
@@ -68,7 +88,7 @@ pub fn records_csv<T: Serialize>(records: &[T]) -> Result<Vec<u8>> {
     if !keys.is_empty() {
         w.write_record(&keys).map_err(fail)?;
         for r in records {
-            let row = object(r)?;
+            let row = flat(object(r)?);
             w.write_record(keys.iter().map(|k| match row.get(k) {
                 Some(Value::String(s)) => s.clone(),
                 Some(Value::Null) | None => String::new(),

@@ -3,6 +3,7 @@
 
 use super::chart::{Axis, Chart, Corner, Series, Style};
 use crate::identification::{Mechanism, Normalized};
+use crate::instrument::average::ThermalAverage;
 use crate::sweep::{Direction, SweepPoint};
 
 /// The x axis of every chart against the rest separation: z_c in nm.
@@ -15,6 +16,10 @@ pub fn separation_axis() -> Axis {
 /// is left out where it is zero at every setpoint (no repulsive contact).
 pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
     type Pick = fn(&SweepPoint) -> f64;
+    type Thermal = Option<fn(&ThermalAverage) -> f64>;
+    type ThermalX = fn(&SweepPoint, &ThermalAverage) -> f64;
+    // An x axis: the axis, a point's x and a thermal average's x.
+    type XAxis<'a> = (Axis, &'a dyn Fn(&SweepPoint) -> f64, ThermalX);
     let nm = |p: &SweepPoint| p.separation_m * 1e9;
     let series = |x: &dyn Fn(&SweepPoint) -> f64, y: Pick| -> Vec<Series> {
         let mut all: Vec<Located> = Vec::new();
@@ -42,9 +47,30 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
         out.extend(not_period_one(&all));
         out
     };
+    // The thermal averages (`approach --temperature`) where the sweep has them, in black
+    // over the coloured markers of the states they average (approach and retract alike:
+    // the thermal motion forgets the direction of the ramp): what an instrument reads
+    // at the points marked as grazing or not period-1.
+    let thermal = |xs: ThermalX, ys: Thermal| -> Vec<Series> {
+        let Some(ys) = ys else { return vec![] };
+        let Some(t) = points.iter().find_map(|p| p.thermal_average) else {
+            return vec![];
+        };
+        let pts: Vec<(f64, f64)> = points
+            .iter()
+            .filter_map(|p| p.thermal_average.map(|a| (xs(p, &a), ys(&a))))
+            .collect();
+        vec![Series::new(
+            &format!("thermal average at {} K", t.temperature_k),
+            pts,
+            Style::Triangles,
+            0,
+        )]
+    };
     let chart =
-        |name: &str, what: &str, x: Axis, xs: &dyn Fn(&SweepPoint) -> f64, y: Axis, ys: Pick| {
-            let series = series(xs, ys);
+        |name: &str, what: &str, (x, xs, txs): XAxis<'_>, (y, ys, tys): (Axis, Pick, Thermal)| {
+            let mut series = series(xs, ys);
+            series.extend(thermal(txs, tys));
             Chart {
                 name: name.into(),
                 title: format!("{title}: {what}"),
@@ -56,20 +82,32 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             }
         };
     let ratio = |p: &SweepPoint| p.observables.amplitude_ratio;
-    // (file stem, caption, axis label, column, value); the first is A/A₀ itself.
-    let quantities: [(&str, &str, &str, &str, Pick); 7] = [
-        ("amplitude", "amplitude", "A/A₀", "amplitude_ratio", |p| {
-            p.observables.amplitude_ratio
-        }),
-        ("phase", "phase", "phase lag φ (deg)", "phase_deg", |p| {
-            p.observables.phase_deg
-        }),
+    // (file stem, caption, axis label, column, value, a thermal average's value); the
+    // first is A/A₀ itself.
+    let quantities: [(&str, &str, &str, &str, Pick, Thermal); 7] = [
+        (
+            "amplitude",
+            "amplitude",
+            "A/A₀",
+            "amplitude_ratio",
+            |p| p.observables.amplitude_ratio,
+            Some(|a| a.amplitude_ratio),
+        ),
+        (
+            "phase",
+            "phase",
+            "phase lag φ (deg)",
+            "phase_deg",
+            |p| p.observables.phase_deg,
+            Some(|a| a.phase_deg),
+        ),
         (
             "e_ts",
             "dissipation",
             "E_ts per cycle (eV)",
             "e_ts_ev",
             |p| p.observables.e_ts_ev,
+            Some(|a| a.e_ts_j / crate::params::ELECTRONVOLT_J),
         ),
         (
             "e_ts_viscous",
@@ -77,6 +115,7 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             "E_ts in the viscous sample per cycle (eV)",
             "e_ts_viscous_ev",
             |p| p.observables.e_ts_viscous_j / crate::params::ELECTRONVOLT_J,
+            None,
         ),
         (
             "e_ts_capillary",
@@ -84,6 +123,7 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             "E_ts in the capillary neck per cycle (eV)",
             "e_ts_capillary_ev",
             |p| p.observables.e_ts_capillary_j / crate::params::ELECTRONVOLT_J,
+            None,
         ),
         (
             "virial",
@@ -91,6 +131,7 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             "virial ⟨F_ts z⟩ (eV)",
             "virial_ev",
             |p| p.observables.virial_j / crate::params::ELECTRONVOLT_J,
+            None,
         ),
         (
             "peak_force",
@@ -98,41 +139,38 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             "peak repulsive force (nN)",
             "peak_force_nn",
             |p| p.observables.peak_force_n * 1e9,
+            None,
         ),
     ];
     // A quantity that is zero throughout (a peak repulsive force where the tip never
     // presses into the sample: the attractive regime; the viscous part of E_ts on an
     // elastic sample) gets no panels.
-    let shown = |q: &&(&str, &str, &str, &str, Pick)| !points.iter().all(|p| q.4(p) == 0.0);
+    let shown =
+        |q: &&(&str, &str, &str, &str, Pick, Thermal)| !points.iter().all(|p| q.4(p) == 0.0);
     let against_separation =
         quantities
             .iter()
             .filter(shown)
-            .map(|&(name, what, label, column, pick)| {
+            .map(|&(name, what, label, column, pick, thermal)| {
                 chart(
                     name,
                     what,
-                    separation_axis(),
-                    &nm,
-                    Axis::linear(label, column),
-                    pick,
+                    (separation_axis(), &nm, |p, _| p.separation_m * 1e9),
+                    (Axis::linear(label, column), pick, thermal),
                 )
             });
-    let against_amplitude =
-        quantities
-            .iter()
-            .skip(1)
-            .filter(shown)
-            .map(|&(name, what, label, column, pick)| {
-                chart(
-                    &format!("{name}_vs_amplitude"),
-                    &format!("{what} vs amplitude"),
-                    Axis::linear("A/A₀", "amplitude_ratio"),
-                    &ratio,
-                    Axis::linear(label, column),
-                    pick,
-                )
-            });
+    let against_amplitude = quantities.iter().skip(1).filter(shown).map(
+        |&(name, what, label, column, pick, thermal)| {
+            chart(
+                &format!("{name}_vs_amplitude"),
+                &format!("{what} vs amplitude"),
+                (Axis::linear("A/A₀", "amplitude_ratio"), &ratio, |_, a| {
+                    a.amplitude_ratio
+                }),
+                (Axis::linear(label, column), pick, thermal),
+            )
+        },
+    );
     against_separation.chain(against_amplitude).collect()
 }
 

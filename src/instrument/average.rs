@@ -1,0 +1,167 @@
+//! What an instrument reads where the deterministic answer is not a stable period-1
+//! orbit away from every switch (a state that grazes a switch, a long lock, irregular
+//! motion): the state averaged over the thermal motion, from independent records under
+//! the thermal force ([`super::thermal`]), each with its own stream, so that the
+//! standard errors are the spread of independent records. Near grazing the touch
+//! pattern is set by perturbations far below the thermal motion; the average over that
+//! motion does not depend on the integrator's tolerance, as the deterministic lock
+//! does.
+
+use super::thermal::{
+    MAX_THERMAL_PERIODS, STEPS_PER_PERIOD, ThermalForce, check_temperature, intensity_hat,
+};
+use crate::dynamics::march::{CycleIntegrals, Phase, Simulation};
+use crate::dynamics::observables::TapObservables;
+use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
+use crate::error::{Error, Result};
+use crate::law::AnyLaw;
+
+/// What an instrument reads of a state under the thermal force, averaged over thermal
+/// records: the means and their standard errors, from the spread of independent
+/// records (streams of the seed). The spread of batches of one record would not do:
+/// near grazing the touches follow a long lock pattern whose part in each batch swings
+/// the batch means, which cancels over the record — such errors came out up to 2.7
+/// times the spread of independent records.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ThermalAverage {
+    /// Temperature, K.
+    pub temperature_k: f64,
+    /// Drive periods averaged (after settling), over all records.
+    pub periods: usize,
+    /// Independent records (each its own settling and stream).
+    pub records: usize,
+    /// Mean energy dissipated in the contact per period, J.
+    pub e_ts_j: f64,
+    /// Its standard error, J.
+    pub e_ts_std_err_j: f64,
+    /// The phase of the averaged fundamental (what a slow lock-in reads), degrees.
+    pub phase_deg: f64,
+    /// Its standard error, degrees.
+    pub phase_std_err_deg: f64,
+    /// The amplitude of the averaged fundamental over A₀.
+    pub amplitude_ratio: f64,
+    /// Its standard error.
+    pub amplitude_ratio_std_err: f64,
+    /// The fraction of periods in which the tip touches (jumps into contact).
+    pub touch_fraction: f64,
+    /// Its standard error.
+    pub touch_fraction_std_err: f64,
+}
+
+/// Independent records a thermal average is made of.
+pub const AVERAGE_RECORDS: usize = 8;
+
+/// A thermal average asked for: the temperature, the drive periods averaged over all
+/// records (after settling) and the seed whose streams 0, 1, … the records draw.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct AverageRequest {
+    /// Temperature, K.
+    pub temperature_k: f64,
+    /// Drive periods averaged, over all records.
+    pub periods: usize,
+    /// Seed of the records' streams.
+    pub seed: u64,
+}
+
+impl AverageRequest {
+    /// Refuse a temperature that is negative or not finite, or a length with fewer than
+    /// 100 periods a record or more than [`MAX_THERMAL_PERIODS`] in all.
+    pub fn check(&self) -> Result<()> {
+        check_temperature(self.temperature_k)?;
+        let per_record = self.periods / AVERAGE_RECORDS;
+        if !(100..=MAX_THERMAL_PERIODS / AVERAGE_RECORDS).contains(&per_record) {
+            return Err(Error::OutOfRange(format!(
+                "a thermal average spans {} to {MAX_THERMAL_PERIODS} drive periods, not {}",
+                100 * AVERAGE_RECORDS,
+                self.periods
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Whether an instrument reads state `o` only as a thermal average: it grazes a switch,
+/// or it is not a stable period-1 orbit (where it is one, away from every switch, the
+/// linear noise theory about it speaks: [`super::noise`]).
+pub fn reads_as_average(o: &TapObservables) -> bool {
+    o.grazing || o.period != Some(1) || o.stable != Some(true)
+}
+
+/// The state `setup` settles on from the free oscillation, under the thermal force
+/// ([`thermal_average_from`] from the free steady motion at the setup's separation).
+pub fn thermal_average(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    request: &AverageRequest,
+) -> Result<ThermalAverage> {
+    request.check()?;
+    let p = Prepared::new(setup, numerics)?;
+    let sim = p.simulation();
+    thermal_average_from(&p, &sim, &sim.free_steady_start(), request)
+}
+
+/// The state `sim` (of `p`, at any separation) settles on from `start` under the
+/// thermal force at the request's temperature ([`STEPS_PER_PERIOD`] steps a period):
+/// [`AVERAGE_RECORDS`] independent records (streams 0, 1, … of the seed, marched in
+/// parallel: the same result on any thread count), each 10 Q/π periods of settling (ten
+/// decay times of the free amplitude) and then its share of the periods; each record's
+/// E_ts, fundamental (A, φ from its summed Fourier projections) and touch fraction;
+/// their means and standard errors. At 0 K every record is the deterministic march's.
+pub fn thermal_average_from(
+    p: &Prepared,
+    sim: &Simulation<'_, AnyLaw>,
+    start: &Phase,
+    request: &AverageRequest,
+) -> Result<ThermalAverage> {
+    use rayon::prelude::*;
+    request.check()?;
+    let per_record = request.periods / AVERAGE_RECORDS;
+    let c = p.setup.cantilever;
+    let a0 = c.free_amplitude_m;
+    let intensity = intensity_hat(request.temperature_k, c.stiffness_n_m, c.quality, a0);
+    let settle = (10.0 * c.quality / std::f64::consts::PI).ceil() as usize;
+    let energy_j = c.stiffness_n_m * a0 * a0;
+    let records: Vec<[f64; 4]> = (0..AVERAGE_RECORDS)
+        .into_par_iter()
+        .map(|stream| -> Result<[f64; 4]> {
+            let mut force =
+                ThermalForce::new(intensity, STEPS_PER_PERIOD, request.seed, stream as u64)?;
+            let mut phase = *start;
+            let ignore = &mut crate::dynamics::numeric::Ignore;
+            force.march(sim, &mut phase, settle, ignore)?;
+            let (mut sum, mut touched) = (None::<CycleIntegrals>, 0usize);
+            for _ in 0..per_record {
+                let (one, _) = force.march(sim, &mut phase, 1, ignore)?;
+                let one = one.expect("one period marched");
+                touched += usize::from(one.jumps_in > 0);
+                sum = Some(sum.map_or(one, |s| s.then(&one)));
+            }
+            let sum = sum.expect("a record has periods");
+            Ok([
+                sum.e_ts_per_period() * energy_j,
+                sum.phase().to_degrees(),
+                sum.amplitude(),
+                touched as f64 / per_record as f64,
+            ])
+        })
+        .collect::<Result<_>>()?;
+    let n = records.len() as f64;
+    let stat = |i: usize| {
+        let (m, var) = crate::numeric::mean_and_variance(records.iter().map(|b| b[i]));
+        (m, (var / n).sqrt())
+    };
+    let ((e, e_se), (ph, ph_se), (a, a_se), (t, t_se)) = (stat(0), stat(1), stat(2), stat(3));
+    Ok(ThermalAverage {
+        temperature_k: request.temperature_k,
+        periods: per_record * AVERAGE_RECORDS,
+        records: AVERAGE_RECORDS,
+        e_ts_j: e,
+        e_ts_std_err_j: e_se,
+        phase_deg: ph,
+        phase_std_err_deg: ph_se,
+        amplitude_ratio: a,
+        amplitude_ratio_std_err: a_se,
+        touch_fraction: t,
+        touch_fraction_std_err: t_se,
+    })
+}
