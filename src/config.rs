@@ -262,7 +262,7 @@ pub struct TapInputs {
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Tip–sample force law.
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     pub law: Option<LawKind>,
     /// The contact.
     #[command(flatten)]

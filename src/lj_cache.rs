@@ -231,7 +231,7 @@ pub fn solve(tabor_mu: f64, reach: Reach, use_cache: bool) -> Result<LjSolution>
         };
         if let (true, Ok(text)) = (replaceable, serde_json::to_string(&entry)) {
             let _ = std::fs::create_dir_all(cache_dir());
-            let _ = output::write_bytes(&path, text.as_bytes());
+            let _ = output::write_unannounced(&path, text.as_bytes());
         }
     }
     Ok(solution)

@@ -1683,3 +1683,61 @@ fn merge_refuses_what_is_not_a_part_file_of_a_job_tapsim_can_run() {
         );
     }
 }
+
+/// One command-line surface: every command takes --quiet; every command that writes a
+/// file names it on stderr ("wrote PATH") unless --quiet (`reproduce` and `figure` list
+/// theirs on stdout, as their output); a value of an enumerated option is taken in any
+/// case (`--law DMT`).
+#[test]
+fn every_command_takes_quiet_and_names_the_files_it_writes() {
+    let dir = common::scratch("announce");
+    let file = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let (csv, png, curve, part) = (
+        file("out.csv"),
+        file("out.png"),
+        file("curve.csv"),
+        file("part.json"),
+    );
+    let runs: Vec<Vec<&str>> = vec![
+        vec!["tap", "--trajectory", &csv],
+        vec!["approach", "--points", "2", "--no-retract", "--csv", &csv],
+        vec!["map", "--steps", "2", "--csv", &csv],
+        vec!["map", "--steps", "2", "--shard", "0/2", "--part", &part],
+        vec!["lj", "--mu", "3", "--curve", &curve],
+        vec!["thermal", "--duration", "0.12s", "--plot", &png],
+    ];
+    for args in &runs {
+        let named = args.last().unwrap();
+        let loud = common::tapsim(args);
+        let err = String::from_utf8_lossy(&loud.stderr);
+        assert!(loud.status.success(), "{args:?}: {err}");
+        assert!(err.contains(&format!("wrote {named}")), "{args:?}: {err}");
+        let mut quiet = args.clone();
+        quiet.push("--quiet");
+        let out = common::tapsim(&quiet);
+        assert!(out.status.success(), "{quiet:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("wrote"), "{quiet:?}: {err}");
+    }
+    for command in [
+        "tap",
+        "approach",
+        "branches",
+        "bifurcation",
+        "contrast",
+        "map",
+        "scan",
+        "thermal",
+        "batch",
+        "merge",
+        "hysteresis",
+        "lj",
+        "figure",
+        "reproduce",
+    ] {
+        let out = common::tapsim(&[command, "--quiet", "--help"]);
+        assert!(out.status.success(), "{command} --quiet");
+    }
+    let v = common::json(&["tap", "--law", "DMT", "--separation", "30nm", "--json"]);
+    assert_eq!(v["law"], "dmt");
+}

@@ -35,7 +35,7 @@ pub struct ApproachArgs {
     #[command(flatten)]
     inputs: TapInputs,
     #[command(flatten)]
-    out: super::SweepOutput,
+    pub(super) out: super::SweepOutput,
     #[command(flatten)]
     range: super::SeparationRange,
     /// Points on the approach (the retract has as many).
@@ -58,7 +58,7 @@ pub struct ApproachArgs {
     /// each point the state at its setpoint (to 1e-9) and the z_c that gives it; a
     /// setpoint the amplitude jumps across, or where the motion is not period-1, is not
     /// held and is listed with why.
-    #[arg(long, value_enum, default_value_t = Sweep::Separation)]
+    #[arg(long, value_enum, ignore_case = true, default_value_t = Sweep::Separation)]
     sweep: Sweep,
     /// Temperature [K; off unless given, 300K is room temperature]: average each point
     /// that grazes a switch or is not a stable period-1 orbit over the thermal motion

@@ -46,7 +46,7 @@ pub struct BatchArgs {
     #[command(flatten)]
     inputs: TapInputs,
     #[command(flatten)]
-    out: super::SweepOutput,
+    pub(super) out: super::SweepOutput,
     /// Worker threads (0: all cores).
     #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
     threads: usize,

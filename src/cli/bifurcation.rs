@@ -22,7 +22,7 @@ pub struct BifurcationArgs {
     #[command(flatten)]
     inputs: TapInputs,
     #[command(flatten)]
-    out: super::SweepOutput,
+    pub(super) out: super::SweepOutput,
     #[command(flatten)]
     range: super::SeparationRange,
     /// Rest separations on the ramp.

@@ -33,7 +33,7 @@ pub struct BranchesArgs {
     #[command(flatten)]
     inputs: TapInputs,
     #[command(flatten)]
-    out: super::SweepOutput,
+    pub(super) out: super::SweepOutput,
     #[command(flatten)]
     range: super::SeparationRange,
     /// Largest step along the branch [m; default 0.01 A₀].

@@ -52,12 +52,12 @@ pub struct ContrastArgs {
     #[command(flatten)]
     inputs: TapInputs,
     #[command(flatten)]
-    out: super::SweepOutput,
+    pub(super) out: super::SweepOutput,
     /// A material, name:key=value,... (repeat; at least two).
     #[arg(long = "material", value_parser = MaterialSpec::parse)]
     materials: Vec<MaterialSpec>,
     /// Laws to compare.
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [LawKind::Jkr, LawKind::Hybrid, LawKind::Lj])]
+    #[arg(long, value_enum, ignore_case = true, value_delimiter = ',', default_values_t = [LawKind::Jkr, LawKind::Hybrid, LawKind::Lj])]
     laws: Vec<LawKind>,
     /// Amplitude setpoints A/A₀, each between 0 and 1.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true,

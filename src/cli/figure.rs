@@ -32,12 +32,15 @@ pub struct FigureArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 2.0)]
     k_hat: f64,
     /// Jump-in variant for figures 4-6.
-    #[arg(long, value_enum, default_value_t = JumpIn::Fit)]
+    #[arg(long, value_enum, ignore_case = true, default_value_t = JumpIn::Fit)]
     jump_in: JumpIn,
     /// Print a manifest as JSON on stdout (per figure: number, title, files) instead of
     /// the paths written.
     #[arg(long)]
     json: bool,
+    /// No notes of files written on stderr.
+    #[arg(long)]
+    pub(super) quiet: bool,
 }
 
 /// Run the subcommand.

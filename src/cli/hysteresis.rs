@@ -37,11 +37,14 @@ pub struct HysteresisArgs {
     stiffness: Option<f64>,
     /// Jump-in separation α̂_A: the fit (17), the closed form (16), or the exact
     /// turning point of the semi-rigid separation (14)-(15).
-    #[arg(long, value_enum, default_value_t = JumpIn::Fit)]
+    #[arg(long, value_enum, ignore_case = true, default_value_t = JumpIn::Fit)]
     jump_in: JumpIn,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
+    /// No notes of files written on stderr.
+    #[arg(long)]
+    pub(super) quiet: bool,
 }
 
 /// Run the subcommand.

@@ -52,6 +52,9 @@ pub struct LjArgs {
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
+    /// No notes of files written on stderr.
+    #[arg(long)]
+    pub(super) quiet: bool,
 }
 
 /// Print `report` as JSON or as the table `text`.

@@ -33,7 +33,7 @@ pub struct MapArgs {
     #[command(flatten)]
     inputs: TapInputs,
     #[command(flatten)]
-    out: super::SweepOutput,
+    pub(super) out: super::SweepOutput,
     /// Smallest work of adhesion [J/m²].
     #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, default_value = "0.02")]
     adhesion_from: f64,
@@ -63,7 +63,7 @@ pub struct MapArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = crate::config::length)]
     amplitude_setpoint: Option<f64>,
     /// With a setpoint: the branch every cell is solved on [default: repulsive].
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     branch: Option<BranchChoice>,
     /// With a setpoint, --temperature adds each cell's thermal phase noise σ_φ through
     /// the lock-in (the linear theory about its orbit; column sigma_phase_deg) and heat

@@ -32,7 +32,7 @@ pub struct MergeArgs {
     #[arg(long)]
     out: Vec<PathBuf>,
     #[command(flatten)]
-    output: super::SweepOutput,
+    pub(super) output: super::SweepOutput,
 }
 
 /// The largest part file read, in bytes (a 200 × 200 map is some 60 MB whole).

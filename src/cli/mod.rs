@@ -68,6 +68,29 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
 }
 
+impl Command {
+    /// Whether the command names each file it writes on stderr: unless --quiet, and not
+    /// `reproduce` or `figure`, whose output on stdout is the list of files written.
+    fn announces_writes(&self) -> bool {
+        let quiet = match self {
+            Command::Tap(a) => a.quiet,
+            Command::Approach(a) => a.out.quiet,
+            Command::Branches(a) => a.out.quiet,
+            Command::Bifurcation(a) => a.out.quiet,
+            Command::Contrast(a) => a.out.quiet,
+            Command::Map(a) => a.out.quiet,
+            Command::Scan(a) => a.out.quiet,
+            Command::Thermal(a) => a.out.quiet,
+            Command::Batch(a) => a.out.quiet,
+            Command::Merge(a) => a.output.quiet,
+            Command::Hysteresis(a) => a.quiet,
+            Command::Lj(a) => a.quiet,
+            Command::Figure(_) | Command::Reproduce(_) => true,
+        };
+        !quiet
+    }
+}
+
 /// The range of rest separations of the commands that sweep it (approach, branches,
 /// bifurcation).
 #[derive(Debug, clap::Args)]
@@ -351,6 +374,9 @@ pub fn main() -> ExitCode {
         crate::report::output::remove_partial_files();
         std::process::exit(130);
     });
+    // Every command names the files it writes on stderr unless --quiet; `reproduce` and
+    // `figure` list them on stdout, their output.
+    crate::report::output::announce_writes(cli.command.announces_writes());
     let outcome = match cli.command {
         Command::Tap(args) => tap::run(args),
         Command::Approach(args) => approach::run(args),

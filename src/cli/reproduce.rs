@@ -21,7 +21,7 @@ pub struct ReproduceArgs {
     out: PathBuf,
     /// Do not report progress on stderr.
     #[arg(long)]
-    quiet: bool,
+    pub(super) quiet: bool,
     /// Print the manifest as JSON on stdout.
     #[arg(long)]
     json: bool,

@@ -56,7 +56,7 @@ pub struct ScanArgs {
     #[command(flatten)]
     inputs: TapInputs,
     #[command(flatten)]
-    out: super::SweepOutput,
+    pub(super) out: super::SweepOutput,
     /// The sample (TOML; default: the built-in two-polymer blend).
     #[arg(long)]
     sample: Option<std::path::PathBuf>,

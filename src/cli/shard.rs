@@ -106,11 +106,10 @@ impl ShardArgs {
         output::write_bytes(&path, text.as_bytes())?;
         if !quiet {
             eprintln!(
-                "part {} of {}: {} of {total} items written to {}",
+                "(part {} of {}: {} of {total} items)",
                 shard.index,
                 shard.count,
-                part.items.len(),
-                path.display()
+                part.items.len()
             );
         }
         Ok(())

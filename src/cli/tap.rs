@@ -99,7 +99,7 @@ pub struct TapArgs {
     /// With a setpoint: the branch whose states are listed [default: all]. Attractive:
     /// the phase lag above the free oscillator's (90° at resonance), net attractive
     /// force; repulsive: below it.
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     branch: Option<BranchChoice>,
     #[command(flatten)]
     noise: super::NoiseArgs,
@@ -112,6 +112,9 @@ pub struct TapArgs {
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
+    /// No progress or notes of files written on stderr.
+    #[arg(long)]
+    pub(super) quiet: bool,
 }
 
 /// Run the subcommand.
@@ -147,7 +150,7 @@ pub fn run(args: TapArgs) -> Result<()> {
     }
     // Another stable period-1 state at this z_c (a bistable setpoint: the free
     // oscillation settles on one, an approach or a retract may sit on the other).
-    let searching = spinner("looking for other stable states at this z_c");
+    let searching = spinner("looking for other stable states at this z_c", args.quiet);
     let coexisting = crate::setpoint::coexisting(&setup, &numerics, &run.observables);
     searching.finish_and_clear();
     let coexisting = coexisting?;
@@ -159,7 +162,7 @@ pub fn run(args: TapArgs) -> Result<()> {
     // switch, what an instrument reads is the average over the thermal motion.
     let average = match args.noise.temperature {
         Some(temperature_k) if reads_as_average(&run.observables) => {
-            let busy = spinner("averaging the state over a thermal record");
+            let busy = spinner("averaging the state over a thermal record", args.quiet);
             let request = AverageRequest {
                 temperature_k,
                 periods: args.thermal_periods,
@@ -258,7 +261,10 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
         .setpoint_ratio(setup.cantilever.free_amplitude_m)
         .expect("called with a setpoint");
     let branch = inputs.branch.unwrap_or(BranchChoice::All).only();
-    let spinner = spinner("following the period-1 families to the setpoint");
+    let spinner = spinner(
+        "following the period-1 families to the setpoint",
+        args.quiet,
+    );
     let states = states_at_setpoint(&setup, &numerics, ratio, branch);
     spinner.finish_and_clear();
     let states = states.map_err(|e| match e {
@@ -325,9 +331,9 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
 
 /// A spinner saying `what` on stderr while it runs, ticking every half second (hidden
 /// where stderr is not a terminal).
-fn spinner(what: &str) -> indicatif::ProgressBar {
+fn spinner(what: &str, quiet: bool) -> indicatif::ProgressBar {
     use std::io::IsTerminal;
-    if !std::io::stderr().is_terminal() {
+    if quiet || !std::io::stderr().is_terminal() {
         return indicatif::ProgressBar::hidden();
     }
     let bar = indicatif::ProgressBar::new_spinner();

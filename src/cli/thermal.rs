@@ -57,7 +57,7 @@ pub struct ThermalArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     #[command(flatten)]
-    out: super::SweepOutput,
+    pub(super) out: super::SweepOutput,
 }
 
 /// The fit beside the truth, as --json prints it.

@@ -15,6 +15,16 @@ use crate::error::{Error, Result};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Whether each file written is announced on stderr ([`announce_writes`]).
+static ANNOUNCE: AtomicBool = AtomicBool::new(false);
+
+/// Announce every file [`write_with`] puts in place on stderr ("wrote PATH"), or not: a
+/// command announces its outputs unless `--quiet`.
+pub fn announce_writes(on: bool) {
+    ANNOUNCE.store(on, Ordering::Relaxed);
+}
 
 /// Temporary files being written.
 static PARTIAL: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
@@ -180,6 +190,21 @@ fn about(path: &Path, tmp: &Path, e: Error) -> Error {
 /// (see the module documentation). On any failure the temporary file is removed and
 /// `path` is left untouched; errors name `path`, never the temporary file.
 pub fn write_with(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    put(path, write)?;
+    if ANNOUNCE.load(Ordering::Relaxed) {
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Write `bytes` to `path` as [`write_bytes`] does, never announced: a file the user
+/// did not ask for (the on-disk cache).
+pub fn write_unannounced(path: &Path, bytes: &[u8]) -> Result<()> {
+    put(path, |tmp| fs::write(tmp, bytes).map_err(|e| io(tmp, e)))
+}
+
+/// [`write_with`] without the announcement.
+fn put(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     match target(path)? {
         Target::Replace(target) => {
             let tmp = Partial::new(&target, true);
