@@ -5,6 +5,7 @@ pub mod bifurcation;
 pub mod branches;
 pub mod chart;
 pub mod contrast;
+pub mod display;
 pub mod heatmap;
 pub mod hysteresis;
 pub mod lj;

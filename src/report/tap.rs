@@ -2,6 +2,7 @@
 //! trajectory charts (deflection and force vs time, force vs separation).
 
 use super::chart::{Axis, Chart, Corner, Series, Style};
+use super::display::{fixed, sci};
 use crate::dynamics::attractors::Attractor;
 use crate::dynamics::harmonics::Harmonic;
 use crate::dynamics::observables::{TapObservables, TapRun, TrajectorySample};
@@ -84,49 +85,73 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
         "phase φ (from energy)",
         format!("{:.4}°", o.phase_from_energy_deg),
     );
+    // Energies are round-off below 1e-12 of the drive's work a cycle, forces below
+    // 1e-12 of kA₀.
+    let energy = o.e_drive_j.abs().max(o.e_damp_j.abs());
+    let joules = |e: f64| format!("{} J", sci(e, 4, energy));
+    let nanonewtons = |f: f64| {
+        let scale = k.stiffness_n_m * k.free_amplitude_m;
+        if f.abs() <= 1e-12 * scale {
+            "0 nN".to_string()
+        } else {
+            format!("{} nN", fixed(f * 1e9, 4))
+        }
+    };
+    let e_ts_round_off = sci(o.e_ts_j, 4, energy) == "0";
     line(
         "E_ts per cycle",
-        format!(
-            "{:.4e} J{} = {:.4} eV",
-            o.e_ts_j,
-            err(o.e_ts_std_err_j, 1.0, 1),
-            o.e_ts_ev
-        ),
+        if e_ts_round_off && o.period.is_some() {
+            "0 J = 0 eV".into()
+        } else {
+            format!(
+                "{:.4e} J{} = {} eV",
+                o.e_ts_j,
+                err(o.e_ts_std_err_j, 1.0, 1),
+                fixed(o.e_ts_ev, 4)
+            )
+        },
     );
     if o.e_ts_viscous_j != 0.0 || o.e_ts_capillary_j != 0.0 {
         line(
             "  adhesion/viscous/capillary",
             format!(
-                "{:.4e} J, {:.4e} J, {:.4e} J",
-                o.e_ts_adhesion_j, o.e_ts_viscous_j, o.e_ts_capillary_j
+                "{}, {}, {}",
+                joules(o.e_ts_adhesion_j),
+                joules(o.e_ts_viscous_j),
+                joules(o.e_ts_capillary_j)
             ),
         );
     }
-    line("law's loop area", format!("{:.4e} J", o.loop_area_j));
+    line("law's loop area", joules(o.loop_area_j));
     line(
         "E_damp, E_drive",
         format!("{:.4e} J, {:.4e} J", o.e_damp_j, o.e_drive_j),
     );
-    line(
-        "energy balance error",
-        format!("{:.2e}", o.energy_balance_rel),
-    );
-    line("virial ⟨F_ts z⟩", format!("{:.4e} J", o.virial_j));
-    line("mean force", format!("{:.4} nN", o.mean_force_n * 1e9));
+    line("energy balance error", sci(o.energy_balance_rel, 2, 0.0));
+    line("virial ⟨F_ts z⟩", joules(o.virial_j));
+    line("mean force", nanonewtons(o.mean_force_n));
     line(
         "peak repulsive / attractive force",
         format!(
-            "{:.4} nN / {:.4} nN",
-            o.peak_force_n * 1e9,
-            o.peak_attractive_force_n * 1e9
+            "{} / {}",
+            if o.peak_force_n > 0.0 {
+                nanonewtons(o.peak_force_n)
+            } else {
+                "none".into()
+            },
+            if o.peak_attractive_force_n < 0.0 {
+                nanonewtons(o.peak_attractive_force_n)
+            } else {
+                "none".into()
+            }
         ),
     );
     line(
         "min separation",
-        format!("{:.4} nm", o.min_separation_m * 1e9),
+        format!("{} nm", fixed(o.min_separation_m * 1e9, 4)),
     );
-    line("contact fraction", format!("{:.4}", o.contact_fraction));
-    line("jumps into contact per cycle", format!("{:.4}", o.jumps_in));
+    line("contact fraction", fixed(o.contact_fraction, 4));
+    line("jumps into contact per cycle", fixed(o.jumps_in, 4));
     if let Some(margin) = o.grazing_margin_m {
         line(
             "grazing margin",
@@ -142,7 +167,7 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
         let amplitudes = |pick: fn(&Harmonic) -> f64, scale: f64| {
             h.iter()
                 .take(3)
-                .map(|h| format!("{:.3}", pick(h) * scale))
+                .map(|h| fixed(pick(h) * scale, 3))
                 .collect::<Vec<_>>()
                 .join(", ")
         };
@@ -167,6 +192,16 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
             } else {
                 ""
             }
+        );
+    }
+    if o.contact_fraction == 0.0 && o.jumps_in == 0.0 && o.law != "none" {
+        let _ = writeln!(
+            s,
+            "note: the tip never comes into contact at this rest separation (its closest \
+             separation is {:.3} nm): at most the law's long-range attraction acts; bring \
+             z_c below about A₀ ({:.3} nm) to tap",
+            o.min_separation_m * 1e9,
+            k.free_amplitude_m * 1e9
         );
     }
     if let Some(list) = &run.attractors {
