@@ -1,0 +1,191 @@
+//! The README's CLI tour, run as a new user runs it: every command of the tour block
+//! succeeds, and the commands that name an effect show it (a touch, a neck, a viscous
+//! share, a non-empty contrast).
+
+mod common;
+
+use std::path::Path;
+
+/// The tour's commands, as the README lists them: one per line (a trailing `\` joins the
+/// next), comments (`#` after whitespace) dropped, `tapsim` first.
+fn tour() -> Vec<Vec<String>> {
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
+        .expect("README.md");
+    let start = readme.find("## CLI tour").expect("a CLI tour section");
+    let block = &readme[start..];
+    let block = &block[block.find("```sh\n").expect("a sh block") + 6..];
+    let block = &block[..block.find("```").expect("the block ends")];
+    let mut commands = Vec::new();
+    let mut current = String::new();
+    for line in block.lines() {
+        let code = match line.find(" #") {
+            Some(i) => &line[..i],
+            None => line,
+        };
+        let code = code.trim();
+        let (code, joined) = match code.strip_suffix('\\') {
+            Some(c) => (c, true),
+            None => (code, false),
+        };
+        current.push(' ');
+        current.push_str(code);
+        if !joined {
+            let words: Vec<String> = current.split_whitespace().map(String::from).collect();
+            if !words.is_empty() {
+                assert_eq!(words[0], "tapsim", "{current}");
+                commands.push(words[1..].to_vec());
+            }
+            current.clear();
+        }
+    }
+    commands
+}
+
+/// Run a tour command in `dir` (the tour's example files from the repository), with
+/// `extra` arguments; its stdout.
+fn run(args: &[String], extra: &[&str], dir: &Path) -> String {
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    let mut all: Vec<String> = args
+        .iter()
+        .map(|a| match a.strip_prefix("examples/") {
+            Some(rest) => examples.join(rest).to_string_lossy().into_owned(),
+            None => a.clone(),
+        })
+        .collect();
+    all.extend(extra.iter().map(|s| s.to_string()));
+    let r = common::run_limited(&all, dir, std::time::Duration::from_secs(120));
+    assert_eq!(r.code, Some(0), "tapsim {}: {}", all.join(" "), r.stderr);
+    r.stdout
+}
+
+fn has(args: &[String], flag: &str) -> bool {
+    args.iter().any(|a| a == flag)
+}
+
+/// Every tour command runs, and each shows what its comment says it shows. The tap
+/// commands are run again with --json for their numbers: a rest-separation state
+/// touches the sample (or, where a law's effect is named, dissipates through it); the
+/// two-material contrast has a Δφ on the repulsive branch at every setpoint, JKR's 5 to
+/// 7 times the hybrid's (README).
+#[test]
+fn every_tour_command_runs_and_shows_its_effect() {
+    let commands = tour();
+    assert!(commands.len() > 30, "{}", commands.len());
+    let dir = common::scratch("tour");
+    // Two at a time from one queue, as the machine has two cores; a merge after the
+    // parts it reads.
+    let (merges, rest): (Vec<_>, Vec<_>) = commands.into_iter().partition(|c| c[0] == "merge");
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| {
+                while let Some(args) =
+                    rest.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+                {
+                    check(args, &dir);
+                }
+            });
+        }
+    });
+    for args in &merges {
+        check(args, &dir);
+    }
+}
+
+fn check(args: &[String], dir: &Path) {
+    let started = std::time::Instant::now();
+    let stdout = run(args, &[], dir);
+    assert_no_round_off(&stdout, &args.join(" "));
+    eprintln!(
+        "{:5.1} s  tapsim {}",
+        started.elapsed().as_secs_f64(),
+        args.join(" ")
+    );
+    let command = args[0].as_str();
+    let is_tap_at_separation = command == "tap"
+        && !has(args, "--setpoint")
+        && !has(args, "--json")
+        && !has(args, "--temperature")
+        && !has(args, "--plot");
+    if is_tap_at_separation {
+        let v: serde_json::Value = serde_json::from_str(&run(args, &["--json"], dir)).unwrap();
+        let num = |k: &str| common::num(&v, k);
+        let what = args.join(" ");
+        assert!(num("jumps_in") > 0.0, "{what}: the tip never touches");
+        if has(args, "--viscosity") {
+            assert!(num("e_ts_viscous_j") > 0.0, "{what}: no viscous share");
+        }
+        if has(args, "--rupture-distance") {
+            assert!(num("e_ts_capillary_j") > 0.0, "{what}: no neck");
+            assert_eq!(v["grazing"], false, "{what}");
+        }
+        if has(args, "--law") && args.iter().any(|a| a == "hybrid") {
+            assert!(num("e_ts_adhesion_j") > 0.0, "{what}: no hysteresis");
+        }
+    }
+    if command == "contrast" && has(args, "--material") {
+        let v: serde_json::Value = serde_json::from_str(&run(args, &["--json"], dir)).unwrap();
+        let rows = v.as_array().expect("rows");
+        let delta = |law: &str, setpoint: f64| {
+            rows.iter()
+                .find(|r| {
+                    r["law"] == law
+                        && r["branch"] == "repulsive"
+                        && (common::num(r, "amplitude_ratio") - setpoint).abs() < 1e-9
+                })
+                .and_then(|r| r["delta_phase_deg"].as_f64())
+        };
+        for setpoint in [0.9, 0.8, 0.7, 0.6, 0.5] {
+            let (jkr, hybrid) = (delta("jkr", setpoint), delta("hybrid", setpoint));
+            let (Some(jkr), Some(hybrid)) = (jkr, hybrid) else {
+                panic!("no repulsive contrast at {setpoint}: {jkr:?} {hybrid:?}")
+            };
+            let ratio = jkr / hybrid;
+            assert!((5.0..=7.0).contains(&ratio), "{setpoint}: {jkr} / {hybrid}");
+        }
+    }
+}
+
+/// A table shows no negative zero (`-0.0000`) and no round-off as data (an exponent
+/// below −30, as in `-3.0e-34 J`).
+fn assert_no_round_off(text: &str, what: &str) {
+    for word in text.split(|c: char| c.is_whitespace() || c == ',' || c == '(' || c == ')') {
+        let digits = word.trim_start_matches(['-', '−']);
+        let negative_zero = digits.len() < word.len()
+            && digits.starts_with("0.")
+            && digits
+                .trim_end_matches(|c: char| !c.is_ascii_digit())
+                .chars()
+                .all(|c| c == '0' || c == '.');
+        assert!(!negative_zero, "{what}: negative zero {word:?}");
+        if let Some(exponent) = digits.split(['e', 'E']).nth(1) {
+            if let Ok(e) = exponent.parse::<i32>() {
+                assert!(
+                    e > -30 || !digits.starts_with(|c: char| c.is_ascii_digit()),
+                    "{what}: round-off {word:?}"
+                );
+            }
+        }
+    }
+}
+
+/// Where the tip never reaches the sample, tap says so and prints its zeros as zeros.
+#[test]
+fn a_state_out_of_reach_says_so_and_prints_zeros_as_zero() {
+    let out = common::tapsim(&["tap", "--separation", "30nm"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("the tip never comes into contact"), "{text}");
+    assert!(text.contains("0 J = 0 eV"), "{text}");
+    assert!(text.contains("none / none"), "{text}");
+    assert_no_round_off(&text, "tap --separation 30nm");
+    let out = common::tapsim(&[
+        "tap",
+        "--law",
+        "dmt",
+        "--hamaker",
+        "1e-19",
+        "--separation",
+        "25nm",
+    ]);
+    assert_no_round_off(&String::from_utf8_lossy(&out.stdout), "dmt far out");
+}
