@@ -113,6 +113,19 @@ impl ContactInputs {
             }
             return Ok(None);
         };
+        // A bare number meant in GPa, caught before it becomes a composite modulus the
+        // user never typed.
+        for (flag, modulus) in [
+            ("--sample-modulus", Some(sample)),
+            ("--tip-modulus", self.tip_modulus),
+        ] {
+            if let Some(e) = modulus.filter(|&e| e > 0.0 && e < 1e3) {
+                return Err(Error::OutOfRange(format!(
+                    "{flag} {e} Pa is below 1 kPa (living cells); bare numbers are in Pa: did \
+                     you mean {e}GPa?"
+                )));
+            }
+        }
         params::composite_modulus(
             self.tip_modulus.unwrap_or(DEFAULT_TIP_MODULUS),
             self.tip_poisson.unwrap_or(DEFAULT_TIP_POISSON),
@@ -270,23 +283,23 @@ pub struct TapInputs {
     /// The law parameters of the registry, one flag each.
     #[command(flatten)]
     pub law_params: LawParamInputs,
-    /// Cantilever spring constant k [N/m; default 40].
-    #[arg(long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Cantilever")]
+    /// Cantilever spring constant k [N/m; default 40]. (Also --k.)
+    #[arg(long, alias = "k", allow_hyphen_values = true, value_parser = stiffness, help_heading = "Cantilever")]
     pub stiffness: Option<f64>,
-    /// Resonance frequency f₀ [Hz; default 300kHz].
-    #[arg(long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Cantilever")]
+    /// Resonance frequency f₀ [Hz; default 300kHz]. (Also --f0.)
+    #[arg(long, alias = "f0", allow_hyphen_values = true, value_parser = frequency, help_heading = "Cantilever")]
     pub resonance: Option<f64>,
-    /// Quality factor Q [default 400].
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Cantilever")]
+    /// Quality factor Q [default 400]. (Also --Q.)
+    #[arg(long, aliases = ["Q", "q"], allow_hyphen_values = true, value_parser = number, help_heading = "Cantilever")]
     pub quality: Option<f64>,
-    /// Free amplitude A₀ [m; default 20nm].
-    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
+    /// Free amplitude A₀ [m; default 20nm]. (Also --A0.)
+    #[arg(long, aliases = ["A0", "a0"], allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
     pub free_amplitude: Option<f64>,
     /// Drive frequency [Hz; default: the resonance frequency].
     #[arg(long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Cantilever")]
     pub drive_frequency: Option<f64>,
-    /// Rest tip–sample separation z_c, α = z_c + z [m; default 16nm].
-    #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
+    /// Rest tip–sample separation z_c, α = z_c + z [m; default 16nm]. (Also --zc.)
+    #[arg(long, alias = "zc", allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
     pub separation: Option<f64>,
     /// Relative tolerance of the integrator [default 1e-9; absolute: 1e-2 of it].
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]

@@ -1740,4 +1740,26 @@ fn every_command_takes_quiet_and_names_the_files_it_writes() {
     }
     let v = common::json(&["tap", "--law", "DMT", "--separation", "30nm", "--json"]);
     assert_eq!(v["law"], "dmt");
+    // The usual short spellings, and bare numbers meant in kHz or GPa caught with the
+    // number the user typed.
+    let short = common::json(&[
+        "tap", "--k", "3", "--Q", "100", "--f0", "70kHz", "--A0", "10nm", "--zc", "8nm", "--json",
+    ]);
+    let long = common::json(&[
+        "tap",
+        "--stiffness",
+        "3",
+        "--quality",
+        "100",
+        "--resonance",
+        "70kHz",
+        "--free-amplitude",
+        "10nm",
+        "--separation",
+        "8nm",
+        "--json",
+    ]);
+    assert_eq!(short, long);
+    common::refused(&["tap", "--resonance", "300"], "did you mean 300kHz?");
+    common::refused(&["tap", "--sample-modulus", "2"], "did you mean 2GPa?");
 }

@@ -169,7 +169,8 @@ fn assert_no_round_off(text: &str, what: &str) {
     }
 }
 
-/// Where the tip never reaches the sample, tap says so and prints its zeros as zeros.
+/// Where the tip never reaches the sample, tap says so and prints its zeros as zeros, and
+/// an approach plot says why it has no peak-force panels.
 #[test]
 fn a_state_out_of_reach_says_so_and_prints_zeros_as_zero() {
     let out = common::tapsim(&["tap", "--separation", "30nm"]);
@@ -188,4 +189,18 @@ fn a_state_out_of_reach_says_so_and_prints_zeros_as_zero() {
         "25nm",
     ]);
     assert_no_round_off(&String::from_utf8_lossy(&out.stdout), "dmt far out");
+    let plot = common::scratch("out_of_reach").join("far.png");
+    let out = common::tapsim(&[
+        "approach",
+        "--from",
+        "30nm",
+        "--to",
+        "22nm",
+        "--points",
+        "3",
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no peak-force panels"), "{err}");
 }

@@ -153,6 +153,15 @@ pub fn run(args: ApproachArgs) -> Result<()> {
         eprintln!("note: setpoint A/A₀ = {r:.4} ({dir}) not held: {why}");
     }
     let title = format!("{} law", setup.law);
+    if args.out.plot.is_some()
+        && !args.out.quiet
+        && points.iter().all(|p| p.observables.peak_force_n == 0.0)
+    {
+        eprintln!(
+            "note: the plot has no peak-force panels: the tip never presses into the sample \
+             anywhere on this sweep (no repulsive force at any point)"
+        );
+    }
     let normalized = args.normalize.then(|| identification::normalize(&points));
     if let Some(normalized) = &normalized {
         let rows: Vec<Identified> = points

@@ -336,9 +336,9 @@ impl TapSetup {
         Range {
             what: "resonance frequency f₀",
             unit: "Hz",
-            lo: 100.0,
+            lo: 1e3,
             hi: 1e8,
-            why: "the range of AFM cantilevers",
+            why: "the range of AFM cantilevers, from soft levers in liquid up",
             meant: Some(("kHz", 1e3)),
         }
         .check(k.resonance_hz)?;
