@@ -55,12 +55,28 @@ pub struct SiSection {
     pub stiffness_n_m: Option<f64>,
     /// The headline loss per cycle in J: with the spring if a stiffness was given,
     /// else the rigid hybrid value.
-    pub w_joule: f64,
-    /// `w_joule` in eV.
+    pub w_j: f64,
+    /// `w_j` in eV.
     pub w_ev: f64,
     /// JKR loss (9) in J.
-    pub w_jkr_joule: f64,
+    pub w_jkr_j: f64,
     /// Rigid-support hybrid loss (18) in J.
+    pub w_hybrid_j: f64,
+    /// The keys these had until 0.1 (`w_joule`, `w_jkr_joule`, `w_hybrid_joule`: the
+    /// same values), kept for one release.
+    #[serde(flatten)]
+    pub deprecated: DeprecatedLossKeys,
+}
+
+/// The loss keys of `hysteresis --json` before every energy key ended in `_j`: the same
+/// values as `w_j`, `w_jkr_j`, `w_hybrid_j`, kept for one release.
+#[derive(Debug, Clone, Serialize)]
+pub struct DeprecatedLossKeys {
+    /// = `w_j`.
+    pub w_joule: f64,
+    /// = `w_jkr_j`.
+    pub w_jkr_joule: f64,
+    /// = `w_hybrid_j`.
     pub w_hybrid_joule: f64,
 }
 
@@ -202,10 +218,15 @@ impl HysteresisSummary {
                         Support::NewtonsPerMetre(k) => Some(k),
                         _ => None,
                     },
-                    w_joule: headline,
+                    w_j: headline,
                     w_ev: headline / ELECTRONVOLT_J,
-                    w_jkr_joule: w_hat_jkr * scale,
-                    w_hybrid_joule: rigid.w_hat * scale,
+                    w_jkr_j: w_hat_jkr * scale,
+                    w_hybrid_j: rigid.w_hat * scale,
+                    deprecated: DeprecatedLossKeys {
+                        w_joule: headline,
+                        w_jkr_joule: w_hat_jkr * scale,
+                        w_hybrid_joule: rigid.w_hat * scale,
+                    },
                 })
             }
             (Input::TaborMu(_), _) => None,

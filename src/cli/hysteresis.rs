@@ -19,7 +19,8 @@ pub const DEFAULT_MU: f64 = 5.0;
 ///
 /// JSON keys (--json): tabor_mu, alpha_hat_a, a_hat_a, alpha_hat_c, a_hat_c, t_hat_c,
 /// w_hat_hybrid, w_hat_jkr, ...; with a stiffness also k_hat, a_hat_b_spring,
-/// a_hat_c_spring, w_hat_spring; with SI inputs also w_joule, w_ev.
+/// a_hat_c_spring, w_hat_spring; with SI inputs also w_j, w_ev (w_joule, w_jkr_joule, w_hybrid_joule: the
+/// old names of w_j, w_jkr_j, w_hybrid_j, kept for one release).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct HysteresisArgs {

@@ -105,9 +105,9 @@ impl HysteresisSummary {
             let _ = writeln!(
                 s,
                 "  W                            {:.4e} J = {:.4} eV",
-                si.w_joule, si.w_ev
+                si.w_j, si.w_ev
             );
-            let _ = writeln!(s, "  W_JKR                        {:.4e} J", si.w_jkr_joule);
+            let _ = writeln!(s, "  W_JKR                        {:.4e} J", si.w_jkr_j);
         }
         s
     }
