@@ -166,7 +166,7 @@ pub fn fig1() -> Chart {
                 "jump-in O→B",
                 vec![(0.0, 0.0), (0.0, b.t_hat)],
                 Style::Dotted,
-                1,
+                3,
             ),
             Series::new(
                 "jump-out C→D",
@@ -416,7 +416,7 @@ pub fn fig5(tabor_mu: f64, k_hat: f64, jump_in: JumpIn) -> Result<Chart> {
     add_jumps(
         (&mut series, &mut labels),
         [a, b, c, d],
-        (1, 1),
+        (1, 3),
         (0.2, 0.35),
     );
     labels.push(label(
