@@ -352,11 +352,19 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         .collect();
     // (The CSV's law column: the legend's name before its colon.)
     let law_of = |name: &str| name.split(':').next().unwrap_or(name).to_string();
-    let chart = sweep_report::identification_chart(
+    let mut chart = sweep_report::identification_chart(
         "tap_identification",
         "Identification curves (approach, polymer A)",
         &curves,
     );
+    // E/E_max from 0 to its plateau at 1, where the hysteresis and the neck step to
+    // alike: said on the figure, since one line hides the other there.
+    chart.y.range = Some((0.0, 1.1));
+    chart.labels.push(crate::report::chart::Label {
+        text: "hybrid and capillary plateaus coincide at 1".into(),
+        x: 0.4,
+        y: 1.05,
+    });
     add(
         render_stack(out, "tap_identification", std::slice::from_ref(&chart))?,
         "E_ts/E_max vs A/A0 on approach: adhesion hysteresis (hybrid) and a capillary \
