@@ -176,7 +176,8 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
     progress("default tap");
     let setup = default_setup();
     let run = tap(&setup, &Numerics::default(), Observe::recording(3))?;
-    let charts = tap_report::trajectory_charts(&run, "hybrid law, defaults");
+    let charts =
+        tap_report::trajectory_charts(&run, "hybrid law, defaults (z_c = 16 nm, A₀ = 20 nm)");
     add(
         render_stack(out, "tap_trajectory", &charts)?,
         "default tap (hybrid law): deflection, force, force-separation loop",

@@ -145,7 +145,12 @@ pub fn run(args: TapArgs) -> Result<()> {
         output::write_bytes(path, &report::trajectory_csv(&run.trajectory)?)?;
     }
     if let Some(path) = &args.plot {
-        let title = format!("{} law", setup.law);
+        let title = format!(
+            "{} law, z_c = {:.4} nm, A₀ = {:.4} nm",
+            setup.law,
+            setup.separation_m * 1e9,
+            setup.cantilever.free_amplitude_m * 1e9
+        );
         plot::render_stack(&report::trajectory_charts(&run, &title), path)?;
     }
     // Another stable period-1 state at this z_c (a bistable setpoint: the free

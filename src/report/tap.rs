@@ -1,7 +1,7 @@
 //! Reports of a tapping run: a table for people, the trajectory as CSV, and the
 //! trajectory charts (deflection and force vs time, force vs separation).
 
-use super::chart::{Axis, Chart, Corner, Series, Style};
+use super::chart::{Axis, Chart, Corner, Label, Series, Style};
 use super::display::{fixed, sci};
 use crate::dynamics::attractors::Attractor;
 use crate::dynamics::harmonics::Harmonic;
@@ -409,7 +409,25 @@ pub fn trajectory_charts(run: &TapRun, title: &str) -> Vec<Chart> {
         x: x_axis,
         y: Axis::linear("force F_ts (nN, repulsive > 0)", "force_nn"),
         series: loop_series,
-        labels: vec![],
+        // What the orbit gives, beside the loop that gives it (right of the jumps, in
+        // the lower half, clear of the legend and the free branch at F = 0).
+        labels: {
+            let o = &run.observables;
+            let x = reach + 0.05 * span;
+            let y = |share: f64| f_lo + share * (f_hi - f_lo);
+            vec![
+                Label {
+                    text: format!("{}, A/A₀ = {:.4}", o.regime, o.amplitude_ratio),
+                    x,
+                    y: y(0.42),
+                },
+                Label {
+                    text: format!("φ = {:.2}°, E_ts = {} eV", o.phase_deg, fixed(o.e_ts_ev, 2)),
+                    x,
+                    y: y(0.3),
+                },
+            ]
+        },
         legend: Corner::UpperRight,
     };
     let portrait = Chart {
