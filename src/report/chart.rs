@@ -121,6 +121,8 @@ pub enum Corner {
     LowerLeft,
     /// Lower right.
     LowerRight,
+    /// No legend: another panel of the same figure carries it.
+    Hidden,
 }
 
 impl Corner {

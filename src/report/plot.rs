@@ -607,18 +607,22 @@ where
         )))
         .map_err(|e| err(&e))?;
     }
-    let legend = place_legend(&ctx, chart, &clip)?;
-    ctx.configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(160, 160, 160))
-        .label_font(("sans-serif", LEGEND_FONT))
-        .position(SeriesLabelPosition::Coordinate(legend.0, legend.1))
-        .draw()
-        .map_err(|e| err(&e))?;
+    let mut legend_covers = 0;
+    if chart.legend != Corner::Hidden {
+        let legend = place_legend(&ctx, chart, &clip)?;
+        ctx.configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .label_font(("sans-serif", LEGEND_FONT))
+            .position(SeriesLabelPosition::Coordinate(legend.0, legend.1))
+            .draw()
+            .map_err(|e| err(&e))?;
+        legend_covers = legend.2;
+    }
     let area = ctx.plotting_area().get_pixel_range();
     Ok(Drawn {
         area,
-        legend_covers: legend.2,
+        legend_covers,
     })
 }
 

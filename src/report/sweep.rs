@@ -171,7 +171,13 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             )
         },
     );
-    against_separation.chain(against_amplitude).collect()
+    // One legend for the figure, in its first panel: every panel has the same entries
+    // (those without thermal averages a subset).
+    let mut charts: Vec<Chart> = against_separation.chain(against_amplitude).collect();
+    for chart in charts.iter_mut().skip(1) {
+        chart.legend = Corner::Hidden;
+    }
+    charts
 }
 
 /// The identification curves of a sweep ([`crate::identification`]): each mechanism's
@@ -234,13 +240,41 @@ pub fn identification_chart(
 
 /// φ against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999 left out), one series
 /// per labelled curve: the phase-contrast view.
+/// The free oscillation's phase (where the curves start, A/A₀ ≥ 0.999) is drawn across
+/// as the line that parts the branches: attractive above it, repulsive below.
 pub fn phase_vs_amplitude(name: &str, title: &str, curves: &[(&str, &[SweepPoint])]) -> Chart {
-    vs_amplitude(
+    let mut chart = vs_amplitude(
         (name, title),
         Axis::linear("phase lag φ (deg)", "phase_deg"),
         |o| o.phase_deg,
         curves,
-    )
+    );
+    let free = curves.iter().find_map(|(_, points)| {
+        points
+            .iter()
+            .find(|p| p.direction == Direction::Approach && p.observables.amplitude_ratio >= 0.999)
+            .map(|p| p.observables.phase_deg)
+    });
+    let shown = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0));
+    let left = shown.fold(f64::INFINITY, f64::min);
+    if let (Some(free), true) = (free, left.is_finite()) {
+        // Over the last quarter of the curves' span, where they leave it, and with points
+        // along it so the legend keeps clear of it.
+        let from = 1.0 - 0.25 * (1.0 - left);
+        chart.series.push(Series::new(
+            &format!("free phase {free:.1}°: attractive above, repulsive below"),
+            (0..=10)
+                .map(|i| (from + (1.0 - from) * f64::from(i) / 10.0, free))
+                .collect(),
+            Style::Dotted,
+            0,
+        ));
+        chart.legend = Corner::quietest(&chart.series);
+    }
+    chart
 }
 
 /// `pick` of each setpoint against A/A₀ on the approach branch (free points A/A₀ ≥ 0.999
@@ -365,7 +399,13 @@ pub fn not_period_one(points: &[Located]) -> Vec<Series> {
         if !points.iter().any(keep) {
             continue;
         }
-        out.push(Series::new(name, vec![], style, 0));
+        // (With several curves, a marker takes the colour of the curve it belongs to.)
+        let name = if colors.len() > 1 {
+            format!("{name}, in its curve's colour")
+        } else {
+            name.to_string()
+        };
+        out.push(Series::new(&name, vec![], style, 0));
         for &color in &colors {
             let pts: Vec<(f64, f64)> = points
                 .iter()
