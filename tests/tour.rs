@@ -204,3 +204,25 @@ fn a_state_out_of_reach_says_so_and_prints_zeros_as_zero() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no peak-force panels"), "{err}");
 }
+
+/// README ("Built-in defaults of `tapsim tap`"): a stable period-1 orbit found in 11
+/// periods, A/A₀ = 0.9415, φ = 75.739°, E_ts = 20.46 eV, grazing margin 3.77 nm — as
+/// `tap --json` prints them.
+#[test]
+fn the_readme_numbers_of_the_defaults_are_what_tap_prints() {
+    let v = common::json(&["tap", "--json"]);
+    let num = |k: &str| common::num(&v, k);
+    assert_eq!(v["regime"], "period-1");
+    assert_eq!(v["stable"], true);
+    assert_eq!(
+        format!(
+            "{} {:.4} {:.3} {:.2} {:.2}",
+            num("cycles"),
+            num("amplitude_ratio"),
+            num("phase_deg"),
+            num("e_ts_ev"),
+            num("grazing_margin_m") * 1e9
+        ),
+        "11 0.9415 75.739 20.46 3.77"
+    );
+}
