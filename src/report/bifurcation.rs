@@ -47,7 +47,7 @@ pub fn bifurcation_charts(samples: &[PoincareSample], title: &str) -> Vec<Chart>
                         .filter(|s| keep(&s.regime))
                         .map(|s| (s.separation_m * 1e9, pick(s)))
                         .collect();
-                    (!pts.is_empty()).then(|| Series::new(legend, pts, Style::Markers, color))
+                    (!pts.is_empty()).then(|| Series::new(legend, pts, Style::Dots, color))
                 })
                 .collect();
             Chart {

@@ -72,6 +72,9 @@ pub enum Style {
     /// Filled triangles at the points, no line (a fourth kind: values of another kind
     /// of calculation, such as thermal averages beside deterministic states).
     Triangles,
+    /// Small filled dots, no line: clouds of many samples (a bifurcation diagram), whose
+    /// structure larger markers would hide.
+    Dots,
 }
 
 impl Style {
@@ -79,7 +82,7 @@ impl Style {
     pub fn is_marker(self) -> bool {
         matches!(
             self,
-            Style::Markers | Style::Squares | Style::Crosses | Style::Triangles
+            Style::Markers | Style::Squares | Style::Crosses | Style::Triangles | Style::Dots
         )
     }
 }

@@ -554,6 +554,17 @@ where
                         .legend(move |(x, y)| Cross::new((x + 10, y), 5, style));
                 }
             }
+            Style::Dots => {
+                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
+                let filled = color.filled();
+                let anno = ctx
+                    .draw_series(inside.map(|p| Circle::new(p, 2, filled)))
+                    .map_err(|e| err(&e))?;
+                if !series.name.is_empty() {
+                    anno.label(series.name.as_str())
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 4, filled));
+                }
+            }
             Style::Triangles => {
                 let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
                 let filled = color.filled();
