@@ -265,14 +265,10 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
             legend: Corner::UpperRight,
         },
     ];
-    // One legend for the figure, in its first panel: the others have the same entries.
-    for (i, chart) in approach_charts.iter_mut().enumerate() {
-        chart.legend = if i == 0 {
-            Corner::quietest(&chart.series)
-        } else {
-            Corner::Hidden
-        };
+    for chart in &mut approach_charts {
+        chart.legend = Corner::quietest(&chart.series);
     }
+    crate::report::chart::share_legends(&mut approach_charts);
     add(
         render_stack(out, "tap_approach_laws", &approach_charts)?,
         "approach-retract curves for the jkr, hybrid and lj laws (polymer A)",

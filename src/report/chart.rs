@@ -172,6 +172,26 @@ pub struct Label {
     pub y: f64,
 }
 
+/// Give a figure's panels one legend where they share one: a panel whose legend
+/// entries all appear in an earlier panel's legend shows none ([`Corner::Hidden`]), so
+/// the same box is not drawn over the data of every panel.
+pub fn share_legends(charts: &mut [Chart]) {
+    let mut shown: Vec<String> = Vec::new();
+    for chart in charts {
+        let names: Vec<&String> = chart
+            .series
+            .iter()
+            .map(|s| &s.name)
+            .filter(|n| !n.is_empty())
+            .collect();
+        if names.iter().all(|n| shown.contains(n)) {
+            chart.legend = Corner::Hidden;
+        } else {
+            shown.extend(names.into_iter().cloned());
+        }
+    }
+}
+
 /// A complete chart.
 #[derive(Debug, Clone, Serialize)]
 pub struct Chart {

@@ -141,6 +141,18 @@ pub fn contrast_charts(
             ));
         }
     }
+    // Room below the curves for the legend, which would otherwise cover some of them.
+    let (lo, hi) = rows
+        .iter()
+        .filter_map(|r| r.delta_phase_deg)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| {
+            (lo.min(d), hi.max(d))
+        });
+    let span = (hi - lo).max(1.0);
+    let mut delta_axis = Axis::linear("Δφ (deg)", "delta_phase_deg");
+    if lo.is_finite() {
+        delta_axis = delta_axis.with_range(lo - 0.7 * span, hi + 0.05 * span);
+    }
     charts.push(Chart {
         name: "contrast".into(),
         title: format!(
@@ -149,7 +161,7 @@ pub fn contrast_charts(
             materials[0].name
         ),
         x: Axis::linear("amplitude setpoint A/A₀", "amplitude_ratio"),
-        y: Axis::linear("Δφ (deg)", "delta_phase_deg"),
+        y: delta_axis,
         series: laws
             .iter()
             .enumerate()
@@ -165,14 +177,15 @@ pub fn contrast_charts(
                         .filter(|r| r.law == law.to_string() && r.branch == branch)
                         .filter_map(|r| r.delta_phase_deg.map(|d| (r.amplitude_ratio, d)))
                         .collect();
-                    let name = format!("{law}, {}", branch_name(branch));
                     // Markers at the setpoints, circles and squares by turns, so a law
-                    // whose Δφ coincides with another's still shows.
-                    let marks = if i % 2 == 0 {
-                        Style::Markers
+                    // whose Δφ coincides with another's still shows; the legend says
+                    // which.
+                    let (marks, shape) = if i % 2 == 0 {
+                        (Style::Markers, "○")
                     } else {
-                        Style::Squares
+                        (Style::Squares, "□")
                     };
+                    let name = format!("{law} {shape}, {}", branch_name(branch));
                     (!pts.is_empty()).then(|| {
                         [
                             Series::new(&name, pts.clone(), style, i + 1),
@@ -186,6 +199,7 @@ pub fn contrast_charts(
         labels: vec![],
         legend: Corner::UpperRight,
     });
+    super::chart::share_legends(&mut charts);
     charts
 }
 

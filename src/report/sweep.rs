@@ -171,12 +171,8 @@ pub fn approach_charts(points: &[SweepPoint], title: &str) -> Vec<Chart> {
             )
         },
     );
-    // One legend for the figure, in its first panel: every panel has the same entries
-    // (those without thermal averages a subset).
     let mut charts: Vec<Chart> = against_separation.chain(against_amplitude).collect();
-    for chart in charts.iter_mut().skip(1) {
-        chart.legend = Corner::Hidden;
-    }
+    super::chart::share_legends(&mut charts);
     charts
 }
 
