@@ -70,21 +70,26 @@ pub struct TapArgs {
     inputs: TapInputs,
     /// Write the trajectory of the last cycles as CSV (t_s, z_m, v_m_s, alpha_m,
     /// force_n, branch).
-    #[arg(long)]
+    #[arg(long, help_heading = "Output")]
     trajectory: Option<PathBuf>,
     /// Plot deflection and force vs time, the force–separation loop and the phase
     /// portrait (.png or .svg).
-    #[arg(long)]
+    #[arg(long, help_heading = "Output")]
     plot: Option<PathBuf>,
     /// Cycles recorded for --trajectory and --plot.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 3)]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        default_value_t = 3,
+        help_heading = "Output"
+    )]
     record_cycles: usize,
     /// March from N documented starts and list every distinct attractor reached, with
     /// how many starts reached it: 1 the free oscillation (what is reported), 2 the
     /// same at tolerances / 100, 3 rest, 4 and 5 ramps from z_c ± 0.1 A₀, then phases
     /// of the free oscillation. A state that grazes a switch lists its attractors from
     /// 6 starts without it. At most 64.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=64))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=64), help_heading = "Numerics")]
     starts: Option<u64>,
     /// Amplitude setpoint A/A₀ (between 0 and 1), as an AFM's z feedback holds it,
     /// instead of a rest separation: every stable period-1 steady state whose amplitude
@@ -110,10 +115,10 @@ pub struct TapArgs {
     #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
     thermal_periods: usize,
     /// Print one JSON object on stdout instead of the table.
-    #[arg(long)]
+    #[arg(long, help_heading = "Output")]
     json: bool,
     /// No progress or notes of files written on stderr.
-    #[arg(long)]
+    #[arg(long, help_heading = "Output")]
     pub(super) quiet: bool,
 }
 
