@@ -122,6 +122,18 @@ fn check(args: &[String], dir: &Path) {
         if has(args, "--law") && args.iter().any(|a| a == "hybrid") {
             assert!(num("e_ts_adhesion_j") > 0.0, "{what}: no hysteresis");
         }
+        if has(args, "--hamaker") {
+            // "a soft lever tapping; an attractive state coexists"
+            assert!(
+                num("phase_deg") < 90.0,
+                "{what}: not on the repulsive branch"
+            );
+            let others = v["coexisting"].as_array().expect("coexisting");
+            assert!(
+                others.iter().any(|o| o["branch"] == "attractive"),
+                "{what}: no attractive state beside it"
+            );
+        }
     }
     if command == "contrast" && has(args, "--material") {
         let v: serde_json::Value = serde_json::from_str(&run(args, &["--json"], dir)).unwrap();
