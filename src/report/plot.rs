@@ -522,59 +522,45 @@ where
     for series in &chart.series {
         let color = PALETTE[series.color % PALETTE.len()];
         let style = color.stroke_width(2);
+        // A marker style: each point inside the axes drawn by `$at`, the legend entry
+        // (for a named series) by `$legend`.
+        macro_rules! marks {
+            ($at:expr, $legend:expr) => {{
+                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
+                let anno = ctx.draw_series(inside.map($at)).map_err(|e| err(&e))?;
+                if !series.name.is_empty() {
+                    anno.label(series.name.as_str()).legend($legend);
+                }
+            }};
+        }
         match series.style {
-            Style::Markers => {
-                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
-                let anno = ctx
-                    .draw_series(inside.map(|p| Circle::new(p, 5, style)))
-                    .map_err(|e| err(&e))?;
-                if !series.name.is_empty() {
-                    anno.label(series.name.as_str())
-                        .legend(move |(x, y)| Circle::new((x + 10, y), 5, style));
-                }
-            }
-            Style::Squares => {
-                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
-                let square =
-                    move |p| EmptyElement::at(p) + Rectangle::new([(-7, -7), (7, 7)], style);
-                let anno = ctx.draw_series(inside.map(square)).map_err(|e| err(&e))?;
-                if !series.name.is_empty() {
-                    anno.label(series.name.as_str()).legend(move |(x, y)| {
-                        Rectangle::new([(x + 3, y - 7), (x + 17, y + 7)], style)
-                    });
-                }
-            }
-            Style::Crosses => {
-                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
-                let anno = ctx
-                    .draw_series(inside.map(|p| Cross::new(p, 5, style)))
-                    .map_err(|e| err(&e))?;
-                if !series.name.is_empty() {
-                    anno.label(series.name.as_str())
-                        .legend(move |(x, y)| Cross::new((x + 10, y), 5, style));
-                }
-            }
+            Style::Markers => marks!(|p| Circle::new(p, 5, style), move |(x, y)| Circle::new(
+                (x + 10, y),
+                5,
+                style
+            )),
+            Style::Squares => marks!(
+                move |p| EmptyElement::at(p) + Rectangle::new([(-7, -7), (7, 7)], style),
+                move |(x, y)| Rectangle::new([(x + 3, y - 7), (x + 17, y + 7)], style)
+            ),
+            Style::Crosses => marks!(|p| Cross::new(p, 5, style), move |(x, y)| Cross::new(
+                (x + 10, y),
+                5,
+                style
+            )),
             Style::Dots => {
-                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
                 let filled = color.filled();
-                let anno = ctx
-                    .draw_series(inside.map(|p| Circle::new(p, 2, filled)))
-                    .map_err(|e| err(&e))?;
-                if !series.name.is_empty() {
-                    anno.label(series.name.as_str())
-                        .legend(move |(x, y)| Circle::new((x + 10, y), 4, filled));
-                }
+                marks!(|p| Circle::new(p, 2, filled), move |(x, y)| Circle::new(
+                    (x + 10, y),
+                    4,
+                    filled
+                ))
             }
             Style::Triangles => {
-                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
                 let filled = color.filled();
-                let anno = ctx
-                    .draw_series(inside.map(|p| TriangleMarker::new(p, 7, filled)))
-                    .map_err(|e| err(&e))?;
-                if !series.name.is_empty() {
-                    anno.label(series.name.as_str())
-                        .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 7, filled));
-                }
+                marks!(|p| TriangleMarker::new(p, 7, filled), move |(x, y)| {
+                    TriangleMarker::new((x + 10, y), 7, filled)
+                })
             }
             Style::Line | Style::Dashed | Style::Dotted => {
                 let (dash, gap) = match series.style {
