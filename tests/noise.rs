@@ -165,11 +165,7 @@ fn the_linear_theory_matches_the_monte_carlo_on_tapping_orbits() {
 /// cannot read (a bandwidth not far below the drive, a negative temperature).
 #[test]
 fn tap_reports_the_thermal_noise_of_its_orbit() {
-    let json = |args: &[&str]| {
-        let mut all = vec!["tap", "--json"];
-        all.extend_from_slice(args);
-        common::json(&all)
-    };
+    let json = |args: &[&str]| common::json_of(&["tap", "--json"], args);
     let v = json(&["--temperature", "300K", "--enbw", "1kHz"]);
     let noise = &v["thermal_noise"];
     let (p, phase) = {
@@ -301,11 +297,7 @@ fn contrast_weighs_each_phase_difference_against_its_thermal_noise() {
 /// oscillation settles on the same orbit there).
 #[test]
 fn tap_at_a_setpoint_reads_each_states_noise() {
-    let json = |args: &[&str]| {
-        let mut all = vec!["tap", "--json", "--temperature", "300K"];
-        all.extend_from_slice(args);
-        common::json(&all)
-    };
+    let json = |args: &[&str]| common::json_of(&["tap", "--json", "--temperature", "300K"], args);
     let listed = json(&["--setpoint", "0.8"]);
     let states = listed["states"].as_array().unwrap();
     assert_eq!(states.len(), 2);

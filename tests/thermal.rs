@@ -351,11 +351,7 @@ fn the_thermal_averages_errors_are_the_spread_of_seeds() {
 /// orbit away from every switch (the defaults, where the linear noise theory speaks).
 #[test]
 fn tap_averages_a_grazing_state_over_the_thermal_motion() {
-    let json = |args: &[&str]| {
-        let mut all = vec!["tap", "--json", "--temperature", "300K"];
-        all.extend_from_slice(args);
-        common::json(&all)
-    };
+    let json = |args: &[&str]| common::json_of(&["tap", "--json", "--temperature", "300K"], args);
     let v = json(&["--separation", "20nm"]);
     assert_eq!(v["grazing"], true);
     let a = &v["thermal_average"];
@@ -390,21 +386,18 @@ fn tap_averages_a_grazing_state_over_the_thermal_motion() {
 fn approach_averages_the_grazing_points_over_the_thermal_motion() {
     let csv = common::scratch("approach_thermal").join("sweep.csv");
     let csv_arg = csv.to_str().unwrap();
-    let sweep = |extra: &[&str]| {
-        let mut args = vec![
-            "approach",
-            "--from",
-            "20.6nm",
-            "--to",
-            "17nm",
-            "--points",
-            "2",
-            "--no-retract",
-            "--json",
-        ];
-        args.extend_from_slice(extra);
-        common::json(&args)
-    };
+    let head = [
+        "approach",
+        "--from",
+        "20.6nm",
+        "--to",
+        "17nm",
+        "--points",
+        "2",
+        "--no-retract",
+        "--json",
+    ];
+    let sweep = |extra: &[&str]| common::json_of(&head, extra);
     let v = sweep(&[
         "--temperature",
         "300K",

@@ -94,7 +94,6 @@ pub fn thermal_average(
     numerics: &Numerics,
     request: &AverageRequest,
 ) -> Result<ThermalAverage> {
-    request.check()?;
     let p = Prepared::new(setup, numerics)?;
     let sim = p.simulation();
     thermal_average_from(&p, &sim, &sim.free_steady_start(), request)

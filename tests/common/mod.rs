@@ -68,6 +68,12 @@ pub fn tapsim(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// [`json`] of a fixed `head` of arguments followed by `tail`: one command line run
+/// with several variations.
+pub fn json_of(head: &[&str], tail: &[&str]) -> serde_json::Value {
+    json(&[head, tail].concat())
+}
+
 /// Run `args`, asserting success, and read the one JSON object it prints.
 pub fn json(args: &[&str]) -> serde_json::Value {
     let out = tapsim(args);
