@@ -48,7 +48,9 @@ pub struct Manifest {
     pub files: Vec<Entry>,
     /// Ŵ_JKR, eq. (9).
     pub w_hat_jkr: f64,
-    /// Ŵ_LJ(μ = 5) with its error estimate.
+    /// Ŵ_LJ(μ = 5) with its error estimate as `{value, error}`: deprecated, kept for one
+    /// release; `lj_mu5.w_hat` and `lj_mu5.w_hat_error` are the same numbers in the
+    /// convention every other document follows.
     pub w_hat_lj_mu5: lj::Estimate,
     /// Ŵ_hybrid(μ = 5), eq. (18).
     pub w_hat_hybrid_mu5: f64,
@@ -56,6 +58,8 @@ pub struct Manifest {
     pub pull_off_over_jkr_mu5: f64,
     /// The default tap's observables.
     pub default_tap: crate::dynamics::observables::TapObservables,
+    /// The Lennard-Jones solution at μ = 5 (every `tapsim lj --mu 5 --json` key).
+    pub lj_mu5: crate::summary::LjSummary,
 }
 
 fn approach(setup: &TapSetup, law: impl Into<LawSpec>, points: usize) -> Result<Vec<SweepPoint>> {
@@ -547,5 +551,6 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         w_hat_hybrid_mu5: w_h5,
         pull_off_over_jkr_mu5: lj5.pull_off_hat.value / jkr::PULL_OFF_T_HAT,
         default_tap: run.observables.clone(),
+        lj_mu5: crate::summary::LjSummary::new(&lj5),
     })
 }

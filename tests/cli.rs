@@ -332,7 +332,10 @@ fn fig6_csv_holds_the_curves_of_eq_26() {
             let expect = tapsim::contact::spring::hysteresis(5.0, k, Default::default())
                 .unwrap()
                 .w_hat;
-            assert!((w - expect).abs() <= 1e-12 * expect);
+            // To the CSV's 10 significant digits (README, Output conventions): half a unit
+            // of the tenth digit in Ŵ, and as much again through k̂, whose rounding moves
+            // Ŵ by at most as much relatively (|d ln Ŵ/d ln k̂| ≤ 1: Ŵ = Ŵ_rigid + c/k̂).
+            assert!((w - expect).abs() <= 1e-9 * expect, "{k}: {w} {expect}");
             checked += 1;
         }
     }
@@ -348,7 +351,8 @@ fn fig6_csv_holds_the_curves_of_eq_26() {
             if row[0].starts_with("μ = 5,") {
                 let (k, w): (f64, f64) = (row[1].parse().unwrap(), row[2].parse().unwrap());
                 let expect = solution.spring_loop(k).unwrap().w_hat;
-                assert!((w - expect).abs() <= 1e-12 * expect, "{k}: {w} {expect}");
+                // To the CSV's digits, as above.
+                assert!((w - expect).abs() <= 1e-9 * expect, "{k}: {w} {expect}");
             }
         }
     }
@@ -786,7 +790,7 @@ fn contrast_splits_the_dissipation_of_a_viscous_sample() {
         "10",
     ]);
     let mut viscous_seen = 0;
-    for r in v.as_array().unwrap() {
+    for r in &common::rows(&v) {
         let pick = |key: &str| r[key].as_array().unwrap().clone();
         let (all, adhesion, viscous) = (
             pick("e_ts_j"),
@@ -851,7 +855,7 @@ fn contrast_reports_a_row_per_law_and_setpoint() {
         "--material",
         "stiff:sample-modulus=1GPa,work-of-adhesion=80mJ/m^2",
     ]);
-    let rows = v.as_array().unwrap();
+    let rows = &common::rows(&v);
     // A row per law, setpoint and branch on which some material has a steady state.
     assert!(rows.len() >= 4, "{rows:?}");
     for law in ["jkr", "hybrid"] {

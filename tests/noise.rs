@@ -243,14 +243,13 @@ fn contrast_weighs_each_phase_difference_against_its_thermal_noise() {
             "--quiet",
         ]);
         let row = |law: &str, branch: &str| {
-            rows.as_array()
-                .unwrap()
+            common::rows(&rows)
                 .iter()
                 .find(|r| r["law"] == law && r["branch"] == branch)
                 .unwrap()
                 .clone()
         };
-        for r in rows.as_array().unwrap() {
+        for r in &common::rows(&rows) {
             let sigma: Vec<Option<f64>> = r["sigma_phase_deg"]
                 .as_array()
                 .unwrap()

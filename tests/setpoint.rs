@@ -130,7 +130,7 @@ fn contrast_and_tap_at_a_setpoint_agree_and_the_apparent_height_is_the_step_in_z
         "--json",
     ]);
     let tap = json(&["tap", "--setpoint", "0.8", "--json"]);
-    let rows = rows.as_array().unwrap();
+    let rows = &common::rows(&rows);
     assert_eq!(rows.len(), 2, "both branches at 0.8");
     for row in rows {
         // Material A is tap's defaults.
@@ -159,8 +159,7 @@ fn readme_contrast_numbers() {
     // README: Δφ (deg) and Δz_c (nm) between the default polymers at 0.8 and 0.9.
     let rows = json(&["contrast", "--setpoints", "0.9,0.8", "--quiet", "--json"]);
     let row = |law: &str, r: f64, branch: &str| {
-        rows.as_array()
-            .unwrap()
+        common::rows(&rows)
             .iter()
             .find(|x| x["law"] == law && x["amplitude_ratio"] == r && x["branch"] == branch)
             .unwrap_or_else(|| panic!("{law} {r} {branch}"))

@@ -90,6 +90,67 @@ fn every_tour_command_runs_and_shows_its_effect() {
     for args in &merges {
         check(args, &dir);
     }
+    // Every CSV the tour wrote (approach, map, merge, batch, lj, trajectories, …).
+    let mut csvs = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "csv") {
+            assert_clean_csv(&std::fs::read_to_string(&path).unwrap(), &path);
+            csvs += 1;
+        }
+    }
+    assert!(csvs >= 5, "the tour wrote {csvs} CSV files");
+}
+
+/// The CSV files `reproduce` wrote into results/ are as clean as the tour's.
+#[test]
+fn the_results_csv_files_are_clean() {
+    let results = Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
+    let mut csvs = 0;
+    for entry in std::fs::read_dir(&results).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "csv") {
+            assert_clean_csv(&std::fs::read_to_string(&path).unwrap(), &path);
+            csvs += 1;
+        }
+    }
+    assert!(csvs >= 10, "{csvs}");
+}
+
+/// A CSV file holds no JSON in a cell, and every number in it is clean: no negative zero,
+/// no exponent below −30 (round-off as data), at most 10 significant digits (no binary
+/// artefact such as 89.99999999999999 for 90).
+fn assert_clean_csv(text: &str, path: &Path) {
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let header = reader.headers().unwrap().clone();
+    for (row, record) in reader.records().enumerate() {
+        let record = record.unwrap();
+        for (column, cell) in header.iter().zip(record.iter()) {
+            let at = || format!("{}: row {} {column} = {cell:?}", path.display(), row + 1);
+            assert!(!cell.starts_with(['[', '{']), "{}: JSON in a cell", at());
+            if cell.parse::<f64>().is_err() {
+                continue;
+            }
+            let unsigned = cell.trim_start_matches('-');
+            let (mantissa, exponent) = match unsigned.split_once(['e', 'E']) {
+                Some((m, e)) => (m, e.parse::<i32>().unwrap()),
+                None => (unsigned, 0),
+            };
+            let digits: String = mantissa.chars().filter(char::is_ascii_digit).collect();
+            let significant = digits.trim_start_matches('0').trim_end_matches('0');
+            assert!(
+                !(cell.starts_with('-') && significant.is_empty()),
+                "{}: negative zero",
+                at()
+            );
+            assert!(significant.len() <= 10, "{}: float artefact", at());
+            assert!(
+                significant.is_empty() || exponent > -30,
+                "{}: round-off as data",
+                at()
+            );
+        }
+    }
 }
 
 fn check(args: &[String], dir: &Path) {
@@ -137,7 +198,7 @@ fn check(args: &[String], dir: &Path) {
     }
     if command == "contrast" && has(args, "--material") {
         let v: serde_json::Value = serde_json::from_str(&run(args, &["--json"], dir)).unwrap();
-        let rows = v.as_array().expect("rows");
+        let rows = &common::rows(&v);
         let delta = |law: &str, setpoint: f64| {
             rows.iter()
                 .find(|r| {

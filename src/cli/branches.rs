@@ -77,7 +77,7 @@ pub fn run(args: BranchesArgs) -> Result<()> {
         if let serde_json::Value::Object(m) = &mut v {
             m.insert("notes".into(), branch.notes.clone().into());
         }
-        outln!("{}", serde_json::to_string_pretty(&v).expect("serialises"));
+        outln!("{}", crate::report::records::document(&v)?);
         return Ok(());
     }
     let stable = branch

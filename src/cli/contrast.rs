@@ -39,7 +39,8 @@ use clap::Args;
 /// from other motion (a long mode lock, irregular) has no σ: its noise is not that of a
 /// small perturbation.
 ///
-/// JSON (--json): one object per law, setpoint and branch with law, materials,
+/// JSON (--json): columns (one array per key, an entry per law, setpoint and branch,
+/// after format_version): law, materials,
 /// amplitude_ratio, branch, phase_deg, regime, converged, grazing, separation_m, e_ts_j,
 /// e_ts_adhesion_j, e_ts_viscous_j and e_ts_capillary_j (one entry per material, null
 /// where it has no steady state on that branch), delta_phase_deg and
@@ -119,7 +120,7 @@ pub fn run(args: ContrastArgs) -> Result<()> {
     if args.out.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&rows).expect("serialises")
+            crate::report::records::document(&crate::report::records::columns_json(&rows)?)?
         );
     } else {
         out!("{}", report::contrast_text(&args.laws, &rows));

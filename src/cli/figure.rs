@@ -39,7 +39,7 @@ pub struct FigureArgs {
     #[arg(long)]
     json: bool,
     /// No notes of files written on stderr.
-    #[arg(long)]
+    #[arg(long, short = 'q')]
     pub(super) quiet: bool,
 }
 
@@ -91,8 +91,7 @@ pub fn run(args: FigureArgs) -> Result<()> {
     if args.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&serde_json::json!({ "figures": manifest }))
-                .expect("serialises")
+            crate::report::records::document(&serde_json::json!({ "figures": manifest }))?
         );
     }
     Ok(())

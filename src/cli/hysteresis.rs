@@ -44,7 +44,7 @@ pub struct HysteresisArgs {
     #[arg(long)]
     json: bool,
     /// No notes of files written on stderr.
-    #[arg(long)]
+    #[arg(long, short = 'q')]
     pub(super) quiet: bool,
 }
 
@@ -65,10 +65,7 @@ pub fn run(args: HysteresisArgs) -> Result<()> {
     };
     let report = HysteresisSummary::compute(input, support, args.jump_in, mu_is_default)?;
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&report).expect("report serialises")
-        );
+        outln!("{}", crate::report::records::document(&report)?);
     } else {
         out!("{}", report.to_text());
     }

@@ -53,17 +53,14 @@ pub struct LjArgs {
     #[arg(long)]
     json: bool,
     /// No notes of files written on stderr.
-    #[arg(long)]
+    #[arg(long, short = 'q')]
     pub(super) quiet: bool,
 }
 
 /// Print `report` as JSON or as the table `text`.
 fn print(report: &impl serde::Serialize, json: bool, text: String) -> Result<()> {
     if json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(report).expect("report serialises")
-        );
+        outln!("{}", crate::report::records::document(report)?);
     } else {
         out!("{text}");
     }

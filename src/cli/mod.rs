@@ -164,7 +164,7 @@ pub struct SweepOutput {
     #[arg(long)]
     pub json: bool,
     /// No progress report on stderr.
-    #[arg(long)]
+    #[arg(long, short = 'q')]
     pub quiet: bool,
 }
 
@@ -309,9 +309,7 @@ impl SweepOutput {
                 draw(path)?;
             }
         }
-        let text = || -> crate::Result<String> {
-            Ok(serde_json::to_string_pretty(&json()?).expect("serialises"))
-        };
+        let text = || -> crate::Result<String> { crate::report::records::document(&json()?) };
         for path in &json_files {
             output::write_bytes(path, format!("{}\n", text()?).as_bytes())?;
         }
@@ -326,10 +324,7 @@ impl SweepOutput {
     /// Print `records` on stdout as one JSON object of equal-length columns (--json).
     pub fn print_json<T: serde::Serialize>(&self, records: &[T]) -> crate::Result<()> {
         let columns = crate::report::records::columns_json(records)?;
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&columns).expect("serialises")
-        );
+        outln!("{}", crate::report::records::document(&columns)?);
         Ok(())
     }
 }

@@ -11,8 +11,10 @@ use std::path::PathBuf;
 /// The Lennard-Jones solutions are cached (first run: about 20 s).
 ///
 /// Prints the files written, one per line; with --json one object instead: files (file,
-/// what), w_hat_jkr, w_hat_lj_mu5 (value, error), w_hat_hybrid_mu5,
-/// pull_off_over_jkr_mu5 and default_tap (every `tapsim tap --json` key).
+/// what), w_hat_jkr, w_hat_hybrid_mu5, pull_off_over_jkr_mu5, default_tap (every
+/// `tapsim tap --json` key) and lj_mu5 (every `tapsim lj --mu 5 --json` key; the
+/// deprecated w_hat_lj_mu5 {value, error} holds its w_hat and w_hat_error for one more
+/// release).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct ReproduceArgs {
@@ -20,7 +22,7 @@ pub struct ReproduceArgs {
     #[arg(long, default_value = "results")]
     out: PathBuf,
     /// Do not report progress on stderr.
-    #[arg(long)]
+    #[arg(long, short = 'q')]
     pub(super) quiet: bool,
     /// Print the manifest as JSON on stdout.
     #[arg(long)]
@@ -36,10 +38,7 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         }
     })?;
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&manifest).expect("serialises")
-        );
+        outln!("{}", crate::report::records::document(&manifest)?);
     } else {
         for f in &manifest.files {
             outln!("{}", args.out.join(&f.file).display());

@@ -118,7 +118,7 @@ pub struct TapArgs {
     #[arg(long, help_heading = "Output")]
     json: bool,
     /// No progress or notes of files written on stderr.
-    #[arg(long, help_heading = "Output")]
+    #[arg(long, short = 'q', help_heading = "Output")]
     pub(super) quiet: bool,
 }
 
@@ -204,7 +204,7 @@ pub fn run(args: TapArgs) -> Result<()> {
                 );
             }
         }
-        outln!("{}", serde_json::to_string_pretty(&v).expect("serialises"));
+        outln!("{}", crate::report::records::document(&v)?);
     } else {
         out!("{}", report::to_text(&setup, &run));
         out!("{}", report::coexisting_text(&coexisting));
@@ -314,10 +314,7 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
             m.insert("setpoint".into(), ratio.into());
             m.insert("states".into(), listed);
         }
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&top).expect("serialises")
-        );
+        outln!("{}", crate::report::records::document(&top)?);
     } else {
         out!("{}", report::setpoint_text(&setup, ratio, &states));
         for (state, noise) in states.iter().zip(&noise) {

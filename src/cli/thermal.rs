@@ -149,10 +149,7 @@ pub fn run(args: ThermalArgs) -> Result<()> {
     args.out
         .write_files(&bins, || charts(&report, &bins, &spectrum))?;
     if args.out.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&report).expect("serialises")
-        );
+        outln!("{}", crate::report::records::document(&report)?);
         return Ok(());
     }
     outln!(

@@ -213,8 +213,9 @@ pub struct Chart {
 
 impl Chart {
     /// The chart's data as CSV in long form: one row per point, columns
-    /// `series`, x column, y column.
+    /// `series`, x column, y column (numbers as [`super::records::csv_number`]).
     pub fn to_csv(&self) -> Result<Vec<u8>> {
+        use super::records::csv_number;
         let mut w = csv::Writer::from_writer(Vec::new());
         let fail = |e: csv::Error| Error::Output {
             path: format!("{}.csv", self.name).into(),
@@ -224,7 +225,7 @@ impl Chart {
             .map_err(fail)?;
         for s in &self.series {
             for &(x, y) in &s.points {
-                w.write_record([s.name.clone(), x.to_string(), y.to_string()])
+                w.write_record([s.name.clone(), csv_number(x), csv_number(y)])
                     .map_err(fail)?;
             }
         }

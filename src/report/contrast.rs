@@ -51,12 +51,10 @@ pub fn contrast_csv(
     }
     w.write_record(&header).map_err(|e| e.to_string())?;
     for r in rows {
-        // (Debug: the shortest text that reads back the same float, with an exponent for
-        // energies of order 1e-19 J.)
-        let cell = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:?}"));
+        let cell = |x: Option<f64>| x.map_or(String::new(), super::records::csv_number);
         let mut rec = vec![
             r.law.clone(),
-            r.amplitude_ratio.to_string(),
+            super::records::csv_number(r.amplitude_ratio),
             branch_name(r.branch).into(),
         ];
         rec.extend(r.phase_deg.iter().map(|&p| cell(p)));

@@ -121,3 +121,29 @@ pub fn refused(args: &[&str], says: &str) {
     assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
     assert!(err.contains(says), "{args:?}: {err}");
 }
+
+/// The rows of a `--json` document of columns (format_version 2: one array per key, an
+/// entry per row): one object per row, the document's scalars (format_version) left out.
+pub fn rows(doc: &serde_json::Value) -> Vec<serde_json::Value> {
+    let columns: Vec<(&String, &Vec<serde_json::Value>)> = doc
+        .as_object()
+        .expect("a document is an object")
+        .iter()
+        .filter_map(|(k, v)| v.as_array().map(|a| (k, a)))
+        .collect();
+    let n = columns.first().map_or(0, |(_, a)| a.len());
+    assert!(
+        columns.iter().all(|(_, a)| a.len() == n),
+        "columns of unequal length"
+    );
+    (0..n)
+        .map(|i| {
+            serde_json::Value::Object(
+                columns
+                    .iter()
+                    .map(|(k, a)| ((*k).clone(), a[i].clone()))
+                    .collect(),
+            )
+        })
+        .collect()
+}
