@@ -21,6 +21,11 @@ use std::path::{Path, PathBuf};
 /// The laws compared in the tapping figures.
 const LAWS: [LawKind; 3] = [LawKind::Jkr, LawKind::Hybrid, LawKind::Lj];
 
+/// The amplitude setpoint of the phase-contrast figure's marked states (the README's
+/// Δφ), and the setpoints on each of its approach curves (`tapsim contrast`'s default).
+const CONTRAST_SETPOINT: f64 = 0.8;
+const CONTRAST_POINTS: usize = 50;
+
 /// The viscous sample of the identification figure (Pa·s): one that settles on the
 /// repulsive orbit at the defaults (from about 25 Pa·s it does not).
 const IDENTIFICATION_VISCOSITY_PA_S: f64 = 10.0;
@@ -299,25 +304,50 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         "approach-retract curves, both polymers, all three laws",
         &mut entries,
     );
-    // Phase contrast: phase vs A/A₀ on approach for both materials, per law.
+    // Phase contrast: phase vs A/A₀ on approach for both materials, per law, as
+    // `tapsim contrast` computes it, with the states at the setpoint 0.8 and their Δφ.
+    progress("phase contrast at A/A0 = 0.8");
+    let contrast_materials = [
+        "A:sample-modulus=0.5GPa,work-of-adhesion=0.1",
+        "B:sample-modulus=1GPa,work-of-adhesion=0.08",
+    ]
+    .map(|spec| {
+        crate::config::MaterialSpec::parse(spec)?.resolve(&crate::config::TapInputs::default())
+    })
+    .into_iter()
+    .collect::<Result<Vec<_>>>()?;
+    let (rows, law_curves) = crate::contrast::contrast(
+        &contrast_materials,
+        &LAWS,
+        (&[CONTRAST_SETPOINT], CONTRAST_POINTS),
+        None,
+        |_| {},
+    )?;
     let contrast: Vec<Chart> = LAWS
         .iter()
-        .map(|law| {
-            let per_material: Vec<(&str, &[SweepPoint])> = curves
+        .map(|&law| {
+            let named: Vec<(String, &[SweepPoint])> = law_curves
                 .iter()
-                .filter(|(_, l, _)| l == law)
-                .map(|(m, _, pts)| (m.as_str(), pts.as_slice()))
+                .filter(|c| c.law == law)
+                .map(|c| (format!("polymer {}", c.material), c.points.as_slice()))
                 .collect();
-            sweep_report::phase_vs_amplitude(
+            let per_material: Vec<(&str, &[SweepPoint])> =
+                named.iter().map(|(n, p)| (n.as_str(), *p)).collect();
+            let mut chart = sweep_report::phase_vs_amplitude(
                 &format!("contrast_{law}"),
-                &format!("Phase contrast, {law} law"),
+                &format!("{law} law"),
                 &per_material,
-            )
+            );
+            let of_law: Vec<&crate::contrast::ContrastRow> =
+                rows.iter().filter(|r| r.law == law.to_string()).collect();
+            crate::report::contrast::mark_setpoint_states(&mut chart, &of_law);
+            chart
         })
         .collect();
     add(
         render_stack(out, "tap_phase_contrast", &contrast)?,
-        "phase vs A/A0 for polymers A and B under the jkr, hybrid and lj laws",
+        "phase vs A/A0 for polymers A and B under the jkr, hybrid and lj laws, with the \
+         states at A/A0 = 0.8 and their phase contrast",
         &mut entries,
     );
 

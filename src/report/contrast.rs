@@ -285,3 +285,61 @@ pub fn contrast_text(laws: &[LawKind], rows: &[ContrastRow]) -> String {
     }
     s
 }
+
+/// Marks on a φ-against-A/A₀ chart of one law the states `rows` (that law's contrast
+/// rows, at one setpoint) list: each material's state on each branch as a triangle in
+/// its curve's colour (material i in colour i + 1, as the curves), in a square where it
+/// grazes a switch, and Δφ (last material − first) on each branch after the title.
+pub fn mark_setpoint_states(chart: &mut Chart, rows: &[&ContrastRow]) {
+    let Some(first) = rows.first() else {
+        return;
+    };
+    let deltas: Vec<String> = rows
+        .iter()
+        .filter_map(|r| {
+            let d = r.delta_phase_deg?;
+            let sign = if d >= 0.0 { "+" } else { "−" };
+            Some(format!("{sign}{:.2}° {}", d.abs(), branch_name(r.branch)))
+        })
+        .collect();
+    if !deltas.is_empty() {
+        write!(
+            chart.title,
+            ", A/A₀ = {}: Δφ = {}",
+            first.amplitude_ratio,
+            deltas.join(", ")
+        )
+        .expect("a String takes text");
+    }
+    let names = &first.materials;
+    chart.series.push(Series::new(
+        &format!(
+            "state at the setpoint, in its curve's colour (Δφ = {} − {})",
+            names[names.len() - 1],
+            names[0]
+        ),
+        vec![],
+        Style::Triangles,
+        0,
+    ));
+    for (i, _) in names.iter().enumerate() {
+        let at = |grazing: bool| -> Vec<(f64, f64)> {
+            rows.iter()
+                .filter(|r| !grazing || r.grazing[i] == Some(true))
+                .filter_map(|r| r.phase_deg[i].map(|p| (r.amplitude_ratio, p)))
+                .collect()
+        };
+        let (all, grazing) = (at(false), at(true));
+        if !all.is_empty() {
+            chart
+                .series
+                .push(Series::new("", all, Style::Triangles, i + 1));
+        }
+        if !grazing.is_empty() {
+            chart
+                .series
+                .push(Series::new("", grazing, Style::Squares, i + 1));
+        }
+    }
+    chart.legend = Corner::quietest(&chart.series);
+}

@@ -121,11 +121,12 @@ fn stack_size(n: usize, arrange: Arrange) -> (u32, u32) {
 }
 
 /// Drawn into memory and encoded there, then written like any other output: file
-/// errors are told as such, and a PNG can go to a device or a FIFO like a CSV.
+/// errors are told as such, and a PNG can go to a device or a FIFO like a CSV. The
+/// pixels are the SVG's, anti-aliased ([`rasterize_smooth`]).
 fn render_stack_png<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
     use image::ImageEncoder;
-    let (pixels, (width, height), _) =
-        rasterize(panels, arrange).map_err(|reason| fail(path, reason))?;
+    let (pixels, (width, height)) =
+        rasterize_smooth(panels, arrange).map_err(|reason| fail(path, reason))?;
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(&pixels, width, height, image::ColorType::Rgb8)
@@ -134,9 +135,13 @@ fn render_stack_png<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Re
 }
 
 /// RGB pixels, their width and height, and where each panel went.
+#[cfg(test)]
 type Raster = (Vec<u8>, (u32, u32), Vec<Drawn>);
 
-/// `panels` drawn into RGB pixels ([`draw_stack`]).
+/// `panels` drawn into RGB pixels by plotters' bitmap backend ([`draw_stack`]): no
+/// anti-aliasing, so every pixel of a series is exactly its colour (what the layout
+/// tests count).
+#[cfg(test)]
 fn rasterize<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<Raster, String> {
     register_font();
     let (width, height) = stack_size(panels.len(), arrange);
@@ -150,15 +155,55 @@ fn rasterize<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<Ra
     Ok((pixels, (width, height), drawn))
 }
 
-fn render_stack_svg<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
+/// The figure's SVG text ([`draw_stack`] into plotters' SVG backend).
+fn svg_text<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<String, String> {
     register_font();
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, stack_size(panels.len(), arrange))
             .into_drawing_area();
-        draw_stack(panels, &root, arrange).map_err(|reason| fail(path, reason))?;
-        root.present().map_err(|e| fail(path, e.to_string()))?;
+        draw_stack(panels, &root, arrange)?;
+        root.present().map_err(|e| e.to_string())?;
     }
+    Ok(text)
+}
+
+/// `panels` as anti-aliased RGB pixels and their size: the figure's SVG drawn by resvg
+/// on white, its text in the embedded DejaVu Sans (plotters writes `sans-serif`).
+fn rasterize_smooth<P: Panel>(
+    panels: &[P],
+    arrange: Arrange,
+) -> std::result::Result<(Vec<u8>, (u32, u32)), String> {
+    use resvg::{tiny_skia, usvg};
+    let svg = svg_text(panels, arrange)?;
+    let mut fonts = usvg::fontdb::Database::new();
+    fonts.load_font_data(dejavu::sans::regular().to_vec());
+    fonts.set_sans_serif_family("DejaVu Sans");
+    let options = usvg::Options {
+        font_family: "DejaVu Sans".into(),
+        fontdb: std::sync::Arc::new(fonts),
+        ..Default::default()
+    };
+    let tree = usvg::Tree::from_str(&svg, &options).map_err(|e| e.to_string())?;
+    let (width, height) = stack_size(panels.len(), arrange);
+    let mut pixmap = tiny_skia::Pixmap::new(width, height).ok_or("an empty figure")?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(
+        &tree,
+        tiny_skia::Transform::identity(),
+        &mut pixmap.as_mut(),
+    );
+    // Opaque (drawn on white): the premultiplied RGBA is the RGB.
+    let rgb = pixmap
+        .data()
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    Ok((rgb, (width, height)))
+}
+
+fn render_stack_svg<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
+    let text = svg_text(panels, arrange).map_err(|reason| fail(path, reason))?;
     output::write_bytes(path, text.as_bytes())
 }
 
@@ -1049,5 +1094,71 @@ mod tests {
         let clip = Clip::new((0.0, 1.0, false), (0.0, 1.0, false));
         let runs = clip.runs(&[(0.1, 0.5), (0.5, 2.0), (0.9, 0.5), (0.95, 0.5)]);
         assert_eq!(runs.len(), 2);
+    }
+
+    /// The PNG's pixels are the bitmap backend's geometry, anti-aliased and with its
+    /// text. Plotters' bitmap backend blends the edges of a wide line but draws a
+    /// marker's ring mostly pixel by pixel, in its colour or not at all; in the PNG the
+    /// rings' edges are blended into the white (three times the pixels only partly of the
+    /// colour), every
+    /// pixel of the colour lies within two pixels of where the bitmap backend drew it, and
+    /// the title is drawn (the embedded font was found: without it resvg would draw no
+    /// text at all).
+    #[test]
+    fn png_markers_are_anti_aliased_where_the_bitmap_draws_them() {
+        let points: Vec<(f64, f64)> = (1..20)
+            .map(|i| (i as f64 / 20.0, 0.3 * i as f64 / 20.0 + 0.1))
+            .collect();
+        let c = chart(
+            Axis::linear("x", "x").with_range(0.0, 1.0),
+            Axis::linear("y", "y").with_range(0.0, 1.0),
+            vec![Series::new("rings", points, Style::Markers, 2)],
+            Corner::UpperRight,
+        );
+        let color = PALETTE[2];
+        // The share t of the marker's colour over white in a pixel (None: another
+        // colour, to within 3 levels).
+        let coverage = |p: &[u8]| {
+            let t = (255.0 - p[0] as f64) / (255.0 - color.0 as f64);
+            let on_white = [color.0, color.1, color.2].iter().zip(p).all(|(&c, &v)| {
+                let expect = t * c as f64 + (1.0 - t) * 255.0;
+                (expect - v as f64).abs() <= 3.0
+            });
+            (t > 0.05 && on_white).then_some(t.min(1.0))
+        };
+        let (bitmap, (width, height), _) =
+            rasterize(std::slice::from_ref(&c), Arrange::Stack).unwrap();
+        let (smooth, size) = rasterize_smooth(std::slice::from_ref(&c), Arrange::Stack).unwrap();
+        assert_eq!(size, (width, height));
+        let partial = |px: &[u8]| {
+            px.chunks(3)
+                .filter(|p| coverage(p).is_some_and(|t| (0.15..0.85).contains(&t)))
+                .count()
+        };
+        let (soft, hard) = (partial(&smooth), partial(&bitmap));
+        // (668 against 212 when written.)
+        assert!(soft > 2 * hard, "partly covered: {soft} PNG, {hard} bitmap");
+        let pixel = |x: usize, y: usize| &smooth[3 * (y * width as usize + x)..][..3];
+        let title_ink = (0..40)
+            .flat_map(|y| (300..660).map(move |x| (x, y)))
+            .filter(|&(x, y)| pixel(x, y).iter().all(|&v| v < 80))
+            .count();
+        assert!(title_ink > 20, "no title: {title_ink} dark pixels");
+        let line: Vec<(i64, i64)> = bitmap
+            .chunks(3)
+            .enumerate()
+            .filter(|(_, p)| coverage(p).is_some())
+            .map(|(i, _)| ((i as u32 % width) as i64, (i as u32 / width) as i64))
+            .collect();
+        for (i, p) in smooth.chunks(3).enumerate() {
+            if coverage(p).is_some_and(|t| t > 0.3) {
+                let (x, y) = ((i as u32 % width) as i64, (i as u32 / width) as i64);
+                assert!(
+                    line.iter()
+                        .any(|&(u, v)| (u - x).abs() <= 2 && (v - y).abs() <= 2),
+                    "a pixel of a ring at ({x}, {y}) far from the bitmap's"
+                );
+            }
+        }
     }
 }
