@@ -59,6 +59,9 @@ pub enum Error {
         /// What went wrong.
         reason: String,
     },
+    /// The work was asked to stop ([`crate::interrupt`]).
+    #[error("interrupted")]
+    Interrupted,
     /// Standard output was closed by its reader (`tapsim … | head`): not a failure of
     /// tapsim's; the command ends quietly.
     #[error("standard output was closed")]

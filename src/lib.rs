@@ -17,6 +17,7 @@ pub mod dynamics;
 pub mod error;
 pub mod identification;
 pub mod instrument;
+pub mod interrupt;
 pub mod law;
 pub mod numeric;
 pub mod params;

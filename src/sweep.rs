@@ -128,6 +128,7 @@ pub fn approach_curve_at(
     let mut phase = p.simulation().free_steady_start();
     let mut out = Vec::with_capacity(ramp.len());
     for (i, &(separation_m, direction)) in ramp.iter().enumerate() {
+        crate::interrupt::check()?;
         let sim = p.simulation_at(separation_m)?;
         let state = sim.steady_state(&mut phase, &p.steady)?;
         let observables = TapObservables::new(&p, &state)?;
@@ -358,6 +359,7 @@ pub fn map_cells_with(
         cells
             .par_iter()
             .map(|&(w, e)| {
+                crate::interrupt::check()?;
                 let mut s = setup.clone();
                 s.contact.work_of_adhesion_j_m2 = w;
                 s.contact.modulus_pa = e;

@@ -329,9 +329,23 @@ impl SweepOutput {
     }
 }
 
-/// Write to standard output (what the `outln!` macro calls).
+thread_local! {
+    /// What this thread's commands print while [`run_captured`] runs them: collected
+    /// here, not written to standard output.
+    static CAPTURED: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Write to standard output (what the `outln!` macro calls), or to the text
+/// [`run_captured`] collects.
 pub fn emit(text: std::fmt::Arguments) -> crate::Result<()> {
     use std::io::Write;
+    let captured = CAPTURED.with_borrow_mut(|c| {
+        c.as_mut()
+            .map(|s| std::fmt::Write::write_fmt(s, text).is_ok())
+    });
+    if captured.is_some() {
+        return Ok(());
+    }
     let mut stdout = std::io::stdout().lock();
     stdout
         .write_fmt(text)
@@ -343,6 +357,66 @@ pub fn emit(text: std::fmt::Arguments) -> crate::Result<()> {
                 reason: e.to_string(),
             },
         })
+}
+
+/// Why a command run by [`run_captured`] did not succeed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Refused {
+    /// What the command line prints on stderr (without its `error: `).
+    pub message: String,
+    /// Whether the arguments themselves were refused (the command line's exit code 2)
+    /// rather than the run (exit code 1).
+    pub usage: bool,
+}
+
+/// Run `tapsim ARGS` in this process, on this thread, and return what it prints on
+/// standard output: the same parsing, defaults, checks and numbers as the command line
+/// (what the Python package calls, with `--json --quiet`). Progress and notes still go
+/// to stderr unless `--quiet`. A refusal carries the command line's message.
+pub fn run_captured(args: &[String]) -> std::result::Result<String, Refused> {
+    let cli =
+        Cli::try_parse_from(std::iter::once("tapsim".to_string()).chain(args.iter().cloned()))
+            .map_err(|e| Refused {
+                message: e
+                    .render()
+                    .to_string()
+                    .trim_start_matches("error: ")
+                    .trim_end()
+                    .to_string(),
+                usage: e.use_stderr(),
+            })?;
+    crate::lj_cache::install();
+    crate::report::output::announce_writes(cli.command.announces_writes());
+    CAPTURED.with_borrow_mut(|c| *c = Some(String::new()));
+    let outcome = dispatch(cli.command);
+    let text = CAPTURED.with_borrow_mut(Option::take).unwrap_or_default();
+    match outcome {
+        Ok(()) => Ok(text),
+        Err(e) => Err(Refused {
+            message: e.to_string(),
+            usage: false,
+        }),
+    }
+}
+
+/// Run one parsed command.
+fn dispatch(command: Command) -> crate::Result<()> {
+    match command {
+        Command::Tap(args) => tap::run(args),
+        Command::Approach(args) => approach::run(args),
+        Command::Branches(args) => branches::run(args),
+        Command::Bifurcation(args) => bifurcation::run(args),
+        Command::Contrast(args) => contrast::run(args),
+        Command::Map(args) => map::run(args),
+        Command::Scan(args) => scan::run(args),
+        Command::Thermal(args) => thermal::run(args),
+        Command::Batch(args) => batch::run(args),
+        Command::Merge(args) => merge::run(args),
+        Command::Hysteresis(args) => hysteresis::run(args),
+        Command::Lj(args) => lj::run(args),
+        Command::Figure(args) => figure::run(args),
+        Command::Reproduce(args) => reproduce::run(args),
+    }
 }
 
 /// Run the command line with the process arguments; the exit code to return.
@@ -372,22 +446,7 @@ pub fn main() -> ExitCode {
     // Every command names the files it writes on stderr unless --quiet; `reproduce` and
     // `figure` list them on stdout, their output.
     crate::report::output::announce_writes(cli.command.announces_writes());
-    let outcome = match cli.command {
-        Command::Tap(args) => tap::run(args),
-        Command::Approach(args) => approach::run(args),
-        Command::Branches(args) => branches::run(args),
-        Command::Bifurcation(args) => bifurcation::run(args),
-        Command::Contrast(args) => contrast::run(args),
-        Command::Map(args) => map::run(args),
-        Command::Scan(args) => scan::run(args),
-        Command::Thermal(args) => thermal::run(args),
-        Command::Batch(args) => batch::run(args),
-        Command::Merge(args) => merge::run(args),
-        Command::Hysteresis(args) => hysteresis::run(args),
-        Command::Lj(args) => lj::run(args),
-        Command::Figure(args) => figure::run(args),
-        Command::Reproduce(args) => reproduce::run(args),
-    };
+    let outcome = dispatch(cli.command);
     match outcome {
         Ok(()) | Err(crate::Error::StdoutClosed) => ExitCode::SUCCESS,
         Err(e) => {
