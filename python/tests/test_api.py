@@ -1,0 +1,161 @@
+"""The Python package against the command line it wraps, and against closed forms."""
+
+import json
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import tapsim
+
+
+def plain(value):
+    """A result's value as the JSON it came from: arrays as lists, masked entries as
+    None."""
+    if isinstance(value, dict):
+        return {k: plain(v) for k, v in value.items()}
+    if isinstance(value, np.ma.MaskedArray):
+        return [plain(v) for v in value.tolist()]
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, list):
+        return [plain(v) for v in value]
+    return value
+
+
+# The defaults and five other setups, each as keyword arguments and as flags.
+SETUPS = [
+    {},
+    {"law": "jkr", "separation": "14nm"},
+    {"law": "hertz", "separation": "12nm", "viscosity": "50Pa·s"},
+    {"setpoint": 0.8},
+    {"law": "dmt", "hamaker": 1e-19, "stiffness": "2N/m", "resonance": "70kHz",
+     "free_amplitude": "10nm", "separation": "8nm"},
+    {"law": "hybrid", "separation": "20nm", "rupture_distance": "2nm"},
+]
+
+
+def flags(options):
+    out = []
+    for key, value in options.items():
+        out.append(f"--{key.replace('_', '-')}={value if isinstance(value, str) else repr(value)}")
+    return out
+
+
+@pytest.mark.parametrize("options", SETUPS, ids=lambda o: ",".join(o) or "defaults")
+def test_tap_is_the_command_line_bit_for_bit(cli, options):
+    r = tapsim.tap(**options)
+    expected = cli("tap", *flags(options))
+    assert plain(r.to_dict()) == expected
+    # The headline numbers, exactly (== on floats: the same bits).
+    for key in ("amplitude_ratio", "phase_deg", "e_ts_j"):
+        assert r[key] == expected[key]
+        assert isinstance(r[key], float)
+
+
+def test_columns_are_numpy_arrays_with_the_command_lines_values(cli):
+    a = tapsim.approach(points=8)
+    expected = cli("approach", "--points=8")
+    assert isinstance(a.phase_deg, np.ndarray) and a.phase_deg.dtype == np.float64
+    assert a.period.dtype == np.int64 or isinstance(a.period, np.ma.MaskedArray)
+    assert len(a.separation_m) == 16  # approach and retract
+    assert plain(a.to_dict()) == expected
+
+
+def test_a_map_is_2d_with_its_axes_and_the_same_on_any_thread_count(cli):
+    script = (
+        "import json, tapsim; m = tapsim.map(steps=4);"
+        "print(json.dumps({k: (v.tolist() if hasattr(v, 'tolist') else v) "
+        "for k, v in m.grid.items() if k == 'phase_deg'}))"
+    )
+    runs = []
+    for threads in ("1", "2"):
+        env = dict(os.environ, RAYON_NUM_THREADS=threads)
+        out = subprocess.run([sys.executable, "-c", script], env=env,
+                             capture_output=True, text=True, check=True)
+        runs.append(out.stdout)
+    assert runs[0] == runs[1]
+    m = tapsim.map(steps=4)
+    assert m.grid["phase_deg"].shape == (4, 4)
+    assert m.modulus_pa.shape == (4,) and m.work_of_adhesion_j_m2.shape == (4,)
+    assert plain(m.to_dict()) == cli("map", "--steps=4")
+
+
+def test_bad_input_raises_value_error_with_the_command_lines_message(cli):
+    with pytest.raises(ValueError) as e:
+        tapsim.tap(stiffness="-1N/m")
+    stderr = cli("tap", "--stiffness=-1N/m", expect_failure=True)
+    assert stderr.strip() == f"error: {e.value}"
+    with pytest.raises(ValueError, match="unexpected argument '--stifness'"):
+        tapsim.tap(stifness=40)
+    with pytest.raises(ValueError, match="setpoint lies between 0 and 1"):
+        tapsim.contrast(setpoints=[1.5])
+    with pytest.raises(TypeError):
+        tapsim.tap(separation=object())
+
+
+def test_setups_vary_and_run_in_parallel_as_one_by_one():
+    base = tapsim.Setup(law="jkr", separation="14nm")
+    varied = [base.replace(separation=f"{z}nm") for z in (12, 14, 16)]
+    assert base.to_dict()["separation"] == "14nm"  # replace made new ones
+    assert varied[1] == base
+    many = tapsim.tap_many(varied)
+    for setup, result in zip(varied, many):
+        one = tapsim.tap(setup)
+        assert plain(result.to_dict()) == plain(one.to_dict())
+    assert tapsim.tap(base, separation="16nm").phase_deg == many[2].phase_deg
+
+
+def test_a_model_is_tap_as_a_function_of_its_parameters():
+    f = tapsim.model(["separation", "sample_modulus"], law="hertz")
+    values = f(13e-9, 1e9)
+    r = tapsim.tap(law="hertz", separation=13e-9, sample_modulus=1e9)
+    assert values.tolist() == [r.amplitude_ratio, r.phase_deg]
+    with pytest.raises(TypeError):
+        f(13e-9)
+
+
+def test_hysteresis_gives_the_papers_closed_forms():
+    # JKR's pull-off under load control is 3π/2 (eq. 8); its loss per cycle Ŵ_JKR
+    # (eq. 9) does not depend on μ, the hybrid's (18) is below it.
+    h = tapsim.hysteresis(mu=5)
+    assert h.pull_off_hat == pytest.approx(1.5 * math.pi, rel=1e-12)
+    assert h.w_hat_hybrid < h.w_hat_jkr
+    assert tapsim.hysteresis(mu=10).w_hat_jkr == h.w_hat_jkr
+
+
+def test_results_show_their_keys():
+    r = tapsim.tap()
+    assert "phase_deg" in dir(r) and "phase_deg" in r
+    assert r.format_version == 2
+    with pytest.raises(AttributeError, match="has no 'phase'"):
+        r.phase
+    assert "tap" in repr(r)
+
+
+def test_ctrl_c_stops_a_long_map():
+    # A 100 × 100 map takes 20 s on two cores; SIGINT a second in ends it at its next
+    # cell with KeyboardInterrupt, and the process exits well before the map would.
+    import signal
+    import time
+
+    script = (
+        "import sys, tapsim\n"
+        "print('started', flush=True)\n"
+        "try:\n"
+        "    tapsim.map(steps=100)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+        "    sys.exit(3)\n"
+    )
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(1.0)
+    p.send_signal(signal.SIGINT)
+    sent = time.monotonic()
+    out, _ = p.communicate(timeout=60)
+    assert p.returncode == 3 and "interrupted" in out
+    assert time.monotonic() - sent < 10
