@@ -222,19 +222,29 @@ pub fn contrast(
             });
         }
     }
-    let mut curves = Vec::new();
-    for m in materials {
-        let (setup, numerics) = (&m.setup, &m.numerics);
-        let a0 = setup.cantilever.free_amplitude_m;
-        let ramp = sweep::ramp(1.2 * a0, 0.3 * a0, points, false)?;
-        let free_phase_deg = crate::setpoint::free_phase_deg(setup);
-        for &law in laws {
-            progress(&format!("{}, {law}", m.name));
+    // Every material under every law, independently and in parallel (the same curves
+    // on any number of threads), in material-then-law order.
+    use rayon::prelude::*;
+    progress(&format!(
+        "{} materials × {} laws, in parallel",
+        materials.len(),
+        laws.len()
+    ));
+    let pairs: Vec<(&Material, LawKind)> = materials
+        .iter()
+        .flat_map(|m| laws.iter().map(move |&law| (m, law)))
+        .collect();
+    let curves = pairs
+        .par_iter()
+        .map(|&(m, law)| {
+            let (setup, numerics) = (&m.setup, &m.numerics);
+            let a0 = setup.cantilever.free_amplitude_m;
+            let ramp = sweep::ramp(1.2 * a0, 0.3 * a0, points, false)?;
             let s = TapSetup {
                 law: setup.law.with_kind(law),
                 ..setup.clone()
             };
-            curves.push(LawCurve {
+            Ok(LawCurve {
                 material: m.name.clone(),
                 law,
                 points: sweep::approach_curve(&s, numerics, &ramp, |_, _| {})?,
@@ -243,11 +253,11 @@ pub fn contrast(
                     numerics,
                     (1.2 * a0, 0.3 * a0),
                 )?,
-                free_phase_deg,
+                free_phase_deg: crate::setpoint::free_phase_deg(setup),
                 setup: s,
-            });
-        }
-    }
+            })
+        })
+        .collect::<Result<Vec<LawCurve>>>()?;
     let mut rows = Vec::new();
     for &law in laws {
         let of_law: Vec<&LawCurve> = materials

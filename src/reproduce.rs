@@ -201,17 +201,24 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         ("polymer A", setup.contact),
         ("polymer B", second_material()),
     ];
-    let mut curves: Vec<(String, LawKind, Vec<SweepPoint>)> = Vec::new();
-    for (name, contact) in &materials {
-        for law in LAWS {
-            progress(&format!("approach curve, {name}, {law}"));
-            let s = TapSetup {
-                contact: *contact,
-                ..setup.clone()
-            };
-            curves.push((name.to_string(), law, approach(&s, law, 40)?));
-        }
-    }
+    progress("approach curves, polymers A and B, three laws (in parallel)");
+    let curves: Vec<(String, LawKind, Vec<SweepPoint>)> = {
+        use rayon::prelude::*;
+        let pairs: Vec<(&str, Contact, LawKind)> = materials
+            .iter()
+            .flat_map(|&(name, contact)| LAWS.iter().map(move |&law| (name, contact, law)))
+            .collect();
+        pairs
+            .par_iter()
+            .map(|&(name, contact, law)| {
+                let s = TapSetup {
+                    contact,
+                    ..setup.clone()
+                };
+                Ok((name.to_string(), law, approach(&s, law, 40)?))
+            })
+            .collect::<Result<_>>()?
+    };
     let series_for =
         |material: &str, y: fn(&SweepPoint) -> f64, x: fn(&SweepPoint) -> f64| -> Vec<Series> {
             let xy = |p: &SweepPoint| (x(p), y(p));

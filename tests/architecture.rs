@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 /// The library's modules (everything outside the `app` feature).
-const LIBRARY: [&str; 14] = [
+const LIBRARY: [&str; 15] = [
     "src/lib.rs",
     "src/contact",
     "src/contrast.rs",
@@ -14,6 +14,7 @@ const LIBRARY: [&str; 14] = [
     "src/error.rs",
     "src/identification.rs",
     "src/instrument",
+    "src/interrupt.rs",
     "src/law",
     "src/numeric.rs",
     "src/params.rs",

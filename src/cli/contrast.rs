@@ -99,7 +99,7 @@ pub fn run(args: ContrastArgs) -> Result<()> {
         request.as_ref(),
         |what| {
             if !quiet {
-                eprintln!("approach curve: {what}");
+                eprintln!("approach curves and orbit families: {what}");
             }
         },
     )?;
