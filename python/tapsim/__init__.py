@@ -93,12 +93,15 @@ class Result:
         return dict(self._data)
 
     def __repr__(self) -> str:
-        shown = []
-        for key in ("law", "amplitude_ratio", "phase_deg", "e_ts_j", "w_hat", "regime"):
-            if key in self._data and not isinstance(self._data[key], (list, dict, _np.ndarray)):
-                shown.append(f"{key}={self._data[key]!r}")
-        more = len(self._data) - len(shown)
-        return f"<tapsim {self.command}: {', '.join(shown) or 'result'} (+{more} keys)>"
+        scalar = [
+            k for k, v in self._data.items()
+            if k != "format_version" and not isinstance(v, (list, dict, _np.ndarray))
+        ]
+        preferred = ("law", "amplitude_ratio", "phase_deg", "e_ts_j", "w_hat", "regime")
+        keys = [k for k in preferred if k in scalar] or scalar[:4]
+        shown = ", ".join(f"{k}={self._data[k]!r}" for k in keys)
+        more = len(self._data) - len(keys)
+        return f"<tapsim {self.command}: {shown or 'columns'} (+{more} keys)>"
 
 
 def _arrays(value: Any) -> Any:
