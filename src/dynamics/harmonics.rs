@@ -30,7 +30,7 @@ const FREE_PIECES_PER_PERIOD: f64 = 40.0;
 /// first derivatives m₀, m₁ and second derivatives c₀, c₁ at t = 0 and 1 (derivatives
 /// with respect to t), and its derivative there.
 #[inline]
-fn quintic_hermite(
+pub(super) fn quintic_hermite(
     t: f64,
     (p0, m0, c0): (f64, f64, f64),
     (p1, m1, c1): (f64, f64, f64),

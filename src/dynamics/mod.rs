@@ -9,6 +9,7 @@ mod capture;
 pub mod continuation;
 mod dopri5;
 pub mod free;
+pub mod gradient;
 pub mod grazing;
 pub mod harmonics;
 pub mod march;

@@ -3,6 +3,7 @@
 use super::attractors::{Attractor, DEFAULT_STARTS, MAX_STARTS, Start, attractors};
 use super::budget;
 use super::free::FreeFlight;
+use super::gradient::GradientObserver;
 use super::harmonics::{Harmonic, HarmonicsObserver};
 use super::march::CycleIntegrals;
 use super::model::{Coupling, Oscillator, V, X};
@@ -431,6 +432,12 @@ pub struct TapRun {
     /// Harmonics 2…10 of the deflection and the force over the periodic orbit, if asked
     /// for and the motion is periodic (null otherwise).
     pub harmonics: Option<Vec<Harmonic>>,
+    /// The tip–sample force gradient averaged over the periodic orbit, ⟨∂F_ts/∂z⟩ in
+    /// N/m (repulsive force positive; a branch switch's step counted as the gradient it
+    /// is to a small oscillation on top: [`super::gradient`]): what a second eigenmode
+    /// with a small amplitude feels, cot φ₂ = −(Q₂/k₂)⟨∂F_ts/∂z⟩. Null where the harmonics
+    /// are (motion that is not periodic, or not asked for).
+    pub mean_force_gradient_n_m: Option<f64>,
     /// What the grazing margin is compared with ([`TapObservables::grazing`]): the
     /// cantilever's rms thermal deflection at 300 K, √(k_B T/k), in m …
     pub thermal_rms_m: f64,
@@ -506,21 +513,28 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<Ta
     let attractors = (starts > 0)
         .then(|| attractors(setup, numerics, &Start::list(starts)))
         .transpose()?;
-    let harmonics = match state.motion.period() {
+    let (harmonics, mean_force_gradient_n_m) = match state.motion.period() {
         Some(n) if observe.harmonics => {
-            let mut observer = HarmonicsObserver::new(&p.law, p.cpl, p.osc);
+            // Both watch the same n periods of the orbit.
+            let mut observer = (
+                HarmonicsObserver::new(&p.law, p.cpl, p.osc),
+                GradientObserver::new(&p.law, p.cpl, p.osc),
+            );
             for _ in 0..n {
                 budget::budgeted(p.steady.max_steps, || sim.cycle(&mut phase, &mut observer))?;
             }
             let cant = &setup.cantilever;
             let a0 = cant.free_amplitude_m;
-            Some(Harmonic::list(
-                &observer.finish(),
-                a0,
-                cant.stiffness_n_m * a0,
-            ))
+            (
+                Some(Harmonic::list(
+                    &observer.0.finish(),
+                    a0,
+                    cant.stiffness_n_m * a0,
+                )),
+                Some(observer.1.finish() * cant.stiffness_n_m + 0.0),
+            )
         }
-        _ => None,
+        _ => (None, None),
     };
     let mut recorder = Recorder::new(&p.law, p.cpl, p.osc);
     for done in 0..record_cycles {
@@ -549,6 +563,7 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<Ta
             .map(|list| list.len() == 1 || list.iter().all(|a| !a.grazing)),
         attractors,
         harmonics,
+        mean_force_gradient_n_m,
         trajectory: recorder.to_si(&p),
         switch_separations_m: (
             p.law.jump_in_alpha_hat() * scale,

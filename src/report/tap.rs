@@ -180,6 +180,15 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
             ),
         );
     }
+    if let Some(g) = run.mean_force_gradient_n_m {
+        line(
+            "force gradient ⟨∂F_ts/∂z⟩ (orbit)",
+            format!(
+                "{} N/m (what a small second mode feels: cot φ₂ = −Q₂⟨∂F_ts/∂z⟩/k₂)",
+                fixed(g, 4)
+            ),
+        );
+    }
     if o.grazing {
         let _ = writeln!(
             s,
