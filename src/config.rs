@@ -814,6 +814,19 @@ pub struct MaterialSpec {
 }
 
 impl MaterialSpec {
+    /// The two polymers `tapsim contrast` compares when given none (and `reproduce`'s
+    /// phase-contrast figure): A, the `tap` defaults' sample; B, stiffer and less
+    /// adhesive.
+    pub fn defaults() -> Result<Vec<Self>> {
+        [
+            "A:sample-modulus=0.5GPa,work-of-adhesion=0.1",
+            "B:sample-modulus=1GPa,work-of-adhesion=0.08",
+        ]
+        .into_iter()
+        .map(Self::parse)
+        .collect()
+    }
+
     /// Parse `name:key=value,key=value` (keys: the flags' names, values with units),
     /// e.g. `b:sample-modulus=1GPa,work-of-adhesion=0.08`.
     pub fn parse(text: &str) -> Result<Self> {

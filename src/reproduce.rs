@@ -314,15 +314,10 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
     // Phase contrast: phase vs A/A₀ on approach for both materials, per law, as
     // `tapsim contrast` computes it, with the states at the setpoint 0.8 and their Δφ.
     progress("phase contrast at A/A0 = 0.8");
-    let contrast_materials = [
-        "A:sample-modulus=0.5GPa,work-of-adhesion=0.1",
-        "B:sample-modulus=1GPa,work-of-adhesion=0.08",
-    ]
-    .map(|spec| {
-        crate::config::MaterialSpec::parse(spec)?.resolve(&crate::config::TapInputs::default())
-    })
-    .into_iter()
-    .collect::<Result<Vec<_>>>()?;
+    let contrast_materials = crate::config::MaterialSpec::defaults()?
+        .iter()
+        .map(|m| m.resolve(&crate::config::TapInputs::default()))
+        .collect::<Result<Vec<_>>>()?;
     let (rows, law_curves) = crate::contrast::contrast(
         &contrast_materials,
         &LAWS,

@@ -61,8 +61,10 @@ fn to_python<'py>(py: Python<'py>, value: Value) -> PyResult<Bound<'py, PyAny>> 
                 let list = PyList::empty(py);
                 for item in items {
                     let row = PyList::empty(py);
-                    for x in item.as_array().into_iter().flatten() {
-                        row.append(to_python(py, x.clone())?)?;
+                    if let Value::Array(values) = item {
+                        for x in values {
+                            row.append(to_python(py, x)?)?;
+                        }
                     }
                     list.append(row)?;
                 }

@@ -76,10 +76,7 @@ pub fn run(args: ContrastArgs) -> Result<()> {
     let base = args.inputs.with_config()?;
     base.no_setpoint("contrast")?;
     let materials = if args.materials.is_empty() {
-        vec![
-            MaterialSpec::parse("A:sample-modulus=0.5GPa,work-of-adhesion=0.1")?,
-            MaterialSpec::parse("B:sample-modulus=1GPa,work-of-adhesion=0.08")?,
-        ]
+        MaterialSpec::defaults()?
     } else {
         args.materials.clone()
     };

@@ -364,9 +364,6 @@ pub fn emit(text: std::fmt::Arguments) -> crate::Result<()> {
 pub struct Refused {
     /// What the command line prints on stderr (without its `error: `).
     pub message: String,
-    /// Whether the arguments themselves were refused (the command line's exit code 2)
-    /// rather than the run (exit code 1).
-    pub usage: bool,
 }
 
 /// Run `tapsim ARGS` in this process, on this thread, and return what it prints on
@@ -383,7 +380,6 @@ pub fn run_captured(args: &[String]) -> std::result::Result<String, Refused> {
                     .trim_start_matches("error: ")
                     .trim_end()
                     .to_string(),
-                usage: e.use_stderr(),
             })?;
     crate::lj_cache::install();
     crate::report::output::announce_writes(cli.command.announces_writes());
@@ -394,7 +390,6 @@ pub fn run_captured(args: &[String]) -> std::result::Result<String, Refused> {
         Ok(()) => Ok(text),
         Err(e) => Err(Refused {
             message: e.to_string(),
-            usage: false,
         }),
     }
 }

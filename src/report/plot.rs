@@ -175,13 +175,19 @@ fn rasterize_smooth<P: Panel>(
     arrange: Arrange,
 ) -> std::result::Result<(Vec<u8>, (u32, u32)), String> {
     use resvg::{tiny_skia, usvg};
+    // The embedded font's database, built once for every figure of the run.
+    static FONTS: std::sync::OnceLock<std::sync::Arc<usvg::fontdb::Database>> =
+        std::sync::OnceLock::new();
+    let fonts = FONTS.get_or_init(|| {
+        let mut fonts = usvg::fontdb::Database::new();
+        fonts.load_font_data(dejavu::sans::regular().to_vec());
+        fonts.set_sans_serif_family("DejaVu Sans");
+        std::sync::Arc::new(fonts)
+    });
     let svg = svg_text(panels, arrange)?;
-    let mut fonts = usvg::fontdb::Database::new();
-    fonts.load_font_data(dejavu::sans::regular().to_vec());
-    fonts.set_sans_serif_family("DejaVu Sans");
     let options = usvg::Options {
         font_family: "DejaVu Sans".into(),
-        fontdb: std::sync::Arc::new(fonts),
+        fontdb: fonts.clone(),
         ..Default::default()
     };
     let tree = usvg::Tree::from_str(&svg, &options).map_err(|e| e.to_string())?;
