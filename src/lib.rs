@@ -11,6 +11,7 @@
 #![warn(missing_docs)]
 
 // The physics library: no file system, no environment, no command line.
+pub mod bimodal;
 pub mod contact;
 pub mod contrast;
 pub mod dynamics;

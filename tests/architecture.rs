@@ -6,7 +6,8 @@
 use std::path::{Path, PathBuf};
 
 /// The library's modules (everything outside the `app` feature).
-const LIBRARY: [&str; 15] = [
+const LIBRARY: [&str; 16] = [
+    "src/bimodal.rs",
     "src/lib.rs",
     "src/contact",
     "src/contrast.rs",

@@ -14,6 +14,7 @@ pub mod grazing;
 pub mod harmonics;
 pub mod march;
 pub mod model;
+pub mod modes;
 pub mod numeric;
 pub mod observables;
 mod recurrence;

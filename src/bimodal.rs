@@ -1,0 +1,287 @@
+//! Bimodal AFM as an instrument uses it: approach curves of several eigenmodes (each
+//! point continued from the last), the rest separation at which the first mode holds an
+//! amplitude setpoint, and the second mode's phase contrast between materials there
+//! (Lozano & García, PRL 100, 076102, 2008: φ₂ at a fixed A₁/A₀₁ tells materials
+//! apart that φ₁ does not).
+
+use crate::contrast::Material;
+use crate::dynamics::modes::orbit::ModalOrbit;
+use crate::dynamics::modes::{Modal, ModalObservables, ModeSet, modal_steady, prepare};
+use crate::dynamics::setup::{Numerics, Prepared};
+use crate::error::{Error, Result};
+use crate::law::LawKind;
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// One point of a several-mode approach curve.
+#[derive(Debug, Clone, Serialize)]
+pub struct ModalPoint {
+    /// Rest separation z_c, m.
+    pub separation_m: f64,
+    /// The steady state there (none: not found, see `note`).
+    pub state: Option<ModalObservables>,
+    /// Why there is no state.
+    pub note: Option<String>,
+}
+
+/// The prepared setup moved to rest separation `separation_m`.
+fn at_separation(p: &Prepared, separation_m: f64) -> Result<Prepared> {
+    let a0 = p.setup.cantilever.free_amplitude_m;
+    if !(separation_m.is_finite() && separation_m > -a0 && separation_m < 100.0 * a0) {
+        return Err(Error::OutOfRange(format!(
+            "rest separation {separation_m:e} m is outside −A₀ … 100 A₀"
+        )));
+    }
+    let mut q = p.clone();
+    q.cpl.a0 = separation_m / p.setup.contact.separation_scale_m();
+    q.setup.separation_m = separation_m;
+    Ok(q)
+}
+
+/// The steady state at `separation_m`, continued from `from` where given (and started
+/// afresh if that fails).
+fn solve_at(
+    p: &Prepared,
+    modal: &Modal,
+    numerics: &Numerics,
+    separation_m: f64,
+    from: Option<&ModalOrbit>,
+) -> Result<(ModalObservables, ModalOrbit)> {
+    crate::interrupt::check()?;
+    let q = at_separation(p, separation_m)?;
+    if let Some(o) = from {
+        if let Ok(found) = modal_steady(&q, modal, numerics, Some((&o.section, o.branch))) {
+            return Ok(found);
+        }
+    }
+    modal_steady(&q, modal, numerics, None)
+}
+
+/// The approach curve over `separations_m` (taken in the order given, each point started
+/// from the last one's orbit: what a slow approach follows).
+pub fn approach(
+    p: &Prepared,
+    modal: &Modal,
+    numerics: &Numerics,
+    separations_m: &[f64],
+    mut progress: impl FnMut(),
+) -> Result<Vec<ModalPoint>> {
+    let mut last: Option<ModalOrbit> = None;
+    let mut points = Vec::with_capacity(separations_m.len());
+    for &z in separations_m {
+        let found = solve_at(p, modal, numerics, z, last.as_ref());
+        progress();
+        points.push(match found {
+            Ok((state, orbit)) => {
+                last = Some(orbit);
+                ModalPoint {
+                    separation_m: z,
+                    state: Some(state),
+                    note: None,
+                }
+            }
+            Err(Error::Interrupted) => return Err(Error::Interrupted),
+            Err(e) => {
+                last = None;
+                ModalPoint {
+                    separation_m: z,
+                    state: None,
+                    note: Some(e.to_string()),
+                }
+            }
+        });
+    }
+    Ok(points)
+}
+
+/// The first mode's amplitude ratio A₁/A₀₁ of a state.
+pub fn first_ratio(s: &ModalObservables) -> f64 {
+    s.modes[0].amplitude_ratio.unwrap_or(f64::NAN)
+}
+
+/// Points of the coarse approach that looks for the setpoint.
+pub const SETPOINT_SCAN: usize = 24;
+
+/// The stable state at which the first mode's amplitude is `setpoint`·A₀₁ on a slow
+/// approach from z_c = A₀₁(1 + setpoint) (the free oscillation, just out of reach)
+/// towards the sample: a coarse approach of [`SETPOINT_SCAN`] points brackets it, and
+/// bisection of z_c (each point continued from the bracket's far end) finds it to
+/// 1e-6 of the amplitude.
+pub fn at_setpoint(
+    p: &Prepared,
+    modal: &Modal,
+    numerics: &Numerics,
+    setpoint: f64,
+) -> Result<ModalObservables> {
+    if !(setpoint > 0.0 && setpoint < 1.0) {
+        return Err(Error::InvalidParameter {
+            name: "setpoint",
+            value: setpoint,
+            reason: "must lie between 0 and 1 (A₁/A₀₁)",
+        });
+    }
+    let a0 = p.setup.cantilever.free_amplitude_m;
+    let (far, near) = (a0 * (1.0 + setpoint), a0 * (setpoint - 0.5).min(0.0));
+    let mut last: Option<(f64, ModalObservables, ModalOrbit)> = None;
+    for k in 0..SETPOINT_SCAN {
+        let z = far + (near - far) * k as f64 / (SETPOINT_SCAN - 1) as f64;
+        let Ok((state, orbit)) = solve_at(p, modal, numerics, z, last.as_ref().map(|l| &l.2))
+        else {
+            last = None;
+            continue;
+        };
+        let ratio = first_ratio(&state);
+        match last.take() {
+            Some((z_hi, hi, orbit_hi)) if ratio <= setpoint && first_ratio(&hi) > setpoint => {
+                return bisect(p, modal, numerics, setpoint, (z_hi, orbit_hi), z);
+            }
+            _ => last = Some((z, state, orbit)),
+        }
+    }
+    Err(Error::NotApplicable(format!(
+        "the first mode's amplitude does not fall through A₁/A₀₁ = {setpoint} on an \
+         approach from {:.4} nm to {:.4} nm",
+        far * 1e9,
+        near * 1e9
+    )))
+}
+
+fn bisect(
+    p: &Prepared,
+    modal: &Modal,
+    numerics: &Numerics,
+    setpoint: f64,
+    (mut z_hi, mut orbit_hi): (f64, ModalOrbit),
+    mut z_lo: f64,
+) -> Result<ModalObservables> {
+    let mut best = None;
+    for _ in 0..60 {
+        let z = 0.5 * (z_hi + z_lo);
+        let (state, orbit) = solve_at(p, modal, numerics, z, Some(&orbit_hi))?;
+        let ratio = first_ratio(&state);
+        let done = (ratio - setpoint).abs() <= 1e-6 || (z_hi - z_lo).abs() < 1e-16;
+        if ratio > setpoint {
+            z_hi = z;
+            orbit_hi = orbit;
+        } else {
+            z_lo = z;
+        }
+        best = Some(state);
+        if done {
+            break;
+        }
+    }
+    let state = best.expect("bisection ran");
+    if (first_ratio(&state) - setpoint).abs() > 1e-4 {
+        return Err(Error::NotApplicable(format!(
+            "the first mode's amplitude jumps across A₁/A₀₁ = {setpoint} (from {:.5} near \
+             z_c = {:.4} nm): no steady state of the approach holds it",
+            first_ratio(&state),
+            z_hi * 1e9
+        )));
+    }
+    Ok(state)
+}
+
+/// The bimodal phase contrast at one setpoint for one law: each material's state.
+#[derive(Debug, Clone, Serialize)]
+pub struct BimodalRow {
+    /// The law.
+    pub law: String,
+    /// The materials.
+    pub materials: Vec<String>,
+    /// A₁/A₀₁ held.
+    pub setpoint: f64,
+    /// φ₁ of each material (degrees; null where no state holds the setpoint).
+    pub phase1_deg: Vec<Option<f64>>,
+    /// φ₂ of each material (degrees).
+    pub phase2_deg: Vec<Option<f64>>,
+    /// A₂/A₀₂ of each material.
+    pub amplitude2_ratio: Vec<Option<f64>>,
+    /// E_ts per first-mode period of each material (J).
+    pub e_ts_j: Vec<Option<f64>>,
+    /// z_c of each (m).
+    pub separation_m: Vec<Option<f64>>,
+    /// Whether each state is a stable orbit.
+    pub stable: Vec<Option<bool>>,
+    /// φ₁(last) − φ₁(first), degrees.
+    pub delta_phase1_deg: Option<f64>,
+    /// φ₂(last) − φ₂(first), degrees: the bimodal contrast.
+    pub delta_phase2_deg: Option<f64>,
+    /// Why a material has no state.
+    pub notes: Vec<Option<String>>,
+}
+
+/// φ₁ and φ₂ of every material at first-mode setpoint `setpoint` under each law of
+/// `laws` (laws and materials in parallel).
+pub fn contrast(
+    materials: &[Material],
+    set: &ModeSet,
+    laws: &[LawKind],
+    setpoint: f64,
+) -> Result<Vec<BimodalRow>> {
+    let jobs: Vec<(usize, usize)> = (0..laws.len())
+        .flat_map(|l| (0..materials.len()).map(move |m| (l, m)))
+        .collect();
+    let results: Vec<Result<ModalObservables>> = jobs
+        .par_iter()
+        .map(|&(l, m)| {
+            let mut setup = materials[m].setup.clone();
+            setup.law = laws[l].into();
+            let (p, modal) = prepare(&setup, set, &materials[m].numerics)?;
+            at_setpoint(&p, &modal, &materials[m].numerics, setpoint)
+        })
+        .collect();
+    // Bad input or an interruption ends the whole comparison; anything else is a note.
+    if let Some(at) = results
+        .iter()
+        .position(|r| matches!(r, Err(Error::InvalidParameter { .. } | Error::Interrupted)))
+    {
+        return Err(results
+            .into_iter()
+            .nth(at)
+            .expect("found")
+            .expect_err("an error"));
+    }
+    let mut rows = Vec::new();
+    for (l, law) in laws.iter().enumerate() {
+        let of = |m: usize| &results[l * materials.len() + m];
+        let get = |f: &dyn Fn(&ModalObservables) -> f64| {
+            (0..materials.len())
+                .map(|m| of(m).as_ref().ok().map(f))
+                .collect::<Vec<_>>()
+        };
+        let phase1 = get(&|s| s.modes[0].phase_deg);
+        let phase2 = get(&|s| s.modes.get(1).map_or(f64::NAN, |m| m.phase_deg));
+        let delta = |v: &[Option<f64>]| match (v.first(), v.last()) {
+            (Some(Some(a)), Some(Some(b))) if v.len() > 1 => Some(b - a),
+            _ => None,
+        };
+        rows.push(BimodalRow {
+            law: law.to_string(),
+            materials: materials.iter().map(|m| m.name.clone()).collect(),
+            setpoint,
+            delta_phase1_deg: delta(&phase1),
+            delta_phase2_deg: delta(&phase2),
+            phase1_deg: phase1,
+            phase2_deg: phase2,
+            amplitude2_ratio: (0..materials.len())
+                .map(|m| {
+                    of(m)
+                        .as_ref()
+                        .ok()
+                        .and_then(|s| s.modes.get(1).and_then(|m| m.amplitude_ratio))
+                })
+                .collect(),
+            e_ts_j: get(&|s| s.e_ts_j),
+            separation_m: get(&|s| s.separation_m),
+            stable: (0..materials.len())
+                .map(|m| of(m).as_ref().ok().map(|s| s.stable))
+                .collect(),
+            notes: (0..materials.len())
+                .map(|m| of(m).as_ref().err().map(|e| e.to_string()))
+                .collect(),
+        });
+    }
+    Ok(rows)
+}

@@ -1,0 +1,203 @@
+//! The steady state of several eigenmodes: a periodic orbit over the common period,
+//! found by Newton's method on the period map with the exact variational equations
+//! (the saltation at every switch included), marching where Newton does not converge,
+//! and classified by its Floquet multipliers.
+
+use super::system::{Modes, PassTally, phi, plain_len, q, tangent_len, v};
+use crate::dynamics::model::State;
+use crate::error::{Error, Result};
+use crate::law::{Branch, ForceLaw};
+use nalgebra::{DMatrix, DVector};
+
+/// A periodic orbit of the modes over one common period.
+#[derive(Debug, Clone)]
+pub struct ModalOrbit {
+    /// The section state at τ = 0: (q₁, q₁′, q₂, q₂′, …).
+    pub section: Vec<f64>,
+    /// The law's branch at τ = 0.
+    pub branch: Branch,
+    /// The carried integrals over the period (the plain layout's components after the
+    /// section state).
+    pub integrals: Vec<f64>,
+    /// What the pass saw of the contact.
+    pub tally: PassTally,
+    /// Floquet multipliers (re, im).
+    pub multipliers: Vec<[f64; 2]>,
+    /// max |P(z) − z| in units of A₀₁.
+    pub residual: f64,
+    /// Common periods integrated in all.
+    pub periods_integrated: usize,
+}
+
+impl ModalOrbit {
+    /// Whether every multiplier lies inside the unit circle.
+    pub fn stable(&self) -> bool {
+        self.multipliers.iter().all(|m| m[0].hypot(m[1]) < 1.0)
+    }
+}
+
+/// How hard to look.
+#[derive(Debug, Clone, Copy)]
+pub struct OrbitOptions {
+    /// The largest |P(z) − z| accepted (units of A₀₁).
+    pub tolerance: f64,
+    /// Common periods integrated at most.
+    pub max_periods: usize,
+}
+
+/// Common periods marched at most where Newton's method fails.
+const MARCH_PERIODS: usize = 200;
+
+/// Newton iterations at most before marching takes over.
+const NEWTON_ITERATIONS: usize = 40;
+
+impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
+    /// The state of layout `S` with section `z`, zero integrals and Φ = I (if carried).
+    fn start<const S: usize>(z: &[f64]) -> State<S> {
+        let mut y = State::<S>::zeros();
+        y.as_mut_slice()[..2 * M].copy_from_slice(z);
+        if S == tangent_len(M) {
+            for k in 0..2 * M {
+                y[phi(M, k, k)] = 1.0;
+            }
+        }
+        y
+    }
+
+    /// The periodic orbit near `z0` (on `branch0` at τ = 0) over the common period
+    /// `period`; `P` and `T` are the plain and the tangent layouts' lengths.
+    pub fn orbit<const P: usize, const T: usize>(
+        &self,
+        z0: &[f64],
+        branch0: Branch,
+        period: f64,
+        opts: &OrbitOptions,
+    ) -> Result<ModalOrbit> {
+        const { assert!(P == plain_len(M) && T == tangent_len(M)) };
+        let d = 2 * M;
+        let mut z = z0.to_vec();
+        let mut branch = branch0;
+        let mut periods = 0usize;
+        let mut best = f64::INFINITY;
+        // Newton on P(z) − z, each step checked against the residual it leads to.
+        for _ in 0..NEWTON_ITERATIONS {
+            let (y, end_branch, tally) =
+                self.pass::<T>(0.0, Self::start::<T>(&z), branch, period)?;
+            periods += 1;
+            let r: Vec<f64> = (0..d).map(|k| y[k] - z[k]).collect();
+            let residual = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            if end_branch != branch {
+                // Not closed on this branch: go on from where the period ended.
+                z = y.as_slice()[..d].to_vec();
+                branch = end_branch;
+                continue;
+            }
+            if residual <= opts.tolerance {
+                let monodromy = DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)]);
+                return Ok(self.finished(&z, branch, &y, tally, &monodromy, residual, periods));
+            }
+            let jacobian =
+                DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)] - f64::from(row == col));
+            let step = jacobian.lu().solve(&DVector::from_vec(r.clone()));
+            match step {
+                Some(step)
+                    if residual < 1e3 * best.min(1.0) && step.iter().all(|s| s.is_finite()) =>
+                {
+                    // Newton step, limited to a tenth of the free amplitude per mode.
+                    let scale = step.amax().max(0.1) / 0.1;
+                    for k in 0..d {
+                        z[k] -= step[k] / scale;
+                    }
+                }
+                _ => z = y.as_slice()[..d].to_vec(),
+            }
+            best = best.min(residual);
+        }
+        // Marching: the period map applied until it returns within the tolerance (a
+        // while: an orbit Newton's method did not find is rarely one marching finds
+        // soon; high-Q modes settle over thousands of periods).
+        let mut last = f64::INFINITY;
+        let limit = periods + opts.max_periods.min(MARCH_PERIODS);
+        while periods < limit {
+            let (y, end_branch, _) = self.pass::<P>(0.0, Self::start::<P>(&z), branch, period)?;
+            periods += 1;
+            let residual = (0..d).fold(0.0f64, |m, k| m.max((y[k] - z[k]).abs()));
+            z = y.as_slice()[..d].to_vec();
+            let closed = end_branch == branch;
+            branch = end_branch;
+            if closed && residual <= opts.tolerance {
+                let (y, end, tally) = self.pass::<T>(0.0, Self::start::<T>(&z), branch, period)?;
+                let residual = (0..d).fold(0.0f64, |m, k| m.max((y[k] - z[k]).abs()));
+                if end == branch && residual <= 10.0 * opts.tolerance {
+                    let monodromy = DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)]);
+                    return Ok(self.finished(
+                        &z,
+                        branch,
+                        &y,
+                        tally,
+                        &monodromy,
+                        residual,
+                        periods + 1,
+                    ));
+                }
+            }
+            last = residual;
+        }
+        Err(Error::Numerical(format!(
+            "the modes settle on no orbit of the common period: Newton's method did not \
+             converge and {MARCH_PERIODS} periods of marching do not return (last return \
+             distance {last:.2e} A₀₁). The motion is of a longer period or irregular (where \
+             the first mode alone is, `tapsim tap` names it), which several modes are not \
+             reported for"
+        )))
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn finished<const T: usize>(
+        &self,
+        z: &[f64],
+        branch: Branch,
+        y: &State<T>,
+        tally: PassTally,
+        monodromy: &DMatrix<f64>,
+        residual: f64,
+        periods: usize,
+    ) -> ModalOrbit {
+        let multipliers = monodromy
+            .complex_eigenvalues()
+            .iter()
+            .map(|c| [c.re, c.im])
+            .collect();
+        ModalOrbit {
+            section: z.to_vec(),
+            branch,
+            integrals: y.as_slice()[2 * M..plain_len(M)].to_vec(),
+            tally,
+            multipliers,
+            residual,
+            periods_integrated: periods,
+        }
+    }
+}
+
+/// The section state of the free steady oscillation of every mode at τ = 0 (each mode's
+/// linear response to its own drive), the first mode's replaced by `first` if given.
+pub fn free_section<const M: usize>(
+    modes: &[super::set::ModeModel; M],
+    first: Option<(f64, f64)>,
+) -> Vec<f64> {
+    let mut z = vec![0.0; 2 * M];
+    for (i, m) in modes.iter().enumerate() {
+        // q = Re[G f e^{iΩτ}], G = c/(r² − Ω² + i rΩ/Q).
+        let (re, im) = (m.r * m.r - m.omega * m.omega, m.damping * m.omega);
+        let den = re * re + im * im;
+        let (g_re, g_im) = (m.gain * m.drive * re / den, -m.gain * m.drive * im / den);
+        z[q(i)] = g_re;
+        z[v(i)] = -m.omega * g_im;
+    }
+    if let Some((x, v1)) = first {
+        z[0] = x;
+        z[1] = v1;
+    }
+    z
+}
