@@ -99,82 +99,115 @@ pub fn first_ratio(s: &ModalObservables) -> f64 {
     s.modes[0].amplitude_ratio.unwrap_or(f64::NAN)
 }
 
-/// Points of the coarse approach that looks for the setpoint.
+/// Points of the coarse approach that brackets the setpoints.
 pub const SETPOINT_SCAN: usize = 24;
 
-/// The stable state at which the first mode's amplitude is `setpoint`·A₀₁ on a slow
-/// approach from z_c = A₀₁(1 + setpoint) (the free oscillation, just out of reach)
-/// towards the sample: a coarse approach of [`SETPOINT_SCAN`] points brackets it, and
-/// bisection of z_c (each point continued from the bracket's far end) finds it to
-/// 1e-6 of the amplitude.
-pub fn at_setpoint(
+/// The states at which the first mode's amplitude is each of `setpoints` (times A₀₁) on a
+/// slow approach from z_c = A₀₁(1 + the largest setpoint) (the free oscillation, just
+/// out of reach) towards the sample: a coarse approach of [`SETPOINT_SCAN`] points
+/// brackets each, and regula falsi on z_c (each point continued from the bracket's far
+/// end) finds it to 1e-7 of A₁/A₀₁. A setpoint the amplitude jumps across has no state.
+pub fn at_setpoints(
     p: &Prepared,
     modal: &Modal,
     numerics: &Numerics,
-    setpoint: f64,
-) -> Result<ModalObservables> {
-    if !(setpoint > 0.0 && setpoint < 1.0) {
+    setpoints: &[f64],
+) -> Result<Vec<Result<ModalObservables>>> {
+    if let Some(&bad) = setpoints.iter().find(|&&s| !(s > 0.0 && s < 1.0)) {
         return Err(Error::InvalidParameter {
             name: "setpoint",
-            value: setpoint,
+            value: bad,
             reason: "must lie between 0 and 1 (A₁/A₀₁)",
         });
     }
+    let top = setpoints.iter().copied().fold(0.0f64, f64::max);
+    let bottom = setpoints.iter().copied().fold(1.0f64, f64::min);
     let a0 = p.setup.cantilever.free_amplitude_m;
-    let (far, near) = (a0 * (1.0 + setpoint), a0 * (setpoint - 0.5).min(0.0));
-    let mut last: Option<(f64, ModalObservables, ModalOrbit)> = None;
+    let (far, near) = (a0 * (1.0 + top), a0 * (bottom - 0.5).min(0.0));
+    let mut scan: Vec<(f64, f64, ModalOrbit)> = Vec::new();
+    let mut last: Option<ModalOrbit> = None;
     for k in 0..SETPOINT_SCAN {
         let z = far + (near - far) * k as f64 / (SETPOINT_SCAN - 1) as f64;
-        let Ok((state, orbit)) = solve_at(p, modal, numerics, z, last.as_ref().map(|l| &l.2))
-        else {
-            last = None;
-            continue;
-        };
-        let ratio = first_ratio(&state);
-        match last.take() {
-            Some((z_hi, hi, orbit_hi)) if ratio <= setpoint && first_ratio(&hi) > setpoint => {
-                return bisect(p, modal, numerics, setpoint, (z_hi, orbit_hi), z);
+        match solve_at(p, modal, numerics, z, last.as_ref()) {
+            Ok((state, orbit)) => {
+                scan.push((z, first_ratio(&state), orbit.clone()));
+                last = Some(orbit);
             }
-            _ => last = Some((z, state, orbit)),
+            Err(Error::Interrupted) => return Err(Error::Interrupted),
+            Err(_) => last = None,
         }
     }
-    Err(Error::NotApplicable(format!(
-        "the first mode's amplitude does not fall through A₁/A₀₁ = {setpoint} on an \
-         approach from {:.4} nm to {:.4} nm",
-        far * 1e9,
-        near * 1e9
-    )))
+    Ok(setpoints
+        .iter()
+        .map(|&setpoint| {
+            let bracket = scan
+                .windows(2)
+                .find(|w| w[0].1 > setpoint && w[1].1 <= setpoint)
+                .ok_or_else(|| {
+                    Error::NotApplicable(format!(
+                        "the first mode's amplitude does not fall through A₁/A₀₁ = \
+                         {setpoint} on an approach from {:.4} nm to {:.4} nm",
+                        far * 1e9,
+                        near * 1e9
+                    ))
+                })?;
+            let (hi, lo) = (&bracket[0], &bracket[1]);
+            falsi(
+                p,
+                modal,
+                numerics,
+                setpoint,
+                (hi.0, hi.1, hi.2.clone()),
+                (lo.0, lo.1),
+            )
+        })
+        .collect())
 }
 
-fn bisect(
+/// Regula falsi (Illinois) on z_c for A₁/A₀₁ = `setpoint` between `hi` (above it, with
+/// its orbit) and `lo` (at or below).
+fn falsi(
     p: &Prepared,
     modal: &Modal,
     numerics: &Numerics,
     setpoint: f64,
-    (mut z_hi, mut orbit_hi): (f64, ModalOrbit),
-    mut z_lo: f64,
+    (mut z_hi, mut r_hi, mut orbit_hi): (f64, f64, ModalOrbit),
+    (mut z_lo, mut r_lo): (f64, f64),
 ) -> Result<ModalObservables> {
-    let mut best = None;
+    let mut side = 0i8;
+    let mut best: Option<ModalObservables> = None;
     for _ in 0..60 {
-        let z = 0.5 * (z_hi + z_lo);
+        let (f_hi, f_lo) = (r_hi - setpoint, r_lo - setpoint);
+        let z = if f_hi != f_lo {
+            z_hi - f_hi * (z_lo - z_hi) / (f_lo - f_hi)
+        } else {
+            0.5 * (z_hi + z_lo)
+        };
         let (state, orbit) = solve_at(p, modal, numerics, z, Some(&orbit_hi))?;
         let ratio = first_ratio(&state);
-        let done = (ratio - setpoint).abs() <= 1e-6 || (z_hi - z_lo).abs() < 1e-16;
+        let done = (ratio - setpoint).abs() <= 1e-7;
         if ratio > setpoint {
-            z_hi = z;
-            orbit_hi = orbit;
+            (z_hi, r_hi, orbit_hi) = (z, ratio, orbit);
+            if side == 1 {
+                r_lo = setpoint + 0.5 * (r_lo - setpoint);
+            }
+            side = 1;
         } else {
-            z_lo = z;
+            (z_lo, r_lo) = (z, ratio);
+            if side == -1 {
+                r_hi = setpoint + 0.5 * (r_hi - setpoint);
+            }
+            side = -1;
         }
         best = Some(state);
-        if done {
+        if done || (z_hi - z_lo).abs() <= 1e-9 * p.setup.cantilever.free_amplitude_m {
             break;
         }
     }
-    let state = best.expect("bisection ran");
-    if (first_ratio(&state) - setpoint).abs() > 1e-4 {
+    let state = best.expect("regula falsi ran");
+    if (first_ratio(&state) - setpoint).abs() > 1e-5 {
         return Err(Error::NotApplicable(format!(
-            "the first mode's amplitude jumps across A₁/A₀₁ = {setpoint} (from {:.5} near \
+            "the first mode's amplitude jumps across A₁/A₀₁ = {setpoint} (to {:.5} near \
              z_c = {:.4} nm): no steady state of the approach holds it",
             first_ratio(&state),
             z_hi * 1e9
@@ -212,76 +245,69 @@ pub struct BimodalRow {
     pub notes: Vec<Option<String>>,
 }
 
-/// φ₁ and φ₂ of every material at first-mode setpoint `setpoint` under each law of
-/// `laws` (laws and materials in parallel).
+/// φ₁ and φ₂ of every material at each first-mode setpoint under each law of `laws`
+/// (each law and material in parallel), rows by law then setpoint.
 pub fn contrast(
     materials: &[Material],
     set: &ModeSet,
     laws: &[LawKind],
-    setpoint: f64,
+    setpoints: &[f64],
 ) -> Result<Vec<BimodalRow>> {
     let jobs: Vec<(usize, usize)> = (0..laws.len())
         .flat_map(|l| (0..materials.len()).map(move |m| (l, m)))
         .collect();
-    let results: Vec<Result<ModalObservables>> = jobs
+    let results: Vec<Result<Vec<Result<ModalObservables>>>> = jobs
         .par_iter()
         .map(|&(l, m)| {
             let mut setup = materials[m].setup.clone();
             setup.law = laws[l].into();
             let (p, modal) = prepare(&setup, set, &materials[m].numerics)?;
-            at_setpoint(&p, &modal, &materials[m].numerics, setpoint)
+            at_setpoints(&p, &modal, &materials[m].numerics, setpoints)
         })
         .collect();
-    // Bad input or an interruption ends the whole comparison; anything else is a note.
-    if let Some(at) = results
-        .iter()
-        .position(|r| matches!(r, Err(Error::InvalidParameter { .. } | Error::Interrupted)))
-    {
-        return Err(results
-            .into_iter()
-            .nth(at)
-            .expect("found")
-            .expect_err("an error"));
+    let mut states = Vec::with_capacity(results.len());
+    for r in results {
+        states.push(r?);
     }
     let mut rows = Vec::new();
     for (l, law) in laws.iter().enumerate() {
-        let of = |m: usize| &results[l * materials.len() + m];
-        let get = |f: &dyn Fn(&ModalObservables) -> f64| {
-            (0..materials.len())
-                .map(|m| of(m).as_ref().ok().map(f))
-                .collect::<Vec<_>>()
-        };
-        let phase1 = get(&|s| s.modes[0].phase_deg);
-        let phase2 = get(&|s| s.modes.get(1).map_or(f64::NAN, |m| m.phase_deg));
-        let delta = |v: &[Option<f64>]| match (v.first(), v.last()) {
-            (Some(Some(a)), Some(Some(b))) if v.len() > 1 => Some(b - a),
-            _ => None,
-        };
-        rows.push(BimodalRow {
-            law: law.to_string(),
-            materials: materials.iter().map(|m| m.name.clone()).collect(),
-            setpoint,
-            delta_phase1_deg: delta(&phase1),
-            delta_phase2_deg: delta(&phase2),
-            phase1_deg: phase1,
-            phase2_deg: phase2,
-            amplitude2_ratio: (0..materials.len())
-                .map(|m| {
-                    of(m)
-                        .as_ref()
-                        .ok()
-                        .and_then(|s| s.modes.get(1).and_then(|m| m.amplitude_ratio))
-                })
-                .collect(),
-            e_ts_j: get(&|s| s.e_ts_j),
-            separation_m: get(&|s| s.separation_m),
-            stable: (0..materials.len())
-                .map(|m| of(m).as_ref().ok().map(|s| s.stable))
-                .collect(),
-            notes: (0..materials.len())
-                .map(|m| of(m).as_ref().err().map(|e| e.to_string()))
-                .collect(),
-        });
+        for (k, &setpoint) in setpoints.iter().enumerate() {
+            let of = |m: usize| states[l * materials.len() + m][k].as_ref().ok();
+            let each = |f: &dyn Fn(&ModalObservables) -> Option<f64>| {
+                (0..materials.len())
+                    .map(|m| of(m).and_then(f))
+                    .collect::<Vec<_>>()
+            };
+            let phase1 = each(&|s| Some(s.modes[0].phase_deg));
+            let phase2 = each(&|s| s.modes.get(1).map(|m| m.phase_deg));
+            let delta = |v: &[Option<f64>]| match (v.first(), v.last()) {
+                (Some(Some(a)), Some(Some(b))) if v.len() > 1 => Some(b - a),
+                _ => None,
+            };
+            rows.push(BimodalRow {
+                law: law.to_string(),
+                materials: materials.iter().map(|m| m.name.clone()).collect(),
+                setpoint,
+                delta_phase1_deg: delta(&phase1),
+                delta_phase2_deg: delta(&phase2),
+                phase1_deg: phase1,
+                phase2_deg: phase2,
+                amplitude2_ratio: each(&|s| s.modes.get(1).and_then(|m| m.amplitude_ratio)),
+                e_ts_j: each(&|s| Some(s.e_ts_j)),
+                separation_m: each(&|s| Some(s.separation_m)),
+                stable: (0..materials.len())
+                    .map(|m| of(m).map(|s| s.stable))
+                    .collect(),
+                notes: (0..materials.len())
+                    .map(|m| {
+                        states[l * materials.len() + m][k]
+                            .as_ref()
+                            .err()
+                            .map(|e| e.to_string())
+                    })
+                    .collect(),
+            });
+        }
     }
     Ok(rows)
 }

@@ -12,7 +12,9 @@
 //!
 //! Flags override the file; the file overrides the built-in defaults.
 
-use crate::dynamics::setup::{Numerics, TapSetup, default_setup};
+use crate::dynamics::modes::set::MAX_MODES;
+use crate::dynamics::modes::{Eigenmode, ModeSet};
+use crate::dynamics::setup::{Cantilever, Numerics, TapSetup, default_setup};
 use crate::error::{Error, Result};
 use crate::law::{LAW_PARAMS, LawKind, LawParam, LawSpec};
 use crate::params::{self, Contact};
@@ -325,6 +327,13 @@ pub struct TapInputs {
     /// Which branch at the setpoint (`branch`).
     #[arg(skip)]
     pub branch: Option<BranchChoice>,
+    /// A parameter file's eigenmodes (`modes`, `[[mode]]`, `ratio-tolerance`).
+    #[arg(skip)]
+    pub mode_file: ModeFile,
+    /// Whether the command reading these inputs simulates several modes ([`ModeInputs`]);
+    /// if not, a file that asks for them is refused.
+    #[arg(skip)]
+    pub takes_modes: bool,
 }
 
 /// Which branch's states at an amplitude setpoint (`--branch`, a parameter file's
@@ -514,6 +523,10 @@ impl TapInputs {
         })?;
         let mut inputs = Self::default();
         for (key, value) in &table {
+            if matches!(key.as_str(), "modes" | "mode" | "ratio-tolerance") {
+                inputs.mode_file.set(key, value)?;
+                continue;
+            }
             if key == "law" {
                 let name = value.as_str().unwrap_or_default();
                 inputs.law = Some(LawKind::from_name(name).ok_or_else(|| Error::Parse {
@@ -591,6 +604,12 @@ impl TapInputs {
                 base.amplitude_setpoint
             },
             branch: self.branch.or(base.branch),
+            mode_file: if self.mode_file == ModeFile::default() {
+                base.mode_file
+            } else {
+                self.mode_file
+            },
+            takes_modes: self.takes_modes || base.takes_modes,
             rtol: self.rtol.or(base.rtol),
             max_cycles: self.max_cycles.or(base.max_cycles),
             tolerance: self.tolerance.or(base.tolerance),
@@ -648,6 +667,19 @@ impl TapInputs {
     /// The setup and numerics: these inputs over the built-in defaults
     /// ([`default_setup`], [`Numerics::default`]).
     pub fn resolve(&self) -> Result<(TapSetup, Numerics)> {
+        if !self.takes_modes
+            && self
+                .mode_file
+                .count
+                .map_or(!self.mode_file.tables.is_empty(), |n| n > 1)
+        {
+            return Err(Error::NotApplicable(
+                "the parameter file asks for several eigenmodes (`modes`), which this command \
+                 does not simulate: `tapsim tap`, `approach` and `contrast` do (remove \
+                 `modes` from the file for this command)"
+                    .into(),
+            ));
+        }
         let d = default_setup();
         let c = &self.contact;
         let contact = Contact {
@@ -697,6 +729,209 @@ impl TapInputs {
             numerics.max_cycles = n as usize;
         }
         Ok((setup, numerics))
+    }
+}
+
+/// One `[[mode]]` table of a parameter file: a higher mode's values (modes 2, 3 in the
+/// order of the tables), each optional over the rectangular-beam defaults.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ModeTable {
+    /// `stiffness` (N/m).
+    pub stiffness: Option<f64>,
+    /// `resonance` (Hz).
+    pub resonance: Option<f64>,
+    /// `quality`.
+    pub quality: Option<f64>,
+    /// `free-amplitude` (m; 0: not driven).
+    pub free_amplitude: Option<f64>,
+}
+
+/// A parameter file's eigenmodes.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ModeFile {
+    /// `modes`: how many.
+    pub count: Option<usize>,
+    /// `[[mode]]`: modes 2, 3.
+    pub tables: Vec<ModeTable>,
+    /// `ratio-tolerance`.
+    pub ratio_tolerance: Option<f64>,
+}
+
+impl ModeFile {
+    fn set(&mut self, key: &str, value: &toml::Value) -> Result<()> {
+        let bad = |reason: String| Error::Parse {
+            name: "config",
+            text: key.to_string(),
+            reason,
+        };
+        match key {
+            "modes" => {
+                let n = value
+                    .as_integer()
+                    .filter(|n| (1..=MAX_MODES as i64).contains(n))
+                    .ok_or_else(|| {
+                        bad(format!("`modes` is a whole number from 1 to {MAX_MODES}"))
+                    })?;
+                self.count = Some(n as usize);
+            }
+            "ratio-tolerance" => {
+                self.ratio_tolerance = Some(units::parse(
+                    "ratio tolerance",
+                    &value_text(value, key, "config value")?,
+                    Dimension::Dimensionless,
+                )?);
+            }
+            _ => {
+                let tables = value
+                    .as_array()
+                    .filter(|a| a.iter().all(toml::Value::is_table));
+                let tables = tables.ok_or_else(|| {
+                    bad(
+                        "`[[mode]]` tables: one per higher mode (2, then 3), with stiffness, \
+                         resonance, quality and free-amplitude"
+                            .into(),
+                    )
+                })?;
+                if tables.len() >= MAX_MODES {
+                    return Err(bad(format!(
+                        "{} `[[mode]]` tables: modes 2 to {MAX_MODES} have one each",
+                        tables.len()
+                    )));
+                }
+                for table in tables.iter().filter_map(toml::Value::as_table) {
+                    let mut mode = ModeTable::default();
+                    for (k, v) in table {
+                        let (slot, name, dim) = match k.as_str() {
+                            "stiffness" => {
+                                (&mut mode.stiffness, "mode stiffness", Dimension::Stiffness)
+                            }
+                            "resonance" => {
+                                (&mut mode.resonance, "mode resonance", Dimension::Frequency)
+                            }
+                            "quality" => {
+                                (&mut mode.quality, "mode quality", Dimension::Dimensionless)
+                            }
+                            "free-amplitude" => (
+                                &mut mode.free_amplitude,
+                                "mode free amplitude",
+                                Dimension::Length,
+                            ),
+                            other => {
+                                return Err(bad(format!(
+                                    "unknown key `{other}` in a [[mode]] table; known: \
+                                     stiffness, resonance, quality, free-amplitude"
+                                )));
+                            }
+                        };
+                        *slot = Some(units::parse(name, &value_text(v, k, "mode value")?, dim)?);
+                    }
+                    self.tables.push(mode);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The eigenmodes of a simulation (`--modes` and the second mode's flags), over a
+/// parameter file's `modes`, `[[mode]]` and `ratio-tolerance`.
+#[derive(Debug, Clone, Default, Args)]
+pub struct ModeInputs {
+    /// Cantilever eigenmodes simulated together, sharing the tip force [1 to 3;
+    /// default 1]. 2 is bimodal AFM: the first mode taps at the drive frequency while
+    /// the second, driven at its own resonance with a small amplitude, feels the force
+    /// gradient over the first mode's orbit (its phase φ₂ is the compositional
+    /// contrast). Higher modes default to a rectangular beam's (f₂ = 6.267 f₀,
+    /// k₂ = k (f₂/f₀)², Q₂ = Q f₂/f₀, A₀₂ = A₀/40), each overridable; in a parameter
+    /// file: `modes = 2` and a `[[mode]]` table per higher mode (stiffness, resonance,
+    /// quality, free-amplitude).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=3), help_heading = "Eigenmodes")]
+    pub modes: Option<u8>,
+    /// Free amplitude A₀₂ of the second mode at its resonance [m; default A₀/40; 0: not
+    /// driven].
+    #[arg(long, value_name = "A02", allow_hyphen_values = true, value_parser = length, help_heading = "Eigenmodes")]
+    pub drive2_amplitude: Option<f64>,
+    /// Spring constant k₂ of the second mode [N/m; default k (f₂/f₀)²].
+    #[arg(long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Eigenmodes")]
+    pub mode2_stiffness: Option<f64>,
+    /// Resonance f₂ of the second mode [Hz; default 6.267 f₀, a rectangular beam's].
+    #[arg(long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Eigenmodes")]
+    pub mode2_resonance: Option<f64>,
+    /// Quality factor Q₂ of the second mode [default Q f₂/f₀].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Eigenmodes")]
+    pub mode2_quality: Option<f64>,
+    /// How far (relative) a higher mode's resonance may be moved so that it is a
+    /// ratio p/q of the first drive frequency (q ≤ 32), making the motion periodic over
+    /// q drive periods; the frequencies simulated are reported [default 0.005: the
+    /// beam's f₂ = 6.267 f₀ becomes 25/4 f₀].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Eigenmodes")]
+    pub ratio_tolerance: Option<f64>,
+}
+
+impl ModeInputs {
+    /// Mark `inputs` as read by a command that simulates several modes.
+    pub fn taken_by(inputs: &mut TapInputs) {
+        inputs.takes_modes = true;
+    }
+
+    /// The higher modes asked for (none: one mode), flags over `file`, over the
+    /// rectangular-beam defaults of `first`.
+    pub fn mode_set(&self, file: &ModeFile, first: &Cantilever) -> Result<Option<ModeSet>> {
+        let count =
+            self.modes
+                .map(usize::from)
+                .or(file.count)
+                .unwrap_or(if file.tables.is_empty() {
+                    1
+                } else {
+                    1 + file.tables.len()
+                });
+        let second_flags = self.drive2_amplitude.is_some()
+            || self.mode2_stiffness.is_some()
+            || self.mode2_resonance.is_some()
+            || self.mode2_quality.is_some();
+        if count == 1 {
+            if second_flags || self.ratio_tolerance.is_some() {
+                return Err(Error::NotApplicable(
+                    "the second mode's flags (--drive2-amplitude, --mode2-*, \
+                     --ratio-tolerance) need --modes 2 or 3"
+                        .into(),
+                ));
+            }
+            return Ok(None);
+        }
+        let mut set = ModeSet::euler_bernoulli(first, count)?;
+        for (mode, table) in set.higher.iter_mut().zip(&file.tables) {
+            apply(mode, table);
+        }
+        apply(
+            &mut set.higher[0],
+            &ModeTable {
+                stiffness: self.mode2_stiffness,
+                resonance: self.mode2_resonance,
+                quality: self.mode2_quality,
+                free_amplitude: self.drive2_amplitude,
+            },
+        );
+        if let Some(t) = self.ratio_tolerance.or(file.ratio_tolerance) {
+            set.ratio_tolerance = t;
+        }
+        Ok(Some(set))
+    }
+}
+
+fn apply(mode: &mut Eigenmode, table: &ModeTable) {
+    if let Some(k) = table.stiffness {
+        mode.stiffness_n_m = k;
+    }
+    if let Some(f) = table.resonance {
+        mode.resonance_hz = f;
+    }
+    if let Some(q) = table.quality {
+        mode.quality = q;
+    }
+    if let Some(a) = table.free_amplitude {
+        mode.free_amplitude_m = a;
     }
 }
 

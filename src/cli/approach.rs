@@ -71,6 +71,8 @@ pub struct ApproachArgs {
     /// each (after ten decay times of settling), whose spread gives the standard errors.
     #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
     thermal_periods: usize,
+    #[command(flatten)]
+    modes: crate::config::ModeInputs,
 }
 
 /// `--sweep`.
@@ -95,9 +97,18 @@ struct Identified<'a> {
 pub(super) const DEFAULT_POINTS: usize = 60;
 
 /// Run the subcommand.
-pub fn run(args: ApproachArgs) -> Result<()> {
+pub fn run(mut args: ApproachArgs) -> Result<()> {
+    args.inputs.takes_modes = true;
     let start = super::SweepStart::new("approach", args.inputs, &args.range)?;
     let (setup, numerics, (from, to)) = (&start.setup, &start.sweep_numerics, start.range);
+    if let Some(set) = args.modes.mode_set(&start.mode_file, &setup.cantilever)? {
+        use super::modal::refuse;
+        refuse(args.sweep == Sweep::Setpoint, "--sweep setpoint")?;
+        refuse(args.normalize, "--normalize")?;
+        refuse(args.temperature.is_some(), "--temperature")?;
+        let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
+        return super::modal::approach(&start, &set, &ramp, &args.out);
+    }
     let thermal = args.temperature.map(|temperature_k| AverageRequest {
         temperature_k,
         periods: args.thermal_periods,

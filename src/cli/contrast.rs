@@ -69,12 +69,15 @@ pub struct ContrastArgs {
     points: usize,
     #[command(flatten)]
     noise: super::NoiseArgs,
+    #[command(flatten)]
+    modes: crate::config::ModeInputs,
 }
 
 /// Run the subcommand.
 pub fn run(args: ContrastArgs) -> Result<()> {
-    let base = args.inputs.with_config()?;
+    let mut base = args.inputs.with_config()?;
     base.no_setpoint("contrast")?;
+    base.takes_modes = true;
     let materials = if args.materials.is_empty() {
         MaterialSpec::defaults()?
     } else {
@@ -85,6 +88,13 @@ pub fn run(args: ContrastArgs) -> Result<()> {
         .iter()
         .map(|m| m.resolve(&base))
         .collect::<Result<Vec<_>>>()?;
+    if let Some(set) = args
+        .modes
+        .mode_set(&base.mode_file, &materials[0].setup.cantilever)?
+    {
+        super::modal::refuse(args.noise.temperature.is_some(), "--temperature")?;
+        return super::modal::contrast(&materials, &set, &args.laws, &args.setpoints, &args.out);
+    }
     let request = args.noise.request();
     if let Some(request) = &request {
         request.check(materials[0].setup.cantilever.drive_frequency_hz)?;

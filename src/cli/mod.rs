@@ -27,6 +27,7 @@ mod hysteresis;
 mod lj;
 mod map;
 mod merge;
+mod modal;
 mod reproduce;
 mod scan;
 mod shard;
@@ -125,6 +126,8 @@ pub struct SweepStart {
     pub sweep_numerics: crate::dynamics::setup::Numerics,
     /// (from, to) in m.
     pub range: (f64, f64),
+    /// The parameter file's eigenmodes.
+    pub mode_file: crate::config::ModeFile,
 }
 
 impl SweepStart {
@@ -144,6 +147,7 @@ impl SweepStart {
             numerics,
             sweep_numerics,
             range,
+            mode_file: inputs.mode_file,
         })
     }
 }

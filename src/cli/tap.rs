@@ -108,6 +108,8 @@ pub struct TapArgs {
     branch: Option<BranchChoice>,
     #[command(flatten)]
     noise: super::NoiseArgs,
+    #[command(flatten)]
+    modes: crate::config::ModeInputs,
     /// Drive periods a --temperature run averages over where the deterministic state
     /// grazes a switch or is not a stable period-1 orbit: eight independent records of
     /// an eighth each (after ten decay times of settling), whose spread gives the
@@ -124,14 +126,28 @@ pub struct TapArgs {
 
 /// Run the subcommand.
 pub fn run(args: TapArgs) -> Result<()> {
-    let inputs =
+    let mut inputs =
         args.inputs
             .clone()
             .holding(args.setpoint, args.amplitude_setpoint, args.branch)?;
+    inputs.takes_modes = true;
+    let (setup, numerics) = inputs.resolve()?;
+    if let Some(set) = args.modes.mode_set(&inputs.mode_file, &setup.cantilever)? {
+        use super::modal::refuse;
+        refuse(args.trajectory.is_some(), "--trajectory")?;
+        refuse(args.plot.is_some(), "--plot")?;
+        refuse(args.starts.is_some(), "--starts")?;
+        refuse(args.noise.temperature.is_some(), "--temperature")?;
+        refuse(inputs.branch.is_some(), "--branch")?;
+        if inputs.holds_setpoint() && inputs.separation.is_some() {
+            return Err(super::separation_and_setpoint());
+        }
+        let ratio = inputs.setpoint_ratio(setup.cantilever.free_amplitude_m);
+        return super::modal::tap(&setup, &numerics, &set, ratio, args.json);
+    }
     if inputs.holds_setpoint() {
         return at_setpoint(&args, inputs);
     }
-    let (setup, numerics) = inputs.resolve()?;
     let wants_trajectory = args.trajectory.is_some() || args.plot.is_some();
     let record = if wants_trajectory {
         args.record_cycles.max(1)

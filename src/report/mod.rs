@@ -10,6 +10,7 @@ pub mod heatmap;
 pub mod hysteresis;
 pub mod lj;
 pub mod map;
+pub mod modes;
 pub mod output;
 pub mod part;
 pub mod plot;

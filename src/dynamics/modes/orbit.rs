@@ -143,7 +143,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             }
             last = residual;
         }
-        Err(Error::Numerical(format!(
+        Err(Error::NotApplicable(format!(
             "the modes settle on no orbit of the common period: Newton's method did not \
              converge and {MARCH_PERIODS} periods of marching do not return (last return \
              distance {last:.2e} A₀₁). The motion is of a longer period or irregular (where \

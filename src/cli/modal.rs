@@ -1,0 +1,137 @@
+//! The several-mode forms of `tap`, `approach` and `contrast` (`--modes 2` or 3).
+
+use crate::bimodal;
+use crate::contrast::Material;
+use crate::dynamics::modes::{ModeSet, modal_steady, prepare};
+use crate::dynamics::setup::{Numerics, TapSetup};
+use crate::error::{Error, Result};
+use crate::law::LawKind;
+use crate::report::modes as report;
+use crate::sweep::Direction;
+
+/// Refuse `flag` (given when `given`) with several modes.
+pub(super) fn refuse(given: bool, flag: &str) -> Result<()> {
+    if given {
+        return Err(Error::NotApplicable(format!(
+            "{flag} is for one mode; with --modes 2 or 3 tapsim reports the several-mode \
+             orbit's lock-in amplitudes, phases and energies per mode"
+        )));
+    }
+    Ok(())
+}
+
+/// `tap --modes N`: the steady state at the rest separation, or at the first mode's
+/// amplitude setpoint `setpoint` (A₁/A₀₁) as a slow approach reaches it.
+pub(super) fn tap(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    set: &ModeSet,
+    setpoint: Option<f64>,
+    json: bool,
+) -> Result<()> {
+    let (p, modal) = prepare(setup, set, numerics)?;
+    let state = match setpoint {
+        None => modal_steady(&p, &modal, numerics, None)?.0,
+        Some(s) => bimodal::at_setpoints(&p, &modal, numerics, &[s])?
+            .pop()
+            .expect("one setpoint asked")?,
+    };
+    if json {
+        let mut v = serde_json::to_value(&state).expect("observables serialise");
+        if let (serde_json::Value::Object(m), Some(s)) = (&mut v, setpoint) {
+            m.insert("setpoint".into(), s.into());
+        }
+        outln!("{}", crate::report::records::document(&v)?);
+    } else {
+        if let Some(s) = setpoint {
+            outln!("first-mode setpoint A₁/A₀₁ = {s}: the state a slow approach reaches there");
+        }
+        out!("{}", report::tap_text(set, &state));
+    }
+    Ok(())
+}
+
+/// `approach --modes N`: the approach (and retract) curve, each point continued from the
+/// last.
+pub(super) fn approach(
+    start: &super::SweepStart,
+    set: &ModeSet,
+    ramp: &[(f64, Direction)],
+    out: &super::SweepOutput,
+) -> Result<()> {
+    let (p, modal) = prepare(&start.setup, set, &start.sweep_numerics)?;
+    let bar = out.progress_bar(ramp.len());
+    let separations: Vec<f64> = ramp.iter().map(|r| r.0).collect();
+    let points = bimodal::approach(&p, &modal, &start.sweep_numerics, &separations, || {
+        bar.inc(1)
+    })?;
+    bar.finish_and_clear();
+    let points: Vec<_> = points.into_iter().zip(ramp.iter().map(|r| r.1)).collect();
+    let rows = report::rows(&points);
+    let title = format!("{} law, {} modes", start.setup.law, set.count());
+    out.write_files(&rows, || report::approach_charts(&rows, &title))?;
+    if out.json {
+        return out.print_json(&rows);
+    }
+    outln!(
+        "{:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>11} {:>8} {:>7}",
+        "z_c (nm)",
+        "dir",
+        "A1/A01",
+        "phi1 (deg)",
+        "A2/A02",
+        "phi2 (deg)",
+        "E_ts (eV)",
+        "contact",
+        "stable"
+    );
+    let f = |v: Option<f64>, p: usize| v.map_or("-".into(), |v| format!("{v:.p$}"));
+    for r in &rows {
+        outln!(
+            "{:>9.3} {:>9} {:>10} {:>10} {:>10} {:>10} {:>11} {:>8} {:>7}",
+            r.separation_m * 1e9,
+            r.direction,
+            f(r.amplitude1_ratio, 6),
+            f(r.phase1_deg, 4),
+            f(r.amplitude2_ratio, 6),
+            f(r.phase2_deg, 4),
+            f(r.e_ts_j.map(|e| e / crate::params::ELECTRONVOLT_J), 4),
+            f(r.contact_fraction, 3),
+            r.stable.map_or("-", |s| if s { "yes" } else { "NO" })
+        );
+    }
+    for r in rows.iter().filter(|r| r.note.is_some()) {
+        outln!(
+            "note: z_c = {:.3} nm ({}): {}",
+            r.separation_m * 1e9,
+            r.direction,
+            r.note.as_deref().unwrap_or_default()
+        );
+    }
+    Ok(())
+}
+
+/// `contrast --modes N`: φ₁ and φ₂ of each material at each first-mode setpoint.
+pub(super) fn contrast(
+    materials: &[Material],
+    set: &ModeSet,
+    laws: &[LawKind],
+    setpoints: &[f64],
+    out: &super::SweepOutput,
+) -> Result<()> {
+    let spinner = out.progress_bar(1);
+    let rows = bimodal::contrast(materials, set, laws, setpoints);
+    spinner.finish_and_clear();
+    let rows = rows?;
+    let names: Vec<String> = laws.iter().map(ToString::to_string).collect();
+    out.write_files(&rows, || report::contrast_charts(&rows, &names))?;
+    if out.json {
+        outln!(
+            "{}",
+            crate::report::records::document(&crate::report::records::columns_json(&rows)?)?
+        );
+    } else {
+        out!("{}", report::contrast_text(&rows));
+    }
+    Ok(())
+}
