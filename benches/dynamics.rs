@@ -333,7 +333,25 @@ fn noise(c: &mut Criterion) {
     group.finish();
 }
 
+/// A bimodal `tap` on the defaults (a beam's second mode, A₀₂ = A₀/40; the issue's
+/// target 20 ms): the one-mode orbit, then Newton's method on the common period of four
+/// drive periods, and the observables; and a third mode on top.
+fn modes(c: &mut Criterion) {
+    use tapsim::dynamics::modes::{ModeSet, tap_modes};
+    let setup = default_setup();
+    let numerics = Numerics::default();
+    let mut group = c.benchmark_group("modes");
+    group.sample_size(20);
+    for count in [2, 3] {
+        let set = ModeSet::euler_bernoulli(&setup.cantilever, count).expect("defaults");
+        group.bench_function(format!("tap --modes {count}, defaults"), |b| {
+            b.iter(|| tap_modes(&setup, &set, &numerics).expect("steady state"))
+        });
+    }
+    group.finish();
+}
+
 criterion_group!(
-    benches, bench, settle, map, setpoint, march, scan_line, noise
+    benches, bench, settle, map, setpoint, march, scan_line, noise, modes
 );
 criterion_main!(benches);

@@ -333,7 +333,9 @@ fn the_several_mode_solver_agrees_with_the_brute_force_march() {
 
 /// The small-amplitude limit against the several-mode solver: φ₂ − 90° of a beam's
 /// second mode (Euler–Bernoulli defaults, A₀₂ = 0.1 nm) against cot φ₂ =
-/// −(Q₂/k₂)⟨∂F_ts/∂z⟩ over the one-mode orbit (tapsim's `mean_force_gradient_n_m`).
+/// −(Q₂/k₂)⟨∂F_ts/∂z⟩ over the one-mode orbit (tapsim's `mean_force_gradient_n_m`):
+/// within 2 % as the issue asks, and within what README states (0.7 % for Hertz,
+/// 1.3 % for the hybrid law).
 #[test]
 fn the_several_mode_phase_meets_the_small_amplitude_limit() {
     use tapsim::dynamics::modes::{ModeSet, tap_modes};
@@ -344,9 +346,9 @@ fn the_several_mode_phase_meets_the_small_amplitude_limit() {
                 separation_m: 12e-9,
                 ..default_setup()
             },
-            0.02,
+            0.007,
         ),
-        (default_setup(), 0.02),
+        (default_setup(), 0.013),
     ] {
         let run = tap(
             &setup,

@@ -65,7 +65,7 @@ class Result:
 
     def __init__(self, command: str, data: Dict[str, Any]):
         self.command = command
-        self._data = {k: _arrays(v) for k, v in data.items()}
+        self._data = {k: _modes(v) if k == "modes" else _arrays(v) for k, v in data.items()}
 
     def __getattr__(self, key: str) -> Any:
         try:
@@ -128,6 +128,23 @@ def _arrays(value: Any) -> Any:
     if rows:
         data, mask = data.reshape(len(value), -1), mask.reshape(len(value), -1)
     return _np.ma.masked_array(data, mask=mask)
+
+
+def _modes(value: Any) -> Any:
+    """A several-mode state's `modes` (one object per mode) as columns, like a sweep's:
+    ``r.modes.phase_deg[1]`` is the second mode's phase."""
+    if not (isinstance(value, list) and value and all(isinstance(x, dict) for x in value)):
+        return _arrays(value)
+    return Result("modes", {k: _column([x[k] for x in value]) for k in value[0]})
+
+
+def _column(values: List[Any]) -> Any:
+    """A column of one object list: float64 (or int64) where every entry is a number,
+    as `_arrays` does otherwise."""
+    if all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in values):
+        kind = _np.int64 if all(isinstance(x, int) for x in values) else _np.float64
+        return _np.array(values, dtype=kind)
+    return _arrays(values)
 
 
 def _flag(key: str) -> str:

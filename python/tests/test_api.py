@@ -147,3 +147,16 @@ def test_ctrl_c_stops_a_long_map():
     out, _ = p.communicate(timeout=60)
     assert p.returncode == 3 and "interrupted" in out
     assert time.monotonic() - sent < 10
+
+
+def test_a_bimodal_state_gives_each_modes_values_as_columns(cli):
+    r = tapsim.tap(modes=2, drive2_amplitude="0.3nm")
+    expected = cli("tap", "--modes=2", "--drive2-amplitude=0.3nm")
+    assert r.common_period_periods == expected["common_period_periods"] == 4
+    for key in ("amplitude_ratio", "phase_deg", "e_exchange_j", "energy_balance_rel"):
+        column = r.modes[key]
+        assert isinstance(column, np.ndarray) and column.dtype == np.float64
+        assert column.tolist() == [m[key] for m in expected["modes"]]
+    assert r.modes.mode.tolist() == [1, 2]
+    # Energy goes round: what the tip force does on the modes is what the contact takes.
+    assert abs(r.modes.e_exchange_j.sum() + r.e_ts_j) <= 1e-6 * r.modes.e_drive_j.sum()

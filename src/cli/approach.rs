@@ -22,6 +22,12 @@ use clap::Args;
 /// there, as an instrument reads it (`tapsim tap --temperature` at that z_c, started
 /// from the sweep's state): E_ts, φ, A/A₀ and the touch fraction with standard errors.
 ///
+/// With --modes 2 (or 3), each point is the several-mode orbit (`tapsim tap --modes`),
+/// continued from the last: columns amplitude1_ratio, phase1_deg, amplitude2_ratio,
+/// phase2_deg, e_ts_j, e_tip1_j, e_tip2_j, contact_fraction, stable, note; --plot draws
+/// φ₁ and φ₂ against A₁/A₀₁ (Lozano & García's plot), the amplitudes and E_ts against
+/// z_c, with gaps where the modes have no orbit of their common period.
+///
 /// Per point: the steady-state observables of `tapsim tap`. Output: a table on stdout,
 /// or --json (one object of equal-length arrays: separation_m, direction, amplitude_m,
 /// amplitude_ratio, phase_deg, e_ts_j, virial_j, mean_force_n, peak_force_n, converged,

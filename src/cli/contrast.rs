@@ -31,6 +31,13 @@ use clap::Args;
 /// setpoint. The table names the motion behind every φ and compares JKR's contrast with
 /// the other laws', branch by branch.
 ///
+/// Bimodal contrast (--modes 2): with a second eigenmode driven at its resonance, the
+/// state a slow approach reaches at each first-mode setpoint A₁/A₀₁, per material and
+/// law; the table gives φ₁ and φ₂ of each material and their contrasts Δφ₁ and Δφ₂
+/// (JSON and CSV: law, materials, setpoint, phase1_deg, phase2_deg, amplitude2_ratio,
+/// e_ts_j, separation_m, stable, delta_phase1_deg, delta_phase2_deg, notes); --plot
+/// draws Δφ₂ and Δφ₁ against the setpoint, a colour per law.
+///
 /// Can a contrast be seen? With --temperature (and --enbw, --lockin-order) each φ on a
 /// stable period-1 orbit gets its thermal noise σ_φ, the standard deviation a lock-in
 /// of that bandwidth reads (the linear theory about the orbit, as `tap --temperature`),

@@ -52,6 +52,17 @@ use std::path::PathBuf;
 /// from six documented starts and lists every attractor reached, with how many starts
 /// reached each, and says whether the answer is well defined (--starts N for any state).
 ///
+/// Several eigenmodes (--modes 2 or 3; bimodal AFM): the higher modes, driven at their
+/// own resonances with small amplitudes (a rectangular beam's by default: f₂ = 6.267 f₀,
+/// A₀₂ = A₀/40), share the tip force; each mode's lock-in amplitude and phase, the
+/// energy its drive puts in, its damping takes and the tip force exchanges with it,
+/// over the common period (a higher mode's frequency is moved within --ratio-tolerance
+/// to p/q times the drive's, and the table says by how much). `--setpoint` then holds
+/// the first mode's A₁/A₀₁, at the state a slow approach reaches. JSON: the keys of the
+/// orbit (e_ts_j, contact_fraction, floquet_multipliers, stable, …) and `modes`, one
+/// object per mode (amplitude_ratio, phase_deg, e_drive_j, e_damp_j, e_exchange_j,
+/// virial_j, energy_balance_rel, …).
+///
 /// JSON keys (--json): amplitude_m, amplitude_ratio, phase_deg, phase_from_energy_deg,
 /// e_ts_j, e_ts_ev, e_ts_adhesion_j, e_ts_viscous_j and e_ts_capillary_j (E_ts by
 /// mechanism), e_damp_j, e_drive_j, energy_balance_rel, virial_j, mean_force_n,

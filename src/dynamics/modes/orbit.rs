@@ -5,6 +5,7 @@
 
 use super::system::{Modes, PassTally, phi, plain_len, q, tangent_len, v};
 use crate::dynamics::model::State;
+use crate::dynamics::numeric::Tolerances;
 use crate::error::{Error, Result};
 use crate::law::{Branch, ForceLaw};
 use nalgebra::{DMatrix, DVector};
@@ -48,6 +49,13 @@ pub struct OrbitOptions {
 /// Common periods marched at most where Newton's method fails.
 const MARCH_PERIODS: usize = 200;
 
+/// How much looser the tolerances of the period map are far from the orbit.
+const COARSE: f64 = 100.0;
+
+/// The return distance (units of A₀₁) below which the period map is taken at the
+/// tolerances.
+const FINE_WITHIN: f64 = 1e-5;
+
 /// Newton iterations at most before marching takes over.
 const NEWTON_ITERATIONS: usize = 40;
 
@@ -80,9 +88,24 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
         let mut periods = 0usize;
         let mut best = f64::INFINITY;
         // Newton on P(z) − z, each step checked against the residual it leads to.
+        // Far from the orbit the period map is taken at COARSE times the tolerances (an
+        // inexact Newton step is as good there); near it, and for what is reported, at
+        // the tolerances.
+        let coarse = Modes {
+            modes: self.modes,
+            law: self.law,
+            cpl: self.cpl,
+            tol: Tolerances {
+                rtol: self.tol.rtol * COARSE,
+                atol: self.tol.atol * COARSE,
+                h_max: self.tol.h_max,
+            },
+        };
         for _ in 0..NEWTON_ITERATIONS {
+            let fine = best <= FINE_WITHIN;
+            let map = if fine { self } else { &coarse };
             let (y, end_branch, tally) =
-                self.pass::<T>(0.0, Self::start::<T>(&z), branch, period)?;
+                map.pass::<T>(0.0, Self::start::<T>(&z), branch, period)?;
             periods += 1;
             let r: Vec<f64> = (0..d).map(|k| y[k] - z[k]).collect();
             let residual = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -92,7 +115,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 branch = end_branch;
                 continue;
             }
-            if residual <= opts.tolerance {
+            if fine && residual <= opts.tolerance {
                 let monodromy = DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)]);
                 return Ok(self.finished(&z, branch, &y, tally, &monodromy, residual, periods));
             }

@@ -1,0 +1,219 @@
+//! Several eigenmodes from the command line: `tap`, `approach` and `contrast` with
+//! `--modes`, parameter files with `[[mode]]` tables, refusals, and the README's
+//! numbers.
+
+mod common;
+use common::{json, num, refused, rows, scratch, tapsim};
+
+#[test]
+fn one_mode_is_todays_model_byte_for_byte() {
+    let plain = tapsim(&["tap", "--json"]);
+    let one = tapsim(&["tap", "--modes", "1", "--json"]);
+    assert!(plain.status.success());
+    assert_eq!(plain.stdout, one.stdout);
+}
+
+#[test]
+fn bimodal_tap_reports_every_mode_and_the_readme_numbers() {
+    let v = json(&["tap", "--modes", "2", "--json"]);
+    assert_eq!(num(&v, "format_version"), 2.0);
+    assert_eq!(num(&v, "common_period_periods"), 4.0);
+    let modes = v["modes"].as_array().expect("a list of modes");
+    assert_eq!(modes.len(), 2);
+    for (i, m) in modes.iter().enumerate() {
+        assert_eq!(num(m, "mode"), (i + 1) as f64);
+        for key in [
+            "resonance_hz",
+            "drive_frequency_hz",
+            "stiffness_n_m",
+            "quality",
+            "free_amplitude_m",
+            "amplitude_m",
+            "amplitude_ratio",
+            "phase_deg",
+            "e_drive_j",
+            "e_damp_j",
+            "e_exchange_j",
+            "virial_j",
+            "energy_balance_rel",
+        ] {
+            assert!(m[key].is_number(), "{key} of mode {}", i + 1);
+        }
+        assert!(num(m, "energy_balance_rel") <= 1e-6);
+    }
+    // README: φ₁ = 75.775°, A₂/A₀₂ = 0.4955 and φ₂ = 29.73° on the defaults; the second
+    // mode at 1.875 MHz (25/4 f₀, the beam's 1.880 MHz moved by −0.27 %); E_ts 20.46 eV.
+    assert!((num(&modes[0], "phase_deg") - 75.775).abs() < 5e-4);
+    assert!((num(&modes[1], "amplitude_ratio") - 0.4955).abs() < 5e-5);
+    assert!((num(&modes[1], "phase_deg") - 29.73).abs() < 5e-3);
+    assert_eq!(num(&modes[1], "resonance_hz"), 1.875e6);
+    assert!((num(&v, "e_ts_ev") - 20.46).abs() < 5e-3);
+    assert_eq!(v["stable"], true);
+    // The table says the same.
+    let text = String::from_utf8(tapsim(&["tap", "--modes", "2"]).stdout).unwrap();
+    assert!(
+        text.contains("1875.000000 kHz simulated (-0.270 %"),
+        "{text}"
+    );
+    assert!(text.contains("29.7323"), "{text}");
+}
+
+#[test]
+fn a_parameter_files_modes_are_its_flags() {
+    let dir = scratch("modes");
+    let cfg = dir.join("bimodal.toml");
+    std::fs::write(
+        &cfg,
+        "modes = 2\nratio-tolerance = 0.001\n[[mode]]\nquality = 500\nfree-amplitude = \"0.2 nm\"\n",
+    )
+    .unwrap();
+    let from_file = json(&["tap", "--config", cfg.to_str().unwrap(), "--json"]);
+    let from_flags = json(&[
+        "tap",
+        "--modes",
+        "2",
+        "--ratio-tolerance",
+        "0.001",
+        "--mode2-quality",
+        "500",
+        "--drive2-amplitude",
+        "0.2nm",
+        "--json",
+    ]);
+    assert_eq!(from_file, from_flags);
+    assert_eq!(num(&from_file, "common_period_periods"), 11.0);
+    assert_eq!(num(&from_file["modes"][1], "quality"), 500.0);
+    // A command that does not simulate several modes refuses the file.
+    refused(
+        &["map", "--config", cfg.to_str().unwrap()],
+        "asks for several eigenmodes",
+    );
+    // Flags win over the file: one mode.
+    let one = json(&[
+        "tap",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--modes",
+        "1",
+        "--json",
+    ]);
+    assert!(one.get("modes").is_none());
+    for (toml, says) in [
+        ("modes = 7\n", "whole number from 1 to 3"),
+        (
+            "[[mode]]\nfoo = 1\n",
+            "unknown key `foo` in a [[mode]] table",
+        ),
+        ("mode = 3\n", "`[[mode]]` tables"),
+    ] {
+        std::fs::write(&cfg, toml).unwrap();
+        refused(&["tap", "--config", cfg.to_str().unwrap()], says);
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn several_modes_refuse_what_they_do_not_report() {
+    refused(
+        &["tap", "--modes", "2", "--plot", "x.png"],
+        "--plot is for one mode",
+    );
+    refused(
+        &["tap", "--modes", "2", "--temperature", "300K"],
+        "--temperature is for one mode",
+    );
+    refused(&["tap", "--drive2-amplitude", "1nm"], "need --modes 2 or 3");
+    let out = tapsim(&["tap", "--modes", "4"]);
+    assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("1..=3"));
+    refused(
+        &["tap", "--modes", "2", "--mode2-quality", "-3"],
+        "mode quality factor",
+    );
+    refused(
+        &["tap", "--modes", "2", "--mode2-resonance", "310kHz"],
+        "must be ordered",
+    );
+    refused(
+        &[
+            "tap",
+            "--modes",
+            "2",
+            "--mode2-resonance",
+            "1.88312345MHz",
+            "--ratio-tolerance",
+            "1e-9",
+        ],
+        "no common denominator",
+    );
+    refused(
+        &["approach", "--modes", "2", "--sweep", "setpoint"],
+        "--sweep setpoint is for one mode",
+    );
+    refused(
+        &["tap", "--modes", "2", "--law", "hertz", "--viscosity", "1"],
+        "rate-independent",
+    );
+}
+
+#[test]
+fn a_bimodal_approach_lists_both_phases() {
+    let dir = scratch("modes-approach");
+    let csv = dir.join("a.csv");
+    let v = json(&[
+        "approach",
+        "--modes",
+        "2",
+        "--points",
+        "4",
+        "--from",
+        "16nm",
+        "--to",
+        "10nm",
+        "--no-retract",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--json",
+        "-q",
+    ]);
+    let points = rows(&v);
+    assert_eq!(points.len(), 4);
+    let mut last = f64::INFINITY;
+    for p in &points {
+        let a1 = num(p, "amplitude1_ratio");
+        assert!(a1 < last, "the amplitude falls on approach");
+        last = a1;
+        assert!(
+            num(p, "phase2_deg") < 90.0,
+            "the contact stiffens the second mode"
+        );
+    }
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("separation_m,direction,amplitude1_ratio,phase1_deg"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// README: the bimodal contrast B − A at A₁/A₀₁ = 0.8 under each law.
+#[test]
+fn the_readme_bimodal_contrast() {
+    let v = json(&[
+        "contrast",
+        "--modes",
+        "2",
+        "--setpoints",
+        "0.8",
+        "--json",
+        "-q",
+    ]);
+    let expect = [
+        ("jkr", -5.542, -8.166),
+        ("hybrid", -4.717, -2.807),
+        ("lj", -5.018, -2.834),
+    ];
+    let rows = rows(&v);
+    assert_eq!(rows.len(), 3);
+    for (row, (law, d2, d1)) in rows.iter().zip(expect) {
+        assert_eq!(row["law"], law);
+        assert!((num(row, "delta_phase2_deg") - d2).abs() < 5e-4, "{row}");
+        assert!((num(row, "delta_phase1_deg") - d1).abs() < 5e-4, "{row}");
+    }
+}
