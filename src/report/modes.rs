@@ -99,11 +99,11 @@ pub fn tap_text(set: &ModeSet, o: &ModalObservables) -> String {
     let _ = writeln!(
         s,
         "a periodic orbit of {} drive periods, {} (largest Floquet multiplier |μ| = {:.6}); \
-         returns to {:.1e} m",
+         returns to {:.1e} of each mode's free motion",
         o.common_period_periods,
         if o.stable { "stable" } else { "UNSTABLE" },
         largest,
-        o.return_distance_m
+        o.return_distance_rel
     );
     s
 }

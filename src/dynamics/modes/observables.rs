@@ -86,8 +86,9 @@ pub struct ModalObservables {
     pub floquet_multipliers: Vec<[f64; 2]>,
     /// Whether all of them lie inside the unit circle.
     pub stable: bool,
-    /// |P(z) − z| at the orbit, m.
-    pub return_distance_m: f64,
+    /// |P(z) − z| at the orbit, each mode's deflection over its free amplitude (its
+    /// velocity over that times its frequency).
+    pub return_distance_rel: f64,
     /// Common periods integrated to find it.
     pub periods_integrated: usize,
 }
@@ -270,7 +271,7 @@ fn observe<const M: usize>(p: &Prepared, modal: &Modal, orbit: &ModalOrbit) -> M
         min_separation_m: p.cpl.alpha_hat(orbit.tally.min_tip, 0.0) * scale,
         stable: orbit.stable(),
         floquet_multipliers: orbit.multipliers.clone(),
-        return_distance_m: orbit.residual * a0,
+        return_distance_rel: orbit.residual,
         periods_integrated: orbit.periods_integrated,
     }
 }

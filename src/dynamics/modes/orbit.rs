@@ -24,7 +24,7 @@ pub struct ModalOrbit {
     pub tally: PassTally,
     /// Floquet multipliers (re, im).
     pub multipliers: Vec<[f64; 2]>,
-    /// max |P(z) − z| in units of A₀₁.
+    /// |P(z) − z| as [`OrbitOptions::tolerance`] measures it.
     pub residual: f64,
     /// Common periods integrated in all.
     pub periods_integrated: usize,
@@ -40,7 +40,9 @@ impl ModalOrbit {
 /// How hard to look.
 #[derive(Debug, Clone, Copy)]
 pub struct OrbitOptions {
-    /// The largest |P(z) − z| accepted (units of A₀₁).
+    /// The largest |P(z) − z| accepted, each mode's deflection in units of its free
+    /// amplitude and its velocity in units of that times its frequency (the first
+    /// mode's: units of A₀₁, as one mode's orbits; a mode that is not driven in A₀₁).
     pub tolerance: f64,
     /// Common periods integrated at most.
     pub max_periods: usize,
@@ -60,6 +62,22 @@ const FINE_WITHIN: f64 = 1e-5;
 const NEWTON_ITERATIONS: usize = 40;
 
 impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
+    /// The size of a difference `r` of section states, each mode's parts over the scale
+    /// of its free motion ([`OrbitOptions::tolerance`]): a small second mode's phase is
+    /// converged as well as the first's.
+    fn distance(&self, r: &[f64]) -> f64 {
+        self.modes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let free =
+                    m.gain * m.drive / (m.r * m.r - m.omega * m.omega).hypot(m.damping * m.omega);
+                let a = if free > 0.0 { free } else { 1.0 };
+                (r[q(i)].abs() / a).max(r[v(i)].abs() / (a * m.omega.max(m.r)))
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// The state of layout `S` with section `z`, zero integrals and Φ = I (if carried).
     fn start<const S: usize>(z: &[f64]) -> State<S> {
         let mut y = State::<S>::zeros();
@@ -108,7 +126,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 map.pass::<T>(0.0, Self::start::<T>(&z), branch, period)?;
             periods += 1;
             let r: Vec<f64> = (0..d).map(|k| y[k] - z[k]).collect();
-            let residual = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let residual = self.distance(&r);
             if end_branch != branch {
                 // Not closed on this branch: go on from where the period ended.
                 z = y.as_slice()[..d].to_vec();
@@ -144,13 +162,13 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
         while periods < limit {
             let (y, end_branch, _) = self.pass::<P>(0.0, Self::start::<P>(&z), branch, period)?;
             periods += 1;
-            let residual = (0..d).fold(0.0f64, |m, k| m.max((y[k] - z[k]).abs()));
+            let residual = self.distance(&(0..d).map(|k| y[k] - z[k]).collect::<Vec<_>>());
             z = y.as_slice()[..d].to_vec();
             let closed = end_branch == branch;
             branch = end_branch;
             if closed && residual <= opts.tolerance {
                 let (y, end, tally) = self.pass::<T>(0.0, Self::start::<T>(&z), branch, period)?;
-                let residual = (0..d).fold(0.0f64, |m, k| m.max((y[k] - z[k]).abs()));
+                let residual = self.distance(&(0..d).map(|k| y[k] - z[k]).collect::<Vec<_>>());
                 if end == branch && residual <= 10.0 * opts.tolerance {
                     let monodromy = DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)]);
                     return Ok(self.finished(

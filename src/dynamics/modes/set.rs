@@ -87,7 +87,7 @@ impl ModeSet {
     pub fn euler_bernoulli(first: &Cantilever, count: usize) -> Result<Self> {
         if !(1..=MAX_MODES).contains(&count) {
             return Err(Error::OutOfRange(format!(
-                "--modes takes 1 to {MAX_MODES}, not {count}"
+                "1 to {MAX_MODES} eigenmodes are simulated, not {count}"
             )));
         }
         Ok(Self {
@@ -205,7 +205,7 @@ impl Modal {
             Error::OutOfRange(format!(
                 "the frequency ratios {ratios:.5?} have no common denominator up to \
                  {MAX_DENOMINATOR} within a relative tolerance of {}: the motion is not \
-                 periodic; allow a larger --ratio-tolerance",
+                 periodic; allow a larger frequency-ratio tolerance",
                 set.ratio_tolerance
             ))
         })?;
