@@ -74,6 +74,12 @@ fn every_tour_command_runs_and_shows_its_effect() {
     let dir = common::scratch("tour");
     // Two at a time from one queue, as the machine has two cores; a merge after the
     // parts it reads.
+    // (`reproduce --out results --json` is the one command left out: tests/cli.rs runs
+    // it as written, checks every file it lists and compares them with results/.)
+    let commands: Vec<_> = commands
+        .into_iter()
+        .filter(|c| c[0] != "reproduce")
+        .collect();
     let (merges, rest): (Vec<_>, Vec<_>) = commands.into_iter().partition(|c| c[0] == "merge");
     let next = std::sync::atomic::AtomicUsize::new(0);
     std::thread::scope(|s| {
@@ -90,12 +96,13 @@ fn every_tour_command_runs_and_shows_its_effect() {
     for args in &merges {
         check(args, &dir);
     }
-    // Every CSV the tour wrote (approach, map, merge, batch, reproduce's, …).
+    // Every CSV the tour wrote (approach, map, merge, batch, …).
     let csvs = csv_files(&dir);
     for path in &csvs {
         assert_clean_csv(&std::fs::read_to_string(path).unwrap(), path);
     }
-    assert!(csvs.len() >= 10, "the tour wrote {} CSV files", csvs.len());
+    // (reproduce's own CSV files are checked in results/ by the test below.)
+    assert!(csvs.len() >= 6, "the tour wrote {} CSV files", csvs.len());
 }
 
 /// The CSV files under `dir`, in its subdirectories too.

@@ -49,7 +49,7 @@ pub struct OrbitOptions {
 }
 
 /// Common periods marched at most where Newton's method fails.
-const MARCH_PERIODS: usize = 200;
+const MARCH_PERIODS: usize = 50;
 
 /// How much looser the tolerances of the period map are far from the orbit.
 const COARSE: f64 = 100.0;
@@ -59,7 +59,7 @@ const COARSE: f64 = 100.0;
 const FINE_WITHIN: f64 = 1e-5;
 
 /// Newton iterations at most before marching takes over.
-const NEWTON_ITERATIONS: usize = 40;
+const NEWTON_ITERATIONS: usize = 25;
 
 impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
     /// The size of a difference `r` of section states, each mode's parts over the scale
@@ -187,7 +187,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
         Err(Error::NotApplicable(format!(
             "the modes settle on no orbit of the common period: Newton's method did not \
              converge and {MARCH_PERIODS} periods of marching do not return (last return \
-             distance {last:.2e} A₀₁). The motion is of a longer period or irregular (where \
+             distance {last:.1e} of the free motion). The motion is of a longer period or irregular (where \
              the first mode alone is, `tapsim tap` names it), which several modes are not \
              reported for"
         )))
