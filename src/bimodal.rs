@@ -311,3 +311,100 @@ pub fn contrast(
     }
     Ok(rows)
 }
+
+/// One cell of a several-mode map over (Δγ, E*).
+#[derive(Debug, Clone, Serialize)]
+pub struct ModalCell {
+    /// Work of adhesion, J/m².
+    pub work_of_adhesion_j_m2: f64,
+    /// Composite modulus, Pa.
+    pub modulus_pa: f64,
+    /// Tabor parameter.
+    pub tabor_mu: f64,
+    /// The rest separation of the state (m; at a first-mode setpoint, where the approach
+    /// holds it).
+    pub separation_m: Option<f64>,
+    /// A₁/A₀₁.
+    pub amplitude1_ratio: Option<f64>,
+    /// φ₁, degrees.
+    pub phase1_deg: Option<f64>,
+    /// A₂/A₀₂.
+    pub amplitude2_ratio: Option<f64>,
+    /// φ₂, degrees.
+    pub phase2_deg: Option<f64>,
+    /// E_ts per first-mode period, J.
+    pub e_ts_j: Option<f64>,
+    /// Whether the orbit is stable.
+    pub stable: Option<bool>,
+    /// Why the cell has no state.
+    pub note: Option<String>,
+}
+
+/// The several-mode state of every cell of the (Δγ, E*) grid (cells in parallel on
+/// `threads`, 0: every core): at the setup's rest separation, or at the first-mode
+/// setpoint `setpoint` as a slow approach reaches it. A cell without a periodic state
+/// is listed with why.
+pub fn map_cells(
+    setup: &crate::dynamics::setup::TapSetup,
+    set: &ModeSet,
+    numerics: &Numerics,
+    (works_j_m2, moduli_pa): (&[f64], &[f64]),
+    threads: usize,
+    progress: impl Fn() + Sync,
+    setpoint: Option<f64>,
+) -> Result<Vec<ModalCell>> {
+    let pool = crate::sweep::thread_pool(threads)?;
+    let cells: Vec<(f64, f64)> = moduli_pa
+        .iter()
+        .flat_map(|&e| works_j_m2.iter().map(move |&w| (w, e)))
+        .collect();
+    pool.install(|| {
+        cells
+            .par_iter()
+            .map(|&(w, e)| {
+                crate::interrupt::check()?;
+                let mut s = setup.clone();
+                s.contact.work_of_adhesion_j_m2 = w;
+                s.contact.modulus_pa = e;
+                let found = prepare(&s, set, numerics).and_then(|(p, modal)| match setpoint {
+                    None => Ok(modal_steady(&p, &modal, numerics, None)?.0),
+                    Some(r) => at_setpoints(&p, &modal, numerics, &[r])?
+                        .pop()
+                        .expect("one setpoint asked"),
+                });
+                let mode = |s: &ModalObservables, i: usize| s.modes.get(i).cloned();
+                let cell = match found {
+                    Ok(state) => ModalCell {
+                        work_of_adhesion_j_m2: w,
+                        modulus_pa: e,
+                        tabor_mu: state.tabor_mu,
+                        separation_m: Some(state.separation_m),
+                        amplitude1_ratio: mode(&state, 0).and_then(|m| m.amplitude_ratio),
+                        phase1_deg: mode(&state, 0).map(|m| m.phase_deg),
+                        amplitude2_ratio: mode(&state, 1).and_then(|m| m.amplitude_ratio),
+                        phase2_deg: mode(&state, 1).map(|m| m.phase_deg),
+                        e_ts_j: Some(state.e_ts_j),
+                        stable: Some(state.stable),
+                        note: None,
+                    },
+                    Err(e @ (Error::NotApplicable(_) | Error::Numerical(_))) => ModalCell {
+                        work_of_adhesion_j_m2: w,
+                        modulus_pa: s.contact.modulus_pa,
+                        tabor_mu: s.contact.tabor_mu(),
+                        separation_m: None,
+                        amplitude1_ratio: None,
+                        phase1_deg: None,
+                        amplitude2_ratio: None,
+                        phase2_deg: None,
+                        e_ts_j: None,
+                        stable: None,
+                        note: Some(e.to_string()),
+                    },
+                    Err(other) => return Err(other),
+                };
+                progress();
+                Ok(cell)
+            })
+            .collect()
+    })
+}

@@ -675,7 +675,7 @@ impl TapInputs {
         {
             return Err(Error::NotApplicable(
                 "the parameter file asks for several eigenmodes (`modes`), which this command \
-                 does not simulate: `tapsim tap`, `approach` and `contrast` do (remove \
+                 does not simulate: `tapsim tap`, `approach`, `contrast` and `map` do (remove \
                  `modes` from the file for this command)"
                     .into(),
             ));

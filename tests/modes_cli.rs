@@ -85,7 +85,7 @@ fn a_parameter_files_modes_are_its_flags() {
     assert_eq!(num(&from_file["modes"][1], "quality"), 500.0);
     // A command that does not simulate several modes refuses the file.
     refused(
-        &["map", "--config", cfg.to_str().unwrap()],
+        &["branches", "--config", cfg.to_str().unwrap()],
         "asks for several eigenmodes",
     );
     // Flags win over the file: one mode.
@@ -216,4 +216,36 @@ fn the_readme_bimodal_contrast() {
         assert!((num(row, "delta_phase2_deg") - d2).abs() < 5e-4, "{row}");
         assert!((num(row, "delta_phase1_deg") - d1).abs() < 5e-4, "{row}");
     }
+}
+
+/// `map --modes 2`: every cell with a state is `tap --modes 2` at that cell, bit for bit;
+/// a cell without one says why.
+#[test]
+fn a_bimodal_map_is_tap_cell_by_cell() {
+    let v = json(&["map", "--modes", "2", "--steps", "3", "--json", "-q"]);
+    let cells = rows(&v);
+    assert_eq!(cells.len(), 9);
+    let mut compared = 0;
+    for c in &cells {
+        if c["phase2_deg"].is_null() {
+            assert!(c["note"].is_string(), "{c}");
+            continue;
+        }
+        let (w, e) = (num(c, "work_of_adhesion_j_m2"), num(c, "modulus_pa"));
+        let t = json(&[
+            "tap",
+            "--modes",
+            "2",
+            "--work-of-adhesion",
+            &w.to_string(),
+            "--modulus",
+            &e.to_string(),
+            "--json",
+        ]);
+        assert_eq!(c["phase2_deg"], t["modes"][1]["phase_deg"]);
+        assert_eq!(c["phase1_deg"], t["modes"][0]["phase_deg"]);
+        assert_eq!(c["e_ts_j"], t["e_ts_j"]);
+        compared += 1;
+    }
+    assert!(compared >= 3, "{compared} cells with a state");
 }

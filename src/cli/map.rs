@@ -18,6 +18,12 @@ use clap::Args;
 /// shows); without it, every cell sits at one rest separation. The result is the same whatever the number of threads. Every `tapsim tap`
 /// option applies (--modulus and --work-of-adhesion are replaced by the grid).
 ///
+/// With --modes 2 (or 3): every cell the several-mode state (`tapsim tap --modes`) at
+/// the rest separation, or with --setpoint at the first mode's A₁/A₀₁ as a slow approach
+/// reaches it; one row per cell (work_of_adhesion_j_m2, modulus_pa, tabor_mu,
+/// separation_m, amplitude1_ratio, phase1_deg, amplitude2_ratio, phase2_deg, e_ts_j,
+/// stable, note), JSON as columns, heat maps of φ₂, φ₁, A₂/A₀₂ and E_ts. Not sharded.
+///
 /// Output: CSV (--csv, one row per cell; without --csv, --json or --plot it goes to
 /// stdout) with work_of_adhesion_j_m2, modulus_pa, tabor_mu and the tap observables
 /// per cell (empty where the law does not apply, with a note). JSON (--json): law, the
@@ -80,18 +86,50 @@ pub struct MapArgs {
     thermal_periods: usize,
     #[command(flatten)]
     split: super::shard::ShardArgs,
+    #[command(flatten)]
+    modes: crate::config::ModeInputs,
 }
 
 /// Run the subcommand.
 pub fn run(args: MapArgs) -> Result<()> {
-    let inputs =
+    let mut inputs =
         args.inputs
             .clone()
             .holding(args.setpoint, args.amplitude_setpoint, args.branch)?;
     if inputs.holds_setpoint() && inputs.separation.is_some() {
         return Err(super::separation_and_setpoint());
     }
+    inputs.takes_modes = true;
     let (setup, numerics) = inputs.resolve()?;
+    let works = sweep::log_grid(
+        "work of adhesion",
+        args.adhesion_from,
+        args.adhesion_to,
+        args.steps,
+    )?;
+    let moduli = sweep::log_grid("modulus", args.modulus_from, args.modulus_to, args.steps)?;
+    if let Some(set) = args.modes.mode_set(&inputs.mode_file, &setup.cantilever)? {
+        use super::modal::refuse;
+        refuse(args.noise.temperature.is_some(), "--temperature")?;
+        refuse(inputs.branch.is_some(), "--branch")?;
+        refuse(
+            args.split.resolve("map", false)?.is_some(),
+            "--shard (and a Slurm array)",
+        )?;
+        let setpoint = inputs.setpoint_ratio(setup.cantilever.free_amplitude_m);
+        let numerics = if setpoint.is_some() {
+            inputs.sweep_numerics(numerics)
+        } else {
+            numerics
+        };
+        return super::modal::map(
+            (&setup, &numerics, &set),
+            (&works, &moduli),
+            args.threads,
+            setpoint,
+            &args.out,
+        );
+    }
     let setpoint = match inputs.setpoint_ratio(setup.cantilever.free_amplitude_m) {
         None => None,
         Some(amplitude_ratio) => {
@@ -107,13 +145,6 @@ pub fn run(args: MapArgs) -> Result<()> {
             })
         }
     };
-    let works = sweep::log_grid(
-        "work of adhesion",
-        args.adhesion_from,
-        args.adhesion_to,
-        args.steps,
-    )?;
-    let moduli = sweep::log_grid("modulus", args.modulus_from, args.modulus_to, args.steps)?;
     let law = setup.law.to_string();
     let total = works.len() * moduli.len();
     let whole_outputs = args.out.csv.is_some() || args.out.plot.is_some() || args.out.json;

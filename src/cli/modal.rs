@@ -135,3 +135,54 @@ pub(super) fn contrast(
     }
     Ok(())
 }
+
+/// `map --modes N`: the several-mode state of every cell of the (Δγ, E*) grid.
+pub(super) fn map(
+    (setup, numerics, set): (&TapSetup, &Numerics, &ModeSet),
+    (works, moduli): (&[f64], &[f64]),
+    threads: usize,
+    setpoint: Option<f64>,
+    out: &super::SweepOutput,
+) -> Result<()> {
+    let bar = out.progress_bar(works.len() * moduli.len());
+    let cells = bimodal::map_cells(
+        setup,
+        set,
+        numerics,
+        (works, moduli),
+        threads,
+        || bar.inc(1),
+        setpoint,
+    );
+    bar.finish_and_clear();
+    let cells = cells?;
+    let title = match setpoint {
+        Some(s) => format!("{} law, {} modes, A₁/A₀₁ = {s}", setup.law, set.count()),
+        None => format!(
+            "{} law, {} modes, z_c = {:.4} nm",
+            setup.law,
+            set.count(),
+            setup.separation_m * 1e9
+        ),
+    };
+    out.emit(
+        ("map", &[]),
+        &cells,
+        || crate::report::records::columns_json(&cells),
+        Some(&|path| {
+            crate::report::plot::render_heatmaps(
+                &report::map_heat_maps(&title, works, moduli, &cells),
+                path,
+            )
+        }),
+    )?;
+    let empty = cells.iter().filter(|c| c.note.is_some()).count();
+    if empty > 0 && !out.quiet {
+        eprintln!(
+            "note: {empty} of {} cells have no periodic state of the modes (column note; \
+             grey on the heat maps)",
+            cells.len()
+        );
+    }
+    Ok(())
+}

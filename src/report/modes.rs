@@ -340,3 +340,51 @@ pub fn contrast_charts(rows: &[BimodalRow], laws: &[String]) -> Vec<Chart> {
         labels: Vec::new(),
     }]
 }
+
+/// A several-mode map's heat maps: φ₁, φ₂, A₂/A₀₂ and E_ts over (Δγ, E*).
+pub fn map_heat_maps(
+    title: &str,
+    works: &[f64],
+    moduli: &[f64],
+    cells: &[crate::bimodal::ModalCell],
+) -> Vec<super::heatmap::HeatMap> {
+    use super::heatmap::{Cell, HeatMap};
+    use crate::bimodal::ModalCell;
+    let panel = |what: &str, label: &str, value: &dyn Fn(&ModalCell) -> Option<f64>| HeatMap {
+        title: format!("{title}: {what}"),
+        x_label: "work of adhesion Δγ (J/m²)".into(),
+        y_label: "composite modulus E* (GPa)".into(),
+        value_label: label.into(),
+        empty_label: "no periodic state, or law n/a".into(),
+        x: works.to_vec(),
+        y: moduli.iter().map(|e| e * 1e-9).collect(),
+        log_axes: true,
+        cells: cells
+            .chunks(works.len())
+            .map(|row| {
+                row.iter()
+                    .map(|c| match value(c) {
+                        Some(value) => Cell::Value {
+                            value,
+                            period_one: true,
+                            grazing: false,
+                        },
+                        None => Cell::NotApplicable,
+                    })
+                    .collect()
+            })
+            .collect(),
+    };
+    vec![
+        panel("second-mode phase", "φ₂ (deg)", &|c| c.phase2_deg),
+        panel("first-mode phase", "φ₁ (deg)", &|c| c.phase1_deg),
+        panel("second-mode amplitude", "A₂/A₀₂", &|c| {
+            c.amplitude2_ratio
+        }),
+        panel(
+            "energy dissipated",
+            "E_ts per first-mode cycle (eV)",
+            &|c| c.e_ts_j.map(|e| e / ELECTRONVOLT_J),
+        ),
+    ]
+}

@@ -69,6 +69,9 @@ impl Eigenmode {
 /// rational multiple of the first mode's drive frequency.
 pub const RATIO_TOLERANCE: f64 = 5e-3;
 
+/// The highest resonance of a higher mode, in first-mode drive frequencies.
+pub const MAX_RATIO: f64 = 100.0;
+
 /// Largest common denominator tried (the common period, in first-mode drive periods).
 pub const MAX_DENOMINATOR: u32 = 32;
 
@@ -195,6 +198,32 @@ impl Modal {
             .collect::<Result<Vec<_>>>()?;
         let drive_hz = first.drive_frequency_hz;
         let ratios: Vec<f64> = higher.iter().map(|m| m.resonance_hz / drive_hz).collect();
+        if let Some(m) = higher.iter().find(|m| !(0.5..=1e7).contains(&m.quality)) {
+            return Err(Error::OutOfRange(format!(
+                "a higher mode's quality factor Q = {} is outside 0.5 to 1e7 (as the first \
+                 mode's)",
+                m.quality
+            )));
+        }
+        if let Some(r) = ratios.iter().find(|&&r| r > MAX_RATIO) {
+            return Err(Error::OutOfRange(format!(
+                "a higher mode's resonance is {r:.4e} times the first mode's drive frequency: \
+                 at most {MAX_RATIO} are resolved (a beam's third mode is at 17.5)"
+            )));
+        }
+        if let Some((m, r)) = higher.iter().zip(&ratios).find(|(m, r)| {
+            let mass = m.stiffness_n_m / first.stiffness_n_m / (*r * *r);
+            !(mass >= 1e-3)
+        }) {
+            return Err(Error::OutOfRange(format!(
+                "a higher mode of stiffness {} N/m at {r:.4} times the drive frequency has a \
+                 modal mass {:.3e} times the first mode's: at least 1e-3 is simulated (the \
+                 tip force would throw so light a mode about; a rectangular beam's modes \
+                 have equal masses, k_i = k₁(f_i/f₁)²)",
+                m.stiffness_n_m,
+                m.stiffness_n_m / first.stiffness_n_m / (r * r)
+            )));
+        }
         if let Some(r) = ratios.iter().find(|&&r| r < 1.5) {
             return Err(Error::OutOfRange(format!(
                 "a higher mode's resonance is {r:.3} times the first mode's drive frequency: \

@@ -304,9 +304,14 @@ fn run<S2: System<S>, const S: usize>(
         Err(StepError::MaxNumStepReached { .. }) if u64::from(max_steps) == left => {
             Err(budget::exhausted())
         }
-        Err(e) => Err(Error::Numerical(format!(
-            "the integrator of the eigenmodes stopped ({e:?}): the motion is too abrupt \
-             for the tolerances"
+        Err(StepError::StepSizeUnderflow { x }) => Err(Error::Numerical(format!(
+            "the integrator's step fell to round-off at τ = {x:.6e} (ω₁t): the modes' \
+             motion there is too abrupt for the tolerances"
+        ))),
+        Err(StepError::MaxNumStepReached { x, n_step }) => Err(Error::Numerical(format!(
+            "one segment of the modes' motion needed more than {n_step} integration steps \
+             at τ = {x:.6e} (ω₁t): too stiff to resolve (a mode far faster than the \
+             first?)"
         ))),
     }
 }
@@ -374,8 +379,12 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             let alpha_start = alpha(&y);
             h = run(&mut seg, tau, tau1, y, &self.tol, h).map_err(|e| match e {
                 Error::Numerical(why) => Error::Numerical(format!(
-                    "{why} (on the {branch:?} branch from τ = {tau:.6}, α̂ = {alpha_start:.6}, \
-                     exits {exits:?})"
+                    "{why} (on the {} branch from τ = {tau:.6}, α̂ = {alpha_start:.6})",
+                    match branch {
+                        Branch::Free => "out-of-contact",
+                        Branch::Contact => "contact",
+                        Branch::Necked => "capillary-neck",
+                    }
                 )),
                 e => e,
             })?;
