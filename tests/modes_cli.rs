@@ -130,6 +130,18 @@ fn several_modes_refuse_what_they_do_not_report() {
         "mode quality factor",
     );
     refused(
+        &["tap", "--modes", "2", "--mode2-quality", "1e12"],
+        "outside 0.5 to 1e7",
+    );
+    refused(
+        &["tap", "--modes", "2", "--mode2-resonance", "1e12"],
+        "at most 100",
+    );
+    refused(
+        &["tap", "--modes", "2", "--mode2-stiffness", "1e-9"],
+        "modal mass",
+    );
+    refused(
         &["tap", "--modes", "2", "--mode2-resonance", "310kHz"],
         "must be ordered",
     );

@@ -213,7 +213,7 @@ impl Modal {
         }
         if let Some((m, r)) = higher.iter().zip(&ratios).find(|(m, r)| {
             let mass = m.stiffness_n_m / first.stiffness_n_m / (*r * *r);
-            !(mass >= 1e-3)
+            mass < 1e-3
         }) {
             return Err(Error::OutOfRange(format!(
                 "a higher mode of stiffness {} N/m at {r:.4} times the drive frequency has a \
