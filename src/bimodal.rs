@@ -246,12 +246,14 @@ pub struct BimodalRow {
 }
 
 /// φ₁ and φ₂ of every material at each first-mode setpoint under each law of `laws`
-/// (each law and material in parallel), rows by law then setpoint.
+/// (each law and material in parallel, each counted by `progress` when done), rows by
+/// law then setpoint.
 pub fn contrast(
     materials: &[Material],
     set: &ModeSet,
     laws: &[LawKind],
     setpoints: &[f64],
+    progress: impl Fn() + Sync,
 ) -> Result<Vec<BimodalRow>> {
     let jobs: Vec<(usize, usize)> = (0..laws.len())
         .flat_map(|l| (0..materials.len()).map(move |m| (l, m)))
@@ -262,7 +264,9 @@ pub fn contrast(
             let mut setup = materials[m].setup.clone();
             setup.law = laws[l].into();
             let (p, modal) = prepare(&setup, set, &materials[m].numerics)?;
-            at_setpoints(&p, &modal, &materials[m].numerics, setpoints)
+            let states = at_setpoints(&p, &modal, &materials[m].numerics, setpoints);
+            progress();
+            states
         })
         .collect();
     let mut states = Vec::with_capacity(results.len());
@@ -353,58 +357,50 @@ pub fn map_cells(
     progress: impl Fn() + Sync,
     setpoint: Option<f64>,
 ) -> Result<Vec<ModalCell>> {
-    let pool = crate::sweep::thread_pool(threads)?;
-    let cells: Vec<(f64, f64)> = moduli_pa
-        .iter()
-        .flat_map(|&e| works_j_m2.iter().map(move |&w| (w, e)))
-        .collect();
-    pool.install(|| {
-        cells
-            .par_iter()
-            .map(|&(w, e)| {
-                crate::interrupt::check()?;
-                let mut s = setup.clone();
-                s.contact.work_of_adhesion_j_m2 = w;
-                s.contact.modulus_pa = e;
-                let found = prepare(&s, set, numerics).and_then(|(p, modal)| match setpoint {
-                    None => Ok(modal_steady(&p, &modal, numerics, None)?.0),
-                    Some(r) => at_setpoints(&p, &modal, numerics, &[r])?
-                        .pop()
-                        .expect("one setpoint asked"),
-                });
-                let mode = |s: &ModalObservables, i: usize| s.modes.get(i).cloned();
-                let cell = match found {
-                    Ok(state) => ModalCell {
-                        work_of_adhesion_j_m2: w,
-                        modulus_pa: e,
-                        tabor_mu: state.tabor_mu,
-                        separation_m: Some(state.separation_m),
-                        amplitude1_ratio: mode(&state, 0).and_then(|m| m.amplitude_ratio),
-                        phase1_deg: mode(&state, 0).map(|m| m.phase_deg),
-                        amplitude2_ratio: mode(&state, 1).and_then(|m| m.amplitude_ratio),
-                        phase2_deg: mode(&state, 1).map(|m| m.phase_deg),
-                        e_ts_j: Some(state.e_ts_j),
-                        stable: Some(state.stable),
-                        note: None,
-                    },
-                    Err(e @ (Error::NotApplicable(_) | Error::Numerical(_))) => ModalCell {
-                        work_of_adhesion_j_m2: w,
-                        modulus_pa: s.contact.modulus_pa,
-                        tabor_mu: s.contact.tabor_mu(),
-                        separation_m: None,
-                        amplitude1_ratio: None,
-                        phase1_deg: None,
-                        amplitude2_ratio: None,
-                        phase2_deg: None,
-                        e_ts_j: None,
-                        stable: None,
-                        note: Some(e.to_string()),
-                    },
-                    Err(other) => return Err(other),
-                };
-                progress();
-                Ok(cell)
+    let every: Vec<usize> = (0..works_j_m2.len() * moduli_pa.len()).collect();
+    crate::sweep::over_grid(
+        setup,
+        (works_j_m2, moduli_pa),
+        &every,
+        threads,
+        progress,
+        |s, (w, e)| {
+            let found = prepare(s, set, numerics).and_then(|(p, modal)| match setpoint {
+                None => Ok(modal_steady(&p, &modal, numerics, None)?.0),
+                Some(r) => at_setpoints(&p, &modal, numerics, &[r])?
+                    .pop()
+                    .expect("one setpoint asked"),
+            });
+            let mode = |s: &ModalObservables, i: usize| s.modes.get(i).cloned();
+            Ok(match found {
+                Ok(state) => ModalCell {
+                    work_of_adhesion_j_m2: w,
+                    modulus_pa: e,
+                    tabor_mu: state.tabor_mu,
+                    separation_m: Some(state.separation_m),
+                    amplitude1_ratio: mode(&state, 0).and_then(|m| m.amplitude_ratio),
+                    phase1_deg: mode(&state, 0).map(|m| m.phase_deg),
+                    amplitude2_ratio: mode(&state, 1).and_then(|m| m.amplitude_ratio),
+                    phase2_deg: mode(&state, 1).map(|m| m.phase_deg),
+                    e_ts_j: Some(state.e_ts_j),
+                    stable: Some(state.stable),
+                    note: None,
+                },
+                Err(why @ (Error::NotApplicable(_) | Error::Numerical(_))) => ModalCell {
+                    work_of_adhesion_j_m2: w,
+                    modulus_pa: e,
+                    tabor_mu: s.contact.tabor_mu(),
+                    separation_m: None,
+                    amplitude1_ratio: None,
+                    phase1_deg: None,
+                    amplitude2_ratio: None,
+                    phase2_deg: None,
+                    e_ts_j: None,
+                    stable: None,
+                    note: Some(why.to_string()),
+                },
+                Err(other) => return Err(other),
             })
-            .collect()
-    })
+        },
+    )
 }

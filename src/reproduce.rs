@@ -361,8 +361,13 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
     // φ₂ at the first mode's setpoints, as `tapsim contrast --modes 2` computes them.
     progress("bimodal phase contrast");
     let modes = ModeSet::euler_bernoulli(&contrast_materials[0].setup.cantilever, 2)?;
-    let bimodal_rows =
-        crate::bimodal::contrast(&contrast_materials, &modes, &LAWS, &BIMODAL_SETPOINTS)?;
+    let bimodal_rows = crate::bimodal::contrast(
+        &contrast_materials,
+        &modes,
+        &LAWS,
+        &BIMODAL_SETPOINTS,
+        || {},
+    )?;
     let law_names: Vec<String> = LAWS.iter().map(ToString::to_string).collect();
     let mut paths = render_stack(
         out,

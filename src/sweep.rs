@@ -336,8 +336,6 @@ pub fn map_cells_with(
     progress: impl Fn() + Sync,
     solve: &CellSolver<'_>,
 ) -> Result<Vec<MapCell>> {
-    use rayon::prelude::*;
-    let pool = thread_pool(threads)?;
     let total = works_j_m2.len() * moduli_pa.len();
     if let Some(&k) = cells.iter().find(|&&k| k >= total) {
         return Err(Error::NotApplicable(format!(
@@ -346,6 +344,55 @@ pub fn map_cells_with(
             moduli_pa.len()
         )));
     }
+    over_grid(
+        setup,
+        (works_j_m2, moduli_pa),
+        cells,
+        threads,
+        progress,
+        |s, (w, e)| {
+            let tabor_mu = s.contact.tabor_mu();
+            Ok(match solve(s) {
+                Ok(state) => MapCell {
+                    work_of_adhesion_j_m2: w,
+                    modulus_pa: e,
+                    tabor_mu,
+                    separation_m: state.separation_m,
+                    observables: Some(state.observables),
+                    note: None,
+                    sigma_phase_deg: state.sigma_phase_deg,
+                    thermal_average: state.thermal_average,
+                },
+                Err(Error::NotApplicable(why)) => MapCell {
+                    work_of_adhesion_j_m2: w,
+                    modulus_pa: e,
+                    tabor_mu,
+                    separation_m: None,
+                    observables: None,
+                    note: Some(why),
+                    sigma_phase_deg: None,
+                    thermal_average: None,
+                },
+                Err(other) => return Err(other),
+            })
+        },
+    )
+}
+
+/// `cell` of each of `cells` (indices into the grid, the work of adhesion fastest) on
+/// `threads` (0: every core): the setup with the cell's Δγ and E*, and (Δγ, E*). The
+/// results in the order of `cells`; each is counted by `progress`, and an interruption
+/// ends the grid.
+pub fn over_grid<T: Send>(
+    setup: &TapSetup,
+    (works_j_m2, moduli_pa): (&[f64], &[f64]),
+    cells: &[usize],
+    threads: usize,
+    progress: impl Fn() + Sync,
+    cell: impl Fn(&TapSetup, (f64, f64)) -> Result<T> + Sync,
+) -> Result<Vec<T>> {
+    use rayon::prelude::*;
+    let pool = thread_pool(threads)?;
     let cells: Vec<(f64, f64)> = cells
         .iter()
         .map(|&k| {
@@ -363,32 +410,9 @@ pub fn map_cells_with(
                 let mut s = setup.clone();
                 s.contact.work_of_adhesion_j_m2 = w;
                 s.contact.modulus_pa = e;
-                let tabor_mu = s.contact.tabor_mu();
-                let cell = match solve(&s) {
-                    Ok(state) => MapCell {
-                        work_of_adhesion_j_m2: w,
-                        modulus_pa: e,
-                        tabor_mu,
-                        separation_m: state.separation_m,
-                        observables: Some(state.observables),
-                        note: None,
-                        sigma_phase_deg: state.sigma_phase_deg,
-                        thermal_average: state.thermal_average,
-                    },
-                    Err(Error::NotApplicable(why)) => MapCell {
-                        work_of_adhesion_j_m2: w,
-                        modulus_pa: e,
-                        tabor_mu,
-                        separation_m: None,
-                        observables: None,
-                        note: Some(why),
-                        sigma_phase_deg: None,
-                        thermal_average: None,
-                    },
-                    Err(other) => return Err(other),
-                };
+                let done = cell(&s, (w, e))?;
                 progress();
-                Ok(cell)
+                Ok(done)
             })
             .collect()
     })

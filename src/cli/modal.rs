@@ -119,9 +119,9 @@ pub(super) fn contrast(
     setpoints: &[f64],
     out: &super::SweepOutput,
 ) -> Result<()> {
-    let spinner = out.progress_bar(1);
-    let rows = bimodal::contrast(materials, set, laws, setpoints);
-    spinner.finish_and_clear();
+    let bar = out.progress_bar(laws.len() * materials.len());
+    let rows = bimodal::contrast(materials, set, laws, setpoints, || bar.inc(1));
+    bar.finish_and_clear();
     let rows = rows?;
     let names: Vec<String> = laws.iter().map(ToString::to_string).collect();
     out.write_files(&rows, || report::contrast_charts(&rows, &names))?;

@@ -142,6 +142,9 @@ pub fn run(args: TapArgs) -> Result<()> {
             .clone()
             .holding(args.setpoint, args.amplitude_setpoint, args.branch)?;
     inputs.takes_modes = true;
+    if inputs.holds_setpoint() && inputs.separation.is_some() {
+        return Err(super::separation_and_setpoint());
+    }
     let (setup, numerics) = inputs.resolve()?;
     if let Some(set) = args.modes.mode_set(&inputs.mode_file, &setup.cantilever)? {
         use super::modal::refuse;
@@ -150,14 +153,11 @@ pub fn run(args: TapArgs) -> Result<()> {
         refuse(args.starts.is_some(), "--starts")?;
         refuse(args.noise.temperature.is_some(), "--temperature")?;
         refuse(inputs.branch.is_some(), "--branch")?;
-        if inputs.holds_setpoint() && inputs.separation.is_some() {
-            return Err(super::separation_and_setpoint());
-        }
         let ratio = inputs.setpoint_ratio(setup.cantilever.free_amplitude_m);
         return super::modal::tap(&setup, &numerics, &set, ratio, args.json);
     }
     if inputs.holds_setpoint() {
-        return at_setpoint(&args, inputs);
+        return at_setpoint(&args, &inputs, (setup, numerics));
     }
     let wants_trajectory = args.trajectory.is_some() || args.plot.is_some();
     let record = if wants_trajectory {
@@ -282,10 +282,14 @@ pub fn run(args: TapArgs) -> Result<()> {
 }
 
 /// `tap --setpoint`: the states at the setpoint, listed.
-fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
-    if inputs.separation.is_some() {
-        return Err(super::separation_and_setpoint());
-    }
+fn at_setpoint(
+    args: &TapArgs,
+    inputs: &TapInputs,
+    (setup, numerics): (
+        crate::dynamics::setup::TapSetup,
+        crate::dynamics::setup::Numerics,
+    ),
+) -> Result<()> {
     if args.trajectory.is_some() || args.plot.is_some() {
         return Err(Error::NotApplicable(
             "--trajectory and --plot draw one state: run `tapsim tap --separation <z_c>` \
@@ -293,7 +297,6 @@ fn at_setpoint(args: &TapArgs, inputs: TapInputs) -> Result<()> {
                 .into(),
         ));
     }
-    let (setup, numerics) = inputs.resolve()?;
     let ratio = inputs
         .setpoint_ratio(setup.cantilever.free_amplitude_m)
         .expect("called with a setpoint");

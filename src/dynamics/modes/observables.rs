@@ -142,11 +142,8 @@ fn solve<const M: usize, const P: usize, const T: usize>(
     // A mode of quality Q turns an integration error into an amplitude error Q times
     // larger: the tolerance is tightened for modes above the first one's Q (one-mode
     // runs keep tapsim's).
-    let q_max = models
-        .iter()
-        .map(|m| m.r / m.damping)
-        .fold(0.0f64, f64::max);
-    let q_first = models[0].r / models[0].damping;
+    let q_max = models.iter().map(ModeModel::quality).fold(0.0f64, f64::max);
+    let q_first = models[0].quality();
     let mut tol = p.tol;
     tol.h_max = p.tol.h_max * p.osc.omega / fastest;
     tol.rtol *= (q_first / q_max).min(1.0);
@@ -203,15 +200,14 @@ fn observe<const M: usize>(p: &Prepared, modal: &Modal, orbit: &ModalOrbit) -> M
             let (c, s) = (at(i, ModeIntegral::Cos), at(i, ModeIntegral::Sin));
             let amp = 2.0 / period * c.hypot(s);
             let exchange = at(i, ModeIntegral::Exchange);
-            let free =
-                m.gain * m.drive / (m.r * m.r - m.omega * m.omega).hypot(m.damping * m.omega);
+            let free = m.free_amplitude();
             let (resonance_hz, stiffness, quality) = if i == 0 {
                 (cant.resonance_hz, k1, cant.quality)
             } else {
                 (
                     modal.resonance_hz[i - 1],
                     k1 * m.r * m.r / m.gain,
-                    m.r / m.damping,
+                    m.quality(),
                 )
             };
             ModeObservables {

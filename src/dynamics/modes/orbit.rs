@@ -70,12 +70,17 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             .iter()
             .enumerate()
             .map(|(i, m)| {
-                let free =
-                    m.gain * m.drive / (m.r * m.r - m.omega * m.omega).hypot(m.damping * m.omega);
+                let free = m.free_amplitude();
                 let a = if free > 0.0 { free } else { 1.0 };
                 (r[q(i)].abs() / a).max(r[v(i)].abs() / (a * m.omega.max(m.r)))
             })
             .fold(0.0, f64::max)
+    }
+
+    /// How far the pass ending at `y` returned from its start `z` ([`Self::distance`]).
+    fn returned<const S: usize>(&self, y: &State<S>, z: &[f64]) -> f64 {
+        let r: Vec<f64> = z.iter().enumerate().map(|(k, z)| y[k] - z).collect();
+        self.distance(&r)
     }
 
     /// The state of layout `S` with section `z`, zero integrals and Φ = I (if carried).
@@ -110,14 +115,12 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
         // inexact Newton step is as good there); near it, and for what is reported, at
         // the tolerances.
         let coarse = Modes {
-            modes: self.modes,
-            law: self.law,
-            cpl: self.cpl,
             tol: Tolerances {
                 rtol: self.tol.rtol * COARSE,
                 atol: self.tol.atol * COARSE,
-                h_max: self.tol.h_max,
+                ..self.tol
             },
+            ..*self
         };
         for _ in 0..NEWTON_ITERATIONS {
             let fine = best <= FINE_WITHIN;
@@ -134,12 +137,11 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 continue;
             }
             if fine && residual <= opts.tolerance {
-                let monodromy = DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)]);
-                return Ok(self.finished(&z, branch, &y, tally, &monodromy, residual, periods));
+                return Ok(self.finished(&z, branch, &y, tally, residual, periods));
             }
             let jacobian =
                 DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)] - f64::from(row == col));
-            let step = jacobian.lu().solve(&DVector::from_vec(r.clone()));
+            let step = jacobian.lu().solve(&DVector::from_vec(r));
             match step {
                 Some(step)
                     if residual < 1e3 * best.min(1.0) && step.iter().all(|s| s.is_finite()) =>
@@ -162,24 +164,15 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
         while periods < limit {
             let (y, end_branch, _) = self.pass::<P>(0.0, Self::start::<P>(&z), branch, period)?;
             periods += 1;
-            let residual = self.distance(&(0..d).map(|k| y[k] - z[k]).collect::<Vec<_>>());
+            let residual = self.returned(&y, &z);
             z = y.as_slice()[..d].to_vec();
             let closed = end_branch == branch;
             branch = end_branch;
             if closed && residual <= opts.tolerance {
                 let (y, end, tally) = self.pass::<T>(0.0, Self::start::<T>(&z), branch, period)?;
-                let residual = self.distance(&(0..d).map(|k| y[k] - z[k]).collect::<Vec<_>>());
+                let residual = self.returned(&y, &z);
                 if end == branch && residual <= 10.0 * opts.tolerance {
-                    let monodromy = DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)]);
-                    return Ok(self.finished(
-                        &z,
-                        branch,
-                        &y,
-                        tally,
-                        &monodromy,
-                        residual,
-                        periods + 1,
-                    ));
+                    return Ok(self.finished(&z, branch, &y, tally, residual, periods + 1));
                 }
             }
             last = residual;
@@ -187,24 +180,25 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
         Err(Error::NotApplicable(format!(
             "the modes settle on no orbit of the common period: Newton's method did not \
              converge and {MARCH_PERIODS} periods of marching do not return (last return \
-             distance {last:.1e} of the free motion). The motion is of a longer period or irregular (where \
-             the first mode alone is, `tapsim tap` names it), which several modes are not \
-             reported for"
+             distance {last:.1e} of the free motion). The motion is of a longer period or \
+             irregular (where the first mode alone is, `tapsim tap` names it), which several \
+             modes are not reported for"
         )))
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// The orbit through `z` on `branch`, from the tangent pass `y` over its period:
+    /// the monodromy matrix is that pass's Φ.
     fn finished<const T: usize>(
         &self,
         z: &[f64],
         branch: Branch,
         y: &State<T>,
         tally: PassTally,
-        monodromy: &DMatrix<f64>,
         residual: f64,
         periods: usize,
     ) -> ModalOrbit {
-        let multipliers = monodromy
+        let d = 2 * M;
+        let multipliers = DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)])
             .complex_eigenvalues()
             .iter()
             .map(|c| [c.re, c.im])

@@ -143,6 +143,17 @@ pub struct ModeModel {
 }
 
 impl ModeModel {
+    /// Qᵢ = rᵢ/(rᵢ/Qᵢ).
+    pub fn quality(&self) -> f64 {
+        self.r / self.damping
+    }
+
+    /// The free amplitude at the drive (units of A₀₁): cᵢfᵢ/|rᵢ² − Ωᵢ² + i rᵢΩᵢ/Qᵢ|.
+    pub fn free_amplitude(&self) -> f64 {
+        self.gain * self.drive
+            / (self.r * self.r - self.omega * self.omega).hypot(self.damping * self.omega)
+    }
+
     /// Mode with resonance ratio `r`, quality `q`, stiffness ratio kᵢ/k₁, driven at
     /// `omega` to a free amplitude `free` (units of A₀₁): the drive that gives it,
     /// fᵢ = free·|rᵢ² − Ωᵢ² + i rᵢΩᵢ/Qᵢ|/cᵢ.
