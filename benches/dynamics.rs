@@ -349,6 +349,28 @@ fn modes(c: &mut Criterion) {
         });
     }
     group.finish();
+    // The bimodal instrument (`scan --modes 2`): a hundred drive periods of the modes
+    // at rtol 2e-7 on the state the loop holds at A₁/A₀₁ = 0.8 on polymer A, each read
+    // by its lock-in, as a scan marches them.
+    use tapsim::dynamics::modes::prepare;
+    use tapsim::instrument::feedback::{PiController, hold_probe};
+    use tapsim::instrument::modal::ModalProbe;
+    use tapsim::instrument::probe::Probe;
+    const PERIODS: u64 = 100;
+    let set = ModeSet::euler_bernoulli(&setup.cantilever, 2).expect("defaults");
+    let materials = [prepare(&setup, &set, &march_numerics()).expect("defaults")];
+    let period = materials[0].1.period() / f64::from(materials[0].1.periods);
+    let mut probe = ModalProbe::new(&materials, 4, 2.0 * period).expect("defaults");
+    let mut controller = PiController::new(0.8, 0.0, 0.002).expect("defaults");
+    let a0 = setup.cantilever.free_amplitude_m;
+    let (_, z) = hold_probe(&mut probe, 0, 1.2 * a0, &mut controller, 6000).expect("engaged");
+    let mut group = c.benchmark_group("scan");
+    group.throughput(Throughput::Elements(PERIODS));
+    group.sample_size(10);
+    group.bench_function("bimodal loop, 100 drive periods", |b| {
+        b.iter(|| probe.march(0, z, PERIODS as usize).expect("marched"))
+    });
+    group.finish();
 }
 
 criterion_group!(

@@ -5,11 +5,12 @@
 //! apart that φ₁ does not).
 
 use crate::contrast::Material;
-use crate::dynamics::modes::orbit::ModalOrbit;
+use crate::dynamics::modes::orbit::{ModalOrbit, free_section};
 use crate::dynamics::modes::{Modal, ModalObservables, ModeSet, modal_steady, prepare};
-use crate::dynamics::setup::{Numerics, Prepared};
+use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
 use crate::law::LawKind;
+pub use crate::setpoint::PhaseBranch;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -99,121 +100,206 @@ pub fn first_ratio(s: &ModalObservables) -> f64 {
     s.modes[0].amplitude_ratio.unwrap_or(f64::NAN)
 }
 
-/// Points of the coarse approach that brackets the setpoints.
-pub const SETPOINT_SCAN: usize = 24;
-
-/// The states at which the first mode's amplitude is each of `setpoints` (times A₀₁) on a
-/// slow approach from z_c = A₀₁(1 + the largest setpoint) (the free oscillation, just
-/// out of reach) towards the sample: a coarse approach of [`SETPOINT_SCAN`] points
-/// brackets each, and regula falsi on z_c (each point continued from the bracket's far
-/// end) finds it to 1e-7 of A₁/A₀₁. A setpoint the amplitude jumps across has no state.
-pub fn at_setpoints(
-    p: &Prepared,
-    modal: &Modal,
-    numerics: &Numerics,
-    setpoints: &[f64],
-) -> Result<Vec<Result<ModalObservables>>> {
-    if let Some(&bad) = setpoints.iter().find(|&&s| !(s > 0.0 && s < 1.0)) {
-        return Err(Error::InvalidParameter {
-            name: "setpoint",
-            value: bad,
-            reason: "must lie between 0 and 1 (A₁/A₀₁)",
-        });
-    }
-    let top = setpoints.iter().copied().fold(0.0f64, f64::max);
-    let bottom = setpoints.iter().copied().fold(1.0f64, f64::min);
-    let a0 = p.setup.cantilever.free_amplitude_m;
-    let (far, near) = (a0 * (1.0 + top), a0 * (bottom - 0.5).min(0.0));
-    let mut scan: Vec<(f64, f64, ModalOrbit)> = Vec::new();
-    let mut last: Option<ModalOrbit> = None;
-    for k in 0..SETPOINT_SCAN {
-        let z = far + (near - far) * k as f64 / (SETPOINT_SCAN - 1) as f64;
-        match solve_at(p, modal, numerics, z, last.as_ref()) {
-            Ok((state, orbit)) => {
-                scan.push((z, first_ratio(&state), orbit.clone()));
-                last = Some(orbit);
-            }
-            Err(Error::Interrupted) => return Err(Error::Interrupted),
-            Err(_) => last = None,
-        }
-    }
-    Ok(setpoints
-        .iter()
-        .map(|&setpoint| {
-            let bracket = scan
-                .windows(2)
-                .find(|w| w[0].1 > setpoint && w[1].1 <= setpoint)
-                .ok_or_else(|| {
-                    Error::NotApplicable(format!(
-                        "the first mode's amplitude does not fall through A₁/A₀₁ = \
-                         {setpoint} on an approach from {:.4} nm to {:.4} nm",
-                        far * 1e9,
-                        near * 1e9
-                    ))
-                })?;
-            let (hi, lo) = (&bracket[0], &bracket[1]);
-            falsi(
-                p,
-                modal,
-                numerics,
-                setpoint,
-                (hi.0, hi.1, hi.2.clone()),
-                (lo.0, lo.1),
-            )
-        })
-        .collect())
+/// A steady state of the modes at a first-mode amplitude setpoint, on its branch.
+#[derive(Debug, Clone, Serialize)]
+pub struct ModalSetpointState {
+    /// The first mode's branch (attractive: φ₁ above the free phase).
+    pub branch: PhaseBranch,
+    /// The state.
+    #[serde(flatten)]
+    pub observables: ModalObservables,
 }
 
-/// Regula falsi (Illinois) on z_c for A₁/A₀₁ = `setpoint` between `hi` (above it, with
-/// its orbit) and `lo` (at or below).
-fn falsi(
-    p: &Prepared,
-    modal: &Modal,
+/// The step along z_c (units of A₀₁) from a one-mode state to the modes' state at the
+/// same setpoint, and the most steps taken.
+const WALK: f64 = 0.005;
+const WALK_STEPS: usize = 200;
+
+/// The several-mode steady states whose first-mode amplitude is `setpoint` × A₀₁, on
+/// `branch` (`None`: both; attractive first), each with why where the modes keep none.
+/// Where one mode holds a setpoint on two branches (coexisting attractors: which one an
+/// AFM images on depends on its history) so may the modes; and on one branch the higher
+/// modes may hold more than one state (a second mode of high Q can itself be bistable).
+/// Each branch's states are seeded at the one-mode state there
+/// ([`crate::setpoint::states_at_setpoint`]) with the higher modes started from
+/// [`SEEDS`] (their free oscillation, inverted, at rest); each distinct one is followed
+/// along z_c to the setpoint (to 1e-7 of A₁/A₀₁). A branch may then list several
+/// states, the one from the free oscillation first; a state whose φ₁ crosses to the other
+/// side of the free phase on the way is not the branch's and is refused.
+pub fn states_at_setpoint(
+    setup: &TapSetup,
+    set: &ModeSet,
     numerics: &Numerics,
     setpoint: f64,
-    (mut z_hi, mut r_hi, mut orbit_hi): (f64, f64, ModalOrbit),
-    (mut z_lo, mut r_lo): (f64, f64),
-) -> Result<ModalObservables> {
-    let mut side = 0i8;
-    let mut best: Option<ModalObservables> = None;
-    for _ in 0..60 {
-        let (f_hi, f_lo) = (r_hi - setpoint, r_lo - setpoint);
-        let z = if f_hi != f_lo {
-            z_hi - f_hi * (z_lo - z_hi) / (f_lo - f_hi)
-        } else {
-            0.5 * (z_hi + z_lo)
-        };
-        let (state, orbit) = solve_at(p, modal, numerics, z, Some(&orbit_hi))?;
-        let ratio = first_ratio(&state);
-        let done = (ratio - setpoint).abs() <= 1e-7;
-        if ratio > setpoint {
-            (z_hi, r_hi, orbit_hi) = (z, ratio, orbit);
-            if side == 1 {
-                r_lo = setpoint + 0.5 * (r_lo - setpoint);
+    branch: Option<PhaseBranch>,
+) -> Result<Vec<(PhaseBranch, Result<ModalSetpointState>)>> {
+    let one = crate::setpoint::states_at_setpoint(setup, numerics, setpoint, branch)?;
+    let free_phase = crate::setpoint::free_phase_deg(setup);
+    let (p, modal) = prepare(setup, set, numerics)?;
+    let mut out = Vec::new();
+    for s in one {
+        let side = s.branch;
+        let q = at_separation(&p, s.separation_m)?;
+        let mut seeds: Vec<(ModalObservables, ModalOrbit)> = Vec::new();
+        let mut failure = None;
+        for scale in SEEDS {
+            let mut start = free_section(&modal.modes, Some((s.phase.x, s.phase.v)));
+            start[2..].iter_mut().for_each(|z| *z *= scale);
+            match modal_steady(&q, &modal, numerics, Some((&start, s.phase.branch))) {
+                Ok((state, orbit)) => {
+                    if PhaseBranch::of(state.modes[0].phase_deg, free_phase) != side {
+                        failure = Some(crossed(side, setpoint, s.separation_m));
+                    } else if !seeds.iter().any(|(o, _)| same_state(o, &state)) {
+                        seeds.push((state, orbit));
+                    }
+                }
+                Err(Error::Interrupted) => return Err(Error::Interrupted),
+                Err(e) => failure = failure.or(Some(e)),
             }
-            side = 1;
-        } else {
-            (z_lo, r_lo) = (z, ratio);
-            if side == -1 {
-                r_hi = setpoint + 0.5 * (r_hi - setpoint);
-            }
-            side = -1;
         }
-        best = Some(state);
-        if done || (z_hi - z_lo).abs() <= 1e-9 * p.setup.cantilever.free_amplitude_m {
+        let mut found: Vec<ModalSetpointState> = Vec::new();
+        for (state, orbit) in seeds {
+            let followed = follow(
+                (&p, &modal, numerics),
+                (setpoint, side, free_phase),
+                (s.separation_m, state, orbit),
+            );
+            match followed {
+                Ok(f)
+                    if found
+                        .iter()
+                        .any(|g| same_state(&g.observables, &f.observables)) => {}
+                Ok(f) => found.push(f),
+                Err(Error::Interrupted) => return Err(Error::Interrupted),
+                Err(e) => failure = Some(e),
+            }
+        }
+        if found.is_empty() {
+            out.push((side, Err(failure.expect("every seed failed, and said why"))));
+        }
+        out.extend(found.into_iter().map(|f| (side, Ok(f))));
+    }
+    Ok(out)
+}
+
+/// The scales of the higher modes' free oscillation the states at a setpoint are seeded
+/// with ([`states_at_setpoint`]).
+pub const SEEDS: [f64; 3] = [1.0, -1.0, 0.0];
+
+/// Whether two states are one (their z_c and every mode's amplitude and phase agree).
+fn same_state(a: &ModalObservables, b: &ModalObservables) -> bool {
+    (a.separation_m - b.separation_m).abs() <= 1e-6 * a.separation_m.abs().max(1e-9)
+        && a.modes.iter().zip(&b.modes).all(|(x, y)| {
+            (x.phase_deg - y.phase_deg).abs() <= 0.01
+                && (x.amplitude_m - y.amplitude_m).abs() <= 1e-4 * x.free_amplitude_m.max(1e-12)
+        })
+}
+
+/// Why a state is not the branch's.
+fn crossed(side: PhaseBranch, setpoint: f64, z: f64) -> Error {
+    Error::NotApplicable(format!(
+        "the {side} state of one mode at A/A₀ = {setpoint} is not kept with the higher \
+         modes: φ₁ crosses to the other side of the free phase near z_c = {:.4} nm",
+        z * 1e9
+    ))
+}
+
+/// The state of `side` holding `setpoint`, followed from `state` (with its orbit) at
+/// z_c = `z0`: along z_c towards the setpoint in steps of [`WALK`] A₀₁, each continued
+/// from the last, to the first crossing; then regula falsi inside it.
+fn follow(
+    (p, modal, numerics): (&Prepared, &Modal, &Numerics),
+    (setpoint, side, free_phase): (f64, PhaseBranch, f64),
+    (z0, state, orbit): (f64, ModalObservables, ModalOrbit),
+) -> Result<ModalSetpointState> {
+    let a0 = p.setup.cantilever.free_amplitude_m;
+    let crossed = |z: f64| crossed(side, setpoint, z);
+    // Walk along z_c from the one-mode state towards the setpoint (A₁ grows
+    // with z_c) in steps of WALK A₀₁, each state continued from the last, to
+    // the first crossing of the setpoint; then regula falsi inside it. (A₁ of
+    // the modes can turn steep near the end of a branch, and more than one
+    // state of a branch may hold a setpoint: this is the one joined to the
+    // one-mode state.)
+    let miss0 = first_ratio(&state) - setpoint;
+    let dir = if miss0 > 0.0 { -1.0 } else { 1.0 };
+    let mut near = (z0, miss0, state, orbit);
+    let mut far: Option<(f64, f64)> = None;
+    for k in 1..=WALK_STEPS {
+        if near.1.abs() <= 1e-7 {
             break;
         }
+        let z = z0 + dir * WALK * a0 * k as f64;
+        let (state, orbit) = solve_at(p, modal, numerics, z, Some(&near.3))?;
+        if PhaseBranch::of(state.modes[0].phase_deg, free_phase) != side {
+            return Err(crossed(z));
+        }
+        let miss = first_ratio(&state) - setpoint;
+        if miss * near.1 <= 0.0 {
+            far = Some((z, miss));
+            break;
+        }
+        near = (z, miss, state, orbit);
     }
-    let state = best.expect("regula falsi ran");
-    if (first_ratio(&state) - setpoint).abs() > 1e-5 {
+    if near.1.abs() <= 1e-7 {
+        return Ok(ModalSetpointState {
+            branch: side,
+            observables: near.2,
+        });
+    }
+    let Some(mut far) = far else {
         return Err(Error::NotApplicable(format!(
-            "the first mode's amplitude jumps across A₁/A₀₁ = {setpoint} (to {:.5} near \
-             z_c = {:.4} nm): no steady state of the approach holds it",
-            first_ratio(&state),
-            z_hi * 1e9
+            "the modes' {side} branch does not reach A₁/A₀₁ = {setpoint} within \
+                 {} A₀ of the one-mode state (A₁/A₀₁ = {:.6} at z_c = {:.4} nm)",
+            WALK * WALK_STEPS as f64,
+            near.1 + setpoint,
+            near.0 * 1e9
         )));
+    };
+    // Regula falsi (Illinois) between `near` (with its orbit) and `far`.
+    let mut side_moved = 0i8;
+    for _ in 0..60 {
+        let (z0, m0, z1, m1) = (near.0, near.1, far.0, far.1);
+        let z = if m0 != m1 {
+            z0 - m0 * (z1 - z0) / (m1 - m0)
+        } else {
+            0.5 * (z0 + z1)
+        };
+        let (state, orbit) = solve_at(p, modal, numerics, z, Some(&near.3))?;
+        if PhaseBranch::of(state.modes[0].phase_deg, free_phase) != side {
+            return Err(crossed(z));
+        }
+        let miss = first_ratio(&state) - setpoint;
+        if miss.abs() <= 1e-7 || (z1 - z0).abs() <= 1e-9 * a0 {
+            if miss.abs() > 1e-5 {
+                return Err(Error::NotApplicable(format!(
+                    "the first mode's amplitude jumps across A₁/A₀₁ = \
+                         {setpoint} near z_c = {:.4} nm on the modes' {side} branch",
+                    z * 1e9
+                )));
+            }
+            return Ok(ModalSetpointState {
+                branch: side,
+                observables: state,
+            });
+        }
+        if miss * m0 > 0.0 {
+            near = (z, miss, state, orbit);
+            if side_moved == 1 {
+                far.1 *= 0.5;
+            }
+            side_moved = 1;
+        } else {
+            far = (z, miss);
+            if side_moved == -1 {
+                near.1 *= 0.5;
+            }
+            side_moved = -1;
+        }
     }
-    Ok(state)
+    Err(Error::NotApplicable(format!(
+        "regula falsi on z_c did not reach A₁/A₀₁ = {setpoint} on the modes' \
+             {side} branch"
+    )))
 }
 
 /// The bimodal phase contrast at one setpoint for one law: each material's state.
@@ -225,6 +311,8 @@ pub struct BimodalRow {
     pub materials: Vec<String>,
     /// A₁/A₀₁ held.
     pub setpoint: f64,
+    /// The first mode's branch every state of the row is on.
+    pub branch: PhaseBranch,
     /// φ₁ of each material (degrees; null where no state holds the setpoint).
     pub phase1_deg: Vec<Option<f64>>,
     /// φ₂ of each material (degrees).
@@ -241,13 +329,18 @@ pub struct BimodalRow {
     pub delta_phase1_deg: Option<f64>,
     /// φ₂(last) − φ₂(first), degrees: the bimodal contrast.
     pub delta_phase2_deg: Option<f64>,
-    /// Why a material has no state.
+    /// Why a material has no state: none holds the setpoint, or several coexist.
     pub notes: Vec<Option<String>>,
 }
 
+/// What one material has at one setpoint: each branch's state or why not, or why it has
+/// none at all.
+type Held = Result<Vec<(PhaseBranch, Result<ModalSetpointState>)>>;
+
 /// φ₁ and φ₂ of every material at each first-mode setpoint under each law of `laws`
 /// (each law and material in parallel, each counted by `progress` when done), rows by
-/// law then setpoint.
+/// law, setpoint and branch: where a setpoint is bistable both branches get a row, and
+/// a contrast is taken only between states on the same branch.
 pub fn contrast(
     materials: &[Material],
     set: &ModeSet,
@@ -258,15 +351,24 @@ pub fn contrast(
     let jobs: Vec<(usize, usize)> = (0..laws.len())
         .flat_map(|l| (0..materials.len()).map(move |m| (l, m)))
         .collect();
-    let results: Vec<Result<Vec<Result<ModalObservables>>>> = jobs
+    let results: Vec<Result<Vec<Held>>> = jobs
         .par_iter()
         .map(|&(l, m)| {
             let mut setup = materials[m].setup.clone();
             setup.law = laws[l].into();
-            let (p, modal) = prepare(&setup, set, &materials[m].numerics)?;
-            let states = at_setpoints(&p, &modal, &materials[m].numerics, setpoints);
+            let numerics = &materials[m].numerics;
+            prepare(&setup, set, numerics)?;
+            let held = setpoints
+                .iter()
+                .map(
+                    |&r| match states_at_setpoint(&setup, set, numerics, r, None) {
+                        Err(Error::Interrupted) => Err(Error::Interrupted),
+                        found => Ok(found),
+                    },
+                )
+                .collect::<Result<Vec<Held>>>();
             progress();
-            states
+            held
         })
         .collect();
     let mut states = Vec::with_capacity(results.len());
@@ -276,41 +378,87 @@ pub fn contrast(
     let mut rows = Vec::new();
     for (l, law) in laws.iter().enumerate() {
         for (k, &setpoint) in setpoints.iter().enumerate() {
-            let of = |m: usize| states[l * materials.len() + m][k].as_ref().ok();
-            let each = |f: &dyn Fn(&ModalObservables) -> Option<f64>| {
-                (0..materials.len())
-                    .map(|m| of(m).and_then(f))
-                    .collect::<Vec<_>>()
-            };
-            let phase1 = each(&|s| Some(s.modes[0].phase_deg));
-            let phase2 = each(&|s| s.modes.get(1).map(|m| m.phase_deg));
-            let delta = |v: &[Option<f64>]| match (v.first(), v.last()) {
-                (Some(Some(a)), Some(Some(b))) if v.len() > 1 => Some(b - a),
-                _ => None,
-            };
-            rows.push(BimodalRow {
-                law: law.to_string(),
-                materials: materials.iter().map(|m| m.name.clone()).collect(),
-                setpoint,
-                delta_phase1_deg: delta(&phase1),
-                delta_phase2_deg: delta(&phase2),
-                phase1_deg: phase1,
-                phase2_deg: phase2,
-                amplitude2_ratio: each(&|s| s.modes.get(1).and_then(|m| m.amplitude_ratio)),
-                e_ts_j: each(&|s| Some(s.e_ts_j)),
-                separation_m: each(&|s| Some(s.separation_m)),
-                stable: (0..materials.len())
-                    .map(|m| of(m).map(|s| s.stable))
-                    .collect(),
-                notes: (0..materials.len())
-                    .map(|m| {
-                        states[l * materials.len() + m][k]
-                            .as_ref()
-                            .err()
-                            .map(|e| e.to_string())
-                    })
-                    .collect(),
-            });
+            for branch in [PhaseBranch::Attractive, PhaseBranch::Repulsive] {
+                // Each material's entry on this branch: its state, why the modes keep
+                // none, or (None) no state of one mode there either.
+                // Each material's state on this branch; or why it has none, or the
+                // coexisting states of the modes it holds the setpoint in (then no one of
+                // them is the material's).
+                let entry = |m: usize| -> std::result::Result<&ModalObservables, String> {
+                    let found = match &states[l * materials.len() + m][k] {
+                        Err(e) => return Err(e.to_string()),
+                        Ok(found) => found,
+                    };
+                    let on: Vec<&Result<ModalSetpointState>> = found
+                        .iter()
+                        .filter(|(b, _)| *b == branch)
+                        .map(|(_, s)| s)
+                        .collect();
+                    match on.as_slice() {
+                        [] => Err(format!(
+                            "no stable state of the first mode holds A₁/A₀₁ = {setpoint} on \
+                             the {branch} branch"
+                        )),
+                        [Ok(s)] => Ok(&s.observables),
+                        [Err(e)] => Err(e.to_string()),
+                        several => Err(format!(
+                            "the modes hold the setpoint here in {} coexisting states ({}): \
+                             which one an AFM images on depends on its history, so no phase \
+                             is given",
+                            several.len(),
+                            several
+                                .iter()
+                                .filter_map(|s| s.as_ref().ok())
+                                .map(|s| {
+                                    let o = &s.observables;
+                                    format!(
+                                        "φ₁ = {:.4}°, φ₂ = {:.4}° at z_c = {:.4} nm",
+                                        o.modes[0].phase_deg,
+                                        o.modes.get(1).map_or(f64::NAN, |m| m.phase_deg),
+                                        o.separation_m * 1e9
+                                    )
+                                })
+                                .collect::<Vec<_>>()
+                                .join("; ")
+                        )),
+                    }
+                };
+                let on_branch = (0..materials.len()).any(|m| {
+                    matches!(&states[l * materials.len() + m][k],
+                        Ok(found) if found.iter().any(|(b, _)| *b == branch))
+                });
+                if !on_branch {
+                    continue;
+                }
+                let each = |f: &dyn Fn(&ModalObservables) -> Option<f64>| {
+                    (0..materials.len())
+                        .map(|m| entry(m).ok().and_then(f))
+                        .collect::<Vec<_>>()
+                };
+                let phase1 = each(&|s| Some(s.modes[0].phase_deg));
+                let phase2 = each(&|s| s.modes.get(1).map(|m| m.phase_deg));
+                let delta = |v: &[Option<f64>]| match (v.first(), v.last()) {
+                    (Some(Some(a)), Some(Some(b))) if v.len() > 1 => Some(b - a),
+                    _ => None,
+                };
+                rows.push(BimodalRow {
+                    law: law.to_string(),
+                    materials: materials.iter().map(|m| m.name.clone()).collect(),
+                    setpoint,
+                    branch,
+                    delta_phase1_deg: delta(&phase1),
+                    delta_phase2_deg: delta(&phase2),
+                    phase1_deg: phase1,
+                    phase2_deg: phase2,
+                    amplitude2_ratio: each(&|s| s.modes.get(1).and_then(|m| m.amplitude_ratio)),
+                    e_ts_j: each(&|s| Some(s.e_ts_j)),
+                    separation_m: each(&|s| Some(s.separation_m)),
+                    stable: (0..materials.len())
+                        .map(|m| entry(m).ok().map(|s| s.stable))
+                        .collect(),
+                    notes: (0..materials.len()).map(|m| entry(m).err()).collect(),
+                });
+            }
         }
     }
     Ok(rows)
@@ -355,7 +503,7 @@ pub fn map_cells(
     (works_j_m2, moduli_pa): (&[f64], &[f64]),
     threads: usize,
     progress: impl Fn() + Sync,
-    setpoint: Option<f64>,
+    setpoint: Option<(f64, PhaseBranch)>,
 ) -> Result<Vec<ModalCell>> {
     let every: Vec<usize> = (0..works_j_m2.len() * moduli_pa.len()).collect();
     crate::sweep::over_grid(
@@ -367,9 +515,21 @@ pub fn map_cells(
         |s, (w, e)| {
             let found = prepare(s, set, numerics).and_then(|(p, modal)| match setpoint {
                 None => Ok(modal_steady(&p, &modal, numerics, None)?.0),
-                Some(r) => at_setpoints(&p, &modal, numerics, &[r])?
-                    .pop()
-                    .expect("one setpoint asked"),
+                Some((r, branch)) => {
+                    let mut found = states_at_setpoint(s, set, numerics, r, Some(branch))?;
+                    match found.len() {
+                        0 => Err(Error::NotApplicable(format!(
+                            "no stable state of the first mode holds A₁/A₀₁ = {r} on the \
+                             {branch} branch"
+                        ))),
+                        1 => found.remove(0).1.map(|s| s.observables),
+                        n => Err(Error::NotApplicable(format!(
+                            "the modes hold A₁/A₀₁ = {r} on the {branch} branch in {n} \
+                             coexisting states (the several-mode `tap` lists them): which one \
+                             an AFM images on depends on its history"
+                        ))),
+                    }
+                }
             });
             let mode = |s: &ModalObservables, i: usize| s.modes.get(i).cloned();
             Ok(match found {

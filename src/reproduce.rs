@@ -377,7 +377,7 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
     paths.push(write_records(out, "tap_bimodal_contrast", &bimodal_rows)?);
     add(
         paths,
-        "bimodal phase contrast between polymers A and B under jkr, hybrid and lj: Δφ₂ of \
+        "bimodal phase contrast between polymers A and B under jkr, hybrid and lj, branch by branch: Δφ₂ of \
          a beam's second mode and Δφ₁ at the first mode's setpoints",
         &mut entries,
     );
@@ -586,8 +586,9 @@ pub fn reproduce(out: &Path, mut progress: impl FnMut(&str)) -> Result<Manifest>
         let f = |v: Option<f64>| v.map_or("–".into(), |v| format!("{v:.3}°"));
         let _ = writeln!(
             md,
-            "| bimodal contrast B − A at A₁/A₀₁ = 0.8, {}: Δφ₂ / Δφ₁ | {} / {} |",
+            "| bimodal contrast B − A at A₁/A₀₁ = 0.8, {}, {}: Δφ₂ / Δφ₁ | {} / {} |",
             r.law,
+            r.branch,
             f(r.delta_phase2_deg),
             f(r.delta_phase1_deg)
         );

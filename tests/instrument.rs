@@ -118,6 +118,77 @@ fn the_z_feedback_rests_where_the_setpoint_solver_puts_the_state() {
     assert!(PiController::new(0.8, 0.0, 0.0).is_err());
 }
 
+/// The instrument on two eigenmodes (the hybrid defaults with a beam's second mode,
+/// A₀₂ = A₀/40): the loop on the first mode's lock-in, engaged from 1.2 A₀, rests at the
+/// separation where the several-mode steady-state solver (Newton on the common period,
+/// a method the march shares only its equations with) puts A₁/A₀₁ = 0.8, and the
+/// second mode's lock-in then reads the solver's φ₂ and A₂/A₀₂.
+#[test]
+fn the_bimodal_feedback_rests_where_the_modal_steady_state_is() {
+    use tapsim::bimodal::{PhaseBranch, states_at_setpoint};
+    use tapsim::dynamics::modes::{ModeSet, prepare};
+    use tapsim::instrument::feedback::{PiController, hold_probe};
+    use tapsim::instrument::modal::ModalProbe;
+    use tapsim::instrument::probe::Probe;
+    let setup = default_setup();
+    let set = ModeSet::euler_bernoulli(&setup.cantilever, 2).unwrap();
+    let numerics = Numerics::default();
+    let marched = Numerics {
+        rtol: tapsim::instrument::MARCH_RTOL,
+        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
+        ..numerics
+    };
+    let materials = [prepare(&setup, &set, &marched).unwrap()];
+    let period = materials[0].1.period() / f64::from(materials[0].1.periods);
+    let mut probe = ModalProbe::new(&materials, 4, 2.0 * period).unwrap();
+    let mut controller = PiController::new(0.8, 0.0, 0.002).unwrap();
+    let a0 = setup.cantilever.free_amplitude_m;
+    let started = std::time::Instant::now();
+    let (samples, _) = hold_probe(&mut probe, 0, 1.2 * a0, &mut controller, 6000).unwrap();
+    eprintln!("6000 periods in {:?}", started.elapsed());
+    assert!((samples[0].amplitude_ratio - 1.0).abs() < 1e-4);
+    let tail = &samples[5500..];
+    for s in tail {
+        assert!(s.error.abs() < 1e-4 * 0.8, "{s:?}");
+    }
+    let z = tail.last().unwrap().separation_m;
+    // The lock-ins' outputs ripple at the common period's frequency (the orbit repeats
+    // every 4 drive periods: lines at Ωᵢ ± Ω₁/4 beat through the filter); a pixel's mean
+    // over whole common periods is what an image shows.
+    let mut read = [(0.0, 0.0); 2];
+    for _ in 0..400 {
+        let r = probe.march(0, z, 1).unwrap();
+        for (sum, r) in read.iter_mut().zip(r) {
+            sum.0 += r.0 / 400.0;
+            sum.1 += r.1 / 400.0;
+        }
+    }
+    // The loop engages from above, onto the attractive branch (φ₁ > 90°), as with one
+    // mode; the solver's state there.
+    let (branch, found) = states_at_setpoint(&setup, &set, &numerics, 0.8, None)
+        .unwrap()
+        .remove(0);
+    assert_eq!(branch, PhaseBranch::Attractive);
+    let solved = found.unwrap().observables;
+    let want = solved.separation_m;
+    eprintln!(
+        "bimodal loop rests at {z:e} m (solver {want:e} m); φ₁ {} ({}), φ₂ {} ({}), A₂/A₀₂ {} ({})",
+        read[0].1,
+        solved.modes[0].phase_deg,
+        read[1].1,
+        solved.modes[1].phase_deg,
+        read[1].0,
+        solved.modes[1].amplitude_ratio.unwrap()
+    );
+    assert!(
+        (z - want).abs() < 0.01e-9,
+        "piezo at {z:e} m, solver {want:e} m"
+    );
+    assert!((read[0].1 - solved.modes[0].phase_deg).abs() < 0.01);
+    assert!((read[1].1 - solved.modes[1].phase_deg).abs() < 0.01);
+    assert!((read[1].0 - solved.modes[1].amplitude_ratio.unwrap()).abs() < 1e-4);
+}
+
 /// A line scanned slowly with the loop closed at A/A₀ = 0.8 over (1) a flat sample of
 /// two materials and (2) a 2 nm step in the height of one: the image shows the apparent
 /// step the setpoint solver predicts (the two materials' z_c at the setpoint on the

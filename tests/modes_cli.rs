@@ -204,7 +204,9 @@ fn a_bimodal_approach_lists_both_phases() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// README: the bimodal contrast B − A at A₁/A₀₁ = 0.8 under each law.
+/// README: the bimodal contrast B − A at A₁/A₀₁ = 0.8 under each law, on the repulsive
+/// branch; on the attractive one, under the hybrid law, B's higher modes hold the setpoint
+/// in two coexisting states, and no phase of B is given.
 #[test]
 fn the_readme_bimodal_contrast() {
     let v = json(&[
@@ -222,12 +224,87 @@ fn the_readme_bimodal_contrast() {
         ("lj", -5.018, -2.834),
     ];
     let rows = rows(&v);
-    assert_eq!(rows.len(), 3);
-    for (row, (law, d2, d1)) in rows.iter().zip(expect) {
+    let repulsive: Vec<_> = rows.iter().filter(|r| r["branch"] == "repulsive").collect();
+    assert_eq!(repulsive.len(), 3);
+    for (row, (law, d2, d1)) in repulsive.into_iter().zip(expect) {
         assert_eq!(row["law"], law);
         assert!((num(row, "delta_phase2_deg") - d2).abs() < 5e-4, "{row}");
         assert!((num(row, "delta_phase1_deg") - d1).abs() < 5e-4, "{row}");
     }
+    // README: on the attractive branch under the hybrid law, Δφ₂ = −25.504°,
+    // Δφ₁ = +2.632° (what the scan shows, `a_bimodal_scan_rests_on_…`).
+    let hybrid = rows
+        .iter()
+        .find(|r| r["branch"] == "attractive" && r["law"] == "hybrid")
+        .expect("the hybrid law's attractive row");
+    assert!(
+        (num(hybrid, "delta_phase2_deg") + 25.504).abs() < 5e-4,
+        "{hybrid}"
+    );
+    assert!(
+        (num(hybrid, "delta_phase1_deg") - 2.632).abs() < 5e-4,
+        "{hybrid}"
+    );
+}
+
+/// `scan --modes 2` over the built-in blend: the loop engaged from above rests on each
+/// polymer in a state `tap --modes 2 --setpoint 0.8` lists for it (the attractive one),
+/// its topography at that state's z_c within 0.01 nm and φ₁, φ₂ within 0.01°.
+#[test]
+fn a_bimodal_scan_rests_on_states_the_setpoint_solver_lists() {
+    let v = json(&[
+        "scan",
+        "--modes",
+        "2",
+        "--pixels",
+        "8",
+        "--line-rate",
+        "40",
+        "--no-retrace",
+        "--json",
+        "-q",
+    ]);
+    let pixels = rows(&v);
+    assert_eq!(pixels.len(), 8);
+    for (pixel, material) in [
+        (3, &[][..]),
+        (
+            7,
+            &["--sample-modulus", "1GPa", "--work-of-adhesion", "0.08"][..],
+        ),
+    ] {
+        let p = &pixels[pixel];
+        let (phi1, phi2, z) = (
+            num(p, "phase_deg"),
+            num(&p["modes"][0], "phase_deg"),
+            num(p, "topography_m"),
+        );
+        let listed = json(
+            &[
+                &["tap", "--modes", "2", "--setpoint", "0.8", "--json"][..],
+                material,
+            ]
+            .concat(),
+        );
+        let states = listed["states"].as_array().unwrap();
+        let matching = states.iter().find(|s| {
+            (num(&s["modes"][0], "phase_deg") - phi1).abs() < 0.01
+                && (num(&s["modes"][1], "phase_deg") - phi2).abs() < 0.01
+                && (num(s, "separation_m") - z).abs() < 0.01e-9
+        });
+        assert!(
+            matching.is_some(),
+            "pixel {pixel}: φ₁ {phi1}, φ₂ {phi2}, z {z:e} among {states:?}"
+        );
+    }
+    // README: the scan's contrast B − A, Δφ₂ = −25.5°, Δφ₁ = +2.6°.
+    let delta = |f: &dyn Fn(&serde_json::Value) -> f64| f(&pixels[7]) - f(&pixels[3]);
+    let d2 = delta(&|p| num(&p["modes"][0], "phase_deg"));
+    let d1 = delta(&|p| num(p, "phase_deg"));
+    assert!(
+        (d2 + 25.5).abs() < 0.05 && (d1 - 2.6).abs() < 0.05,
+        "{d2} {d1}"
+    );
 }
 
 /// `map --modes 2`: every cell with a state is `tap --modes 2` at that cell, bit for bit;

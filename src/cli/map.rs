@@ -19,8 +19,8 @@ use clap::Args;
 /// option applies (--modulus and --work-of-adhesion are replaced by the grid).
 ///
 /// With --modes 2 (or 3): every cell the several-mode state (`tapsim tap --modes`) at
-/// the rest separation, or with --setpoint at the first mode's A₁/A₀₁ as a slow approach
-/// reaches it; one row per cell (work_of_adhesion_j_m2, modulus_pa, tabor_mu,
+/// the rest separation, or with --setpoint at the first mode's A₁/A₀₁ on --branch
+/// (repulsive by default); one row per cell (work_of_adhesion_j_m2, modulus_pa, tabor_mu,
 /// separation_m, amplitude1_ratio, phase1_deg, amplitude2_ratio, phase2_deg, e_ts_j,
 /// stable, note), JSON as columns, heat maps of φ₂, φ₁, A₂/A₀₂ and E_ts. Not sharded.
 ///
@@ -111,12 +111,17 @@ pub fn run(args: MapArgs) -> Result<()> {
     if let Some(set) = args.modes.mode_set(&inputs.mode_file, &setup.cantilever)? {
         use super::modal::refuse;
         refuse(args.noise.temperature.is_some(), "--temperature")?;
-        refuse(inputs.branch.is_some(), "--branch")?;
         refuse(
             args.split.resolve("map", false)?.is_some(),
             "--shard (and a Slurm array)",
         )?;
-        let setpoint = inputs.setpoint_ratio(setup.cantilever.free_amplitude_m);
+        let setpoint = match inputs.setpoint_ratio(setup.cantilever.free_amplitude_m) {
+            None => None,
+            Some(ratio) => {
+                crate::setpoint::check_ratio(ratio)?;
+                Some((ratio, one_branch(inputs.branch)?))
+            }
+        };
         let numerics = if setpoint.is_some() {
             inputs.sweep_numerics(numerics)
         } else {
@@ -134,14 +139,9 @@ pub fn run(args: MapArgs) -> Result<()> {
         None => None,
         Some(amplitude_ratio) => {
             crate::setpoint::check_ratio(amplitude_ratio)?;
-            let Some(branch) = inputs.branch.unwrap_or(BranchChoice::Repulsive).only() else {
-                return Err(Error::NotApplicable(
-                    "a map is solved on one branch: --branch attractive or repulsive".into(),
-                ));
-            };
             Some(MapSetpoint {
                 amplitude_ratio,
-                branch,
+                branch: one_branch(inputs.branch)?,
             })
         }
     };
@@ -256,4 +256,16 @@ pub(super) fn emit<T: report::MapRecord>(
         );
     }
     Ok(())
+}
+
+/// The one branch a map at a setpoint is solved on (repulsive unless told).
+fn one_branch(choice: Option<BranchChoice>) -> Result<crate::setpoint::PhaseBranch> {
+    choice
+        .unwrap_or(BranchChoice::Repulsive)
+        .only()
+        .ok_or_else(|| {
+            Error::NotApplicable(
+                "a map is solved on one branch: --branch attractive or repulsive".into(),
+            )
+        })
 }

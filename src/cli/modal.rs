@@ -7,6 +7,7 @@ use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
 use crate::law::LawKind;
 use crate::report::modes as report;
+use crate::setpoint::PhaseBranch;
 use crate::sweep::Direction;
 
 /// Refuse `flag` (given when `given`) with several modes.
@@ -20,33 +21,77 @@ pub(super) fn refuse(given: bool, flag: &str) -> Result<()> {
     Ok(())
 }
 
-/// `tap --modes N`: the steady state at the rest separation, or at the first mode's
-/// amplitude setpoint `setpoint` (A₁/A₀₁) as a slow approach reaches it.
+/// `tap --modes N`: the steady state at the rest separation, or every state at the
+/// first mode's amplitude setpoint (A₁/A₀₁, on the branch given or on both).
 pub(super) fn tap(
     setup: &TapSetup,
     numerics: &Numerics,
     set: &ModeSet,
-    setpoint: Option<f64>,
+    setpoint: Option<(f64, Option<PhaseBranch>)>,
     json: bool,
 ) -> Result<()> {
-    let (p, modal) = prepare(setup, set, numerics)?;
-    let state = match setpoint {
-        None => modal_steady(&p, &modal, numerics, None)?.0,
-        Some(s) => bimodal::at_setpoints(&p, &modal, numerics, &[s])?
-            .pop()
-            .expect("one setpoint asked")?,
+    let Some((ratio, branch)) = setpoint else {
+        let (p, modal) = prepare(setup, set, numerics)?;
+        let state = modal_steady(&p, &modal, numerics, None)?.0;
+        if json {
+            outln!("{}", crate::report::records::document(&state)?);
+        } else {
+            out!("{}", report::tap_text(set, &state));
+        }
+        return Ok(());
     };
+    crate::setpoint::check_ratio(ratio)?;
+    let found = bimodal::states_at_setpoint(setup, set, numerics, ratio, branch)?;
+    let (states, notes): (Vec<_>, Vec<_>) = found.into_iter().partition(|(_, s)| s.is_ok());
+    let states: Vec<bimodal::ModalSetpointState> =
+        states.into_iter().filter_map(|(_, s)| s.ok()).collect();
+    let notes: Vec<String> = notes
+        .into_iter()
+        .filter_map(|(_, s)| s.err().map(|e| e.to_string()))
+        .collect();
+    if states.is_empty() {
+        return Err(Error::NotApplicable(notes.join("; ")));
+    }
     if json {
-        let mut v = serde_json::to_value(&state).expect("observables serialise");
-        if let (serde_json::Value::Object(m), Some(s)) = (&mut v, setpoint) {
-            m.insert("setpoint".into(), s.into());
+        let listed = serde_json::to_value(&states).expect("states serialise");
+        let mut top = listed[0].clone();
+        if let serde_json::Value::Object(m) = &mut top {
+            m.insert("setpoint".into(), ratio.into());
+            m.insert("states".into(), listed);
+            m.insert("notes".into(), notes.into());
         }
-        outln!("{}", crate::report::records::document(&v)?);
-    } else {
-        if let Some(s) = setpoint {
-            outln!("first-mode setpoint A₁/A₀₁ = {s}: the state a slow approach reaches there");
+        outln!("{}", crate::report::records::document(&top)?);
+        return Ok(());
+    }
+    outln!(
+        "first-mode setpoint A₁/A₀₁ = {ratio}: {} hold it{}",
+        match states.len() {
+            1 => "1 state of the modes".to_string(),
+            n => format!("{n} states of the modes"),
+        },
+        if states.len() > 1 {
+            " (coexisting attractors: which one an AFM images on depends on how it got \
+             there, approach or retract)"
+        } else {
+            ""
         }
-        out!("{}", report::tap_text(set, &state));
+    );
+    for s in &states {
+        let on: Vec<_> = states.iter().filter(|t| t.branch == s.branch).collect();
+        let which = match on.iter().position(|t| std::ptr::eq(*t, s)) {
+            Some(i) if on.len() > 1 => {
+                format!(", state {} of {}: the higher modes differ", i + 1, on.len())
+            }
+            _ => String::new(),
+        };
+        outln!(
+            "\n{} branch (φ₁ on the {0} side of the free phase){which}:",
+            s.branch
+        );
+        out!("{}", report::tap_text(set, &s.observables));
+    }
+    for note in &notes {
+        outln!("note: {note}");
     }
     Ok(())
 }
@@ -141,7 +186,7 @@ pub(super) fn map(
     (setup, numerics, set): (&TapSetup, &Numerics, &ModeSet),
     (works, moduli): (&[f64], &[f64]),
     threads: usize,
-    setpoint: Option<f64>,
+    setpoint: Option<(f64, PhaseBranch)>,
     out: &super::SweepOutput,
 ) -> Result<()> {
     let bar = out.progress_bar(works.len() * moduli.len());
@@ -157,7 +202,11 @@ pub(super) fn map(
     bar.finish_and_clear();
     let cells = cells?;
     let title = match setpoint {
-        Some(s) => format!("{} law, {} modes, A₁/A₀₁ = {s}", setup.law, set.count()),
+        Some((s, branch)) => format!(
+            "{} law, {} modes, A₁/A₀₁ = {s}, {branch}",
+            setup.law,
+            set.count()
+        ),
         None => format!(
             "{} law, {} modes, z_c = {:.4} nm",
             setup.law,

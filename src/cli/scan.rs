@@ -5,7 +5,10 @@ use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
 use crate::instrument::feedback::PiController;
 use crate::instrument::lockin::LockIn;
-use crate::instrument::scan::{MAX_IMAGE_PIXELS, MAX_PIXELS, Pixel, row, settled_material};
+use crate::instrument::modal::ModalProbe;
+use crate::instrument::scan::{
+    MAX_IMAGE_PIXELS, MAX_PIXELS, Pixel, row, row_probe, settled_material,
+};
 use crate::instrument::thermal::{
     STEPS_PER_PERIOD, ThermalForce, check_temperature, intensity_hat,
 };
@@ -46,6 +49,16 @@ use serde_json::value::RawValue;
 ///
 /// The cantilever is marched at an integrator tolerance of 2e-7 (--rtol to change it):
 /// the energy balance of the default orbit stays below 1e-6 there.
+///
+/// Bimodal imaging (--modes 2 or 3): the higher modes driven at their resonances (as
+/// in `tapsim tap --modes`), each read by its own lock-in (the same filter) while the
+/// loop holds the first mode's A₁/A₀₁; every pixel adds each higher mode's
+/// amplitude ratio and phase (JSON `modes`; CSV modes_1_mode, modes_1_amplitude_ratio,
+/// modes_1_phase_deg, …), and the plot φ₂ beside φ₁. About 16 times slower than one
+/// mode (a second mode at 6.25 f₀ of Q ≈ 2 500 is integrated with it); no thermal
+/// noise. The loop engages from above, as with one mode; where the modes hold the
+/// setpoint in several states (`tapsim tap --modes 2 --setpoint 0.8` lists them) the
+/// image shows the one the scan's history leads to.
 ///
 /// Output: a table, --json (a record per pixel: direction, line, y_m, x_m,
 /// topography_m, amplitude_ratio, error, phase_deg), --csv, --plot (one line: topography
@@ -102,6 +115,8 @@ pub struct ScanArgs {
     #[arg(long, default_value_t = 1, help_heading = "Thermal noise")]
     seed: u64,
     #[command(flatten)]
+    modes: crate::config::ModeInputs,
+    #[command(flatten)]
     split: super::shard::ShardArgs,
 }
 
@@ -124,7 +139,8 @@ const ENGAGE_PERIODS: usize = 10_000;
 
 /// Run the subcommand.
 pub fn run(args: ScanArgs) -> Result<()> {
-    let base = args.inputs.clone().with_config()?;
+    let mut base = args.inputs.clone().with_config()?;
+    base.takes_modes = true;
     base.no_setpoint("scan")?;
     if base.separation.is_some() {
         return Err(Error::NotApplicable(
@@ -159,11 +175,28 @@ pub fn run(args: ScanArgs) -> Result<()> {
         numerics.rtol = crate::instrument::MARCH_RTOL;
         numerics.atol = 1e-2 * crate::instrument::MARCH_RTOL;
     }
+    let first_setup = &sample.materials[0].1;
+    let set = args
+        .modes
+        .mode_set(&base.mode_file, &first_setup.cantilever)?;
+    if set.is_some() {
+        super::modal::refuse(args.temperature.is_some(), "--temperature")?;
+    }
     let prepared = sample
         .materials
         .iter()
         .map(|(_, s)| Prepared::new(s, &numerics))
         .collect::<Result<Vec<_>>>()?;
+    let modal = match &set {
+        Some(set) => Some(
+            sample
+                .materials
+                .iter()
+                .map(|(_, s)| crate::dynamics::modes::prepare(s, set, &numerics))
+                .collect::<Result<Vec<_>>>()?,
+        ),
+        None => None,
+    };
     let whole_outputs = args.out.csv.is_some() || args.out.plot.is_some() || args.out.json;
     let shard = args.split.resolve("scan", whole_outputs)?;
     let mine = shard.unwrap_or(Shard::WHOLE).items(args.lines);
@@ -220,6 +253,19 @@ pub fn run(args: ScanArgs) -> Result<()> {
             mine.par_iter()
                 .map(|&j| {
                     bar.inc(1);
+                    if let Some(modal) = &modal {
+                        let mut probe =
+                            ModalProbe::new(modal, lockin.order(), lockin.time_constant_hat())?;
+                        return row_probe(
+                            &mut probe,
+                            &lines[j].1,
+                            shape,
+                            controller,
+                            ENGAGE_PERIODS,
+                            !args.no_retrace,
+                            |_| bar.inc(1),
+                        );
+                    }
                     let force =
                         ThermalForce::new(intensity, STEPS_PER_PERIOD, args.seed, j as u64)?;
                     row(
@@ -271,6 +317,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
             (per_pixel, args.lockin_order, args.lockin_periods),
             (args.proportional_gain, args.integral_gain),
             (args.temperature, args.seed),
+            &set,
         ))
         .expect("a configuration serialises");
         return args.split.write(
@@ -300,19 +347,32 @@ pub fn run(args: ScanArgs) -> Result<()> {
         args.setpoint,
         args.pixels
     );
-    outln!(
+    let higher = rows.first().map_or(0, |r| r.pixel.modes.len());
+    let mut head = format!(
         "{:>10} {:>10} {:>8} {:>12} {:>10} {:>10} {:>10}",
         "y (nm)",
         "x (nm)",
         "dir",
         "height (nm)",
-        "A/A0",
+        if higher > 0 { "A1/A01" } else { "A/A0" },
         "error",
-        "phi (deg)"
+        if higher > 0 {
+            "phi1 (deg)"
+        } else {
+            "phi (deg)"
+        }
     );
+    for k in 2..2 + higher {
+        head += &format!(
+            " {:>10} {:>10}",
+            format!("A{k}/A0{k}"),
+            format!("phi{k} (deg)")
+        );
+    }
+    outln!("{head}");
     for r in &rows {
         let p = &r.pixel;
-        outln!(
+        let mut line = format!(
             "{:>10.2} {:>10.2} {:>8} {:>12.4} {:>10.6} {:>10.2e} {:>10.4}",
             r.y_m * 1e9,
             p.x_m * 1e9,
@@ -322,6 +382,10 @@ pub fn run(args: ScanArgs) -> Result<()> {
             p.error,
             p.phase_deg
         );
+        for m in &p.modes {
+            line += &format!(" {:>10.6} {:>10.4}", m.amplitude_ratio, m.phase_deg);
+        }
+        outln!("{line}");
     }
     if let Some(t) = args.temperature {
         // Each material's settled trace pixels: their mean phase and scatter.
@@ -373,8 +437,8 @@ pub fn run(args: ScanArgs) -> Result<()> {
 }
 
 /// What a plot shows of a pixel's record: its direction (trace?), position (y, x in m),
-/// topography (m) and phase (deg).
-type Point = (bool, f64, f64, f64, f64);
+/// topography (m), phase (deg) and the second mode's phase (deg), if read.
+type Point = (bool, f64, f64, f64, f64, Option<f64>);
 
 /// A pixel's record, as computed or as read back from a part file.
 pub(super) trait ScanRecord: serde::Serialize {
@@ -391,6 +455,7 @@ impl ScanRecord for Row {
             p.x_m,
             p.topography_m,
             p.phase_deg,
+            p.modes.first().map(|m| m.phase_deg),
         ))
     }
 }
@@ -436,14 +501,14 @@ fn draw<T: ScanRecord>(job: &Job, records: &[T], path: &std::path::Path) -> Resu
 
 /// Topography and phase profiles, trace and retrace.
 fn charts(rows: &[Point]) -> Vec<Chart> {
-    let profile = |name: &str, title: &str, label: &str, pick: fn(&Point) -> f64| {
+    let profile = |name: &str, title: &str, label: &str, pick: fn(&Point) -> Option<f64>| {
         let series: Vec<Series> = [("trace", Style::Line, 1), ("retrace", Style::Dashed, 2)]
             .into_iter()
             .filter_map(|(dir, style, color)| {
                 let points: Vec<(f64, f64)> = rows
                     .iter()
                     .filter(|r| r.0 == (dir == "trace"))
-                    .map(|r| (r.2 * 1e9, pick(r)))
+                    .filter_map(|r| Some((r.2 * 1e9, pick(r)?)))
                     .collect();
                 (!points.is_empty()).then(|| Series::new(dir, points, style, color))
             })
@@ -458,24 +523,51 @@ fn charts(rows: &[Point]) -> Vec<Chart> {
             labels: vec![],
         }
     };
-    vec![
+    let bimodal = rows.iter().any(|r| r.5.is_some());
+    let mut charts = vec![
         profile(
             "topography_nm",
             "topography (z piezo)",
             "height (nm)",
-            |p| p.3 * 1e9,
+            |p| Some(p.3 * 1e9),
         ),
-        profile("phase_deg", "lock-in phase", "phase lag φ (deg)", |p| p.4),
-    ]
+        profile(
+            "phase_deg",
+            if bimodal {
+                "first mode's lock-in phase"
+            } else {
+                "lock-in phase"
+            },
+            if bimodal {
+                "phase lag φ₁ (deg)"
+            } else {
+                "phase lag φ (deg)"
+            },
+            |p| Some(p.4),
+        ),
+    ];
+    if bimodal {
+        charts.push(profile(
+            "phase2_deg",
+            "second mode's lock-in phase",
+            "phase lag φ₂ (deg)",
+            |p| p.5,
+        ));
+    }
+    charts
 }
 
 /// Heat maps of the trace's topography and phase over the image, side by side.
 fn images(rows: &[Point], lines: usize, pixels: usize, setpoint: f64) -> Vec<HeatMap> {
+    let bimodal = rows.iter().any(|r| r.5.is_some());
     let trace: Vec<&Point> = rows.iter().filter(|r| r.0).collect();
     let x: Vec<f64> = trace.iter().take(pixels).map(|r| r.2 * 1e9).collect();
     let y: Vec<f64> = trace.iter().step_by(pixels).map(|r| r.1 * 1e9).collect();
     let map = |title: &str, label: &str, pick: fn(&Point) -> f64| HeatMap {
-        title: format!("{title} at A/A₀ = {setpoint} (trace)"),
+        title: format!(
+            "{title} at {} = {setpoint} (trace)",
+            if bimodal { "A₁/A₀₁" } else { "A/A₀" }
+        ),
         x_label: "x along the line (nm)".into(),
         y_label: "y across the lines (nm)".into(),
         value_label: label.into(),
@@ -497,8 +589,16 @@ fn images(rows: &[Point], lines: usize, pixels: usize, setpoint: f64) -> Vec<Hea
         empty_label: String::new(),
         log_axes: false,
     };
-    vec![
-        map("topography", "z piezo height (nm)", |p| p.3 * 1e9),
-        map("phase", "lock-in phase φ (deg)", |p| p.4),
-    ]
+    let mut maps = vec![map("topography", "z piezo height (nm)", |p| p.3 * 1e9)];
+    if bimodal {
+        maps.push(map("first mode's phase", "lock-in phase φ₁ (deg)", |p| p.4));
+        maps.push(map(
+            "second mode's phase",
+            "lock-in phase φ₂ (deg)",
+            |p| p.5.unwrap_or(f64::NAN),
+        ));
+    } else {
+        maps.push(map("phase", "lock-in phase φ (deg)", |p| p.4));
+    }
+    maps
 }

@@ -58,7 +58,8 @@ use std::path::PathBuf;
 /// energy its drive puts in, its damping takes and the tip force exchanges with it,
 /// over the common period (a higher mode's frequency is moved within --ratio-tolerance
 /// to p/q times the drive's, and the table says by how much). `--setpoint` then holds
-/// the first mode's A₁/A₀₁, at the state a slow approach reaches. JSON: the keys of the
+/// the first mode's A₁/A₀₁: every state that holds it, on each branch (--branch), each
+/// followed from the one-mode state on its branch. JSON: the keys of the
 /// orbit (e_ts_j, contact_fraction, floquet_multipliers, stable, …) and `modes`, one
 /// object per mode (amplitude_ratio, phase_deg, e_drive_j, e_damp_j, e_exchange_j,
 /// virial_j, energy_balance_rel, …).
@@ -152,9 +153,15 @@ pub fn run(args: TapArgs) -> Result<()> {
         refuse(args.plot.is_some(), "--plot")?;
         refuse(args.starts.is_some(), "--starts")?;
         refuse(args.noise.temperature.is_some(), "--temperature")?;
-        refuse(inputs.branch.is_some(), "--branch")?;
         let ratio = inputs.setpoint_ratio(setup.cantilever.free_amplitude_m);
-        return super::modal::tap(&setup, &numerics, &set, ratio, args.json);
+        let branch = inputs.branch.unwrap_or(BranchChoice::All).only();
+        return super::modal::tap(
+            &setup,
+            &numerics,
+            &set,
+            ratio.map(|r| (r, branch)),
+            args.json,
+        );
     }
     if inputs.holds_setpoint() {
         return at_setpoint(&args, &inputs, (setup, numerics));

@@ -9,6 +9,7 @@
 //! instrument records as topography.
 
 use super::lockin::LockIn;
+use super::probe::{OneMode, Probe};
 use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
 use crate::dynamics::setup::Prepared;
@@ -94,11 +95,9 @@ pub struct LoopSample {
 }
 
 /// Run the z feedback on `p` for `periods` drive periods from the oscillator state
-/// `phase` at rest separation `start_m` (the free oscillation, say): the lock-in first
-/// settles there with the loop open, then each period is marched at the current z_c with
-/// `lockin` watching, under `force` (the thermal force, [`ThermalForce::none`] for
-/// none), and `controller` moves z_c. Returns every closed-loop period's
-/// sample and the rest separation the loop has moved to; `phase` is left at the end.
+/// `phase` at rest separation `start_m` (the free oscillation, say), read by `lockin`,
+/// under `force` (the thermal force, [`ThermalForce::none`] for none): [`hold_probe`]
+/// with the point mass. `phase` is left at the end.
 pub fn hold(
     p: &Prepared,
     (start_m, phase): (f64, &mut Phase),
@@ -107,22 +106,39 @@ pub fn hold(
     force: &mut ThermalForce,
     periods: usize,
 ) -> Result<(Vec<LoopSample>, f64)> {
-    let a0 = p.setup.cantilever.free_amplitude_m;
+    let mut probe = OneMode {
+        materials: std::slice::from_ref(p),
+        phase,
+        lockin,
+        force,
+    };
+    hold_probe(&mut probe, 0, start_m, controller, periods)
+}
+
+/// Run the z feedback on `probe` over its material `material` for `periods` drive
+/// periods from rest separation `start_m`: the lock-ins first settle there with the
+/// loop open ([`Probe::settling_periods`]), then each period is marched at the current
+/// z_c and `controller` moves z_c on the first mode's amplitude. Returns every
+/// closed-loop period's sample and the rest separation the loop has moved to.
+pub fn hold_probe<P: Probe>(
+    probe: &mut P,
+    material: usize,
+    start_m: f64,
+    controller: &mut PiController,
+    periods: usize,
+) -> Result<(Vec<LoopSample>, f64)> {
+    let a0 = probe.free_amplitude_m();
     let mut z = start_m;
-    // The lock-in settles on the motion at the start before the loop closes (its step
-    // response is within 1e-4 of 1 after 12 + 3n time constants).
-    let settle = (12.0 + 3.0 * lockin.order() as f64) * lockin.time_constant_hat()
-        / p.simulation().osc.period();
-    force.march(&p.simulation_at(z)?, phase, settle.ceil() as usize, lockin)?;
+    let settle = probe.settling_periods();
+    probe.march(material, z, settle)?;
     let mut out = Vec::with_capacity(periods);
     for _ in 0..periods {
-        force.march(&p.simulation_at(z)?, phase, 1, lockin)?;
-        let amplitude_ratio = lockin.amplitude();
+        let (amplitude_ratio, phase_deg) = probe.march(material, z, 1)?[0];
         let (dz, error) = controller.update(amplitude_ratio);
         out.push(LoopSample {
             separation_m: z,
             amplitude_ratio,
-            phase_deg: lockin.phase_deg(),
+            phase_deg,
             error,
         });
         z += dz * a0;

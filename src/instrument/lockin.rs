@@ -64,6 +64,8 @@ pub struct LockIn {
     /// step observed (to follow the marcher's rewinds of τ by whole periods).
     next: i64,
     seen_until: Option<f64>,
+    /// The state component it demodulates (the deflection x; a mode's qᵢ).
+    component: usize,
 }
 
 impl LockIn {
@@ -110,7 +112,17 @@ impl LockIn {
             last_input: None,
             next: 0,
             seen_until: None,
+            component: X.index(),
         })
+    }
+
+    /// The lock-in demodulating component `index` of the integrated state instead of the
+    /// deflection x: one eigenmode's deflection qᵢ ([`crate::dynamics::modes`]).
+    pub fn reading(self, index: usize) -> Self {
+        Self {
+            component: index,
+            ..self
+        }
     }
 
     /// The filter order n.
@@ -236,7 +248,7 @@ impl StepObserver for LockIn {
     fn step<const N: usize>(&mut self, a: &StepEnd<N>, b: &StepEnd<N>, _: Branch) {
         for k in self.samples_in(a.tau, b.tau) {
             let tau = k as f64 * self.interval;
-            self.sample(k, hermite(a, b, X, tau));
+            self.sample(k, hermite(a, b, self.component, tau));
         }
     }
 
@@ -245,6 +257,18 @@ impl StepObserver for LockIn {
         let first = samples.start as f64 * self.interval;
         for (k, (x, _)) in samples.zip(flight.samples(first, self.interval)) {
             self.sample(k, x);
+        }
+    }
+}
+
+/// Several lock-ins watching one integration (one per eigenmode, each reading its
+/// mode's deflection at its own reference: [`LockIn::reading`]).
+pub struct LockIns<'a>(pub &'a mut [LockIn]);
+
+impl StepObserver for LockIns<'_> {
+    fn step<const N: usize>(&mut self, a: &StepEnd<N>, b: &StepEnd<N>, branch: Branch) {
+        for l in self.0.iter_mut() {
+            l.step(a, b, branch);
         }
     }
 }

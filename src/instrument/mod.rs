@@ -5,7 +5,9 @@
 pub mod average;
 pub mod feedback;
 pub mod lockin;
+pub mod modal;
 pub mod noise;
+pub mod probe;
 pub mod scan;
 pub mod spectrum;
 pub mod thermal;

@@ -11,8 +11,10 @@
 
 use super::feedback::PiController;
 use super::lockin::LockIn;
+use super::probe::{OneMode, Probe};
 use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
+use crate::dynamics::modes::MAX_MODES;
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
 
@@ -32,50 +34,93 @@ pub struct Region {
     pub height_m: f64,
 }
 
-/// What is recorded over one pixel: means over its drive periods.
+/// What a lock-in of a higher mode read over a pixel: means over its drive periods.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ModeReading {
+    /// The mode (2 the second).
+    pub mode: usize,
+    /// Its amplitude over its free amplitude, Aᵢ/A₀ᵢ.
+    pub amplitude_ratio: f64,
+    /// Its phase lag, degrees.
+    pub phase_deg: f64,
+}
+
+/// What is recorded over one pixel: means over its drive periods.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Pixel {
     /// The pixel's centre, in m.
     pub x_m: f64,
     /// The z piezo position (topography), in m.
     pub topography_m: f64,
-    /// The lock-in amplitude ratio A/A₀.
+    /// The lock-in amplitude ratio A/A₀ (the first mode's).
     pub amplitude_ratio: f64,
     /// The amplitude error A/A₀ − setpoint (0 where below 1e-12: round-off).
     pub error: f64,
-    /// The lock-in phase, degrees.
+    /// The lock-in phase, degrees (the first mode's).
     pub phase_deg: f64,
+    /// The higher modes' lock-ins (none for the point mass).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub modes: Vec<ModeReading>,
 }
 
 /// Scan a line of length `length_m` in `pixels` pixels of `periods_per_pixel` drive
 /// periods each, over `materials` laid out by `regions` (sorted by `until_m`), with the
 /// loop already holding the setpoint from the piezo position `start_z_m` and the
 /// oscillator state `phase` (as [`super::feedback::hold`] leaves them over the first
-/// region, say). All
-/// materials must share the cantilever (its drive period sets the time), and the
-/// thermal force `force` shakes it ([`ThermalForce::none`] for none). `progress` is
-/// told each pixel done. Returns the pixels and the piezo position at the end.
+/// region, say): [`line_probe`] with the point mass. All materials must share the
+/// cantilever (its drive period sets the time), and the thermal force `force` shakes it
+/// ([`ThermalForce::none`] for none). `progress` is told each pixel done. Returns the
+/// pixels and the piezo position at the end.
 pub fn line(
     materials: &[Prepared],
     regions: &[Region],
-    (length_m, pixels, periods_per_pixel): (f64, usize, usize),
+    shape: (f64, usize, usize),
     (lockin, controller, force): (&mut LockIn, &mut PiController, &mut ThermalForce),
     start_z_m: f64,
     phase: &mut Phase,
-    mut progress: impl FnMut(usize),
+    progress: impl FnMut(usize),
 ) -> Result<(Vec<Pixel>, f64)> {
-    if regions.is_empty() || regions.iter().any(|r| r.material >= materials.len()) {
+    let mut probe = OneMode {
+        materials,
+        phase,
+        lockin,
+        force,
+    };
+    line_probe(&mut probe, regions, shape, controller, start_z_m, progress)
+}
+
+/// Refuse a layout without regions or naming a material beyond `materials`.
+fn check_regions(regions: &[Region], materials: usize) -> Result<()> {
+    if regions.is_empty() || regions.iter().any(|r| r.material >= materials) {
         return Err(Error::NotApplicable(
             "a scanned sample needs regions, each naming one of its materials".into(),
         ));
     }
+    Ok(())
+}
+
+/// Scan a line of length `length_m` in `pixels` pixels of `periods_per_pixel` drive
+/// periods each with `probe` over its materials laid out by `regions`, the loop holding
+/// the setpoint from the piezo position `start_z_m`. Each drive period is marched at the
+/// material and height under the tip at its start. `progress` is told each pixel done.
+/// Returns the pixels and the piezo position at the end.
+pub fn line_probe<P: Probe>(
+    probe: &mut P,
+    regions: &[Region],
+    (length_m, pixels, periods_per_pixel): (f64, usize, usize),
+    controller: &mut PiController,
+    start_z_m: f64,
+    mut progress: impl FnMut(usize),
+) -> Result<(Vec<Pixel>, f64)> {
+    check_regions(regions, probe.materials())?;
     crate::error::positive("scan length", length_m)?;
     if pixels == 0 || periods_per_pixel == 0 {
         return Err(Error::NotApplicable(
             "a scan line needs at least one pixel of at least one drive period".into(),
         ));
     }
-    let a0 = materials[0].setup.cantilever.free_amplitude_m;
+    let a0 = probe.free_amplitude_m();
+    let modes = probe.modes();
     let step = length_m / (pixels * periods_per_pixel) as f64;
     // The region under the tip: x only grows, so the index only moves on.
     let mut under = 0;
@@ -83,21 +128,22 @@ pub fn line(
     let mut out = Vec::with_capacity(pixels);
     for i in 0..pixels {
         let mut sum = [0.0; 4];
+        let mut higher = [(0.0, 0.0); MAX_MODES];
         for j in 0..periods_per_pixel {
             let x = step * (i * periods_per_pixel + j) as f64;
             while under + 1 < regions.len() && x >= regions[under].until_m {
                 under += 1;
             }
             let region = &regions[under];
-            let p = &materials[region.material];
-            force.march(&p.simulation_at(z - region.height_m)?, phase, 1, lockin)?;
-            let amplitude = lockin.amplitude();
+            let read = probe.march(region.material, z - region.height_m, 1)?;
+            let (amplitude, phase_deg) = read[0];
             let (dz, error) = controller.update(amplitude);
-            for (s, v) in sum
-                .iter_mut()
-                .zip([z, amplitude, error, lockin.phase_deg()])
-            {
+            for (s, v) in sum.iter_mut().zip([z, amplitude, error, phase_deg]) {
                 *s += v;
+            }
+            for (s, r) in higher.iter_mut().zip(&read).take(modes).skip(1) {
+                s.0 += r.0;
+                s.1 += r.1;
             }
             z += dz * a0;
         }
@@ -113,6 +159,13 @@ pub fn line(
                 sum[2] / n
             },
             phase_deg: sum[3] / n,
+            modes: (1..modes)
+                .map(|k| ModeReading {
+                    mode: k + 1,
+                    amplitude_ratio: higher[k].0 / n,
+                    phase_deg: higher[k].1 / n,
+                })
+                .collect(),
         });
         progress(i + 1);
     }
@@ -261,60 +314,71 @@ impl Layout {
     }
 }
 
-/// One line of an image as an AFM records it: the loop engaged over the line's first
-/// region from the free oscillation at 1.2 A₀ ([`super::feedback::hold`] for
-/// `engage_periods`), then trace and (if `retrace`) retrace, each by [`line()`]. The
-/// lock-in, the controller and the thermal force (its own stream for each line) start
-/// from the given ones, so every line is independent of the others (computed in any
-/// order, on any thread, with the same result).
-/// Returns the trace and the retrace (x as the trace's, not mirrored).
-#[allow(clippy::too_many_arguments)]
+/// One line of an image as [`row_probe`] scans it with the point mass over `materials`,
+/// read by `lockin`, under the thermal force `force`.
 pub fn row(
     materials: &[Prepared],
     regions: &[Region],
-    (length_m, pixels, periods_per_pixel): (f64, usize, usize),
+    shape: (f64, usize, usize),
     (lockin, controller, force): (LockIn, PiController, ThermalForce),
+    engage_periods: usize,
+    retrace: bool,
+    progress: impl FnMut(usize),
+) -> Result<(Vec<Pixel>, Option<Vec<Pixel>>)> {
+    let (mut lockin, mut force) = (lockin, force);
+    check_regions(regions, materials.len())?;
+    let mut phase = materials[regions[0].material]
+        .simulation()
+        .free_steady_start();
+    let mut probe = OneMode {
+        materials,
+        phase: &mut phase,
+        lockin: &mut lockin,
+        force: &mut force,
+    };
+    row_probe(
+        &mut probe,
+        regions,
+        shape,
+        controller,
+        engage_periods,
+        retrace,
+        progress,
+    )
+}
+
+/// One line of an image: the loop engaged over the first region from 1.2 A₀
+/// (`engage_periods` drive periods, [`super::feedback::hold_probe`]), then the line
+/// scanned ([`line_probe`]) and, with `retrace`, scanned back (its pixels in the
+/// trace's x).
+pub fn row_probe<P: Probe>(
+    probe: &mut P,
+    regions: &[Region],
+    (length_m, pixels, periods_per_pixel): (f64, usize, usize),
+    controller: PiController,
     engage_periods: usize,
     retrace: bool,
     mut progress: impl FnMut(usize),
 ) -> Result<(Vec<Pixel>, Option<Vec<Pixel>>)> {
-    let (mut lockin, mut controller, mut force) = (lockin, controller, force);
-    let Some(first) = regions.first().and_then(|r| materials.get(r.material)) else {
-        return Err(Error::NotApplicable(
-            "a scanned sample needs regions, each naming one of its materials".into(),
-        ));
-    };
-    let a0 = first.setup.cantilever.free_amplitude_m;
-    let mut phase = first.simulation().free_steady_start();
-    let (_, rest) = super::feedback::hold(
-        first,
-        (1.2 * a0, &mut phase),
-        &mut lockin,
+    let mut controller = controller;
+    check_regions(regions, probe.materials())?;
+    let a0 = probe.free_amplitude_m();
+    let (_, rest) = super::feedback::hold_probe(
+        probe,
+        regions[0].material,
+        1.2 * a0,
         &mut controller,
-        &mut force,
         engage_periods,
     )?;
     // The loop holds the rest separation; the piezo stands that much above the surface.
     let z = rest + regions[0].height_m;
     let shape = (length_m, pixels, periods_per_pixel);
-    let loop_state = (&mut lockin, &mut controller, &mut force);
-    let (trace, end) = line(
-        materials,
-        regions,
-        shape,
-        loop_state,
-        z,
-        &mut phase,
-        &mut progress,
-    )?;
+    let (trace, end) = line_probe(probe, regions, shape, &mut controller, z, &mut progress)?;
     if !retrace {
         return Ok((trace, None));
     }
     let back = mirrored(regions, length_m);
-    let loop_state = (&mut lockin, &mut controller, &mut force);
-    let (mut retrace, _) = line(
-        materials, &back, shape, loop_state, end, &mut phase, progress,
-    )?;
+    let (mut retrace, _) = line_probe(probe, &back, shape, &mut controller, end, progress)?;
     for p in &mut retrace {
         p.x_m = length_m - p.x_m;
     }

@@ -2,7 +2,7 @@
 //! charts (φ₁ and φ₂ against A₁/A₀₁), and the bimodal contrast table and chart.
 
 use super::chart::{Axis, Chart, Corner, Series, Style};
-use crate::bimodal::{BimodalRow, ModalPoint};
+use crate::bimodal::{BimodalRow, ModalPoint, PhaseBranch};
 use crate::dynamics::modes::{ModalObservables, ModeSet};
 use crate::params::ELECTRONVOLT_J;
 use crate::sweep::Direction;
@@ -257,7 +257,7 @@ pub fn contrast_text(rows: &[BimodalRow]) -> String {
         return s;
     };
     let names = &first.materials;
-    let _ = write!(s, "{:>8} {:>7}", "law", "A1/A01");
+    let _ = write!(s, "{:>8} {:>7} {:>10}", "law", "A1/A01", "branch");
     for n in names {
         let _ = write!(
             s,
@@ -271,7 +271,13 @@ pub fn contrast_text(rows: &[BimodalRow]) -> String {
         v.map_or(format!("{:>w$}", "-"), |v| format!("{v:>w$.p$}"))
     };
     for r in rows {
-        let _ = write!(s, "{:>8} {:>7.3}", r.law, r.setpoint);
+        let _ = write!(
+            s,
+            "{:>8} {:>7.3} {:>10}",
+            r.law,
+            r.setpoint,
+            r.branch.to_string()
+        );
         for (p1, p2) in r.phase1_deg.iter().zip(&r.phase2_deg) {
             let _ = write!(s, " {} {}", f(*p1, 12, 4), f(*p2, 12, 4));
         }
@@ -284,8 +290,9 @@ pub fn contrast_text(rows: &[BimodalRow]) -> String {
     }
     let _ = writeln!(
         s,
-        "(φ in degrees; d_phi = φ({}) − φ({}); each state the one a slow approach reaches at \
-         the first mode's setpoint)",
+        "(φ in degrees; d_phi = φ({}) − φ({}) between states on the same branch; branch: the \
+         first mode's, attractive with φ₁ above the free phase; where both hold the setpoint \
+         they coexist, and which one an AFM images on depends on how it got there)",
         names.last().map_or("", String::as_str),
         names.first().map_or("", String::as_str)
     );
@@ -294,8 +301,8 @@ pub fn contrast_text(rows: &[BimodalRow]) -> String {
             if let Some(note) = note {
                 let _ = writeln!(
                     s,
-                    "note: {} law, A1/A01 = {}, {name}: {note}",
-                    r.law, r.setpoint
+                    "note: {} law, A1/A01 = {}, {}, {name}: {note}",
+                    r.law, r.setpoint, r.branch
                 );
             }
         }
@@ -303,42 +310,70 @@ pub fn contrast_text(rows: &[BimodalRow]) -> String {
     s
 }
 
-/// The bimodal contrast chart: Δφ₂ (and Δφ₁) against the setpoint, a line per law.
+/// The bimodal contrast charts, one per branch: Δφ₂ (and Δφ₁) against the setpoint, a
+/// line per law.
 pub fn contrast_charts(rows: &[BimodalRow], laws: &[String]) -> Vec<Chart> {
-    let mut series = Vec::new();
-    for (c, law) in laws.iter().enumerate() {
-        let of_law = || rows.iter().filter(move |r| &r.law == law);
-        series.push(Series::new(
-            &format!("Δφ₂, {law}"),
-            of_law()
-                .filter_map(|r| Some((r.setpoint, r.delta_phase2_deg?)))
-                .collect(),
-            Style::Line,
-            c,
-        ));
-        series.push(Series::new(
-            &format!("Δφ₁, {law}"),
-            of_law()
-                .filter_map(|r| Some((r.setpoint, r.delta_phase1_deg?)))
-                .collect(),
-            Style::Dashed,
-            c,
-        ));
-    }
     let names = rows.first().map_or(Vec::new(), |r| r.materials.clone());
-    vec![Chart {
-        name: "bimodal_contrast".into(),
-        title: format!(
-            "bimodal contrast {} − {}: second mode (solid) and first (dashed)",
-            names.last().map_or("", String::as_str),
-            names.first().map_or("", String::as_str)
-        ),
-        x: Axis::linear("first-mode setpoint A₁/A₀₁", "amplitude1_ratio"),
-        y: Axis::linear("phase contrast Δφ (deg)", "delta_phase_deg"),
-        legend: Corner::quietest(&series),
-        series,
-        labels: Vec::new(),
-    }]
+    let mut charts = Vec::new();
+    for branch in [PhaseBranch::Repulsive, PhaseBranch::Attractive] {
+        if !rows.iter().any(|r| r.branch == branch) {
+            continue;
+        }
+        let mut series = Vec::new();
+        // The attractive branch holds few setpoints, often not neighbours: markers.
+        let (second, first) = match branch {
+            PhaseBranch::Repulsive => (Style::Line, Style::Dashed),
+            PhaseBranch::Attractive => (Style::Markers, Style::Squares),
+        };
+        for (c, law) in laws.iter().enumerate() {
+            let of_law = || {
+                rows.iter()
+                    .filter(move |r| &r.law == law && r.branch == branch)
+            };
+            for (name, style, pick) in [
+                (
+                    "Δφ₂",
+                    second,
+                    (|r: &BimodalRow| r.delta_phase2_deg) as fn(_) -> _,
+                ),
+                ("Δφ₁", first, |r: &BimodalRow| r.delta_phase1_deg),
+            ] {
+                let points: Vec<(f64, f64)> = of_law()
+                    .filter_map(|r| Some((r.setpoint, pick(r)?)))
+                    .collect();
+                if !points.is_empty() {
+                    series.push(Series::new(&format!("{name}, {law}"), points, style, c));
+                }
+            }
+        }
+        if series.is_empty() && !charts.is_empty() {
+            continue;
+        }
+        charts.push(Chart {
+            name: format!("bimodal_contrast_{branch}"),
+            title: format!(
+                "bimodal contrast {} − {}, {branch} branch: second mode ({}), first ({})",
+                names.last().map_or("", String::as_str),
+                names.first().map_or("", String::as_str),
+                if second == Style::Line {
+                    "solid"
+                } else {
+                    "circles"
+                },
+                if first == Style::Dashed {
+                    "dashed"
+                } else {
+                    "squares"
+                },
+            ),
+            x: Axis::linear("first-mode setpoint A₁/A₀₁", "amplitude1_ratio"),
+            y: Axis::linear("phase contrast Δφ (deg)", "delta_phase_deg"),
+            legend: Corner::quietest(&series),
+            series,
+            labels: Vec::new(),
+        });
+    }
+    charts
 }
 
 /// A several-mode map's heat maps: φ₁, φ₂, A₂/A₀₂ and E_ts over (Δγ, E*).

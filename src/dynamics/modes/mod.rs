@@ -11,4 +11,4 @@ pub mod set;
 pub mod system;
 
 pub use observables::{ModalObservables, ModeObservables, modal_steady, prepare, tap_modes};
-pub use set::{Eigenmode, Modal, ModeSet};
+pub use set::{Eigenmode, MAX_MODES, Modal, ModeSet};

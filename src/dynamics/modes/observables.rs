@@ -3,7 +3,7 @@
 //! the contact takes.
 
 use super::orbit::{ModalOrbit, OrbitOptions, free_section};
-use super::set::{Modal, ModeModel, ModeSet};
+use super::set::{Modal, ModeSet};
 use super::system::{ModeIntegral, Modes, force_integral, plain_len, tangent_len};
 use crate::dynamics::budget;
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
@@ -134,26 +134,7 @@ fn solve<const M: usize, const P: usize, const T: usize>(
     numerics: &Numerics,
     start: Option<(&[f64], crate::law::Branch)>,
 ) -> Result<(ModalObservables, ModalOrbit)> {
-    let models: [ModeModel; M] = std::array::from_fn(|i| modal.modes[i]);
-    let fastest = models
-        .iter()
-        .map(|m| m.omega.max(m.r))
-        .fold(1.0f64, f64::max);
-    // A mode of quality Q turns an integration error into an amplitude error Q times
-    // larger: the tolerance is tightened for modes above the first one's Q (one-mode
-    // runs keep tapsim's).
-    let q_max = models.iter().map(ModeModel::quality).fold(0.0f64, f64::max);
-    let q_first = models[0].quality();
-    let mut tol = p.tol;
-    tol.h_max = p.tol.h_max * p.osc.omega / fastest;
-    tol.rtol *= (q_first / q_max).min(1.0);
-    tol.atol *= (q_first / q_max).min(1.0);
-    let modes = Modes {
-        modes: models,
-        law: &p.law,
-        cpl: p.cpl,
-        tol,
-    };
+    let modes = Modes::<_, M>::of(p, modal);
     let (z, branch) = match start {
         Some((z, b)) => (z.to_vec(), b),
         None => {
@@ -168,7 +149,7 @@ fn solve<const M: usize, const P: usize, const T: usize>(
             } else {
                 crate::law::Branch::Free
             };
-            (free_section(&models, first), branch)
+            (free_section(&modes.modes, first), branch)
         }
     };
     let opts = OrbitOptions {

@@ -61,6 +61,9 @@ const FINE_WITHIN: f64 = 1e-5;
 /// Newton iterations at most before marching takes over.
 const NEWTON_ITERATIONS: usize = 25;
 
+/// Halvings of a Newton step that returned farther than its start.
+const BACKTRACKS: usize = 4;
+
 impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
     /// The size of a difference `r` of section states, each mode's parts over the scale
     /// of its free motion ([`OrbitOptions::tolerance`]): a small second mode's phase is
@@ -122,6 +125,9 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             },
             ..*self
         };
+        let mut last_step: Option<(Vec<f64>, Vec<f64>)> = None;
+        let mut from_branch = branch;
+        let mut backtracks = 0;
         for _ in 0..NEWTON_ITERATIONS {
             let fine = best <= FINE_WITHIN;
             let map = if fine { self } else { &coarse };
@@ -139,6 +145,19 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             if fine && residual <= opts.tolerance {
                 return Ok(self.finished(&z, branch, &y, tally, residual, periods));
             }
+            // A step that returned farther than the best point is halved from there (up
+            // to BACKTRACKS times): near an orbit that grazes a switch the period map
+            // jumps, and a whole step lands on another pattern of contacts.
+            if residual > best && backtracks < BACKTRACKS {
+                if let Some((from, step)) = &mut last_step {
+                    backtracks += 1;
+                    step.iter_mut().for_each(|s| *s *= 0.5);
+                    z = from.iter().zip(step.iter()).map(|(a, s)| a - s).collect();
+                    branch = from_branch;
+                    continue;
+                }
+            }
+            backtracks = 0;
             let jacobian =
                 DMatrix::from_fn(d, d, |row, col| y[phi(M, row, col)] - f64::from(row == col));
             let step = jacobian.lu().solve(&DVector::from_vec(r));
@@ -148,19 +167,29 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 {
                     // Newton step, limited to a tenth of the free amplitude per mode.
                     let scale = step.amax().max(0.1) / 0.1;
+                    let applied: Vec<f64> = step.iter().map(|s| s / scale).collect();
+                    from_branch = branch;
+                    last_step = Some((z.clone(), applied.clone()));
                     for k in 0..d {
-                        z[k] -= step[k] / scale;
+                        z[k] -= applied[k];
                     }
                 }
-                _ => z = y.as_slice()[..d].to_vec(),
+                _ => {
+                    last_step = None;
+                    z = y.as_slice()[..d].to_vec();
+                }
             }
             best = best.min(residual);
         }
-        // Marching: the period map applied until it returns within the tolerance (a
-        // while: an orbit Newton's method did not find is rarely one marching finds
-        // soon; high-Q modes settle over thousands of periods).
+        // Marching: the period map applied until it returns within the tolerance, in
+        // windows of MARCH_PERIODS. A window that contracts the return distance (an orbit
+        // Newton's method missed, whose high-Q modes settle slowly)
+        // earns the next while the rate it contracts at reaches the tolerance within
+        // `max_periods`; one that does not ends the search.
         let mut last = f64::INFINITY;
-        let limit = periods + opts.max_periods.min(MARCH_PERIODS);
+        let budget = periods + opts.max_periods;
+        let mut limit = periods + opts.max_periods.min(MARCH_PERIODS);
+        let mut window_start = f64::INFINITY;
         while periods < limit {
             let (y, end_branch, _) = self.pass::<P>(0.0, Self::start::<P>(&z), branch, period)?;
             periods += 1;
@@ -176,13 +205,25 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 }
             }
             last = residual;
+            if window_start.is_infinite() {
+                window_start = residual;
+            }
+            if periods == limit && closed {
+                let rate = (residual / window_start).powf(1.0 / MARCH_PERIODS as f64);
+                let needed = (opts.tolerance / residual).ln() / rate.ln();
+                if rate < 0.999 && periods as f64 + needed <= budget as f64 {
+                    limit = (periods + MARCH_PERIODS).min(budget);
+                }
+                window_start = residual;
+            }
         }
         Err(Error::NotApplicable(format!(
             "the modes settle on no orbit of the common period: Newton's method did not \
-             converge and {MARCH_PERIODS} periods of marching do not return (last return \
-             distance {last:.1e} of the free motion). The motion is of a longer period or \
-             irregular (where the first mode alone is, `tapsim tap` names it), which several \
-             modes are not reported for"
+             converge and {} periods of marching do not return (last return distance \
+             {last:.1e} of the free motion). The motion is of a longer period or irregular \
+             (where the first mode alone is, `tapsim tap` names it), which several modes are \
+             not reported for",
+            periods
         )))
     }
 
@@ -217,11 +258,8 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
 
 /// The section state of the free steady oscillation of every mode at τ = 0 (each mode's
 /// linear response to its own drive), the first mode's replaced by `first` if given.
-pub fn free_section<const M: usize>(
-    modes: &[super::set::ModeModel; M],
-    first: Option<(f64, f64)>,
-) -> Vec<f64> {
-    let mut z = vec![0.0; 2 * M];
+pub fn free_section(modes: &[super::set::ModeModel], first: Option<(f64, f64)>) -> Vec<f64> {
+    let mut z = vec![0.0; 2 * modes.len()];
     for (i, m) in modes.iter().enumerate() {
         // q = Re[G f e^{iΩτ}], G = c/(r² − Ω² + i rΩ/Q).
         let (re, im) = (m.r * m.r - m.omega * m.omega, m.damping * m.omega);

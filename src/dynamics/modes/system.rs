@@ -11,12 +11,14 @@
 //! ∫qᵢ sin Ωᵢτ), ∫f, and with a tangent the 2M × 2M matrix Φ = ∂z/∂z₀ of the section
 //! state z = (q₁, q₁′, …) — a layout of [`plain_len`] or [`tangent_len`] components.
 
-use super::set::ModeModel;
+use super::set::{Modal, ModeModel};
 use crate::dynamics::budget;
 use crate::dynamics::dopri5::{self, Settings, StepError, System};
 use crate::dynamics::model::{Coupling, State};
-use crate::dynamics::numeric::Tolerances;
+use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver, Tolerances};
+use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
+use crate::law::AnyLaw;
 use crate::law::{Branch, ForceLaw};
 use crate::numeric::bracketed_root;
 
@@ -87,6 +89,33 @@ pub struct Modes<'a, L, const M: usize> {
     pub cpl: Coupling,
     /// Integrator tolerances.
     pub tol: Tolerances,
+}
+
+impl<'a, const M: usize> Modes<'a, AnyLaw, M> {
+    /// The first `M` modes of `modal` on the prepared setup `p` (its law, coupling and
+    /// tolerances). A mode of quality Q turns an integration error into an amplitude
+    /// error Q times larger: the tolerances are tightened by the first mode's Q over the
+    /// highest (one mode keeps tapsim's), and the longest step shortened for the
+    /// fastest mode.
+    pub fn of(p: &'a Prepared, modal: &Modal) -> Self {
+        let models: [ModeModel; M] = std::array::from_fn(|i| modal.modes[i]);
+        let fastest = models
+            .iter()
+            .map(|m| m.omega.max(m.r))
+            .fold(1.0f64, f64::max);
+        let q_max = models.iter().map(ModeModel::quality).fold(0.0f64, f64::max);
+        let tighter = (models[0].quality() / q_max).min(1.0);
+        let mut tol = p.tol;
+        tol.h_max = p.tol.h_max * p.osc.omega / fastest;
+        tol.rtol *= tighter;
+        tol.atol *= tighter;
+        Self {
+            modes: models,
+            law: &p.law,
+            cpl: p.cpl,
+            tol,
+        }
+    }
 }
 
 impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
@@ -164,16 +193,8 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
     }
 }
 
-/// A sample at the end of an accepted step.
-#[derive(Clone, Copy)]
-struct End<const S: usize> {
-    tau: f64,
-    y: State<S>,
-    dy: State<S>,
-}
-
 /// Cubic Hermite interpolation of the tip deflection on the step [a, b] at τ.
-fn tip_at<const M: usize, const S: usize>(a: &End<S>, b: &End<S>, tau: f64) -> f64 {
+fn tip_at<const M: usize, const S: usize>(a: &StepEnd<S>, b: &StepEnd<S>, tau: f64) -> f64 {
     let h = b.tau - a.tau;
     let t = (tau - a.tau) / h;
     let (t2, t3) = (t * t, t * t * t);
@@ -200,27 +221,31 @@ const SHORTEST: f64 = 1e-9;
 /// step is not stepped over).
 const PROBES: usize = 8;
 
-/// One branch integrated until its first switch (or the end).
-struct Segment<'m, 'a, L, const M: usize, const S: usize> {
+/// One branch integrated until its first switch (or the end), each accepted step short
+/// of the switch shown to the observer (if any).
+struct Segment<'m, 'a, 'o, L, const M: usize, const S: usize, O> {
     modes: &'m Modes<'a, L, M>,
+    observer: Option<&'o mut O>,
     branch: Branch,
     /// Tip deflections at which the branch ends: falling to `below`, rising to `above`.
     below: Option<f64>,
     above: Option<f64>,
-    last: Option<End<S>>,
+    last: Option<StepEnd<S>>,
     /// The step the crossing is in, where, and whether it is the level below.
-    hit: Option<(End<S>, f64, bool)>,
+    hit: Option<(StepEnd<S>, f64, bool)>,
     end: Option<State<S>>,
 }
 
-impl<L: ForceLaw, const M: usize, const S: usize> System<S> for Segment<'_, '_, L, M, S> {
+impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
+    for Segment<'_, '_, '_, L, M, S, O>
+{
     #[inline]
     fn system(&self, tau: f64, y: &State<S>, dy: &mut State<S>) {
         self.modes.rhs(self.branch, tau, y, dy);
     }
 
     fn solout(&mut self, tau: f64, y: &State<S>, dy: &State<S>) -> bool {
-        let end = End {
+        let end = StepEnd {
             tau,
             y: *y,
             dy: *dy,
@@ -271,6 +296,9 @@ impl<L: ForceLaw, const M: usize, const S: usize> System<S> for Segment<'_, '_, 
         if near(self.below, -1.0) || near(self.above, 1.0) {
             self.hit = Some((start, tau, near(self.below, -1.0)));
             return true;
+        }
+        if let Some(o) = self.observer.as_deref_mut() {
+            o.step(&start, &end, self.branch);
         }
         false
     }
@@ -343,9 +371,22 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
     pub fn pass<const S: usize>(
         &self,
         tau0: f64,
+        y: State<S>,
+        branch: Branch,
+        tau1: f64,
+    ) -> Result<(State<S>, Branch, PassTally)> {
+        self.pass_observed(tau0, y, branch, tau1, &mut Ignore)
+    }
+
+    /// [`Self::pass`], each accepted step (cut at the switches) shown to `observer`: a
+    /// lock-in watching the motion ([`crate::instrument::modal`]).
+    pub fn pass_observed<const S: usize, O: StepObserver>(
+        &self,
+        tau0: f64,
         mut y: State<S>,
         mut branch: Branch,
         tau1: f64,
+        observer: &mut O,
     ) -> Result<(State<S>, Branch, PassTally)> {
         let mut tally = PassTally {
             min_tip: Self::tip(&y),
@@ -360,6 +401,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             let exits = self.law.exits(branch);
             let mut seg = Segment {
                 modes: self,
+                observer: Some(&mut *observer),
                 branch,
                 below: exits.below.map(|(l, _)| self.cpl.x_at(l)),
                 above: exits.above.map(|(l, _)| self.cpl.x_at(l)),
@@ -367,7 +409,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 hit: None,
                 end: None,
             };
-            seg.last = Some(End {
+            seg.last = Some(StepEnd {
                 tau,
                 y,
                 dy: {
@@ -391,8 +433,9 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             let (next_tau, next_y, next_branch) = match seg.hit {
                 Some((start, at, falling)) => {
                     // Integrate again from the step's start to the crossing.
-                    let mut to = Segment {
+                    let mut to = Segment::<L, M, S, O> {
                         modes: self,
+                        observer: None,
                         branch,
                         below: None,
                         above: None,
@@ -430,6 +473,18 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                     let next = if falling { exits.below } else { exits.above }
                         .expect("a hit crosses a level")
                         .1;
+                    // The step cut at the switch, as the observer sees it.
+                    let mut dy = State::<S>::zeros();
+                    self.rhs(branch, at, &y_at, &mut dy);
+                    observer.step(
+                        &start,
+                        &StepEnd {
+                            tau: at,
+                            y: y_at,
+                            dy,
+                        },
+                        branch,
+                    );
                     (at, y_at, next)
                 }
                 None => (tau1, seg.end.unwrap_or(y), branch),
