@@ -134,6 +134,18 @@ pub fn states_at_setpoint(
     branch: Option<PhaseBranch>,
 ) -> Result<Vec<(PhaseBranch, Result<ModalSetpointState>)>> {
     let one = crate::setpoint::states_at_setpoint(setup, numerics, setpoint, branch)?;
+    from_one_mode(setup, set, numerics, setpoint, one)
+}
+
+/// The modes' states at `setpoint` seeded at the one-mode states `one` that hold it
+/// ([`states_at_setpoint`]).
+fn from_one_mode(
+    setup: &TapSetup,
+    set: &ModeSet,
+    numerics: &Numerics,
+    setpoint: f64,
+    one: Vec<crate::setpoint::SetpointState>,
+) -> Result<Vec<(PhaseBranch, Result<ModalSetpointState>)>> {
     let free_phase = crate::setpoint::free_phase_deg(setup);
     let (p, modal) = prepare(setup, set, numerics)?;
     let mut out = Vec::new();
@@ -142,10 +154,20 @@ pub fn states_at_setpoint(
         let q = at_separation(&p, s.separation_m)?;
         let mut seeds: Vec<(ModalObservables, ModalOrbit)> = Vec::new();
         let mut failure = None;
-        for scale in SEEDS {
+        for (k, scale) in SEEDS.into_iter().enumerate() {
             let mut start = free_section(&modal.modes, Some((s.phase.x, s.phase.v)));
             start[2..].iter_mut().for_each(|z| *z *= scale);
-            match modal_steady(&q, &modal, numerics, Some((&start, s.phase.branch))) {
+            // The other seeds look for other states nearby: Newton's method and a short
+            // march only (a long march from them finds what the first one's finds).
+            let seed_numerics = Numerics {
+                max_cycles: if k == 0 {
+                    numerics.max_cycles
+                } else {
+                    SEED_MARCH * modal.periods as usize
+                },
+                ..*numerics
+            };
+            match modal_steady(&q, &modal, &seed_numerics, Some((&start, s.phase.branch))) {
                 Ok((state, orbit)) => {
                     if PhaseBranch::of(state.modes[0].phase_deg, free_phase) != side {
                         failure = Some(crossed(side, setpoint, s.separation_m));
@@ -185,6 +207,10 @@ pub fn states_at_setpoint(
 /// The scales of the higher modes' free oscillation the states at a setpoint are seeded
 /// with ([`states_at_setpoint`]).
 pub const SEEDS: [f64; 3] = [1.0, -1.0, 0.0];
+
+/// Common periods a seed other than the first is marched at most where Newton's method
+/// does not converge from it.
+const SEED_MARCH: usize = 10;
 
 /// Whether two states are one (their z_c and every mode's amplitude and phase agree).
 fn same_state(a: &ModalObservables, b: &ModalObservables) -> bool {
@@ -358,14 +384,31 @@ pub fn contrast(
             setup.law = laws[l].into();
             let numerics = &materials[m].numerics;
             prepare(&setup, set, numerics)?;
+            // The one-mode families once for every setpoint (as one mode's contrast
+            // takes them), the whole search only where they hold none.
+            let one = Prepared::new(&setup, numerics)?;
+            let a0 = setup.cantilever.free_amplitude_m;
+            let lowest = setpoints.iter().copied().fold(1.0f64, f64::min);
+            let family = crate::setpoint::families(
+                &one,
+                numerics,
+                (1.2 * a0, (lowest - 0.35).max(0.02) * a0),
+            )?;
             let held = setpoints
                 .iter()
-                .map(
-                    |&r| match states_at_setpoint(&setup, set, numerics, r, None) {
+                .map(|&r| {
+                    let found = crate::setpoint::check_ratio(r)
+                        .and_then(|()| crate::setpoint::states_on(&one, &family, r, None))
+                        .and_then(|on| match on.is_empty() {
+                            true => crate::setpoint::states_at_setpoint(&setup, numerics, r, None),
+                            false => Ok(on),
+                        })
+                        .and_then(|on| from_one_mode(&setup, set, numerics, r, on));
+                    match found {
                         Err(Error::Interrupted) => Err(Error::Interrupted),
                         found => Ok(found),
-                    },
-                )
+                    }
+                })
                 .collect::<Result<Vec<Held>>>();
             progress();
             held

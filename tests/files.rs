@@ -336,17 +336,36 @@ fn an_interrupted_reproduce_can_be_rerun_into_its_own_directory() {
             .iter()
             .any(|n| n.starts_with(".tapsim-reproduce"))
     );
-    // Run again into the same directory: accepted, and finished it is marked by its
-    // README alone.
-    let again = tapsim()
+    // Run again into the same directory: accepted (it writes its first figure again
+    // rather than refusing the directory), and interrupted again, it is left marked.
+    // (That a finished run leaves its README alone, no marker, tests/cli.rs checks.)
+    std::fs::remove_file(out.join("fig1_jkr_cycle.csv")).unwrap();
+    let mut again = tapsim()
         .args(["reproduce", "--quiet", "--out", path(&out)])
         .env("TAPSIM_CACHE", dir.join("cache"))
-        .output()
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
         .unwrap();
-    assert!(again.status.success(), "{}", stderr(&again));
-    assert!(out.join("README.md").is_file());
+    let start = Instant::now();
+    while !out.join("fig1_jkr_cycle.csv").exists() {
+        if let Some(status) = again.try_wait().unwrap() {
+            let mut why = String::new();
+            std::io::Read::read_to_string(&mut again.stderr.take().unwrap(), &mut why).unwrap();
+            panic!("the rerun ended with {status} before writing: {why}");
+        }
+        assert!(start.elapsed() < Duration::from_secs(60), "nothing written");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &again.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    assert_eq!(again.wait().unwrap().code(), Some(130));
+    assert!(!out.join("README.md").exists());
     assert!(
-        !listing(&out)
+        listing(&out)
             .iter()
             .any(|n| n.starts_with(".tapsim-reproduce"))
     );

@@ -187,6 +187,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
         // earns the next while the rate it contracts at reaches the tolerance within
         // `max_periods`; one that does not ends the search.
         let mut last = f64::INFINITY;
+        let newton_periods = periods;
         let budget = periods + opts.max_periods;
         let mut limit = periods + opts.max_periods.min(MARCH_PERIODS);
         let mut window_start = f64::INFINITY;
@@ -223,7 +224,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
              {last:.1e} of the free motion). The motion is of a longer period or irregular \
              (where the first mode alone is, `tapsim tap` names it), which several modes are \
              not reported for",
-            periods
+            periods - newton_periods
         )))
     }
 
