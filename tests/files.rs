@@ -307,20 +307,24 @@ fn peak_memory_is_bounded_at_the_largest_requests() {
     }
 }
 
-#[test]
-fn an_interrupted_reproduce_can_be_rerun_into_its_own_directory() {
-    let dir = scratch("reproduce-interrupted");
-    let out = dir.join("results");
+/// Start `tapsim reproduce` into `out`, interrupt it (SIGINT) once it has written its
+/// first figure, and check it stopped as interrupted (exit 130), unfinished (no README)
+/// and marked as such.
+fn reproduce_interrupted(dir: &Path, out: &Path) {
     let mut child = tapsim()
-        .args(["reproduce", "--quiet", "--out", path(&out)])
+        .args(["reproduce", "--quiet", "--out", path(out)])
         .env("TAPSIM_CACHE", dir.join("cache"))
         .stdout(Stdio::null())
-        .stderr(Stdio::null())
+        .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // Interrupted once it has begun writing (its first figure).
     let start = Instant::now();
     while !out.join("fig1_jkr_cycle.csv").exists() {
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut why = String::new();
+            std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut why).unwrap();
+            panic!("reproduce ended with {status} before writing: {why}");
+        }
         assert!(start.elapsed() < Duration::from_secs(60), "nothing written");
         std::thread::sleep(Duration::from_millis(5));
     }
@@ -332,41 +336,20 @@ fn an_interrupted_reproduce_can_be_rerun_into_its_own_directory() {
     assert_eq!(child.wait().unwrap().code(), Some(130));
     assert!(!out.join("README.md").exists(), "it was not interrupted");
     assert!(
-        listing(&out)
+        listing(out)
             .iter()
             .any(|n| n.starts_with(".tapsim-reproduce"))
     );
+}
+
+#[test]
+fn an_interrupted_reproduce_can_be_rerun_into_its_own_directory() {
+    let dir = scratch("reproduce-interrupted");
+    let out = dir.join("results");
+    reproduce_interrupted(&dir, &out);
     // Run again into the same directory: accepted (it writes its first figure again
-    // rather than refusing the directory), and interrupted again, it is left marked.
-    // (That a finished run leaves its README alone, no marker, tests/cli.rs checks.)
+    // rather than refusing the directory). (That a finished run leaves its README
+    // alone, no marker, tests/cli.rs checks.)
     std::fs::remove_file(out.join("fig1_jkr_cycle.csv")).unwrap();
-    let mut again = tapsim()
-        .args(["reproduce", "--quiet", "--out", path(&out)])
-        .env("TAPSIM_CACHE", dir.join("cache"))
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while !out.join("fig1_jkr_cycle.csv").exists() {
-        if let Some(status) = again.try_wait().unwrap() {
-            let mut why = String::new();
-            std::io::Read::read_to_string(&mut again.stderr.take().unwrap(), &mut why).unwrap();
-            panic!("the rerun ended with {status} before writing: {why}");
-        }
-        assert!(start.elapsed() < Duration::from_secs(60), "nothing written");
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    let kill = Command::new("kill")
-        .args(["-INT", &again.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    assert_eq!(again.wait().unwrap().code(), Some(130));
-    assert!(!out.join("README.md").exists());
-    assert!(
-        listing(&out)
-            .iter()
-            .any(|n| n.starts_with(".tapsim-reproduce"))
-    );
+    reproduce_interrupted(&dir, &out);
 }

@@ -165,6 +165,26 @@ fn several_modes_refuse_what_they_do_not_report() {
         &["tap", "--modes", "2", "--law", "hertz", "--viscosity", "1"],
         "rate-independent",
     );
+    refused(
+        &["scan", "--modes", "2", "--temperature", "300K"],
+        "--temperature is for one mode",
+    );
+    refused(
+        &["scan", "--modes", "2", "--drive2-amplitude", "0"],
+        "mode 2 is not driven",
+    );
+    refused(
+        &[
+            "map",
+            "--modes",
+            "2",
+            "--setpoint",
+            "0.8",
+            "--branch",
+            "all",
+        ],
+        "a map is solved on one branch",
+    );
 }
 
 #[test]

@@ -2,7 +2,7 @@
 //! mode) at a time over a material at the rest separation the piezo sets, read by its
 //! lock-ins after each period. The loop ([`super::feedback`]) and the scan
 //! ([`super::scan`]) run any probe: the point mass under a thermal force ([`OneMode`])
-//! or several eigenmodes ([`super::modal::Modes`]).
+//! or several eigenmodes ([`super::modal::ModalProbe`]).
 
 use super::lockin::LockIn;
 use super::thermal::ThermalForce;
