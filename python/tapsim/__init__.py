@@ -132,10 +132,24 @@ def _arrays(value: Any) -> Any:
 
 def _modes(value: Any) -> Any:
     """A several-mode state's `modes` (one object per mode) as columns, like a sweep's:
-    ``r.modes.phase_deg[1]`` is the second mode's phase."""
-    if not (isinstance(value, list) and value and all(isinstance(x, dict) for x in value)):
+    ``r.modes.phase_deg[1]`` is the second mode's phase. A scan's (per pixel, one object
+    per higher mode) as 2-D columns: ``r.modes.phase_deg[i, 0]`` is pixel i's φ₂."""
+    if not (isinstance(value, list) and value):
         return _arrays(value)
-    return Result("modes", {k: _column([x[k] for x in value]) for k in value[0]})
+    if all(isinstance(x, dict) for x in value):
+        return Result("modes", {k: _column([x[k] for x in value]) for k in value[0]})
+    rows = [x for x in value if isinstance(x, list)]
+    if (
+        len(rows) == len(value)
+        and rows[0]
+        and all(len(r) == len(rows[0]) and all(isinstance(m, dict) for m in r) for r in rows)
+    ):
+        keys = rows[0][0]
+        return Result(
+            "modes",
+            {k: _np.array([[m[k] for m in r] for r in rows]) for k in keys},
+        )
+    return _arrays(value)
 
 
 def _column(values: List[Any]) -> Any:

@@ -160,3 +160,14 @@ def test_a_bimodal_state_gives_each_modes_values_as_columns(cli):
     assert r.modes.mode.tolist() == [1, 2]
     # Energy goes round: what the tip force does on the modes is what the contact takes.
     assert abs(r.modes.e_exchange_j.sum() + r.e_ts_j) <= 1e-6 * r.modes.e_drive_j.sum()
+
+
+def test_a_bimodal_scan_gives_each_pixels_higher_modes_as_2d_columns(cli):
+    args = dict(modes=2, pixels=2, line_rate=400, no_retrace=True)
+    r = tapsim.scan(**args)
+    expected = cli("scan", "--modes=2", "--pixels=2", "--line-rate=400", "--no-retrace")
+    assert r.modes.phase_deg.shape == (2, 1)
+    assert r.modes.mode.tolist() == [[2], [2]]
+    for key in ("amplitude_ratio", "phase_deg"):
+        assert r.modes[key][:, 0].tolist() == [row[0][key] for row in expected["modes"]]
+    assert r.phase_deg.tolist() == expected["phase_deg"]
