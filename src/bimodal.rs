@@ -134,24 +134,22 @@ pub fn states_at_setpoint(
     branch: Option<PhaseBranch>,
 ) -> Result<Vec<(PhaseBranch, Result<ModalSetpointState>)>> {
     let one = crate::setpoint::states_at_setpoint(setup, numerics, setpoint, branch)?;
-    from_one_mode(setup, set, numerics, setpoint, one)
+    let (p, modal) = prepare(setup, set, numerics)?;
+    from_one_mode((&p, &modal, numerics), setpoint, one)
 }
 
 /// The modes' states at `setpoint` seeded at the one-mode states `one` that hold it
-/// ([`states_at_setpoint`]).
+/// ([`states_at_setpoint`]), `p` and `modal` the setup prepared ([`prepare`]).
 fn from_one_mode(
-    setup: &TapSetup,
-    set: &ModeSet,
-    numerics: &Numerics,
+    (p, modal, numerics): (&Prepared, &Modal, &Numerics),
     setpoint: f64,
     one: Vec<crate::setpoint::SetpointState>,
 ) -> Result<Vec<(PhaseBranch, Result<ModalSetpointState>)>> {
-    let free_phase = crate::setpoint::free_phase_deg(setup);
-    let (p, modal) = prepare(setup, set, numerics)?;
+    let free_phase = crate::setpoint::free_phase_deg(&p.setup);
     let mut out = Vec::new();
     for s in one {
         let side = s.branch;
-        let q = at_separation(&p, s.separation_m)?;
+        let q = at_separation(p, s.separation_m)?;
         let mut seeds: Vec<(ModalObservables, ModalOrbit)> = Vec::new();
         let mut failure = None;
         for (k, scale) in SEEDS.into_iter().enumerate() {
@@ -167,7 +165,7 @@ fn from_one_mode(
                 },
                 ..*numerics
             };
-            match modal_steady(&q, &modal, &seed_numerics, Some((&start, s.phase.branch))) {
+            match modal_steady(&q, modal, &seed_numerics, Some((&start, s.phase.branch))) {
                 Ok((state, orbit)) => {
                     if PhaseBranch::of(state.modes[0].phase_deg, free_phase) != side {
                         failure = Some(crossed(side, setpoint, s.separation_m));
@@ -182,7 +180,7 @@ fn from_one_mode(
         let mut found: Vec<ModalSetpointState> = Vec::new();
         for (state, orbit) in seeds {
             let followed = follow(
-                (&p, &modal, numerics),
+                (p, modal, numerics),
                 (setpoint, side, free_phase),
                 (s.separation_m, state, orbit),
             );
@@ -240,12 +238,8 @@ fn follow(
 ) -> Result<ModalSetpointState> {
     let a0 = p.setup.cantilever.free_amplitude_m;
     let crossed = |z: f64| crossed(side, setpoint, z);
-    // Walk along z_c from the one-mode state towards the setpoint (A₁ grows
-    // with z_c) in steps of WALK A₀₁, each state continued from the last, to
-    // the first crossing of the setpoint; then regula falsi inside it. (A₁ of
-    // the modes can turn steep near the end of a branch, and more than one
-    // state of a branch may hold a setpoint: this is the one joined to the
-    // one-mode state.)
+    // A₁ grows with z_c. (It can turn steep near the end of a branch, and more than
+    // one state of a branch may hold a setpoint: this is the one joined to `state`.)
     let miss0 = first_ratio(&state) - setpoint;
     let dir = if miss0 > 0.0 { -1.0 } else { 1.0 };
     let mut near = (z0, miss0, state, orbit);
@@ -383,10 +377,9 @@ pub fn contrast(
             let mut setup = materials[m].setup.clone();
             setup.law = laws[l].into();
             let numerics = &materials[m].numerics;
-            prepare(&setup, set, numerics)?;
+            let (one, modal) = prepare(&setup, set, numerics)?;
             // The one-mode families once for every setpoint (as one mode's contrast
             // takes them), the whole search only where they hold none.
-            let one = Prepared::new(&setup, numerics)?;
             let a0 = setup.cantilever.free_amplitude_m;
             let lowest = setpoints.iter().copied().fold(1.0f64, f64::min);
             let family = crate::setpoint::families(
@@ -403,7 +396,7 @@ pub fn contrast(
                             true => crate::setpoint::states_at_setpoint(&setup, numerics, r, None),
                             false => Ok(on),
                         })
-                        .and_then(|on| from_one_mode(&setup, set, numerics, r, on));
+                        .and_then(|on| from_one_mode((&one, &modal, numerics), r, on));
                     match found {
                         Err(Error::Interrupted) => Err(Error::Interrupted),
                         found => Ok(found),
@@ -516,7 +509,7 @@ pub struct ModalCell {
     pub modulus_pa: f64,
     /// Tabor parameter.
     pub tabor_mu: f64,
-    /// The rest separation of the state (m; at a first-mode setpoint, where the approach
+    /// The rest separation of the state (m; at a first-mode setpoint, where the state
     /// holds it).
     pub separation_m: Option<f64>,
     /// A₁/A₀₁.
@@ -537,8 +530,8 @@ pub struct ModalCell {
 
 /// The several-mode state of every cell of the (Δγ, E*) grid (cells in parallel on
 /// `threads`, 0: every core): at the setup's rest separation, or at the first-mode
-/// setpoint `setpoint` as a slow approach reaches it. A cell without a periodic state
-/// is listed with why.
+/// setpoint on the branch given ([`states_at_setpoint`]; a cell whose modes hold it in
+/// several states lists that instead). A cell without a periodic state is listed with why.
 pub fn map_cells(
     setup: &crate::dynamics::setup::TapSetup,
     set: &ModeSet,

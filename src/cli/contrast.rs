@@ -32,9 +32,10 @@ use clap::Args;
 /// the other laws', branch by branch.
 ///
 /// Bimodal contrast (--modes 2): with a second eigenmode driven at its resonance, the
-/// state a slow approach reaches at each first-mode setpoint A₁/A₀₁, per material and
-/// law; the table gives φ₁ and φ₂ of each material and their contrasts Δφ₁ and Δφ₂
-/// (JSON and CSV: law, materials, setpoint, phase1_deg, phase2_deg, amplitude2_ratio,
+/// states at each first-mode setpoint A₁/A₀₁ on each branch, per material and law; the
+/// table gives φ₁ and φ₂ of each material and their contrasts Δφ₁ and Δφ₂ (a material
+/// whose modes hold a setpoint in several states gets none, with a note listing them)
+/// (JSON and CSV: law, materials, setpoint, branch, phase1_deg, phase2_deg, amplitude2_ratio,
 /// e_ts_j, separation_m, stable, delta_phase1_deg, delta_phase2_deg, notes); --plot
 /// draws Δφ₂ and Δφ₁ against the setpoint, a colour per law.
 ///

@@ -189,10 +189,9 @@ pub fn run(args: ScanArgs) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let modal = match &set {
         Some(set) => Some(
-            sample
-                .materials
+            prepared
                 .iter()
-                .map(|(_, s)| crate::dynamics::modes::prepare(s, set, &numerics))
+                .map(|p| crate::dynamics::modes::with_modes(p.clone(), set))
                 .collect::<Result<Vec<_>>>()?,
         ),
         None => None,

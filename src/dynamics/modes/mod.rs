@@ -10,5 +10,7 @@ pub mod orbit;
 pub mod set;
 pub mod system;
 
-pub use observables::{ModalObservables, ModeObservables, modal_steady, prepare, tap_modes};
+pub use observables::{
+    ModalObservables, ModeObservables, modal_steady, prepare, tap_modes, with_modes,
+};
 pub use set::{Eigenmode, MAX_MODES, Modal, ModeSet};

@@ -96,7 +96,11 @@ pub struct ModalObservables {
 /// The modes of `set` on `setup` made ready: the prepared one-mode setup and the modal
 /// model. Refuses a rate-dependent law (a viscous or relaxing sample: one mode only).
 pub fn prepare(setup: &TapSetup, set: &ModeSet, numerics: &Numerics) -> Result<(Prepared, Modal)> {
-    let p = Prepared::new(setup, numerics)?;
+    with_modes(Prepared::new(setup, numerics)?, set)
+}
+
+/// [`prepare`] from a setup already prepared for one mode.
+pub fn with_modes(p: Prepared, set: &ModeSet) -> Result<(Prepared, Modal)> {
     if p.law.is_rate_dependent() {
         return Err(Error::NotApplicable(
             "several modes are simulated with rate-independent laws (hybrid, jkr, lj, dmt, \
