@@ -67,6 +67,7 @@ pub fn approach(
     separations_m: &[f64],
     mut progress: impl FnMut(),
 ) -> Result<Vec<ModalPoint>> {
+    modal.common_period()?;
     let mut last: Option<ModalOrbit> = None;
     let mut points = Vec::with_capacity(separations_m.len());
     for &z in separations_m {
@@ -133,8 +134,9 @@ pub fn states_at_setpoint(
     setpoint: f64,
     branch: Option<PhaseBranch>,
 ) -> Result<Vec<(PhaseBranch, Result<ModalSetpointState>)>> {
-    let one = crate::setpoint::states_at_setpoint(setup, numerics, setpoint, branch)?;
     let (p, modal) = prepare(setup, set, numerics)?;
+    modal.common_period()?;
+    let one = crate::setpoint::states_at_setpoint(setup, numerics, setpoint, branch)?;
     from_one_mode((&p, &modal, numerics), setpoint, one)
 }
 
@@ -161,7 +163,7 @@ fn from_one_mode(
                 max_cycles: if k == 0 {
                     numerics.max_cycles
                 } else {
-                    SEED_MARCH * modal.periods as usize
+                    SEED_MARCH * modal.common_period()?.0 as usize
                 },
                 ..*numerics
             };
@@ -378,6 +380,7 @@ pub fn contrast(
             setup.law = laws[l].into();
             let numerics = &materials[m].numerics;
             let (one, modal) = prepare(&setup, set, numerics)?;
+            modal.common_period()?;
             // The one-mode families once for every setpoint (as one mode's contrast
             // takes them), the whole search only where they hold none.
             let a0 = setup.cantilever.free_amplitude_m;
@@ -542,6 +545,7 @@ pub fn map_cells(
     setpoint: Option<(f64, PhaseBranch)>,
 ) -> Result<Vec<ModalCell>> {
     let every: Vec<usize> = (0..works_j_m2.len() * moduli_pa.len()).collect();
+    Modal::new(&setup.cantilever, set)?.common_period()?;
     crate::sweep::over_grid(
         setup,
         (works_j_m2, moduli_pa),

@@ -34,6 +34,38 @@ pub(crate) fn mean_and_variance(values: impl Iterator<Item = f64> + Clone) -> (f
     (mean, var)
 }
 
+/// How many leading values of a series of batch means `ys` are a transient, by the
+/// marginal standard error rule (MSER; White, Simulation 69, 323, 1997): the cut d ≤ n/2
+/// that minimises the variance of the remaining values over (n − d)², taken only where
+/// it at least halves that of the whole series (a stationary series' minimum is at
+/// d = 0 but for chance) and where dropping the d values moves the mean by more than
+/// `moves_by` (a cut that changes nothing reported is chance, or a transient too small
+/// to matter). Fewer than 4 values: none.
+pub(crate) fn transient_cut(ys: &[f64], moves_by: f64) -> usize {
+    let n = ys.len();
+    if n < 4 {
+        return 0;
+    }
+    let mean = |d: usize| ys[d..].iter().sum::<f64>() / (n - d) as f64;
+    let mser = |d: usize| {
+        let (rest, m) = (&ys[d..], mean(d));
+        rest.iter().map(|y| (y - m).powi(2)).sum::<f64>() / ((n - d) as f64).powi(3)
+    };
+    let whole = mser(0);
+    let (best, at) = (1..=n / 2)
+        .map(|d| (d, mser(d)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("n >= 4");
+    let moves = (mean(best) - mean(0)).abs() > moves_by;
+    if at < 0.5 * whole && moves { best } else { 0 }
+}
+
+/// An angle difference brought into (−π, π].
+pub(crate) fn wrap_angle(d: f64) -> f64 {
+    use std::f64::consts::PI;
+    PI - (PI - d).rem_euclid(2.0 * PI)
+}
+
 /// The polynomial through `points` (distinct abscissae) at `x`, in Lagrange form.
 pub(crate) fn lagrange(points: &[(f64, f64)], x: f64) -> f64 {
     (0..points.len())
@@ -55,7 +87,7 @@ pub(crate) fn distance_to_interval(x: f64, lo: f64, hi: f64) -> f64 {
 
 /// Root of `f` in the bracket `[lo, hi]` (signs of `f(lo)` and `f(hi)` must differ),
 /// by the Illinois variant of regula falsi: bracketing like bisection, superlinear
-/// like the secant method. Stops when the bracket is below `x_tol` (absolute) or
+/// like the secant method. Stops when the bracket is below `x_tol`·(1 + |x|) or
 /// `f` is exactly zero.
 pub(crate) fn bracketed_root(
     what: &str,

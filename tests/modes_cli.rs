@@ -58,6 +58,40 @@ fn bimodal_tap_reports_every_mode_and_the_readme_numbers() {
     assert!(text.contains("29.7323"), "{text}");
 }
 
+/// Drives with no common period (`--ratio-tolerance 0`: the beam's f₂ = 6.266893 f₀ as
+/// it is): `tap` reports window averages, each with its error, and says what they are.
+/// README: φ₂ = 29.80° and A₂/A₀₂ = 0.4969 there (29.73° and 0.4955 at 25/4).
+#[test]
+fn modes_without_a_common_period_are_averaged_over_windows() {
+    let v = json(&["tap", "--modes", "2", "--ratio-tolerance", "0", "--json"]);
+    assert!(v["motion"].as_str().unwrap().contains("no common period"));
+    assert_eq!(v["converged"], true);
+    assert_eq!(num(&v, "windows"), 8.0);
+    let modes = v["modes"].as_array().expect("a list of modes");
+    // The beam's second mode as it is, not moved to 25/4 f₀.
+    assert!((num(&modes[1], "resonance_hz") - 1880.0679e3).abs() < 0.1);
+    for m in modes {
+        for key in [
+            "amplitude_ratio",
+            "amplitude_ratio_std_err",
+            "phase_deg",
+            "phase_std_err_deg",
+            "e_exchange_j",
+            "e_exchange_std_err_j",
+        ] {
+            assert!(m[key].is_number(), "{key}");
+        }
+        // Errors far below the digits printed (README and table).
+        assert!(num(m, "phase_std_err_deg") < 5e-4);
+    }
+    assert!((num(&modes[1], "phase_deg") - 29.80).abs() < 5e-3);
+    assert!((num(&modes[1], "amplitude_ratio") - 0.4969).abs() < 5e-5);
+    assert!((num(&modes[0], "phase_deg") - 75.772).abs() < 5e-4);
+    let text = String::from_utf8(tapsim(&["tap", "--modes", "2", "--ratio-tolerance", "0"]).stdout)
+        .unwrap();
+    assert!(text.contains("have no common period"), "{text}");
+}
+
 #[test]
 fn a_parameter_files_modes_are_its_flags() {
     let dir = scratch("modes");
@@ -145,18 +179,23 @@ fn several_modes_refuse_what_they_do_not_report() {
         &["tap", "--modes", "2", "--mode2-resonance", "310kHz"],
         "must be ordered",
     );
-    refused(
-        &[
-            "tap",
-            "--modes",
-            "2",
+    // Drives with no common period have no orbit to follow or hold at a setpoint:
+    // only `tap` at a separation averages them over windows.
+    for command in [
+        &["approach", "--modes", "2"][..],
+        &["contrast", "--modes", "2"],
+        &["map", "--modes", "2"],
+        &["tap", "--modes", "2", "--setpoint", "0.8"],
+    ] {
+        let mut args = command.to_vec();
+        args.extend([
             "--mode2-resonance",
             "1.88312345MHz",
             "--ratio-tolerance",
             "1e-9",
-        ],
-        "no common denominator",
-    );
+        ]);
+        refused(&args, "no common denominator");
+    }
     refused(
         &["approach", "--modes", "2", "--sweep", "setpoint"],
         "--sweep setpoint is for one mode",

@@ -162,6 +162,18 @@ def test_a_bimodal_state_gives_each_modes_values_as_columns(cli):
     assert abs(r.modes.e_exchange_j.sum() + r.e_ts_j) <= 1e-6 * r.modes.e_drive_j.sum()
 
 
+def test_modes_without_a_common_period_give_averages_with_errors(cli):
+    # The beam's f2 as it is (ratio tolerance 0): window averages, each with its error.
+    r = tapsim.tap(modes=2, ratio_tolerance=0)
+    expected = cli("tap", "--modes=2", "--ratio-tolerance=0")
+    assert "no common period" in r.motion and r.converged
+    for key in ("amplitude_ratio", "phase_deg", "phase_std_err_deg"):
+        assert r.modes[key].tolist() == [m[key] for m in expected["modes"]]
+    assert (r.modes.phase_std_err_deg < 1e-3).all()
+    with pytest.raises(ValueError, match="no common denominator"):
+        tapsim.tap(modes=2, ratio_tolerance=0, setpoint=0.8)
+
+
 def test_a_bimodal_scan_gives_each_pixels_higher_modes_as_2d_columns(cli):
     args = dict(modes=2, pixels=2, line_rate=400, no_retrace=True)
     r = tapsim.scan(**args)

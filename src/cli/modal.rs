@@ -2,7 +2,7 @@
 
 use crate::bimodal;
 use crate::contrast::Material;
-use crate::dynamics::modes::{ModeSet, modal_steady, prepare};
+use crate::dynamics::modes::{ModeSet, modal_steady, modal_windowed, prepare};
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
 use crate::law::LawKind;
@@ -28,10 +28,25 @@ pub(super) fn tap(
     numerics: &Numerics,
     set: &ModeSet,
     setpoint: Option<(f64, Option<PhaseBranch>)>,
-    json: bool,
+    (json, quiet): (bool, bool),
 ) -> Result<()> {
     let Some((ratio, branch)) = setpoint else {
         let (p, modal) = prepare(setup, set, numerics)?;
+        if modal.periods.is_none() {
+            let busy = super::tap::spinner(
+                "averaging the modes over windows of thousands of drive periods",
+                quiet,
+            );
+            let state = modal_windowed(&p, &modal, numerics);
+            busy.finish_and_clear();
+            let state = state?;
+            if json {
+                outln!("{}", crate::report::records::document(&state)?);
+            } else {
+                out!("{}", report::windowed_text(set, &state));
+            }
+            return Ok(());
+        }
         let state = modal_steady(&p, &modal, numerics, None)?.0;
         if json {
             outln!("{}", crate::report::records::document(&state)?);

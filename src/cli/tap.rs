@@ -160,7 +160,7 @@ pub fn run(args: TapArgs) -> Result<()> {
             &numerics,
             &set,
             ratio.map(|r| (r, branch)),
-            args.json,
+            (args.json, args.quiet),
         );
     }
     if inputs.holds_setpoint() {
@@ -375,7 +375,7 @@ fn at_setpoint(
 
 /// A spinner saying `what` on stderr while it runs, ticking every half second (hidden
 /// where stderr is not a terminal).
-fn spinner(what: &str, quiet: bool) -> indicatif::ProgressBar {
+pub(super) fn spinner(what: &str, quiet: bool) -> indicatif::ProgressBar {
     use std::io::IsTerminal;
     if quiet || !std::io::stderr().is_terminal() {
         return indicatif::ProgressBar::hidden();

@@ -58,8 +58,11 @@ pub(crate) fn spend(steps: u64) -> Result<()> {
     Ok(())
 }
 
-/// The error of an exhausted budget.
+/// The error of an exhausted budget (which it leaves spent: [`left`] is 0 after it).
 pub(crate) fn exhausted() -> Error {
+    if LEFT.get().is_some() {
+        LEFT.set(Some(0));
+    }
     Error::Numerical(format!(
         "gave up after {} integration steps (the work budget of one steady state): \
          the motion is too costly to resolve with these parameters. Usual causes: a \

@@ -218,23 +218,18 @@ fn batch_statistics(
     } else {
         StdErr {
             amplitude: std_err_of(&|b| b.amplitude()),
-            phase: std_err_of(&|b| wrap_angle(b.phase() - phase)),
+            phase: std_err_of(&|b| crate::numeric::wrap_angle(b.phase() - phase)),
             e_ts: std_err_of(&|b| b.e_ts_per_period()),
         }
     };
     (window, std_err)
 }
 
-/// How many leading batches of a window are transient, by the marginal standard error
-/// rule (MSER; White, Simulation 69, 323, 1997): for A, φ and E_ts per period, the cut d
-/// ≤ n/2 that minimises the variance of the remaining batch values over (n − d)², taken
-/// only where it at least halves that of the whole window (a stationary window's
-/// minimum is at d = 0 but for chance) and where dropping the d batches moves the
-/// window's mean by more than `tolerance` (A relative, φ in rad, E_ts relative to
-/// E_drive, as the standard errors are judged): a cut that changes nothing reported is
-/// chance, or a transient too small to matter. The largest such cut of the three. A
-/// transient that creeps (past a fold's ghost, say) shows up as leading batches far
-/// from the rest.
+/// How many leading batches of a window are transient: for A, φ and E_ts per period,
+/// the MSER cut ([`crate::numeric::transient_cut`]) that moves the window's mean by
+/// more than `tolerance` (A relative, φ in rad, E_ts relative to E_drive, as the
+/// standard errors are judged); the largest of the three. A transient that creeps
+/// (past a fold's ghost, say) shows up as leading batches far from the rest.
 fn transient_batches(batches: &[CycleIntegrals], tolerance: f64) -> usize {
     let n = batches.len();
     if n < 4 {
@@ -244,30 +239,13 @@ fn transient_batches(batches: &[CycleIntegrals], tolerance: f64) -> usize {
     let phase = window.phase();
     let cut = |value: &dyn Fn(&CycleIntegrals) -> f64, scale: f64| {
         let ys: Vec<f64> = batches.iter().map(value).collect();
-        let mean = |d: usize| ys[d..].iter().sum::<f64>() / (n - d) as f64;
-        let mser = |d: usize| {
-            let (rest, m) = (&ys[d..], mean(d));
-            rest.iter().map(|y| (y - m).powi(2)).sum::<f64>() / ((n - d) as f64).powi(3)
-        };
-        let whole = mser(0);
-        let (best, at) = (1..=n / 2)
-            .map(|d| (d, mser(d)))
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .expect("n >= 4");
-        let moves = (mean(best) - mean(0)).abs() > tolerance * scale;
-        if at < 0.5 * whole && moves { best } else { 0 }
+        crate::numeric::transient_cut(&ys, tolerance * scale)
     };
     let relative_to = |x: f64| if x > 0.0 { x } else { 1.0 };
     cut(&|b| b.amplitude(), relative_to(window.amplitude()))
-        .max(cut(&|b| wrap_angle(b.phase() - phase), 1.0))
+        .max(cut(&|b| crate::numeric::wrap_angle(b.phase() - phase), 1.0))
         .max(cut(
             &|b| b.e_ts_per_period(),
             relative_to(window.e_drive_per_period().abs()),
         ))
-}
-
-/// An angle difference brought into (−π, π].
-fn wrap_angle(d: f64) -> f64 {
-    use std::f64::consts::PI;
-    PI - (PI - d).rem_euclid(2.0 * PI)
 }

@@ -6,7 +6,7 @@
 //! The modes are marched with the steady-state solver's equations and switch handling
 //! ([`crate::dynamics::modes::system`]), one first-mode drive period at a time, τ taken
 //! back by the common period each time one ends (every drive's phase is the same
-//! there). Each lock-in reads its own mode's deflection qᵢ — what `tap --modes` reports
+//! there); drives with no common period are marched as they are, τ never taken back. Each lock-in reads its own mode's deflection qᵢ — what `tap --modes` reports
 //! as Aᵢ, φᵢ; a photodiode's lock-in reads the tip's Σqⱼ, which also holds the other
 //! modes' motion at Ωᵢ. No thermal force: the thermal instrument is the point mass's.
 
@@ -29,7 +29,8 @@ pub struct ModalProbe<'a> {
     /// Each mode's (qᵢ, qᵢ′).
     section: [f64; 2 * MAX_MODES],
     branch: Branch,
-    /// The first-mode drive period the next march starts with, within the common period.
+    /// The first-mode drive period the next march starts with, within the common period
+    /// (counted on where the drives have none: τ is then not taken back).
     period_index: u32,
 }
 
@@ -86,7 +87,7 @@ impl<'a> ModalProbe<'a> {
         let (p, modal) = &self.materials[material];
         let mut modes = Modes::<_, M>::of(p, modal);
         modes.cpl = p.simulation_at(separation_m)?.cpl;
-        let period = modal.period() / f64::from(modal.periods);
+        let period = march_period(modal);
         for _ in 0..periods {
             let k = self.period_index;
             let mut y = State::<P>::zeros();
@@ -100,9 +101,19 @@ impl<'a> ModalProbe<'a> {
             )?;
             self.section[..2 * M].copy_from_slice(&y.as_slice()[..2 * M]);
             self.branch = branch;
-            self.period_index = (k + 1) % modal.periods;
+            self.period_index = modal.periods.map_or(k + 1, |q| (k + 1) % q);
         }
         Ok(())
+    }
+}
+
+/// The first mode's drive period in τ (taken as the common period over q where there
+/// is one: the commensurate instrument bit for bit as before drives without a common
+/// period were marched).
+fn march_period(modal: &Modal) -> f64 {
+    match modal.common_period() {
+        Ok((q, period)) => period / f64::from(q),
+        Err(_) => modal.drive_period(),
     }
 }
 
@@ -121,7 +132,7 @@ impl Probe for ModalProbe<'_> {
 
     fn settling_periods(&self) -> usize {
         let modal = &self.materials[0].1;
-        settling_periods(&self.lockins[0], modal.period() / f64::from(modal.periods))
+        settling_periods(&self.lockins[0], march_period(modal))
     }
 
     fn march(&mut self, material: usize, separation_m: f64, periods: usize) -> Result<Readings> {

@@ -3,7 +3,7 @@
 
 use super::chart::{Axis, Chart, Corner, Series, Style};
 use crate::bimodal::{BimodalRow, ModalPoint, PhaseBranch};
-use crate::dynamics::modes::{ModalObservables, ModeSet};
+use crate::dynamics::modes::{ModalObservables, ModeSet, WindowedModes};
 use crate::params::ELECTRONVOLT_J;
 use crate::sweep::Direction;
 use serde::Serialize;
@@ -104,6 +104,130 @@ pub fn tap_text(set: &ModeSet, o: &ModalObservables) -> String {
         if o.stable { "stable" } else { "UNSTABLE" },
         largest,
         o.return_distance_rel
+    );
+    s
+}
+
+/// `tap --modes` for drives with no common period: the window averages, each with its
+/// standard error.
+pub fn windowed_text(set: &ModeSet, o: &WindowedModes) -> String {
+    let mut s = String::new();
+    // A standard error of 0: the batch means agree to round-off.
+    let pm = |v: String, e: f64| {
+        if e > 0.0 {
+            format!("{v} ± {e:.1e}")
+        } else {
+            v
+        }
+    };
+    let ev = |j: f64| j / ELECTRONVOLT_J;
+    let _ = writeln!(
+        s,
+        "{} eigenmodes, {} law (Tabor μ = {:.3}), z_c = {:.4} nm",
+        o.modes.len(),
+        o.law,
+        o.tabor_mu,
+        o.separation_m * 1e9
+    );
+    let ratios: Vec<String> = o
+        .modes
+        .iter()
+        .skip(1)
+        .map(|m| {
+            format!(
+                "{:.6}",
+                m.drive_frequency_hz / o.modes[0].drive_frequency_hz
+            )
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "drive frequency ratios {} have no common period (no p/q, q ≤ 32, within the \
+         tolerance {}): the motion is not periodic. Time averages over whole periods of \
+         each mode, weighted across each of {} windows of {} first-mode periods (± the \
+         standard error of the windows' values; none where they agree to round-off), \
+         started from the one-mode steady state with the higher modes' free motion on \
+         top: another start may find another attractor.",
+        ratios.join(", "),
+        set.ratio_tolerance,
+        o.windows,
+        o.window_periods
+    );
+    let _ = writeln!(
+        s,
+        "{:>4} {:>12} {:>10} {:>8} {:>9} {:>21} {:>21} {:>11} {:>11} {:>21}",
+        "mode",
+        "f (kHz)",
+        "k (N/m)",
+        "Q",
+        "A0 (nm)",
+        "A/A0",
+        "phi (deg)",
+        "E_drive(eV)",
+        "E_damp(eV)",
+        "E_tip (eV)"
+    );
+    for m in &o.modes {
+        let ratio = match (m.amplitude_ratio, m.amplitude_ratio_std_err) {
+            (Some(r), Some(e)) => pm(format!("{r:.6}"), e),
+            _ => pm(
+                format!("{:.5} nm", m.amplitude_m * 1e9),
+                m.amplitude_std_err_m * 1e9,
+            ),
+        };
+        let _ = writeln!(
+            s,
+            "{:>4} {:>12.4} {:>10.4} {:>8.1} {:>9.4} {:>21} {:>21} {:>11.4} {:>11.4} {:>21}",
+            m.mode,
+            m.drive_frequency_hz * 1e-3,
+            m.stiffness_n_m,
+            m.quality,
+            m.free_amplitude_m * 1e9,
+            ratio,
+            pm(format!("{:.4}", m.phase_deg), m.phase_std_err_deg),
+            ev(m.e_drive_j),
+            ev(m.e_damp_j),
+            pm(
+                format!("{:.4}", ev(m.e_exchange_j)),
+                ev(m.e_exchange_std_err_j)
+            ),
+        );
+    }
+    let _ = writeln!(
+        s,
+        "(energies per first-mode drive period; E_tip = ∫F_ts q̇ᵢ dt, the work the tip force \
+         does on the mode)"
+    );
+    let _ = writeln!(
+        s,
+        "E_ts = {} eV per first-mode period (adhesion {:.4}, capillary {:.4}); drives − \
+         damping − E_ts = {:.1e} of the drives' work (the modes' stored energy differs at \
+         the window's ends)",
+        pm(format!("{:.4}", o.e_ts_ev), ev(o.e_ts_std_err_j)),
+        ev(o.e_ts_adhesion_j),
+        ev(o.e_ts_capillary_j),
+        o.energy_balance_rel
+    );
+    let _ = writeln!(
+        s,
+        "in contact {:.2} % of the time, {:.3} jump(s) in per first-mode period; mean force \
+         {:.4} nN",
+        100.0 * o.contact_fraction,
+        o.jumps_in,
+        o.mean_force_n * 1e9
+    );
+    let _ = writeln!(
+        s,
+        "averaged over {:.0} first-mode periods, {:.0} integrated{}",
+        o.periods_averaged,
+        o.periods_integrated,
+        if o.converged {
+            String::new()
+        } else {
+            " — NOT converged: the budget (of drive periods or integration steps) ran out before every \
+             error was below the average tolerance"
+                .to_string()
+        }
     );
     s
 }

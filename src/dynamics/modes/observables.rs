@@ -138,39 +138,51 @@ fn solve<const M: usize, const P: usize, const T: usize>(
     numerics: &Numerics,
     start: Option<(&[f64], crate::law::Branch)>,
 ) -> Result<(ModalObservables, ModalOrbit)> {
+    let (q, period) = modal.common_period()?;
     let modes = Modes::<_, M>::of(p, modal);
     let (z, branch) = match start {
         Some((z, b)) => (z.to_vec(), b),
-        None => {
-            let sim = p.simulation();
-            let mut phase = sim.free_steady_start();
-            let first = sim
-                .steady_state(&mut phase, &p.steady)
-                .ok()
-                .map(|_| (phase.x, phase.v));
-            let branch = if first.is_some() {
-                phase.branch
-            } else {
-                crate::law::Branch::Free
-            };
-            (free_section(&modes.modes, first), branch)
-        }
+        None => one_mode_start(p, &modes.modes),
     };
     let opts = OrbitOptions {
         tolerance: numerics.tolerance,
-        max_periods: (numerics.max_cycles / modal.periods as usize).max(10),
+        max_periods: (numerics.max_cycles / q as usize).max(10),
     };
-    let orbit = modes.orbit::<P, T>(&z, branch, modal.period(), &opts)?;
-    Ok((observe::<M>(p, modal, &orbit), orbit))
+    let orbit = modes.orbit::<P, T>(&z, branch, period, &opts)?;
+    Ok((observe::<M>(p, modal, (q, period), &orbit), orbit))
 }
 
-fn observe<const M: usize>(p: &Prepared, modal: &Modal, orbit: &ModalOrbit) -> ModalObservables {
+/// Where the modes start without a given state: the one-mode steady state (if it has
+/// one) with the higher modes' free oscillations on top.
+pub(super) fn one_mode_start(
+    p: &Prepared,
+    modes: &[super::set::ModeModel],
+) -> (Vec<f64>, crate::law::Branch) {
+    let sim = p.simulation();
+    let mut phase = sim.free_steady_start();
+    let first = sim
+        .steady_state(&mut phase, &p.steady)
+        .ok()
+        .map(|_| (phase.x, phase.v));
+    let branch = if first.is_some() {
+        phase.branch
+    } else {
+        crate::law::Branch::Free
+    };
+    (free_section(modes, first), branch)
+}
+
+fn observe<const M: usize>(
+    p: &Prepared,
+    modal: &Modal,
+    (q, period): (u32, f64),
+    orbit: &ModalOrbit,
+) -> ModalObservables {
     let cant = &p.setup.cantilever;
     let contact = &p.setup.contact;
     let (k1, a0) = (cant.stiffness_n_m, cant.free_amplitude_m);
     let energy = k1 * a0 * a0;
-    let periods = f64::from(modal.periods);
-    let period = modal.period();
+    let periods = f64::from(q);
     let at = |i: usize, w: ModeIntegral| orbit.integrals[super::system::integral(M, i, w) - 2 * M];
     let drives: Vec<f64> = (0..M)
         .map(|i| modal.modes[i].drive * at(i, ModeIntegral::Drive))
@@ -239,7 +251,7 @@ fn observe<const M: usize>(p: &Prepared, modal: &Modal, orbit: &ModalOrbit) -> M
         law: p.setup.law.to_string(),
         tabor_mu: contact.tabor_mu(),
         separation_m: p.cpl.a0 * scale,
-        common_period_periods: modal.periods,
+        common_period_periods: q,
         modes,
         e_ts_j,
         e_ts_ev: e_ts_j / ELECTRONVOLT_J,

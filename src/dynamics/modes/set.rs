@@ -175,15 +175,20 @@ impl ModeModel {
 pub struct Modal {
     /// Every mode, the first first.
     pub modes: Vec<ModeModel>,
-    /// The common period in first-mode drive periods (the common denominator q).
-    pub periods: u32,
+    /// The common period in first-mode drive periods (the common denominator q); none
+    /// where the drives have no common period (window averages only).
+    pub periods: Option<u32>,
     /// The higher modes' resonance (= drive) frequencies as simulated, in Hz.
     pub resonance_hz: Vec<f64>,
+    /// The tolerance the ratios were made commensurate within.
+    pub ratio_tolerance: f64,
 }
 
 impl Modal {
     /// The model of `first` and `set`: each higher mode's resonance moved to pᵢ/q times
-    /// the first mode's drive frequency (within the set's tolerance) and driven there.
+    /// the first mode's drive frequency (within the set's tolerance; q ≤
+    /// [`MAX_DENOMINATOR`]) and driven there, or, where no such q exists (or the
+    /// tolerance is 0 and the ratios are not exactly rational), kept as given.
     pub fn new(first: &Cantilever, set: &ModeSet) -> Result<Self> {
         let first = first.validated()?;
         if set.higher.len() >= MAX_MODES {
@@ -193,13 +198,13 @@ impl Modal {
             )));
         }
         if !(set.ratio_tolerance.is_finite()
-            && set.ratio_tolerance > 0.0
+            && set.ratio_tolerance >= 0.0
             && set.ratio_tolerance < 0.1)
         {
             return Err(Error::InvalidParameter {
                 name: "frequency-ratio tolerance",
                 value: set.ratio_tolerance,
-                reason: "must be above 0 and below 0.1",
+                reason: "must be at least 0 (the frequencies as given) and below 0.1",
             });
         }
         let higher = set
@@ -241,19 +246,22 @@ impl Modal {
                  the modes must be ordered, each above 1.5 f_drive,1"
             )));
         }
-        let (q, p) = common_denominator(&ratios, set.ratio_tolerance).ok_or_else(|| {
-            Error::OutOfRange(format!(
-                "the frequency ratios {ratios:.5?} have no common denominator up to \
-                 {MAX_DENOMINATOR} within a relative tolerance of {}: the motion is not \
-                 periodic; allow a larger frequency-ratio tolerance",
-                set.ratio_tolerance
-            ))
-        })?;
         let omega1 = first.omega_ratio();
         let mut modes = vec![ModeModel::new(1.0, first.quality, 1.0, omega1, 1.0)];
         let mut resonance_hz = Vec::new();
-        for (m, &p) in higher.iter().zip(&p) {
-            let omega = omega1 * f64::from(p) / f64::from(q);
+        // Commensurate: each higher mode moved to pᵢ/q of the drive frequency. Otherwise
+        // the frequencies as given, and no common period.
+        let common = common_denominator(&ratios, set.ratio_tolerance);
+        for (i, m) in higher.iter().enumerate() {
+            // (Products taken in this order: the commensurate model bit for bit as
+            // before window averages existed.)
+            let (omega, hz) = match &common {
+                Some((q, p)) => (
+                    omega1 * f64::from(p[i]) / f64::from(*q),
+                    drive_hz * f64::from(p[i]) / f64::from(*q),
+                ),
+                None => (omega1 * ratios[i], m.resonance_hz),
+            };
             modes.push(ModeModel::new(
                 omega,
                 m.quality,
@@ -261,21 +269,49 @@ impl Modal {
                 omega,
                 m.free_amplitude_m / first.free_amplitude_m,
             ));
-            resonance_hz.push(drive_hz * f64::from(p) / f64::from(q));
+            resonance_hz.push(hz);
         }
         Ok(Self {
             modes,
-            periods: q,
+            periods: common.map(|(q, _)| q),
             resonance_hz,
+            ratio_tolerance: set.ratio_tolerance,
         })
     }
 
-    /// The common period in τ.
-    pub fn period(&self) -> f64 {
-        2.0 * std::f64::consts::PI * f64::from(self.periods) / self.modes[0].omega
+    /// The common period: q first-mode drive periods, and in τ. Refuses drives with no
+    /// common period (no pᵢ/q with q ≤ [`MAX_DENOMINATOR`] within the tolerance).
+    pub fn common_period(&self) -> Result<(u32, f64)> {
+        let q = self.periods.ok_or_else(|| {
+            let ratios: Vec<f64> = self.modes[1..]
+                .iter()
+                .map(|m| m.omega / self.modes[0].omega)
+                .collect();
+            Error::NotApplicable(format!(
+                "the frequency ratios {ratios:.6?} have no common denominator up to \
+                 {MAX_DENOMINATOR} within a relative tolerance of {}: the motion is not \
+                 periodic, and has no orbit to find or follow; its averages over windows \
+                 are computed at one rest separation (the tap command), or allow a larger \
+                 frequency-ratio tolerance",
+                self.ratio_tolerance
+            ))
+        })?;
+        Ok((
+            q,
+            2.0 * std::f64::consts::PI * f64::from(q) / self.modes[0].omega,
+        ))
+    }
+
+    /// The first mode's drive period in τ.
+    pub fn drive_period(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.modes[0].omega
+    }
+
+    /// Mode i's own drive period in τ.
+    pub fn own_period(&self, i: usize) -> f64 {
+        2.0 * std::f64::consts::PI / self.modes[i].omega
     }
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;

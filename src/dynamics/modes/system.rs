@@ -278,9 +278,12 @@ impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
                     |t| tip_at::<M, S>(&start, &end, t) - level,
                     lo,
                     t,
-                    1e-14 * h.max(1e-300),
-                )
-                .unwrap_or(t);
+                    // (The tolerance is relative to 1 + |τ|: 1e-14 of the step, but
+                    // not below a few units of τ's round-off, which a bracket cannot
+                    // shrink under — it then ended unconverged at the probe.)
+                    (1e-14 * h / (1.0 + t.abs())).max(4.0 * f64::EPSILON),
+                );
+                let at = at.unwrap_or(t);
                 self.hit = Some((start, at, falling));
                 return true;
             }
@@ -383,10 +386,25 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
     pub fn pass_observed<const S: usize, O: StepObserver>(
         &self,
         tau0: f64,
+        y: State<S>,
+        branch: Branch,
+        tau1: f64,
+        observer: &mut O,
+    ) -> Result<(State<S>, Branch, PassTally)> {
+        self.pass_stepped(tau0, y, branch, tau1, observer, &mut 0.0)
+    }
+
+    /// [`Self::pass_observed`] starting with the step `h` (0: the integrator's own
+    /// guess), left at the step proposed at the end: passes that follow one another
+    /// (to each mode's period ends, [`super::window`]) go on with the step they had.
+    pub fn pass_stepped<const S: usize, O: StepObserver>(
+        &self,
+        tau0: f64,
         mut y: State<S>,
         mut branch: Branch,
         tau1: f64,
         observer: &mut O,
+        h: &mut f64,
     ) -> Result<(State<S>, Branch, PassTally)> {
         let mut tally = PassTally {
             min_tip: Self::tip(&y),
@@ -394,7 +412,6 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             ..PassTally::default()
         };
         let mut tau = tau0;
-        let mut h = 0.0;
         let alpha = |y: &State<S>| self.cpl.alpha_hat(Self::tip(y), 0.0);
         let mut switches = 0u32;
         while tau1 - tau > 1e-13 * tau1.abs().max(1.0) {
@@ -419,7 +436,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 },
             });
             let alpha_start = alpha(&y);
-            h = run(&mut seg, tau, tau1, y, &self.tol, h).map_err(|e| match e {
+            *h = run(&mut seg, tau, tau1, y, &self.tol, *h).map_err(|e| match e {
                 Error::Numerical(why) => Error::Numerical(format!(
                     "{why} (on the {} branch from τ = {tau:.6}, α̂ = {alpha_start:.6})",
                     match branch {
