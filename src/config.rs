@@ -863,7 +863,9 @@ pub struct ModeInputs {
     /// How far (relative) a higher mode's resonance may be moved so that it is a
     /// ratio p/q of the first drive frequency (q ≤ 32), making the motion periodic over
     /// q drive periods; the frequencies simulated are reported [default 0.005: the
-    /// beam's f₂ = 6.267 f₀ becomes 25/4 f₀].
+    /// beam's f₂ = 6.267 f₀ becomes 25/4 f₀]. 0 keeps every frequency as given: with no
+    /// common period, `tap` reports averages over windows, each with its error, and
+    /// `scan` marches the modes as they are.
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Eigenmodes")]
     pub ratio_tolerance: Option<f64>,
 }

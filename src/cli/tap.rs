@@ -57,7 +57,9 @@ use std::path::PathBuf;
 /// A₀₂ = A₀/40), share the tip force; each mode's lock-in amplitude and phase, the
 /// energy its drive puts in, its damping takes and the tip force exchanges with it,
 /// over the common period (a higher mode's frequency is moved within --ratio-tolerance
-/// to p/q times the drive's, and the table says by how much). `--setpoint` then holds
+/// to p/q times the drive's, and the table says by how much; with --ratio-tolerance 0
+/// the frequencies stay as given and, with no common period, the motion is averaged
+/// over windows of thousands of periods, each number with its error). `--setpoint` then holds
 /// the first mode's A₁/A₀₁: every state that holds it, on each branch (--branch), each
 /// followed from the one-mode state on its branch. JSON: the keys of the
 /// orbit (e_ts_j, contact_fraction, floquet_multipliers, stable, …) and `modes`, one
