@@ -16,6 +16,7 @@ pub mod contact;
 pub mod contrast;
 pub mod dynamics;
 pub mod error;
+pub mod fit;
 pub mod identification;
 pub mod instrument;
 pub mod interrupt;

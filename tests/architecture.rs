@@ -6,13 +6,14 @@
 use std::path::{Path, PathBuf};
 
 /// The library's modules (everything outside the `app` feature).
-const LIBRARY: [&str; 16] = [
+const LIBRARY: [&str; 17] = [
     "src/bimodal.rs",
     "src/lib.rs",
     "src/contact",
     "src/contrast.rs",
     "src/dynamics",
     "src/error.rs",
+    "src/fit",
     "src/identification.rs",
     "src/instrument",
     "src/interrupt.rs",

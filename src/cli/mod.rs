@@ -23,6 +23,7 @@ mod bifurcation;
 mod branches;
 mod contrast;
 mod figure;
+mod fit;
 mod hysteresis;
 mod lj;
 mod map;
@@ -58,6 +59,7 @@ enum Command {
     Branches(branches::BranchesArgs),
     Bifurcation(bifurcation::BifurcationArgs),
     Contrast(contrast::ContrastArgs),
+    Fit(fit::FitArgs),
     Map(map::MapArgs),
     Scan(scan::ScanArgs),
     Thermal(thermal::ThermalArgs),
@@ -79,6 +81,7 @@ impl Command {
             Command::Branches(a) => a.out.quiet,
             Command::Bifurcation(a) => a.out.quiet,
             Command::Contrast(a) => a.out.quiet,
+            Command::Fit(a) => a.quiet,
             Command::Map(a) => a.out.quiet,
             Command::Scan(a) => a.out.quiet,
             Command::Thermal(a) => a.out.quiet,
@@ -406,6 +409,7 @@ fn dispatch(command: Command) -> crate::Result<()> {
         Command::Branches(args) => branches::run(args),
         Command::Bifurcation(args) => bifurcation::run(args),
         Command::Contrast(args) => contrast::run(args),
+        Command::Fit(args) => fit::run(args),
         Command::Map(args) => map::run(args),
         Command::Scan(args) => scan::run(args),
         Command::Thermal(args) => thermal::run(args),

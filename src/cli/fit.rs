@@ -1,0 +1,368 @@
+//! `tapsim fit`: a measured approach curve fitted by the simulator, and what the data
+//! determine.
+
+use crate::config::{TapInputs, length, number};
+use crate::error::{Error, Result};
+use crate::fit::{FitOptions, FitReport, Measured, Parameter, fit};
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+
+/// From a measured approach curve back to the material: which modulus and work of
+/// adhesion (and piezo offset) make the simulated approach — each point a converged
+/// steady state, started from the last as an approach goes — match the amplitude and
+/// phase measured, by weighted least squares (Levenberg–Marquardt), and how sure the
+/// data let one be.
+///
+/// DATA is a CSV whose header names the columns with their units: a position
+/// (z_nm, z_m, z_c_nm, z_c_m, separation_nm, separation_m, position_nm or position_m;
+/// from far to near, its zero unknown: the offset is fitted), and an amplitude
+/// (amplitude_nm, amplitude_m or amplitude_ratio, A/A₀) and/or a phase (phase_deg).
+/// Rows of a `direction` column other than "approach" are left out, so the CSV
+/// `tapsim approach --csv curve.csv` writes is read as it is. Every parameter not
+/// fitted is the setup's (the usual flags), and the fitted ones start there.
+///
+/// Reported: each parameter with its linearised standard error and 68 % and 95 %
+/// intervals; χ²/dof; the Jacobian's singular values and condition number; the
+/// correlations; and what the data leave open — a parameter they do not determine is
+/// flagged and given no value, two that trade off are named. Example:
+///
+///   tapsim approach --from 18.5nm --to 8nm --points 30 --no-retract --csv curve.csv
+///   tapsim fit curve.csv --modulus 1GPa --work-of-adhesion 0.2J/m^2
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct FitArgs {
+    /// The measured curve (CSV with a header, see above).
+    data: PathBuf,
+    /// Parameters to fit, comma-separated [default: modulus,work-of-adhesion,z-offset].
+    #[arg(long, value_delimiter = ',', value_enum)]
+    fit: Vec<FitParameter>,
+    /// Starting offset of the positions: z_c = position + offset [m; default 0].
+    #[arg(long, allow_hyphen_values = true, value_parser = length)]
+    offset: Option<f64>,
+    /// The amplitude's standard deviation [m]. With --sigma-phase: the weights, taken as
+    /// given. Without either: 0.02 nm and 0.05° relative weights, the scale estimated
+    /// from the residuals (χ²/dof).
+    #[arg(long, allow_hyphen_values = true, value_parser = length)]
+    sigma_amplitude: Option<f64>,
+    /// The phase's standard deviation [degrees].
+    #[arg(long, allow_hyphen_values = true, value_parser = number)]
+    sigma_phase: Option<f64>,
+    /// Most simulated curves (each residual evaluation or Jacobian column is one)
+    /// [default 400].
+    #[arg(long, default_value_t = 400)]
+    max_curves: usize,
+    #[command(flatten)]
+    inputs: TapInputs,
+    /// Print JSON instead of a table.
+    #[arg(long, help_heading = "Output")]
+    json: bool,
+    /// No progress on stderr.
+    #[arg(long, short = 'q', help_heading = "Output")]
+    pub(super) quiet: bool,
+}
+
+/// A parameter on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum FitParameter {
+    /// Composite modulus E*.
+    Modulus,
+    /// Work of adhesion Δγ.
+    WorkOfAdhesion,
+    /// Range ε (the Lennard-Jones equilibrium gap).
+    Range,
+    /// The positions' offset.
+    ZOffset,
+}
+
+impl From<FitParameter> for Parameter {
+    fn from(p: FitParameter) -> Self {
+        match p {
+            FitParameter::Modulus => Parameter::Modulus,
+            FitParameter::WorkOfAdhesion => Parameter::WorkOfAdhesion,
+            FitParameter::Range => Parameter::Range,
+            FitParameter::ZOffset => Parameter::ZOffset,
+        }
+    }
+}
+
+/// The largest data file read.
+const MAX_DATA_BYTES: u64 = 64 << 20;
+
+/// A column's values in SI, by the header's name: its kind and scale.
+fn column_kind(name: &str) -> Option<(&'static str, f64)> {
+    let n = name.trim().to_ascii_lowercase();
+    let position = ["z", "z_c", "separation", "position"];
+    for p in position {
+        if n == format!("{p}_m") {
+            return Some(("position", 1.0));
+        }
+        if n == format!("{p}_nm") {
+            return Some(("position", 1e-9));
+        }
+    }
+    match n.as_str() {
+        "amplitude_m" => Some(("amplitude", 1.0)),
+        "amplitude_nm" => Some(("amplitude", 1e-9)),
+        "amplitude_ratio" => Some(("amplitude_ratio", 1.0)),
+        "phase_deg" => Some(("phase", 1.0)),
+        "direction" => Some(("direction", 1.0)),
+        _ => None,
+    }
+}
+
+/// The columns of a data file, in SI.
+struct Columns {
+    position_m: Vec<f64>,
+    amplitude_m: Option<Vec<f64>>,
+    phase_deg: Option<Vec<f64>>,
+}
+
+/// Read the measured curve of `path` (amplitudes as ratios made m with `a0_m`).
+fn read_data(path: &std::path::Path, a0_m: f64) -> Result<Columns> {
+    let fail = |reason: String| Error::Parse {
+        name: "data file",
+        text: path.display().to_string(),
+        reason,
+    };
+    let bytes = crate::config::read_input(path, MAX_DATA_BYTES, fail)?;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(bytes.as_slice());
+    let headers = reader
+        .headers()
+        .map_err(|e| fail(format!("no CSV header: {e}")))?
+        .clone();
+    let mut at: std::collections::HashMap<&'static str, (usize, f64)> = Default::default();
+    for (i, h) in headers.iter().enumerate() {
+        if let Some((kind, scale)) = column_kind(h) {
+            if kind == "position" && at.contains_key("position") {
+                continue;
+            }
+            if at.insert(kind, (i, scale)).is_some() {
+                return Err(fail(format!("two columns give the {kind}")));
+            }
+        }
+    }
+    if at.contains_key("amplitude") && at.contains_key("amplitude_ratio") {
+        at.remove("amplitude_ratio");
+    }
+    let Some(&(pos_col, pos_scale)) = at.get("position") else {
+        return Err(fail(
+            "no position column (z_nm, z_m, z_c_nm, z_c_m, separation_nm, separation_m, \
+             position_nm or position_m)"
+                .into(),
+        ));
+    };
+    let amp = at
+        .get("amplitude")
+        .copied()
+        .or_else(|| at.get("amplitude_ratio").map(|&(i, _)| (i, a0_m)));
+    let phase = at.get("phase").copied();
+    if amp.is_none() && phase.is_none() {
+        return Err(fail(
+            "no amplitude (amplitude_nm, amplitude_m, amplitude_ratio) or phase (phase_deg) \
+             column"
+                .into(),
+        ));
+    }
+    let direction = at.get("direction").map(|&(i, _)| i);
+    let (mut z, mut a, mut p) = (Vec::new(), Vec::new(), Vec::new());
+    for (row, record) in reader.records().enumerate() {
+        let record = record.map_err(|e| fail(format!("row {}: {e}", row + 2)))?;
+        if direction.is_some_and(|d| record.get(d).is_some_and(|v| v != "approach")) {
+            continue;
+        }
+        let value = |(col, scale): (usize, f64), what: &str| -> Result<f64> {
+            let text = record.get(col).unwrap_or("");
+            text.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .map(|v| v * scale)
+                .ok_or_else(|| {
+                    fail(format!(
+                        "row {}: the {what} {text:?} is not a number",
+                        row + 2
+                    ))
+                })
+        };
+        z.push(value((pos_col, pos_scale), "position")?);
+        if let Some(c) = amp {
+            a.push(value(c, "amplitude")?);
+        }
+        if let Some(c) = phase {
+            p.push(value(c, "phase")?);
+        }
+    }
+    Ok(Columns {
+        position_m: z,
+        amplitude_m: amp.map(|_| a),
+        phase_deg: phase.map(|_| p),
+    })
+}
+
+/// Run the subcommand.
+pub fn run(args: FitArgs) -> Result<()> {
+    let (setup, numerics) = args.inputs.resolve()?;
+    let numerics = crate::sweep::sweep_numerics(numerics, (false, false));
+    let Columns {
+        position_m,
+        amplitude_m,
+        phase_deg,
+    } = read_data(&args.data, setup.cantilever.free_amplitude_m)?;
+    let given = args.sigma_amplitude.is_some() || args.sigma_phase.is_some();
+    if given
+        && ((amplitude_m.is_some() && args.sigma_amplitude.is_none())
+            || (phase_deg.is_some() && args.sigma_phase.is_none()))
+    {
+        return Err(Error::NotApplicable(
+            "give the standard deviation of every channel the data hold (--sigma-amplitude \
+             and --sigma-phase), or neither (then estimated from the residuals)"
+                .into(),
+        ));
+    }
+    let data = Measured {
+        position_m,
+        amplitude_m,
+        phase_deg,
+        sigma_amplitude_m: args.sigma_amplitude.unwrap_or(0.02e-9),
+        sigma_phase_deg: args.sigma_phase.unwrap_or(0.05),
+    };
+    let parameters: Vec<Parameter> = if args.fit.is_empty() {
+        vec![
+            Parameter::Modulus,
+            Parameter::WorkOfAdhesion,
+            Parameter::ZOffset,
+        ]
+    } else {
+        args.fit.iter().map(|&p| p.into()).collect()
+    };
+    if args.max_curves == 0 {
+        return Err(Error::NotApplicable(
+            "--max-curves must be at least 1".into(),
+        ));
+    }
+    let options = FitOptions {
+        parameters,
+        offset_start_m: args.offset.unwrap_or(0.0),
+        estimate_sigma: !given,
+        max_curves: args.max_curves,
+    };
+    let busy = super::tap::spinner("fitting: simulating approach curves", args.quiet);
+    let report = fit(&setup, &numerics, &data, &options, |n| {
+        busy.set_message(format!("fitting: {n} approach curves simulated"));
+    });
+    busy.finish_and_clear();
+    let report = report?;
+    if args.json {
+        outln!("{}", crate::report::records::document(&report)?);
+    } else {
+        out!("{}", text(&report, &setup.law.to_string(), &data));
+    }
+    Ok(())
+}
+
+fn text(r: &FitReport, law: &str, data: &Measured) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let channels = match (data.amplitude_m.is_some(), data.phase_deg.is_some()) {
+        (true, true) => "amplitude and phase",
+        (true, false) => "amplitude",
+        _ => "phase",
+    };
+    let _ = writeln!(
+        s,
+        "fit of {} points ({channels}), {law} law: {} simulated curves, {} ({})",
+        data.position_m.len(),
+        r.curves,
+        if r.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        r.termination
+    );
+    let _ = writeln!(
+        s,
+        "{:<24} {:>13} {:>13} {:>11} {:>29} {:>29}",
+        "parameter", "start", "fitted", "±1σ", "68 % interval", "95 % interval"
+    );
+    for p in &r.parameters {
+        // The offset in nm, to 1e-4 nm (far below any data's resolution); the others
+        // to six digits.
+        let offset = p.name == Parameter::ZOffset.key();
+        let g = |v: f64| {
+            if offset {
+                format!("{:.4} nm", v * 1e9)
+            } else {
+                format!("{v:.5e}")
+            }
+        };
+        let iv =
+            |i: Option<[f64; 2]>| i.map_or("-".into(), |[a, b]| format!("[{}, {}]", g(a), g(b)));
+        let _ = writeln!(
+            s,
+            "{:<24} {:>13} {:>13} {:>11} {:>29} {:>29}",
+            p.name,
+            g(p.start),
+            p.value.map_or("not identifiable".into(), g),
+            p.std_err.map_or("-".into(), |e| if offset {
+                format!("{:.4} nm", e * 1e9)
+            } else {
+                format!("{e:.2e}")
+            }),
+            iv(p.interval_68),
+            iv(p.interval_95)
+        );
+    }
+    let _ = writeln!(
+        s,
+        "χ²/dof = {} ({} degrees of freedom; σ {})",
+        if r.reduced_chi_square >= 1e-3 {
+            format!("{:.3}", r.reduced_chi_square)
+        } else {
+            format!("{:.1e}", r.reduced_chi_square)
+        },
+        r.degrees_of_freedom,
+        if r.sigma_estimated {
+            "estimated from the residuals: the intervals are scaled by it"
+        } else {
+            "as given"
+        }
+    );
+    let id = &r.identifiability;
+    let _ = writeln!(
+        s,
+        "singular values of the weighted Jacobian [{}]; condition number {}",
+        id.singular_values
+            .iter()
+            .map(|v| format!("{v:.3e}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        id.condition_number
+            .map_or("— (a parameter the data do not see)".into(), |c| format!(
+                "{c:.3e}"
+            ))
+    );
+    let names: Vec<&str> = r.parameters.iter().map(|p| p.name).collect();
+    let _ = writeln!(s, "correlations:");
+    for (name, row) in names.iter().zip(&id.correlations) {
+        let cells: Vec<String> = row
+            .iter()
+            .map(|c| c.map_or("     -".into(), |c| format!("{c:+.3}")))
+            .collect();
+        let _ = writeln!(s, "  {name:<24} {}", cells.join(" "));
+    }
+    for note in &id.notes {
+        let _ = writeln!(s, "note: {note}");
+    }
+    if r.fitted.well_defined.iter().any(|w| !w) {
+        let _ = writeln!(
+            s,
+            "note: {} of the fitted curve's points are not stable period-1 orbits clear of \
+             the law's switches: their values are averages perturbations can change, and \
+             the fit there is less sure than its intervals say",
+            r.fitted.well_defined.iter().filter(|w| !**w).count()
+        );
+    }
+    s
+}

@@ -1,0 +1,20 @@
+//! From a measured approach curve back to the material: weighted least squares of
+//! simulated steady states against amplitude and phase measured over the piezo position
+//! (whose zero, the rest separation's offset, is unknown), by Levenberg–Marquardt
+//! (the `levenberg-marquardt` crate, a port of MINPACK's lmder; Moré, 1978), the
+//! Jacobian by finite differences of converged steady states; then what the data say of
+//! each parameter — the Jacobian's singular values and condition number, the
+//! parameters' correlations, linearised 68 % and 95 % intervals, and a flag on any
+//! parameter the data do not determine (Chandrashekar et al., Soft Matter 18, 8748,
+//! 2022, on why the inverse problem of AM-AFM needs one).
+//!
+//! [`model`] is the forward model (the curve of a parameter set), [`solve`] the fit and
+//! [`identifiability`] what its Jacobian says.
+
+pub mod identifiability;
+pub mod model;
+pub mod solve;
+
+pub use identifiability::{Identifiability, ParameterEstimate};
+pub use model::{Curve, Measured, Parameter};
+pub use solve::{FitOptions, FitReport, fit};

@@ -1,0 +1,185 @@
+//! Fitting measured approach curves (issue 32): the round trip — a curve simulated with
+//! known parameters, noise added, fitted back — and what the fit says of what the data
+//! determine.
+
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use tapsim::dynamics::setup::{Numerics, TapSetup, default_setup};
+use tapsim::fit::{FitOptions, Measured, Parameter, fit, model::curve};
+use tapsim::sweep::sweep_numerics;
+
+/// The true offset of the piezo's zero: z_c = position + 3 nm.
+const OFFSET_M: f64 = 3e-9;
+/// The noise: 0.02 nm in amplitude, 0.05° in phase.
+const SIGMA_A_M: f64 = 0.02e-9;
+const SIGMA_PHI_DEG: f64 = 0.05;
+
+fn numerics() -> Numerics {
+    sweep_numerics(Numerics::default(), (false, false))
+}
+
+/// Piezo positions of an approach from z_c = 18.5 nm to 8 nm in `n` points (the hybrid
+/// defaults tap period-1 there, on the attractive branch).
+fn positions(n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| 18.5e-9 - 10.5e-9 * i as f64 / (n - 1) as f64 - OFFSET_M)
+        .collect()
+}
+
+/// The curve of `truth` at `positions` with noise drawn from `seed`.
+fn measured(truth: &TapSetup, positions: &[f64], seed: u64) -> Measured {
+    let c = curve(truth, &numerics(), positions, OFFSET_M).unwrap();
+    assert!(c.well_defined.iter().all(|&w| w), "{:?}", c.well_defined);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let (na, np) = (
+        Normal::new(0.0, SIGMA_A_M).unwrap(),
+        Normal::new(0.0, SIGMA_PHI_DEG).unwrap(),
+    );
+    Measured {
+        position_m: positions.to_vec(),
+        amplitude_m: Some(
+            c.amplitude_m
+                .iter()
+                .map(|a| a + na.sample(&mut rng))
+                .collect(),
+        ),
+        phase_deg: Some(
+            c.phase_deg
+                .iter()
+                .map(|p| p + np.sample(&mut rng))
+                .collect(),
+        ),
+        sigma_amplitude_m: SIGMA_A_M,
+        sigma_phase_deg: SIGMA_PHI_DEG,
+    }
+}
+
+fn options(offset_start_m: f64) -> FitOptions {
+    FitOptions {
+        parameters: vec![
+            Parameter::Modulus,
+            Parameter::WorkOfAdhesion,
+            Parameter::ZOffset,
+        ],
+        offset_start_m,
+        estimate_sigma: false,
+        max_curves: 400,
+    }
+}
+
+/// Noise-free data are the limit: fitted from a start 50 % and 20 % off (and 0.5 nm in
+/// the offset), the truth comes back to 1e-6 — the forward model and the optimiser,
+/// with nothing between them and the answer.
+#[test]
+fn noise_free_data_give_back_the_truth() {
+    let truth = default_setup();
+    let mut data = measured(&truth, &positions(30), 0);
+    let clean = curve(&truth, &numerics(), &data.position_m, OFFSET_M).unwrap();
+    data.amplitude_m = Some(clean.amplitude_m);
+    data.phase_deg = Some(clean.phase_deg);
+    let mut start = truth.clone();
+    start.contact.modulus_pa *= 1.5;
+    start.contact.work_of_adhesion_j_m2 *= 1.2;
+    let r = fit(
+        &start,
+        &numerics(),
+        &data,
+        &options(OFFSET_M + 0.5e-9),
+        |_| {},
+    )
+    .unwrap();
+    assert!(r.converged, "{}", r.termination);
+    let got: Vec<f64> = r.parameters.iter().map(|p| p.value.unwrap()).collect();
+    eprintln!("{got:?} in {} curves", r.curves);
+    assert!((got[0] / truth.contact.modulus_pa - 1.0).abs() < 1e-6);
+    assert!((got[1] / truth.contact.work_of_adhesion_j_m2 - 1.0).abs() < 1e-6);
+    assert!((got[2] - OFFSET_M).abs() < 1e-6 * 1e-9);
+    assert!(r.chi_square < 1e-6);
+}
+
+/// With 0.02 nm and 0.05° of noise on 30 points of the attractive branch, fitted from
+/// three starts (E* and Δγ off by factors of 2 and 1.5, the offset by 1–3 nm): each
+/// start ends on the same minimum (to 1e-4), χ²/dof is what noise of the stated size
+/// gives (within 3 standard deviations of 1), and the truth lies inside the 95 %
+/// intervals. The data fix E*·Δγ-like combinations better than either — the report says
+/// so (correlation above 0.95) and the intervals are wide accordingly (E* to about
+/// 2.4 %, Δγ to 1.4 %): within 1 % the issue asks for, the attractive branch alone does
+/// not determine them at this noise.
+#[test]
+#[ignore = "slow (about a minute in release: three fits of some 100 curves each): run with cargo test --release --test fit -- --ignored"]
+fn a_noisy_approach_curve_is_fitted_back_from_three_starts() {
+    let truth = default_setup();
+    let data = measured(&truth, &positions(30), 7);
+    let mut found: Vec<Vec<f64>> = Vec::new();
+    for (e, w, off) in [(2.0, 0.5, 2e-9), (1.5, 1.5, 5e-9), (0.7, 1.2, 1e-9)] {
+        let mut start = truth.clone();
+        start.contact.modulus_pa *= e;
+        start.contact.work_of_adhesion_j_m2 *= w;
+        let r = fit(&start, &numerics(), &data, &options(off), |_| {}).unwrap();
+        let got: Vec<f64> = r.parameters.iter().map(|p| p.value.unwrap()).collect();
+        eprintln!(
+            "start ({e}, {w}, {off:e}): {got:?} ± {:?}, chi2/dof {:.3} in {} curves",
+            r.parameters
+                .iter()
+                .map(|p| p.std_err.unwrap())
+                .collect::<Vec<_>>(),
+            r.reduced_chi_square,
+            r.curves
+        );
+        assert!(r.converged, "{}", r.termination);
+        let dof = r.degrees_of_freedom as f64;
+        assert!((r.reduced_chi_square - 1.0).abs() < 3.0 * (2.0 / dof).sqrt());
+        let truths = [
+            truth.contact.modulus_pa,
+            truth.contact.work_of_adhesion_j_m2,
+            OFFSET_M,
+        ];
+        for (p, t) in r.parameters.iter().zip(truths) {
+            let [lo, hi] = p.interval_95.unwrap();
+            assert!(lo <= t && t <= hi, "{}: {t} outside [{lo}, {hi}]", p.name);
+        }
+        let corr = r.identifiability.correlations[0][1].unwrap();
+        assert!(corr > 0.95);
+        assert!(
+            r.identifiability
+                .notes
+                .iter()
+                .any(|n| n.contains("trade off"))
+        );
+        if let Some(first) = found.first() {
+            for (a, b) in got.iter().zip(first) {
+                assert!((a / b - 1.0).abs() < 1e-4, "{got:?} against {first:?}");
+            }
+        }
+        found.push(got);
+    }
+}
+
+/// Data from far from the sample (the free oscillation at every point) do not see the
+/// material: E* and Δγ are flagged, given no value, and the Jacobian's smallest
+/// singular values are zero (no condition number). A fit never puts a number on what
+/// the data cannot tell.
+#[test]
+fn a_parameter_the_data_do_not_see_is_given_no_value() {
+    let truth = default_setup();
+    let far: Vec<f64> = (0..8).map(|i| 40e-9 - 1e-9 * i as f64).collect();
+    let c = curve(&truth, &numerics(), &far, 0.0).unwrap();
+    let data = Measured {
+        position_m: far,
+        amplitude_m: Some(c.amplitude_m),
+        phase_deg: Some(c.phase_deg),
+        sigma_amplitude_m: SIGMA_A_M,
+        sigma_phase_deg: SIGMA_PHI_DEG,
+    };
+    let r = fit(&truth, &numerics(), &data, &options(0.0), |_| {}).unwrap();
+    for p in &r.parameters {
+        assert!(!p.identifiable && p.value.is_none(), "{p:?}");
+    }
+    assert_eq!(r.identifiability.condition_number, None);
+    assert!(
+        r.identifiability
+            .notes
+            .iter()
+            .any(|n| n.contains("does not change the data"))
+    );
+}
