@@ -183,3 +183,67 @@ fn a_parameter_the_data_do_not_see_is_given_no_value() {
             .any(|n| n.contains("does not change the data"))
     );
 }
+
+/// The profile likelihood of E* and Δγ (each held, the others refitted) against the
+/// linearised intervals on the noisy data above: the model is nearly straight over
+/// them here, so the two agree — each endpoint within 5 % of the interval's half-width.
+#[test]
+#[ignore = "slow (some 20 fits in release): run with cargo test --release --test fit -- --ignored"]
+fn profile_intervals_meet_the_linearised_ones_where_the_model_is_straight() {
+    use tapsim::fit::profile;
+    let truth = default_setup();
+    let data = measured(&truth, &positions(30), 7);
+    let opts = options(OFFSET_M);
+    let best = fit(&truth, &numerics(), &data, &opts, |_| {}).unwrap();
+    for which in [Parameter::Modulus, Parameter::WorkOfAdhesion] {
+        let p = profile(&truth, &numerics(), &data, &opts, &best, which, |_| {}).unwrap();
+        let lin = best.parameters.iter().find(|e| e.name == p.name).unwrap();
+        for (prof, lin) in [
+            (p.interval_68, lin.interval_68.unwrap()),
+            (p.interval_95, lin.interval_95.unwrap()),
+        ] {
+            let half = 0.5 * (lin[1] - lin[0]);
+            eprintln!("{}: profile {prof:?}, linearised {lin:?}", p.name);
+            for (a, b) in prof.iter().zip(lin) {
+                assert!((a.unwrap() - b).abs() < 0.05 * half);
+            }
+        }
+    }
+}
+
+/// Coverage: over 200 replicas of the noise (seeds 1000–1199), each fitted from the
+/// truth, the 68 % intervals of E* and of Δγ hold the truth in 68 ± 5 % of them — the
+/// stated errors are the errors.
+#[test]
+#[ignore = "slow (200 fits in release, about a minute on two cores): run with cargo test --release --test fit -- --ignored"]
+fn the_68_percent_intervals_cover_the_truth_in_68_percent_of_replicas() {
+    use rayon::prelude::*;
+    let truth = default_setup();
+    let pos = positions(30);
+    let covered: Vec<(bool, bool)> = (1000..1200u64)
+        .into_par_iter()
+        .map(|seed| {
+            let data = measured(&truth, &pos, seed);
+            let r = fit(&truth, &numerics(), &data, &options(OFFSET_M), |_| {}).unwrap();
+            let inside = |k: usize, t: f64| {
+                let [lo, hi] = r.parameters[k].interval_68.unwrap();
+                lo <= t && t <= hi
+            };
+            (
+                inside(0, truth.contact.modulus_pa),
+                inside(1, truth.contact.work_of_adhesion_j_m2),
+            )
+        })
+        .collect();
+    let share = |f: &dyn Fn(&(bool, bool)) -> bool| {
+        covered.iter().filter(|c| f(c)).count() as f64 / covered.len() as f64
+    };
+    let (e, w) = (share(&|c| c.0), share(&|c| c.1));
+    eprintln!(
+        "68 % intervals cover E* in {:.1} %, Δγ in {:.1} %",
+        100.0 * e,
+        100.0 * w
+    );
+    assert!((e - 0.68).abs() <= 0.05, "E*: {e}");
+    assert!((w - 0.68).abs() <= 0.05, "Δγ: {w}");
+}

@@ -22,6 +22,7 @@ See ``help(tapsim.Result)`` and the README's "Python" section.
 from __future__ import annotations
 
 import copy as _copy
+import os as _os
 from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence
 
 import numpy as _np
@@ -43,6 +44,7 @@ __all__ = [
     "thermal",
     "hysteresis",
     "lj",
+    "fit",
     "tap_many",
     "model",
 ]
@@ -299,6 +301,16 @@ def lj(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
     """The Lennard-Jones solution at a Tabor parameter (``tapsim lj``, mu required):
     the folds A and C, W_LJ with its error estimate."""
     return _run("lj", setup, kwargs)
+
+
+def fit(data: Any, setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
+    """A measured approach curve (a CSV path: position, amplitude and/or phase columns
+    with units in the header, as ``tapsim fit`` reads it) fitted by the simulator
+    (``tapsim fit``): ``parameters`` (value, std_err, interval_68, interval_95,
+    identifiable), ``identifiability`` (singular_values, condition_number, correlations,
+    notes), chi_square, the fitted curve; ``profile=True`` adds ``profiles``."""
+    args = _argv("fit", _options(setup, kwargs))
+    return Result("fit", _tapsim.run([args[0], _os.fspath(data)] + args[1:]))
 
 
 def tap_many(setups: Iterable[Setup], /, **common: Any) -> List[Result]:

@@ -174,6 +174,19 @@ def test_modes_without_a_common_period_give_averages_with_errors(cli):
         tapsim.tap(modes=2, ratio_tolerance=0, setpoint=0.8)
 
 
+def test_fit_reads_the_curve_approach_writes_and_gives_it_back(cli, tmp_path):
+    path = tmp_path / "curve.csv"
+    tapsim.approach(**{"from": "18.5nm"}, to="8nm", points=8, no_retract=True, csv=str(path))
+    r = tapsim.fit(path, modulus="0.8GPa", work_of_adhesion="0.12J/m^2")
+    expected = cli("fit", str(path), "--modulus=0.8GPa", "--work-of-adhesion=0.12J/m^2")
+    assert [p["value"] for p in r.parameters] == [p["value"] for p in expected["parameters"]]
+    assert abs(r.parameters[1]["value"] / 0.1 - 1) < 1e-6
+    with pytest.raises(ValueError, match="far to near"):
+        rising = tmp_path / "rising.csv"
+        rising.write_text("z_nm,phase_deg\n8,120\n9,121\n10,122\n")
+        tapsim.fit(rising)
+
+
 def test_a_bimodal_scan_gives_each_pixels_higher_modes_as_2d_columns(cli):
     args = dict(modes=2, pixels=2, line_rate=400, no_retrace=True)
     r = tapsim.scan(**args)

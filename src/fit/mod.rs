@@ -17,4 +17,4 @@ pub mod solve;
 
 pub use identifiability::{Identifiability, ParameterEstimate};
 pub use model::{Curve, Measured, Parameter};
-pub use solve::{FitOptions, FitReport, fit};
+pub use solve::{FitOptions, FitReport, Profile, fit, profile};

@@ -299,3 +299,150 @@ impl<F: Fn(usize)> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, F> {
         self.jacobian_at(&self.x, &r0)
     }
 }
+
+/// A parameter's profile: the best χ² with it held at each value and the others
+/// refitted, and the intervals where χ² rises by 1 and 3.84 over the minimum (Venzon &
+/// Moolgavkar, Appl. Statist. 37, 87, 1988) — exact where the linearised intervals
+/// assume the model straight.
+#[derive(Debug, Clone, Serialize)]
+pub struct Profile {
+    /// The parameter's key.
+    pub name: &'static str,
+    /// The values it was held at (SI), in increasing order, the estimate among them.
+    pub values: Vec<f64>,
+    /// χ² − χ²_min there (over χ²/dof where the standard deviations are estimated).
+    pub delta_chi_square: Vec<f64>,
+    /// Where Δχ² = 1 on each side (null on a side the profile does not reach it: the
+    /// data do not bound the parameter there).
+    pub interval_68: [Option<f64>; 2],
+    /// Where Δχ² = 3.84.
+    pub interval_95: [Option<f64>; 2],
+}
+
+/// Steps of a profile on each side, in linearised standard errors.
+const PROFILE_STEP: f64 = 0.75;
+/// Most steps on each side (4.5 standard errors).
+const PROFILE_STEPS: usize = 6;
+
+/// The profile of `which` about the fit `best` of `options.parameters` to `data` (the
+/// setup `setup` and options as given to [`fit`]).
+pub fn profile(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    data: &Measured,
+    options: &FitOptions,
+    best: &FitReport,
+    which: Parameter,
+    progress: impl Fn(usize),
+) -> Result<Profile> {
+    let k = options
+        .parameters
+        .iter()
+        .position(|&p| p == which)
+        .ok_or_else(|| Error::NotApplicable(format!("{} was not fitted", which.key())))?;
+    let est = &best.parameters[k];
+    let (Some(value), Some(std_err)) = (est.value, est.std_err) else {
+        return Err(Error::NotApplicable(format!(
+            "{} has no estimate with an error to profile about",
+            which.key()
+        )));
+    };
+    // The best fit's setup and offset: every fitted value in place.
+    let mut at_best = setup.clone();
+    let mut offset = options.offset_start_m;
+    for (p, e) in options.parameters.iter().zip(&best.parameters) {
+        if let Some(v) = e.value {
+            p.set(&mut at_best, &mut offset, v);
+        }
+    }
+    let others: Vec<Parameter> = options
+        .parameters
+        .iter()
+        .copied()
+        .filter(|&p| p != which)
+        .collect();
+    let factor = if best.sigma_estimated {
+        best.reduced_chi_square
+    } else {
+        1.0
+    };
+    let curves = Cell::new(0usize);
+    // χ² with `which` held at `v`, the others refitted from `start` (setup, offset).
+    let held = |v: f64, start: &(TapSetup, f64)| -> Result<(f64, (TapSetup, f64))> {
+        let (mut s, mut off) = start.clone();
+        which.set(&mut s, &mut off, v);
+        let r = if others.is_empty() {
+            let c = curve(&s, numerics, &data.position_m, off)?;
+            curves.set(curves.get() + 1);
+            progress(curves.get());
+            let chi: f64 = data.residuals(&c).iter().map(|r| r * r).sum();
+            return Ok((chi, (s, off)));
+        } else {
+            let done = curves.get();
+            fit(
+                &s,
+                numerics,
+                data,
+                &FitOptions {
+                    parameters: others.clone(),
+                    offset_start_m: off,
+                    estimate_sigma: false,
+                    max_curves: options.max_curves,
+                },
+                |n| progress(done + n),
+            )?
+        };
+        curves.set(curves.get() + r.curves);
+        for (p, e) in others.iter().zip(&r.parameters) {
+            if let Some(x) = e.value {
+                p.set(&mut s, &mut off, x);
+            }
+        }
+        Ok((r.chi_square, (s, off)))
+    };
+    let step = |i: f64| {
+        if which.is_scale() {
+            value * (i * PROFILE_STEP * std_err / value).exp()
+        } else {
+            value + i * PROFILE_STEP * std_err
+        }
+    };
+    let mut points = vec![(value, 0.0)];
+    for side in [-1.0, 1.0] {
+        let mut start = (at_best.clone(), offset);
+        for i in 1..=PROFILE_STEPS {
+            let v = step(side * i as f64);
+            let (chi, next) = held(v, &start)?;
+            let delta = ((chi - best.chi_square) / factor).max(0.0);
+            points.push((v, delta));
+            start = next;
+            if delta > 3.84 * 1.5 {
+                break;
+            }
+        }
+    }
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Each crossing by linear interpolation of the signed root √Δχ², nearly straight
+    // in the parameter where the model is nearly linear.
+    let crossing = |level: f64, side: f64| -> Option<f64> {
+        let mut run: Vec<&(f64, f64)> = points
+            .iter()
+            .filter(|(v, _)| (v - value) * side >= 0.0)
+            .collect();
+        if side < 0.0 {
+            run.reverse();
+        }
+        run.windows(2).find_map(|w| {
+            let (a, b) = (w[0], w[1]);
+            let (ra, rb) = (a.1.sqrt(), b.1.sqrt());
+            (ra <= level && rb > level).then(|| a.0 + (b.0 - a.0) * (level - ra) / (rb - ra))
+        })
+    };
+    Ok(Profile {
+        name: which.key(),
+        values: points.iter().map(|p| p.0).collect(),
+        delta_chi_square: points.iter().map(|p| p.1).collect(),
+        interval_68: [crossing(1.0, -1.0), crossing(1.0, 1.0)],
+        interval_95: [crossing(1.96, -1.0), crossing(1.96, 1.0)],
+    })
+}
