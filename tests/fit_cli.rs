@@ -77,6 +77,11 @@ fn bad_data_are_refused_with_why() {
     };
     let rising = write("rising.csv", "z_nm,phase_deg\n8,120\n9,121\n10,122\n");
     refused(&["fit", &rising], "from far to near");
+    let within = write(
+        "within.csv",
+        "segment,z_nm,phase_deg\na,10,120\na,9,121\nb,10,120\nb,11,121\n",
+    );
+    refused(&["fit", &within], "point 4");
     let nameless = write("nameless.csv", "height,phase_deg\n10,120\n9,121\n8,122\n");
     refused(&["fit", &nameless], "no position column");
     let words = write("words.csv", "z_nm,phase_deg\n10,120\n9,abc\n8,122\n");
@@ -93,5 +98,52 @@ fn bad_data_are_refused_with_why() {
     );
     refused(&["fit", &good, "--fit", "modulus,modulus"], "chosen twice");
     refused(&["fit", "/nonexistent/data.csv"], "No such file");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Two approaches in one file (a `segment` column): one from far (the attractive
+/// branch) and one begun at 8 nm (the repulsive), fitted for E*, Δγ and ε together —
+/// the data determine all three (condition number below 100) and give back the truth.
+#[test]
+fn approaches_joined_by_a_segment_column_are_fitted_together() {
+    let dir = scratch("fit-segments");
+    let mut joined = String::from("segment,z_m,amplitude_m,phase_deg\n");
+    for (label, from, to) in [("far", "18.5nm", "8nm"), ("near", "8nm", "2nm")] {
+        let csv = dir.join(format!("{label}.csv"));
+        let csv = csv.to_str().unwrap();
+        let out = tapsim(&[
+            "approach", "--from", from, "--to", to, "--points", "10", "--no-retract", "-q",
+            "--csv", csv,
+        ]);
+        assert!(out.status.success());
+        let mut r = csv::Reader::from_path(csv).unwrap();
+        let h = r.headers().unwrap().clone();
+        let col = |name: &str| h.iter().position(|x| x == name).unwrap();
+        let (z, a, p) = (col("separation_m"), col("amplitude_m"), col("phase_deg"));
+        for row in r.records() {
+            let row = row.unwrap();
+            joined.push_str(&format!("{label},{},{},{}\n", &row[z], &row[a], &row[p]));
+        }
+    }
+    let data = dir.join("joined.csv");
+    std::fs::write(&data, joined).unwrap();
+    let v = json(&[
+        "fit",
+        data.to_str().unwrap(),
+        "--fit",
+        "modulus,work-of-adhesion,range",
+        "--sigma-amplitude",
+        "0.02nm",
+        "--sigma-phase",
+        "0.05",
+        "--work-of-adhesion",
+        "0.11J/m^2",
+        "--json",
+    ]);
+    let cond = num(&v["identifiability"], "condition_number");
+    assert!(cond < 100.0, "{cond}");
+    let params = v["parameters"].as_array().unwrap();
+    assert!((num(&params[1], "value") / 0.1 - 1.0).abs() < 1e-5);
+    assert!((num(&params[2], "value") / 0.3e-9 - 1.0).abs() < 1e-5);
     std::fs::remove_dir_all(dir).unwrap();
 }

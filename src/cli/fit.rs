@@ -18,7 +18,11 @@ use std::path::PathBuf;
 /// from far to near, its zero unknown: the offset is fitted), and an amplitude
 /// (amplitude_nm, amplitude_m or amplitude_ratio, A/A₀) and/or a phase (phase_deg).
 /// Rows of a `direction` column other than "approach" are left out, so the CSV
-/// `tapsim approach --csv curve.csv` writes is read as it is. Every parameter not
+/// `tapsim approach --csv curve.csv` writes is read as it is. A `segment` column joins
+/// several approaches: a new one begins where its label changes, each simulated from
+/// the free oscillation at its first position (as `tapsim approach --from` starts) — an
+/// approach begun near the sample reaches the repulsive branch, one from far stays on
+/// the attractive. Every parameter not
 /// fitted is the setup's (the usual flags), and the fitted ones start there.
 ///
 /// Reported: each parameter with its linearised standard error and 68 % and 95 %
@@ -112,6 +116,7 @@ fn column_kind(name: &str) -> Option<(&'static str, f64)> {
         "amplitude_ratio" => Some(("amplitude_ratio", 1.0)),
         "phase_deg" => Some(("phase", 1.0)),
         "direction" => Some(("direction", 1.0)),
+        "segment" => Some(("segment", 1.0)),
         _ => None,
     }
 }
@@ -119,6 +124,7 @@ fn column_kind(name: &str) -> Option<(&'static str, f64)> {
 /// The columns of a data file, in SI.
 struct Columns {
     position_m: Vec<f64>,
+    segments: Vec<usize>,
     amplitude_m: Option<Vec<f64>>,
     phase_deg: Option<Vec<f64>>,
 }
@@ -172,7 +178,10 @@ fn read_data(path: &std::path::Path, a0_m: f64) -> Result<Columns> {
         ));
     }
     let direction = at.get("direction").map(|&(i, _)| i);
+    let segment = at.get("segment").map(|&(i, _)| i);
     let (mut z, mut a, mut p) = (Vec::new(), Vec::new(), Vec::new());
+    let mut segments = Vec::new();
+    let mut label: Option<String> = None;
     for (row, record) in reader.records().enumerate() {
         let record = record.map_err(|e| fail(format!("row {}: {e}", row + 2)))?;
         if direction.is_some_and(|d| record.get(d).is_some_and(|v| v != "approach")) {
@@ -191,6 +200,11 @@ fn read_data(path: &std::path::Path, a0_m: f64) -> Result<Columns> {
                     ))
                 })
         };
+        let this = segment.map(|c| record.get(c).unwrap_or("").to_string());
+        if z.is_empty() || this != label {
+            segments.push(z.len());
+            label = this;
+        }
         z.push(value((pos_col, pos_scale), "position")?);
         if let Some(c) = amp {
             a.push(value(c, "amplitude")?);
@@ -201,6 +215,7 @@ fn read_data(path: &std::path::Path, a0_m: f64) -> Result<Columns> {
     }
     Ok(Columns {
         position_m: z,
+        segments,
         amplitude_m: amp.map(|_| a),
         phase_deg: phase.map(|_| p),
     })
@@ -212,6 +227,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     let numerics = crate::sweep::sweep_numerics(numerics, (false, false));
     let Columns {
         position_m,
+        segments,
         amplitude_m,
         phase_deg,
     } = read_data(&args.data, setup.cantilever.free_amplitude_m)?;
@@ -228,6 +244,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     }
     let data = Measured {
         position_m,
+        segments,
         amplitude_m,
         phase_deg,
         sigma_amplitude_m: args.sigma_amplitude.unwrap_or(0.02e-9),

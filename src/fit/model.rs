@@ -58,13 +58,18 @@ impl Parameter {
     }
 }
 
-/// A measured approach curve: piezo positions (any zero; far to near) with the
-/// amplitude and/or the phase read there, and each channel's standard deviation (the
-/// weights of the least squares).
+/// A measured approach curve — or several, one after another — : piezo positions (any
+/// zero; far to near in each) with the amplitude and/or the phase read there, and each
+/// channel's standard deviation (the weights of the least squares).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measured {
-    /// Piezo positions, m, decreasing (an approach).
+    /// Piezo positions, m, decreasing within each approach.
     pub position_m: Vec<f64>,
+    /// Where each approach begins (indices into the positions, the first 0): each is
+    /// simulated from the free oscillation at its first position, as `approach` starts
+    /// — a second approach begun close to the sample reaches the repulsive branch where
+    /// one from far stays on the attractive one.
+    pub segments: Vec<usize>,
     /// Amplitudes, m.
     pub amplitude_m: Option<Vec<f64>>,
     /// Phases, degrees (90° free at resonance).
@@ -110,9 +115,24 @@ impl Measured {
                 )));
             }
         }
-        if let Some(i) = self.position_m.windows(2).position(|w| w[1] >= w[0]) {
+        if self.segments.first() != Some(&0)
+            || self.segments.windows(2).any(|w| w[1] <= w[0])
+            || self.segments.last().is_some_and(|&l| l >= n)
+        {
             return Err(Error::NotApplicable(format!(
-                "a fit takes an approach curve, positions from far to near: point {} \
+                "the approaches must begin at increasing points from the first, each with a \
+                 point of its own: {:?} for {n} points",
+                self.segments
+            )));
+        }
+        if let Some(i) = self
+            .position_m
+            .windows(2)
+            .enumerate()
+            .position(|(i, w)| w[1] >= w[0] && !self.segments.contains(&(i + 1)))
+        {
+            return Err(Error::NotApplicable(format!(
+                "a fit takes approach curves, positions from far to near: point {} \
                  ({:e} m) does not lie nearer than point {} ({:e} m)",
                 i + 2,
                 self.position_m[i + 1],
@@ -127,6 +147,27 @@ impl Measured {
             crate::error::positive("phase standard deviation", self.sigma_phase_deg)?;
         }
         Ok(self)
+    }
+
+    /// The curves of `setup` at the measured positions shifted by `offset_m`, each
+    /// approach from the free oscillation at its first position, joined.
+    pub fn simulate(&self, setup: &TapSetup, numerics: &Numerics, offset_m: f64) -> Result<Curve> {
+        let n = self.position_m.len();
+        let mut joined: Option<Curve> = None;
+        for (k, &start) in self.segments.iter().enumerate() {
+            let end = self.segments.get(k + 1).copied().unwrap_or(n);
+            let c = curve(setup, numerics, &self.position_m[start..end], offset_m)?;
+            match joined.as_mut() {
+                None => joined = Some(c),
+                Some(j) => {
+                    j.separation_m.extend(c.separation_m);
+                    j.amplitude_m.extend(c.amplitude_m);
+                    j.phase_deg.extend(c.phase_deg);
+                    j.well_defined.extend(c.well_defined);
+                }
+            }
+        }
+        joined.ok_or_else(|| Error::NotApplicable("no approach to simulate".into()))
     }
 
     /// Residuals per point: one per channel measured.

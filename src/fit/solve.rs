@@ -3,7 +3,7 @@
 //! simulated curves (each point a converged steady state, started from the last).
 
 use super::identifiability::{Identifiability, ParameterEstimate, assess};
-use super::model::{Curve, Measured, Parameter, curve};
+use super::model::{Curve, Measured, Parameter};
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
@@ -170,7 +170,7 @@ pub fn fit(
             "χ²/dof = {reduced:.3} is far above 1: the fitted curve does not describe the data              (a local minimum reached from this start, a law or fixed parameters that cannot              describe them, or standard deviations set too small); the intervals assume a fit              that does"
         ));
     }
-    let fitted = curve(&fitted_setup, numerics, &data.position_m, offset)?;
+    let fitted = data.simulate(&fitted_setup, numerics, offset)?;
     Ok(FitReport {
         parameters: estimates,
         identifiability,
@@ -243,7 +243,7 @@ impl<F: Fn(usize)> Problem<'_, F> {
             return None;
         }
         let (setup, offset) = self.physical(x);
-        let simulated = curve(&setup, self.numerics, &self.data.position_m, offset);
+        let simulated = self.data.simulate(&setup, self.numerics, offset);
         self.curves.set(self.curves.get() + 1);
         (self.progress)(self.curves.get());
         match simulated {
@@ -372,7 +372,7 @@ pub fn profile(
         let (mut s, mut off) = start.clone();
         which.set(&mut s, &mut off, v);
         let r = if others.is_empty() {
-            let c = curve(&s, numerics, &data.position_m, off)?;
+            let c = data.simulate(&s, numerics, off)?;
             curves.set(curves.get() + 1);
             progress(curves.get());
             let chi: f64 = data.residuals(&c).iter().map(|r| r * r).sum();
