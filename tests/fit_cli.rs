@@ -51,6 +51,7 @@ fn an_approach_curve_is_fitted_back() {
     let notes = v["identifiability"]["notes"].to_string();
     assert!(notes.contains("own precision"), "{notes}");
     assert!(notes.contains("trade off"), "{notes}");
+    let plot = dir.join("fit.svg");
     let text = String::from_utf8(
         tapsim(&[
             "fit",
@@ -59,11 +60,21 @@ fn an_approach_curve_is_fitted_back() {
             "0.8GPa",
             "--work-of-adhesion",
             "0.12J/m^2",
+            "--plot",
+            plot.to_str().unwrap(),
         ])
         .stdout,
     )
     .unwrap();
     assert!(text.contains("5.93312e8"), "{text}");
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    for label in [
+        "measured (curve.csv)",
+        "fitted (hybrid law)",
+        "phase residual",
+    ] {
+        assert!(svg.contains(label), "{label}");
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -98,6 +109,10 @@ fn bad_data_are_refused_with_why() {
     );
     refused(&["fit", &good, "--fit", "modulus,modulus"], "chosen twice");
     refused(&["fit", "/nonexistent/data.csv"], "No such file");
+    refused(
+        &["fit", &good, "--plot", "fit.txt"],
+        "must end in .png or .svg",
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -112,8 +127,17 @@ fn approaches_joined_by_a_segment_column_are_fitted_together() {
         let csv = dir.join(format!("{label}.csv"));
         let csv = csv.to_str().unwrap();
         let out = tapsim(&[
-            "approach", "--from", from, "--to", to, "--points", "10", "--no-retract", "-q",
-            "--csv", csv,
+            "approach",
+            "--from",
+            from,
+            "--to",
+            to,
+            "--points",
+            "10",
+            "--no-retract",
+            "-q",
+            "--csv",
+            csv,
         ]);
         assert!(out.status.success());
         let mut r = csv::Reader::from_path(csv).unwrap();

@@ -63,6 +63,10 @@ pub struct FitArgs {
     max_curves: usize,
     #[command(flatten)]
     inputs: TapInputs,
+    /// Plot the measured and fitted amplitude and phase against z_c, and the weighted
+    /// residuals (.png or .svg).
+    #[arg(long, help_heading = "Output")]
+    plot: Option<PathBuf>,
     /// Print JSON instead of a table.
     #[arg(long, help_heading = "Output")]
     json: bool,
@@ -223,6 +227,18 @@ fn read_data(path: &std::path::Path, a0_m: f64) -> Result<Columns> {
 
 /// Run the subcommand.
 pub fn run(args: FitArgs) -> Result<()> {
+    if let Some(path) = &args.plot {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        if !matches!(ext.as_deref(), Some("png" | "svg")) {
+            return Err(Error::NotApplicable(format!(
+                "{}: the plot file must end in .png or .svg",
+                path.display()
+            )));
+        }
+    }
     let (setup, numerics) = args.inputs.resolve()?;
     let numerics = crate::sweep::sweep_numerics(numerics, (false, false));
     let Columns {
@@ -276,6 +292,14 @@ pub fn run(args: FitArgs) -> Result<()> {
     });
     busy.finish_and_clear();
     let report = report?;
+    if let Some(path) = &args.plot {
+        let source = args
+            .data
+            .file_name()
+            .map_or("data".into(), |n| n.to_string_lossy().into_owned());
+        let charts = crate::report::fit::charts(&report, &data, &source, &setup.law.to_string());
+        crate::report::plot::render_stack(&charts, path)?;
+    }
     let mut profiles = Vec::new();
     if args.profile {
         for (p, e) in options.parameters.iter().zip(&report.parameters) {

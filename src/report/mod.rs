@@ -6,6 +6,7 @@ pub mod branches;
 pub mod chart;
 pub mod contrast;
 pub mod display;
+pub mod fit;
 pub mod heatmap;
 pub mod hysteresis;
 pub mod lj;
