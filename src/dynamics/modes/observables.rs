@@ -198,15 +198,7 @@ fn observe<const M: usize>(
             let amp = 2.0 / period * c.hypot(s);
             let exchange = at(i, ModeIntegral::Exchange);
             let free = m.free_amplitude();
-            let (resonance_hz, stiffness, quality) = if i == 0 {
-                (cant.resonance_hz, k1, cant.quality)
-            } else {
-                (
-                    modal.resonance_hz[i - 1],
-                    k1 * m.r * m.r / m.gain,
-                    m.quality(),
-                )
-            };
+            let (resonance_hz, stiffness, quality) = modal.in_si(cant, i);
             ModeObservables {
                 mode: i + 1,
                 resonance_hz,
@@ -242,9 +234,11 @@ fn observe<const M: usize>(
     let total_damp: f64 = damps.iter().sum();
     // A loop of work-function differences that cancels (a conservative law's) leaves
     // round-off of the values summed, not a dissipation.
-    let floor = 1e-12 * (total_drive.abs() + to_energy * orbit.tally.work_scale_hat);
-    let resolved = |e: f64| if e.abs() <= floor { 0.0 } else { e };
-    let (adhesion, capillary) = (resolved(e_ts - capillary), resolved(capillary));
+    let (adhesion, capillary) = resolved_dissipation(
+        e_ts,
+        capillary,
+        total_drive.abs() + to_energy * orbit.tally.work_scale_hat,
+    );
     let e_ts_j = (adhesion + capillary) / periods * energy;
     let scale = contact.separation_scale_m();
     ModalObservables {
@@ -267,6 +261,16 @@ fn observe<const M: usize>(
         return_distance_rel: orbit.residual,
         periods_integrated: orbit.periods_integrated,
     }
+}
+
+/// The contact's dissipation split into its adhesion-hysteresis and capillary parts
+/// (units of k₁A₀₁² or J alike), each 0 where it is within 1e-12 of `scale` (the sums it
+/// came from: a conservative law's work functions cancel to their round-off, not to a
+/// dissipation).
+pub(super) fn resolved_dissipation(total: f64, capillary: f64, scale: f64) -> (f64, f64) {
+    let floor = 1e-12 * scale;
+    let resolved = |e: f64| if e.abs() <= floor { 0.0 } else { e };
+    (resolved(total - capillary), resolved(capillary))
 }
 
 /// The steady state of `set`'s modes on `setup` (Rodríguez & García's bimodal

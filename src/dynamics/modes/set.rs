@@ -302,6 +302,21 @@ impl Modal {
         ))
     }
 
+    /// Mode i's resonance (Hz), stiffness (N/m) and Q, the first mode's `first`'s:
+    /// kᵢ = k₁rᵢ²/cᵢ, a higher mode's resonance as simulated.
+    pub fn in_si(&self, first: &Cantilever, i: usize) -> (f64, f64, f64) {
+        let m = &self.modes[i];
+        if i == 0 {
+            (first.resonance_hz, first.stiffness_n_m, first.quality)
+        } else {
+            (
+                self.resonance_hz[i - 1],
+                first.stiffness_n_m * m.r * m.r / m.gain,
+                m.quality(),
+            )
+        }
+    }
+
     /// The first mode's drive period in τ.
     pub fn drive_period(&self) -> f64 {
         2.0 * std::f64::consts::PI / self.modes[0].omega

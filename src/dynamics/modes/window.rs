@@ -15,7 +15,7 @@
 //! (relative) and φᵢ (rad) and E_ts (relative to the drives' work) are within the
 //! average tolerance, or the cycle budget is spent (then not converged, and said).
 
-use super::observables::one_mode_start;
+use super::observables::{one_mode_start, resolved_dissipation};
 use super::set::Modal;
 use super::system::{ModeIntegral, Modes, force_integral, integral, plain_len};
 use crate::dynamics::budget;
@@ -554,15 +554,7 @@ fn report<const M: usize>(
             let free = m.free_amplitude();
             let amp = w.amplitude(own[i]);
             let amp_err = scatter(s.amplitude[i].error, amp);
-            let (resonance_hz, stiffness, quality) = if i == 0 {
-                (cant.resonance_hz, k1, cant.quality)
-            } else {
-                (
-                    modal.resonance_hz[i - 1],
-                    k1 * m.r * m.r / m.gain,
-                    m.quality(),
-                )
-            };
+            let (resonance_hz, stiffness, quality) = modal.in_si(cant, i);
             WindowedMode {
                 mode: i + 1,
                 resonance_hz,
@@ -588,12 +580,11 @@ fn report<const M: usize>(
     let c = &s.contact;
     let span = c.weight * first_period;
     let to_energy = p.cpl.f_scale / p.cpl.a1;
-    // A conservative law's work functions cancel to the round-off of the values
-    // summed: no dissipation.
-    let floor = 1e-12 * (c.drive_less_damp.abs() + to_energy * c.work_scale_hat);
-    let resolved = |e: f64| if e.abs() <= floor { 0.0 } else { e };
-    let capillary = resolved(to_energy * c.capillary_hat);
-    let adhesion = resolved(to_energy * (c.dissipated_hat - c.capillary_hat));
+    let (adhesion, capillary) = resolved_dissipation(
+        to_energy * c.dissipated_hat,
+        to_energy * c.capillary_hat,
+        c.drive_less_damp.abs() + to_energy * c.work_scale_hat,
+    );
     let e_ts_j = (adhesion + capillary) / span * per_period;
     let scale = contact.separation_scale_m();
     WindowedModes {
