@@ -118,6 +118,40 @@ fn the_z_feedback_rests_where_the_setpoint_solver_puts_the_state() {
     assert!(PiController::new(0.8, 0.0, 0.0).is_err());
 }
 
+/// The modes of `set` on `setup`, prepared at the instrument's marching tolerances.
+fn marched_modes(
+    setup: &tapsim::dynamics::setup::TapSetup,
+    set: &tapsim::dynamics::modes::ModeSet,
+) -> [(
+    tapsim::dynamics::setup::Prepared,
+    tapsim::dynamics::modes::Modal,
+); 1] {
+    let marched = Numerics {
+        rtol: tapsim::instrument::MARCH_RTOL,
+        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
+        ..Numerics::default()
+    };
+    [tapsim::dynamics::modes::prepare(setup, set, &marched).unwrap()]
+}
+
+/// The first two modes' lock-in readings (A/A₀, φ) averaged over `periods` drive
+/// periods at `z`: the ripple of lines beating through the filter averaged away.
+fn mean_readings(
+    probe: &mut impl tapsim::instrument::probe::Probe,
+    z: f64,
+    periods: usize,
+) -> [(f64, f64); 2] {
+    let mut read = [(0.0, 0.0); 2];
+    for _ in 0..periods {
+        let r = probe.march(0, z, 1).unwrap();
+        for (sum, r) in read.iter_mut().zip(r) {
+            sum.0 += r.0 / periods as f64;
+            sum.1 += r.1 / periods as f64;
+        }
+    }
+    read
+}
+
 /// The instrument on two eigenmodes (the hybrid defaults with a beam's second mode,
 /// A₀₂ = A₀/40): the loop on the first mode's lock-in, engaged from 1.2 A₀, rests at the
 /// separation where the several-mode steady-state solver (Newton on the common period,
@@ -126,19 +160,13 @@ fn the_z_feedback_rests_where_the_setpoint_solver_puts_the_state() {
 #[test]
 fn the_bimodal_feedback_rests_where_the_modal_steady_state_is() {
     use tapsim::bimodal::{PhaseBranch, states_at_setpoint};
-    use tapsim::dynamics::modes::{ModeSet, prepare};
+    use tapsim::dynamics::modes::ModeSet;
     use tapsim::instrument::feedback::{PiController, hold_probe};
     use tapsim::instrument::modal::ModalProbe;
-    use tapsim::instrument::probe::Probe;
     let setup = default_setup();
     let set = ModeSet::euler_bernoulli(&setup.cantilever, 2).unwrap();
     let numerics = Numerics::default();
-    let marched = Numerics {
-        rtol: tapsim::instrument::MARCH_RTOL,
-        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
-        ..numerics
-    };
-    let materials = [prepare(&setup, &set, &marched).unwrap()];
+    let materials = marched_modes(&setup, &set);
     let period = materials[0].1.drive_period();
     let mut probe = ModalProbe::new(&materials, 4, 2.0 * period).unwrap();
     let mut controller = PiController::new(0.8, 0.0, 0.002).unwrap();
@@ -155,14 +183,7 @@ fn the_bimodal_feedback_rests_where_the_modal_steady_state_is() {
     // The lock-ins' outputs ripple at the common period's frequency (the orbit repeats
     // every 4 drive periods: lines at Ωᵢ ± Ω₁/4 beat through the filter); a pixel's mean
     // over whole common periods is what an image shows.
-    let mut read = [(0.0, 0.0); 2];
-    for _ in 0..400 {
-        let r = probe.march(0, z, 1).unwrap();
-        for (sum, r) in read.iter_mut().zip(r) {
-            sum.0 += r.0 / 400.0;
-            sum.1 += r.1 / 400.0;
-        }
-    }
+    let read = mean_readings(&mut probe, z, 400);
     // The loop engages from above, onto the attractive branch (φ₁ > 90°), as with one
     // mode; the solver's state there.
     let (branch, found) = states_at_setpoint(&setup, &set, &numerics, 0.8, None)
@@ -885,24 +906,12 @@ fn lock_ins_on_modes_without_a_common_period_read_the_window_averages() {
     let (p, modal) = prepare(&setup, &set, &numerics).unwrap();
     assert_eq!(modal.periods, None);
     let averaged = modal_windowed(&p, &modal, &numerics).unwrap();
-    let marched = Numerics {
-        rtol: tapsim::instrument::MARCH_RTOL,
-        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
-        ..numerics
-    };
-    let materials = [prepare(&setup, &set, &marched).unwrap()];
+    let materials = marched_modes(&setup, &set);
     let period = materials[0].1.drive_period();
     let mut probe = ModalProbe::new(&materials, 4, 2.0 * period).unwrap();
     let z = setup.separation_m;
     probe.march(0, z, 800).unwrap();
-    let mut read = [(0.0, 0.0); 2];
-    for _ in 0..400 {
-        let r = probe.march(0, z, 1).unwrap();
-        for (sum, r) in read.iter_mut().zip(r) {
-            sum.0 += r.0 / 400.0;
-            sum.1 += r.1 / 400.0;
-        }
-    }
+    let read = mean_readings(&mut probe, z, 400);
     for (i, (a, phi)) in read.iter().enumerate() {
         let m = &averaged.modes[i];
         eprintln!(
