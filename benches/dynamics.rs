@@ -386,7 +386,67 @@ fn modes(c: &mut Criterion) {
     group.finish();
 }
 
+/// The round trip (`tapsim fit`): 30 points of the hybrid defaults' approach
+/// with 0.02 nm and 0.05° of noise (seed 7), E*, Δγ and the offset fitted from E*
+/// doubled, Δγ halved and the offset 1 nm off (the target: under 10 s).
+fn fit(c: &mut Criterion) {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    use tapsim::fit::{FitOptions, Measured, Parameter, model::curve};
+    let truth = default_setup();
+    let numerics = tapsim::sweep::sweep_numerics(Numerics::default(), (false, false));
+    let offset = 3e-9;
+    let positions: Vec<f64> = (0..30)
+        .map(|i| 18.5e-9 - 10.5e-9 * f64::from(i) / 29.0 - offset)
+        .collect();
+    let clean = curve(&truth, &numerics, &positions, offset).expect("defaults");
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let (na, np) = (
+        Normal::new(0.0, 0.02e-9).expect("sigma"),
+        Normal::new(0.0, 0.05).expect("sigma"),
+    );
+    let data = Measured {
+        position_m: positions.clone(),
+        segments: vec![0],
+        amplitude_m: Some(
+            clean
+                .amplitude_m
+                .iter()
+                .map(|a| a + na.sample(&mut rng))
+                .collect(),
+        ),
+        phase_deg: Some(
+            clean
+                .phase_deg
+                .iter()
+                .map(|p| p + np.sample(&mut rng))
+                .collect(),
+        ),
+        sigma_amplitude_m: 0.02e-9,
+        sigma_phase_deg: 0.05,
+    };
+    let mut start = truth.clone();
+    start.contact.modulus_pa *= 2.0;
+    start.contact.work_of_adhesion_j_m2 *= 0.5;
+    let options = FitOptions {
+        parameters: vec![
+            Parameter::Modulus,
+            Parameter::WorkOfAdhesion,
+            Parameter::ZOffset,
+        ],
+        offset_start_m: offset - 1e-9,
+        estimate_sigma: false,
+        max_curves: 400,
+    };
+    let mut group = c.benchmark_group("fit");
+    group.sample_size(10);
+    group.bench_function("round trip, 30 points, start 2x off", |b| {
+        b.iter(|| tapsim::fit::fit(&start, &numerics, &data, &options, |_| {}).expect("fit"))
+    });
+    group.finish();
+}
+
 criterion_group!(
-    benches, bench, settle, map, setpoint, march, scan_line, noise, modes
+    benches, bench, settle, map, setpoint, march, scan_line, noise, modes, fit
 );
 criterion_main!(benches);
