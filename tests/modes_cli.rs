@@ -81,8 +81,8 @@ fn modes_without_a_common_period_are_averaged_over_windows() {
         ] {
             assert!(m[key].is_number(), "{key}");
         }
-        // Errors far below the digits printed (README and table).
-        assert!(num(m, "phase_std_err_deg") < 5e-4);
+        // README: errors below 1e-6°, far below the digits printed.
+        assert!(num(m, "phase_std_err_deg") < 1e-6);
     }
     assert!((num(&modes[1], "phase_deg") - 29.80).abs() < 5e-3);
     assert!((num(&modes[1], "amplitude_ratio") - 0.4969).abs() < 5e-5);
