@@ -127,6 +127,13 @@ pub fn fit(
     let residuals = problem
         .evaluate(&x)
         .ok_or_else(|| Error::Numerical("the fitted curve could not be simulated".into()))?;
+    // The fitted curve is the one just evaluated (the Jacobian's columns replace it).
+    let fitted = problem
+        .cache
+        .borrow()
+        .as_ref()
+        .map(|(_, c, _)| c.clone())
+        .expect("the solution was just evaluated");
     let jacobian = problem
         .jacobian_at(&x, &residuals)
         .ok_or_else(|| Error::Numerical("the fit's Jacobian could not be simulated".into()))?;
@@ -170,7 +177,6 @@ pub fn fit(
             "χ²/dof = {reduced:.3} is far above 1: the fitted curve does not describe the data              (a local minimum reached from this start, a law or fixed parameters that cannot              describe them, or standard deviations set too small); the intervals assume a fit              that does"
         ));
     }
-    let fitted = data.simulate(&fitted_setup, numerics, offset)?;
     Ok(FitReport {
         parameters: estimates,
         identifiability,
@@ -191,6 +197,9 @@ pub fn fit(
     })
 }
 
+/// Coordinates, the curve simulated there and its weighted residuals.
+type Evaluated = (DVector<f64>, Curve, DVector<f64>);
+
 /// The least-squares problem the optimiser sees: x the fitted coordinates (0 at the
 /// start), the residuals a simulated curve's.
 struct Problem<'a, F: Fn(usize)> {
@@ -204,8 +213,8 @@ struct Problem<'a, F: Fn(usize)> {
     max_curves: usize,
     /// The first failure (a curve that could not be simulated), reported as the fit's.
     failure: RefCell<Option<Error>>,
-    /// The last coordinates evaluated and their residuals.
-    cache: RefCell<Option<(DVector<f64>, DVector<f64>)>>,
+    /// The last coordinates evaluated, their curve and its residuals.
+    cache: RefCell<Option<Evaluated>>,
     progress: &'a F,
 }
 
@@ -231,7 +240,7 @@ impl<F: Fn(usize)> Problem<'_, F> {
     /// The weighted residuals at `x` (None, with the failure kept, where the curve
     /// cannot be simulated or the budget of curves is spent).
     fn evaluate(&self, x: &DVector<f64>) -> Option<DVector<f64>> {
-        if let Some((at, r)) = self.cache.borrow().as_ref() {
+        if let Some((at, _, r)) = self.cache.borrow().as_ref() {
             if at == x {
                 return Some(r.clone());
             }
@@ -249,7 +258,7 @@ impl<F: Fn(usize)> Problem<'_, F> {
         match simulated {
             Ok(c) => {
                 let r = DVector::from_vec(self.data.residuals(&c));
-                *self.cache.borrow_mut() = Some((x.clone(), r.clone()));
+                *self.cache.borrow_mut() = Some((x.clone(), c, r.clone()));
                 Some(r)
             }
             Err(e) => {
@@ -319,6 +328,16 @@ pub struct Profile {
     pub interval_95: [Option<f64>; 2],
 }
 
+/// Put the values `fitted` found for `parameters` into `setup` and `offset_m` (a
+/// parameter given no value keeps its own).
+fn apply(parameters: &[Parameter], fitted: &FitReport, setup: &mut TapSetup, offset_m: &mut f64) {
+    for (p, e) in parameters.iter().zip(&fitted.parameters) {
+        if let Some(v) = e.value {
+            p.set(setup, offset_m, v);
+        }
+    }
+}
+
 /// Steps of a profile on each side, in linearised standard errors.
 const PROFILE_STEP: f64 = 0.75;
 /// Most steps on each side (4.5 standard errors).
@@ -350,11 +369,7 @@ pub fn profile(
     // The best fit's setup and offset: every fitted value in place.
     let mut at_best = setup.clone();
     let mut offset = options.offset_start_m;
-    for (p, e) in options.parameters.iter().zip(&best.parameters) {
-        if let Some(v) = e.value {
-            p.set(&mut at_best, &mut offset, v);
-        }
-    }
+    apply(&options.parameters, best, &mut at_best, &mut offset);
     let others: Vec<Parameter> = options
         .parameters
         .iter()
@@ -393,11 +408,7 @@ pub fn profile(
             )?
         };
         curves.set(curves.get() + r.curves);
-        for (p, e) in others.iter().zip(&r.parameters) {
-            if let Some(x) = e.value {
-                p.set(&mut s, &mut off, x);
-            }
-        }
+        apply(&others, &r, &mut s, &mut off);
         Ok((r.chi_square, (s, off)))
     };
     let step = |i: f64| {

@@ -87,7 +87,7 @@ impl<'a> ModalProbe<'a> {
         let (p, modal) = &self.materials[material];
         let mut modes = Modes::<_, M>::of(p, modal);
         modes.cpl = p.simulation_at(separation_m)?.cpl;
-        let period = march_period(modal);
+        let period = modal.march_period();
         for _ in 0..periods {
             let k = self.period_index;
             let mut y = State::<P>::zeros();
@@ -107,16 +107,6 @@ impl<'a> ModalProbe<'a> {
     }
 }
 
-/// The first mode's drive period in τ (taken as the common period over q where there
-/// is one: the commensurate instrument bit for bit as before drives without a common
-/// period were marched).
-fn march_period(modal: &Modal) -> f64 {
-    match modal.common_period() {
-        Ok((q, period)) => period / f64::from(q),
-        Err(_) => modal.drive_period(),
-    }
-}
-
 impl Probe for ModalProbe<'_> {
     fn modes(&self) -> usize {
         self.lockins.len()
@@ -132,7 +122,7 @@ impl Probe for ModalProbe<'_> {
 
     fn settling_periods(&self) -> usize {
         let modal = &self.materials[0].1;
-        settling_periods(&self.lockins[0], march_period(modal))
+        settling_periods(&self.lockins[0], modal.march_period())
     }
 
     fn march(&mut self, material: usize, separation_m: f64, periods: usize) -> Result<Readings> {

@@ -9,18 +9,20 @@ use crate::sweep::Direction;
 use serde::Serialize;
 use std::fmt::Write as _;
 
+/// The first line of a several-mode state: modes, law, Tabor μ, z_c.
+fn heading(s: &mut String, modes: usize, law: &str, tabor_mu: f64, separation_m: f64) {
+    let _ = writeln!(
+        s,
+        "{modes} eigenmodes, {law} law (Tabor μ = {tabor_mu:.3}), z_c = {:.4} nm",
+        separation_m * 1e9
+    );
+}
+
 /// `tap --modes N` for people.
 pub fn tap_text(set: &ModeSet, o: &ModalObservables) -> String {
     let mut s = String::new();
     let ev = |j: f64| j / ELECTRONVOLT_J;
-    let _ = writeln!(
-        s,
-        "{} eigenmodes, {} law (Tabor μ = {:.3}), z_c = {:.4} nm",
-        o.modes.len(),
-        o.law,
-        o.tabor_mu,
-        o.separation_m * 1e9
-    );
+    heading(&mut s, o.modes.len(), &o.law, o.tabor_mu, o.separation_m);
     for (mode, asked) in o.modes.iter().skip(1).zip(&set.higher) {
         let moved = mode.resonance_hz / asked.resonance_hz - 1.0;
         let _ = writeln!(
@@ -121,14 +123,7 @@ pub fn windowed_text(set: &ModeSet, o: &WindowedModes) -> String {
         }
     };
     let ev = |j: f64| j / ELECTRONVOLT_J;
-    let _ = writeln!(
-        s,
-        "{} eigenmodes, {} law (Tabor μ = {:.3}), z_c = {:.4} nm",
-        o.modes.len(),
-        o.law,
-        o.tabor_mu,
-        o.separation_m * 1e9
-    );
+    heading(&mut s, o.modes.len(), &o.law, o.tabor_mu, o.separation_m);
     let ratios: Vec<String> = o
         .modes
         .iter()

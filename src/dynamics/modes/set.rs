@@ -296,10 +296,21 @@ impl Modal {
                 self.ratio_tolerance
             ))
         })?;
-        Ok((
-            q,
-            2.0 * std::f64::consts::PI * f64::from(q) / self.modes[0].omega,
-        ))
+        Ok((q, self.periods_hat(q)))
+    }
+
+    /// `q` first-mode drive periods in τ (the common period's arithmetic, kept as it
+    /// was: 2πq/Ω₁).
+    fn periods_hat(&self, q: u32) -> f64 {
+        2.0 * std::f64::consts::PI * f64::from(q) / self.modes[0].omega
+    }
+
+    /// The period a march goes by: the common period over q where there is one (so the
+    /// commensurate instrument is bit for bit as before), else the first mode's drive
+    /// period. Builds no refusal (a hot path: every march of the instrument).
+    pub fn march_period(&self) -> f64 {
+        self.periods
+            .map_or(self.drive_period(), |q| self.periods_hat(q) / f64::from(q))
     }
 
     /// Mode i's resonance (Hz), stiffness (N/m) and Q, the first mode's `first`'s:
@@ -319,7 +330,7 @@ impl Modal {
 
     /// The first mode's drive period in τ.
     pub fn drive_period(&self) -> f64 {
-        2.0 * std::f64::consts::PI / self.modes[0].omega
+        self.own_period(0)
     }
 
     /// Mode i's own drive period in τ.
