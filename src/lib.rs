@@ -24,6 +24,7 @@ pub mod law;
 pub mod numeric;
 pub mod params;
 pub mod quasistatic;
+pub mod reconstruct;
 pub mod setpoint;
 pub mod summary;
 pub mod sweep;

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 /// The library's modules (everything outside the `app` feature).
-const LIBRARY: [&str; 17] = [
+const LIBRARY: [&str; 18] = [
     "src/bimodal.rs",
     "src/lib.rs",
     "src/contact",
@@ -21,6 +21,7 @@ const LIBRARY: [&str; 17] = [
     "src/numeric.rs",
     "src/params.rs",
     "src/quasistatic.rs",
+    "src/reconstruct.rs",
     "src/setpoint.rs",
     "src/summary.rs",
     "src/sweep.rs",

@@ -45,6 +45,7 @@ __all__ = [
     "hysteresis",
     "lj",
     "fit",
+    "reconstruct",
     "tap_many",
     "model",
 ]
@@ -311,6 +312,16 @@ def fit(data: Any, setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
     notes), chi_square, the fitted curve; ``profile=True`` adds ``profiles``."""
     args = _argv("fit", _options(setup, kwargs))
     return Result("fit", _tapsim.run([args[0], _os.fspath(data)] + args[1:]))
+
+
+def reconstruct(data: Any, setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
+    """The force and the loss an AM curve implies (``tapsim reconstruct``; a CSV path
+    with position, amplitude and phase columns, units in the header, as ``tapsim
+    approach --csv`` writes it): columns closest_m, force_n, e_ts_j, in_phase_force_n,
+    frequency_shift (with ``with_law=True`` also law_approach_force_n and
+    law_retract_force_n), and notes."""
+    args = _argv("reconstruct", _options(setup, kwargs))
+    return Result("reconstruct", _tapsim.run([args[0], _os.fspath(data)] + args[1:]))
 
 
 def tap_many(setups: Iterable[Setup], /, **common: Any) -> List[Result]:

@@ -187,6 +187,22 @@ def test_fit_reads_the_curve_approach_writes_and_gives_it_back(cli, tmp_path):
         tapsim.fit(rising)
 
 
+def test_reconstruct_gives_the_force_of_the_curve_approach_writes(cli, tmp_path):
+    path = tmp_path / "dmt.csv"
+    law = dict(law="dmt", work_of_adhesion=0.02)
+    tapsim.approach(**{"from": "30nm"}, to="6nm", points=120, no_retract=True, csv=str(path), **law)
+    r = tapsim.reconstruct(path, with_law=True, **law)
+    expected = cli("reconstruct", str(path), "--with-law", "--law=dmt", "--work-of-adhesion=0.02")
+    assert r.force_n.tolist() == expected["force_n"]
+    assert isinstance(r.closest_m, np.ndarray) and np.all(np.diff(r.closest_m) > 0)
+    largest = np.max(np.abs(r.law_approach_force_n))
+    assert np.max(np.abs(r.force_n - r.law_approach_force_n)) < 0.05 * largest
+    with pytest.raises(ValueError, match="both the amplitude and the phase"):
+        amplitude_only = tmp_path / "a.csv"
+        amplitude_only.write_text("z_nm,amplitude_nm\n30,20\n29,19.9\n28,19.8\n")
+        tapsim.reconstruct(amplitude_only)
+
+
 def test_a_bimodal_scan_gives_each_pixels_higher_modes_as_2d_columns(cli):
     args = dict(modes=2, pixels=2, line_rate=400, no_retrace=True)
     r = tapsim.scan(**args)

@@ -1,6 +1,7 @@
 //! `tapsim fit`: a measured approach curve fitted by the simulator, and what the data
 //! determine.
 
+use super::curve_data::{Columns, read_curve};
 use crate::config::{TapInputs, length, number};
 use crate::error::{Error, Result};
 use crate::fit::{FitOptions, FitReport, Measured, Parameter, Profile, fit, profile};
@@ -99,146 +100,9 @@ impl From<FitParameter> for Parameter {
     }
 }
 
-/// The largest data file read.
-const MAX_DATA_BYTES: u64 = 64 << 20;
-
-/// A column's values in SI, by the header's name: its kind and scale.
-fn column_kind(name: &str) -> Option<(&'static str, f64)> {
-    let n = name.trim().to_ascii_lowercase();
-    let position = ["z", "z_c", "separation", "position"];
-    for p in position {
-        if n == format!("{p}_m") {
-            return Some(("position", 1.0));
-        }
-        if n == format!("{p}_nm") {
-            return Some(("position", 1e-9));
-        }
-    }
-    match n.as_str() {
-        "amplitude_m" => Some(("amplitude", 1.0)),
-        "amplitude_nm" => Some(("amplitude", 1e-9)),
-        "amplitude_ratio" => Some(("amplitude_ratio", 1.0)),
-        "phase_deg" => Some(("phase", 1.0)),
-        "direction" => Some(("direction", 1.0)),
-        "segment" => Some(("segment", 1.0)),
-        _ => None,
-    }
-}
-
-/// The columns of a data file, in SI.
-struct Columns {
-    position_m: Vec<f64>,
-    segments: Vec<usize>,
-    amplitude_m: Option<Vec<f64>>,
-    phase_deg: Option<Vec<f64>>,
-}
-
-/// Read the measured curve of `path` (amplitudes as ratios made m with `a0_m`).
-fn read_data(path: &std::path::Path, a0_m: f64) -> Result<Columns> {
-    let fail = |reason: String| Error::Parse {
-        name: "data file",
-        text: path.display().to_string(),
-        reason,
-    };
-    let bytes = crate::config::read_input(path, MAX_DATA_BYTES, fail)?;
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(bytes.as_slice());
-    let headers = reader
-        .headers()
-        .map_err(|e| fail(format!("no CSV header: {e}")))?
-        .clone();
-    let mut at: std::collections::HashMap<&'static str, (usize, f64)> = Default::default();
-    for (i, h) in headers.iter().enumerate() {
-        if let Some((kind, scale)) = column_kind(h) {
-            if kind == "position" && at.contains_key("position") {
-                continue;
-            }
-            if at.insert(kind, (i, scale)).is_some() {
-                return Err(fail(format!("two columns give the {kind}")));
-            }
-        }
-    }
-    if at.contains_key("amplitude") && at.contains_key("amplitude_ratio") {
-        at.remove("amplitude_ratio");
-    }
-    let Some(&(pos_col, pos_scale)) = at.get("position") else {
-        return Err(fail(
-            "no position column (z_nm, z_m, z_c_nm, z_c_m, separation_nm, separation_m, \
-             position_nm or position_m)"
-                .into(),
-        ));
-    };
-    let amp = at
-        .get("amplitude")
-        .copied()
-        .or_else(|| at.get("amplitude_ratio").map(|&(i, _)| (i, a0_m)));
-    let phase = at.get("phase").copied();
-    if amp.is_none() && phase.is_none() {
-        return Err(fail(
-            "no amplitude (amplitude_nm, amplitude_m, amplitude_ratio) or phase (phase_deg) \
-             column"
-                .into(),
-        ));
-    }
-    let direction = at.get("direction").map(|&(i, _)| i);
-    let segment = at.get("segment").map(|&(i, _)| i);
-    let (mut z, mut a, mut p) = (Vec::new(), Vec::new(), Vec::new());
-    let mut segments = Vec::new();
-    let mut label: Option<String> = None;
-    for (row, record) in reader.records().enumerate() {
-        let record = record.map_err(|e| fail(format!("row {}: {e}", row + 2)))?;
-        if direction.is_some_and(|d| record.get(d).is_some_and(|v| v != "approach")) {
-            continue;
-        }
-        let value = |(col, scale): (usize, f64), what: &str| -> Result<f64> {
-            let text = record.get(col).unwrap_or("");
-            text.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .map(|v| v * scale)
-                .ok_or_else(|| {
-                    fail(format!(
-                        "row {}: the {what} {text:?} is not a number",
-                        row + 2
-                    ))
-                })
-        };
-        let this = segment.map(|c| record.get(c).unwrap_or("").to_string());
-        if z.is_empty() || this != label {
-            segments.push(z.len());
-            label = this;
-        }
-        z.push(value((pos_col, pos_scale), "position")?);
-        if let Some(c) = amp {
-            a.push(value(c, "amplitude")?);
-        }
-        if let Some(c) = phase {
-            p.push(value(c, "phase")?);
-        }
-    }
-    Ok(Columns {
-        position_m: z,
-        segments,
-        amplitude_m: amp.map(|_| a),
-        phase_deg: phase.map(|_| p),
-    })
-}
-
 /// Run the subcommand.
 pub fn run(args: FitArgs) -> Result<()> {
-    if let Some(path) = &args.plot {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        if !matches!(ext.as_deref(), Some("png" | "svg")) {
-            return Err(Error::NotApplicable(format!(
-                "{}: the plot file must end in .png or .svg",
-                path.display()
-            )));
-        }
-    }
+    super::check_plot_path(args.plot.as_deref())?;
     let (setup, numerics) = args.inputs.resolve()?;
     let numerics = crate::sweep::sweep_numerics(numerics, (false, false));
     let Columns {
@@ -246,7 +110,8 @@ pub fn run(args: FitArgs) -> Result<()> {
         segments,
         amplitude_m,
         phase_deg,
-    } = read_data(&args.data, setup.cantilever.free_amplitude_m)?;
+        ..
+    } = read_curve(&args.data, &setup.cantilever, "approach")?;
     let given = args.sigma_amplitude.is_some() || args.sigma_phase.is_some();
     if given
         && ((amplitude_m.is_some() && args.sigma_amplitude.is_none())

@@ -1,6 +1,23 @@
 //! The `tapsim` command line: parse, call the library, print. Each subcommand lives in
 //! its own module.
 
+/// Refuse a plot file that is neither .png nor .svg, before any work is done.
+pub fn check_plot_path(path: Option<&std::path::Path>) -> crate::Result<()> {
+    let Some(path) = path else { return Ok(()) };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if matches!(ext.as_deref(), Some("png" | "svg")) {
+        Ok(())
+    } else {
+        Err(crate::Error::NotApplicable(format!(
+            "{}: the plot file must end in .png or .svg",
+            path.display()
+        )))
+    }
+}
+
 /// `println!` that returns instead of panicking when standard output fails: a closed
 /// pipe ends the command quietly ([`crate::Error::StdoutClosed`]), any other failure (a
 /// full disk) is an error.
@@ -22,6 +39,7 @@ mod batch;
 mod bifurcation;
 mod branches;
 mod contrast;
+mod curve_data;
 mod figure;
 mod fit;
 mod hysteresis;
@@ -29,6 +47,7 @@ mod lj;
 mod map;
 mod merge;
 mod modal;
+mod reconstruct;
 mod reproduce;
 mod scan;
 mod shard;
@@ -60,6 +79,7 @@ enum Command {
     Bifurcation(bifurcation::BifurcationArgs),
     Contrast(contrast::ContrastArgs),
     Fit(fit::FitArgs),
+    Reconstruct(reconstruct::ReconstructArgs),
     Map(map::MapArgs),
     Scan(scan::ScanArgs),
     Thermal(thermal::ThermalArgs),
@@ -82,6 +102,7 @@ impl Command {
             Command::Bifurcation(a) => a.out.quiet,
             Command::Contrast(a) => a.out.quiet,
             Command::Fit(a) => a.quiet,
+            Command::Reconstruct(a) => a.quiet,
             Command::Map(a) => a.out.quiet,
             Command::Scan(a) => a.out.quiet,
             Command::Thermal(a) => a.out.quiet,
@@ -410,6 +431,7 @@ fn dispatch(command: Command) -> crate::Result<()> {
         Command::Bifurcation(args) => bifurcation::run(args),
         Command::Contrast(args) => contrast::run(args),
         Command::Fit(args) => fit::run(args),
+        Command::Reconstruct(args) => reconstruct::run(args),
         Command::Map(args) => map::run(args),
         Command::Scan(args) => scan::run(args),
         Command::Thermal(args) => thermal::run(args),

@@ -15,6 +15,7 @@ pub mod modes;
 pub mod output;
 pub mod part;
 pub mod plot;
+pub mod reconstruct;
 pub mod records;
 pub mod sweep;
 pub mod tap;

@@ -1,0 +1,168 @@
+//! A measured (or simulated) AM curve read from CSV, as `tapsim fit` and
+//! `tapsim reconstruct` take it: columns named with their units in the header.
+
+use crate::dynamics::setup::Cantilever;
+use crate::error::{Error, Result};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// The largest data file read.
+const MAX_DATA_BYTES: u64 = 64 << 20;
+
+/// What a column holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Kind {
+    Position,
+    Amplitude,
+    AmplitudeRatio,
+    Phase,
+    Deflection,
+    MeanForce,
+    Direction,
+    Segment,
+}
+
+/// A column's kind and the factor that makes its values SI, by the header's name.
+fn column_kind(name: &str) -> Option<(Kind, f64)> {
+    let n = name.trim().to_ascii_lowercase();
+    for p in ["z", "z_c", "separation", "position"] {
+        if n == format!("{p}_m") {
+            return Some((Kind::Position, 1.0));
+        }
+        if n == format!("{p}_nm") {
+            return Some((Kind::Position, 1e-9));
+        }
+    }
+    match n.as_str() {
+        "amplitude_m" => Some((Kind::Amplitude, 1.0)),
+        "amplitude_nm" => Some((Kind::Amplitude, 1e-9)),
+        "amplitude_ratio" => Some((Kind::AmplitudeRatio, 1.0)),
+        "phase_deg" => Some((Kind::Phase, 1.0)),
+        "deflection_m" => Some((Kind::Deflection, 1.0)),
+        "deflection_nm" => Some((Kind::Deflection, 1e-9)),
+        "mean_force_n" => Some((Kind::MeanForce, 1.0)),
+        "direction" => Some((Kind::Direction, 1.0)),
+        "segment" => Some((Kind::Segment, 1.0)),
+        _ => None,
+    }
+}
+
+/// The columns of a data file, in SI.
+pub struct Columns {
+    /// Positions, m, in the file's order.
+    pub position_m: Vec<f64>,
+    /// Where each segment (a run of one `segment` label) begins.
+    pub segments: Vec<usize>,
+    /// Amplitudes, m.
+    pub amplitude_m: Option<Vec<f64>>,
+    /// Phases, degrees.
+    pub phase_deg: Option<Vec<f64>>,
+    /// Mean deflections, m (a deflection column, or the mean force over k).
+    pub mean_deflection_m: Option<Vec<f64>>,
+}
+
+/// Read the curve of `path`: the rows whose `direction` column (if any) is `direction`;
+/// amplitudes given as ratios are made m with the cantilever's A₀, a mean force is made a
+/// deflection with its k.
+pub fn read_curve(path: &Path, cantilever: &Cantilever, direction: &str) -> Result<Columns> {
+    let fail = |reason: String| Error::Parse {
+        name: "data file",
+        text: path.display().to_string(),
+        reason,
+    };
+    let bytes = crate::config::read_input(path, MAX_DATA_BYTES, fail)?;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(bytes.as_slice());
+    let headers = reader
+        .headers()
+        .map_err(|e| fail(format!("no CSV header: {e}")))?
+        .clone();
+    let mut at: HashMap<Kind, (usize, f64)> = HashMap::new();
+    for (i, h) in headers.iter().enumerate() {
+        if let Some((kind, scale)) = column_kind(h) {
+            if kind == Kind::Position && at.contains_key(&Kind::Position) {
+                continue;
+            }
+            if at.insert(kind, (i, scale)).is_some() {
+                let what = format!("{kind:?}").to_lowercase();
+                return Err(fail(format!("two columns give the {what}")));
+            }
+        }
+    }
+    let Some(&position) = at.get(&Kind::Position) else {
+        return Err(fail(
+            "no position column (z_nm, z_m, z_c_nm, z_c_m, separation_nm, separation_m, \
+             position_nm or position_m)"
+                .into(),
+        ));
+    };
+    let amp = at.get(&Kind::Amplitude).copied().or_else(|| {
+        at.get(&Kind::AmplitudeRatio)
+            .map(|&(i, _)| (i, cantilever.free_amplitude_m))
+    });
+    let phase = at.get(&Kind::Phase).copied();
+    if amp.is_none() && phase.is_none() {
+        return Err(fail(
+            "no amplitude (amplitude_nm, amplitude_m, amplitude_ratio) or phase (phase_deg) \
+             column"
+                .into(),
+        ));
+    }
+    let deflection = at.get(&Kind::Deflection).copied().or_else(|| {
+        at.get(&Kind::MeanForce)
+            .map(|&(i, _)| (i, 1.0 / cantilever.stiffness_n_m))
+    });
+    let direction_col = at.get(&Kind::Direction).map(|&(i, _)| i);
+    let segment = at.get(&Kind::Segment).map(|&(i, _)| i);
+    let (mut z, mut a, mut p, mut d) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut segments = Vec::new();
+    let mut label: Option<String> = None;
+    for (row, record) in reader.records().enumerate() {
+        let record = record.map_err(|e| fail(format!("row {}: {e}", row + 2)))?;
+        if direction_col.is_some_and(|c| record.get(c).is_some_and(|v| v != direction)) {
+            continue;
+        }
+        let value = |(col, scale): (usize, f64), what: &str| -> Result<f64> {
+            let text = record.get(col).unwrap_or("");
+            text.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .map(|v| v * scale)
+                .ok_or_else(|| {
+                    fail(format!(
+                        "row {}: the {what} {text:?} is not a number",
+                        row + 2
+                    ))
+                })
+        };
+        let this = segment.map(|c| record.get(c).unwrap_or("").to_string());
+        if z.is_empty() || this != label {
+            segments.push(z.len());
+            label = this;
+        }
+        z.push(value(position, "position")?);
+        if let Some(c) = amp {
+            a.push(value(c, "amplitude")?);
+        }
+        if let Some(c) = phase {
+            p.push(value(c, "phase")?);
+        }
+        if let Some(c) = deflection {
+            d.push(value(c, "deflection")?);
+        }
+    }
+    if z.is_empty() {
+        return Err(fail(match direction_col {
+            Some(_) => format!("no rows with direction \"{direction}\""),
+            None => "no data rows".into(),
+        }));
+    }
+    Ok(Columns {
+        position_m: z,
+        segments,
+        amplitude_m: amp.map(|_| a),
+        phase_deg: phase.map(|_| p),
+        mean_deflection_m: deflection.map(|_| d),
+    })
+}
