@@ -280,6 +280,68 @@ fn a_parameter_the_data_do_not_see_is_given_no_value() {
     );
 }
 
+/// A parameter that does not change the data is reported unidentifiable and given no
+/// value (the example): a viscous sample (η = 10 Pa·s under the hybrid law)
+/// that the tip never indents — on the attractive branch it jumps into contact at a
+/// positive separation and leaves again, the Kelvin–Voigt force acting only on
+/// indentation. The report says what data would show it. On the repulsive branch, where
+/// the tip indents, the same fit gives the viscosity a value with an interval holding
+/// the truth.
+#[test]
+fn a_viscosity_the_tip_never_indents_is_given_no_value() {
+    let mut truth = default_setup();
+    truth.law.viscosity_pa_s = Some(10.0);
+    let span = |from: f64, to: f64, n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|i| from - (from - to) * i as f64 / (n - 1) as f64)
+            .collect()
+    };
+    let opts = FitOptions {
+        parameters: vec![
+            Parameter::Modulus,
+            Parameter::WorkOfAdhesion,
+            Parameter::Viscosity,
+        ],
+        offset_start_m: 0.0,
+        estimate_sigma: false,
+        max_curves: 40,
+    };
+    let fitted = |position_m: Vec<f64>| {
+        let mut data = Measured {
+            position_m,
+            segments: vec![0],
+            amplitude_m: None,
+            phase_deg: None,
+            sigma_amplitude_m: SIGMA_A_M,
+            sigma_phase_deg: SIGMA_PHI_DEG,
+        };
+        let c = data.simulate(&truth, &numerics(), 0.0).unwrap();
+        data.amplitude_m = Some(c.amplitude_m);
+        data.phase_deg = Some(c.phase_deg.clone());
+        (
+            fit(&truth, &numerics(), &data, &opts, |_| {}).unwrap(),
+            c.phase_deg,
+        )
+    };
+    let (attractive, phases) = fitted(span(18.5e-9, 8e-9, 16));
+    assert!(phases.iter().all(|&p| p > 90.0), "{phases:?}");
+    let eta = &attractive.parameters[2];
+    assert_eq!(eta.name, "viscosity_pa_s");
+    assert!(eta.value.is_none() && eta.interval_95.is_none(), "{eta:?}");
+    let notes = attractive.identifiability.notes.join("\n");
+    assert!(
+        notes.contains("viscosity_pa_s does not change the data") && notes.contains("indents"),
+        "{notes}"
+    );
+    // E* and Δγ are still seen (their values come back).
+    assert!(attractive.parameters[..2].iter().all(|p| p.value.is_some()));
+    let (repulsive, phases) = fitted(span(8e-9, 3e-9, 16));
+    assert!(phases.iter().all(|&p| p < 90.0), "{phases:?}");
+    let eta = &repulsive.parameters[2];
+    let [lo, hi] = eta.interval_95.expect("identifiable where the tip indents");
+    assert!(lo < 10.0 && 10.0 < hi, "[{lo}, {hi}]");
+}
+
 /// The profile likelihood of E* and Δγ (each held, the others refitted) against the
 /// linearised intervals on the noisy data above: the model is nearly straight over
 /// them here, so the two agree — each endpoint within 5 % of the interval's half-width.

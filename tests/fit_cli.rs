@@ -75,6 +75,47 @@ fn an_approach_curve_is_fitted_back() {
     ] {
         assert!(svg.contains(label), "{label}");
     }
+    // --csv: the data beside the fit, one row per point; the fitted values are the
+    // JSON's curve, the residuals its residuals (amplitudes first).
+    let rows = dir.join("fit.csv");
+    let out = tapsim(&[
+        "fit",
+        csv,
+        "--modulus",
+        "0.8GPa",
+        "--work-of-adhesion",
+        "0.12J/m^2",
+        "--offset",
+        "0.3nm",
+        "-q",
+        "--csv",
+        rows.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let mut r = csv::Reader::from_path(&rows).unwrap();
+    let h = r.headers().unwrap().clone();
+    let col = |name: &str| h.iter().position(|x| x == name).unwrap();
+    let records: Vec<csv::StringRecord> = r.records().map(|r| r.unwrap()).collect();
+    assert_eq!(records.len(), 12);
+    let fitted_phase = v["fitted"]["phase_deg"].as_array().unwrap();
+    let residuals = v["residuals"].as_array().unwrap();
+    for (i, row) in records.iter().enumerate() {
+        let cell = |name: &str| row[col(name)].parse::<f64>().unwrap();
+        let same = |a: f64, b: &serde_json::Value| (a / b.as_f64().unwrap() - 1.0).abs() < 1e-9;
+        assert!(same(cell("fitted_phase_deg"), &fitted_phase[i]));
+        // (fitted − measured)/σ, σ the default weights 0.02 nm and 0.05°.
+        let (ra, rp) = (cell("amplitude_residual"), cell("phase_residual"));
+        let expect_a = (cell("fitted_amplitude_m") - cell("amplitude_m")) / 0.02e-9;
+        let expect_p = (cell("fitted_phase_deg") - cell("phase_deg")) / 0.05;
+        assert!((ra - expect_a).abs() < 1e-6 && (rp - expect_p).abs() < 1e-6);
+        assert!(
+            same(ra, &residuals[i]) || ra == 0.0,
+            "{ra} {}",
+            residuals[i]
+        );
+        assert!(same(rp, &residuals[12 + i]) || rp == 0.0);
+        assert_eq!(&row[col("well_defined")], "true");
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -113,6 +154,11 @@ fn bad_data_are_refused_with_why() {
         &["fit", &good, "--plot", "fit.txt"],
         "must end in .png or .svg",
     );
+    refused(
+        &["fit", &good, "--fit", "viscosity"],
+        "needs a viscous sample to start from",
+    );
+    refused(&["fit", &good, "--fit", "hamaker"], "needs the dmt law");
     std::fs::remove_dir_all(dir).unwrap();
 }
 

@@ -9,7 +9,9 @@ use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
 /// From a measured approach curve back to the material: which modulus and work of
-/// adhesion (and piezo offset) make the simulated approach — each point a converged
+/// adhesion (and piezo offset; or, with --fit, the range ε, the dmt law's Hamaker
+/// constant, a viscous sample's viscosity, a relaxing one's relaxation time) make the
+/// simulated approach — each point a converged
 /// steady state, started from the last as an approach goes — match the amplitude and
 /// phase measured, by weighted least squares (Levenberg–Marquardt), and how sure the
 /// data let one be.
@@ -29,7 +31,9 @@ use std::path::PathBuf;
 /// Reported: each parameter with its linearised standard error and 68 % and 95 %
 /// intervals; χ²/dof; the Jacobian's singular values and condition number; the
 /// correlations; and what the data leave open — a parameter they do not determine is
-/// flagged and given no value, two that trade off are named. Example:
+/// flagged and given no value (with what data would show it), two that trade off are
+/// named. --csv writes the data beside the fit point by point, --plot draws them (and
+/// the profiles). Example:
 ///
 ///   tapsim approach --from 18.5nm --to 8nm --points 30 --no-retract --csv curve.csv
 ///   tapsim fit curve.csv --modulus 1GPa --work-of-adhesion 0.2J/m^2
@@ -64,10 +68,15 @@ pub struct FitArgs {
     max_curves: usize,
     #[command(flatten)]
     inputs: TapInputs,
-    /// Plot the measured and fitted amplitude and phase against z_c, and the weighted
-    /// residuals (.png or .svg).
+    /// Plot the measured and fitted amplitude and phase against z_c, the weighted
+    /// residuals, and with --profile each profile's Δχ² (.png or .svg).
     #[arg(long, help_heading = "Output")]
     plot: Option<PathBuf>,
+    /// Write the data beside the fit as CSV: per point the position, the fitted z_c,
+    /// the measured and fitted amplitude and phase, the weighted residuals, and whether
+    /// the fitted state there is a stable period-1 orbit clear of the law's switches.
+    #[arg(long, help_heading = "Output")]
+    csv: Option<PathBuf>,
     /// Print JSON instead of a table.
     #[arg(long, help_heading = "Output")]
     json: bool,
@@ -85,6 +94,13 @@ enum FitParameter {
     WorkOfAdhesion,
     /// Range ε (the Lennard-Jones equilibrium gap).
     Range,
+    /// The dmt law's Hamaker constant H.
+    Hamaker,
+    /// A viscous sample's viscosity η (start from --viscosity).
+    Viscosity,
+    /// A relaxing sample's relaxation time (start from --relaxation-time, with
+    /// --unrelaxed-modulus).
+    RelaxationTime,
     /// The positions' offset.
     ZOffset,
 }
@@ -95,6 +111,9 @@ impl From<FitParameter> for Parameter {
             FitParameter::Modulus => Parameter::Modulus,
             FitParameter::WorkOfAdhesion => Parameter::WorkOfAdhesion,
             FitParameter::Range => Parameter::Range,
+            FitParameter::Hamaker => Parameter::Hamaker,
+            FitParameter::Viscosity => Parameter::Viscosity,
+            FitParameter::RelaxationTime => Parameter::RelaxationTime,
             FitParameter::ZOffset => Parameter::ZOffset,
         }
     }
@@ -157,14 +176,6 @@ pub fn run(args: FitArgs) -> Result<()> {
     });
     busy.finish_and_clear();
     let report = report?;
-    if let Some(path) = &args.plot {
-        let source = args
-            .data
-            .file_name()
-            .map_or("data".into(), |n| n.to_string_lossy().into_owned());
-        let charts = crate::report::fit::charts(&report, &data, &source, &setup.law.to_string());
-        crate::report::plot::render_stack(&charts, path)?;
-    }
     let mut profiles = Vec::new();
     if args.profile {
         for (p, e) in options.parameters.iter().zip(&report.parameters) {
@@ -178,6 +189,22 @@ pub fn run(args: FitArgs) -> Result<()> {
             busy.finish_and_clear();
             profiles.push(done?);
         }
+    }
+    if let Some(path) = &args.csv {
+        crate::report::output::write_bytes(
+            path,
+            &crate::report::records::records_csv(&crate::report::fit::rows(&report, &data))?,
+        )?;
+    }
+    if let Some(path) = &args.plot {
+        let source = args
+            .data
+            .file_name()
+            .map_or("data".into(), |n| n.to_string_lossy().into_owned());
+        let mut charts =
+            crate::report::fit::charts(&report, &data, &source, &setup.law.to_string());
+        charts.extend(profiles.iter().map(crate::report::fit::profile_chart));
+        crate::report::plot::render_stack(&charts, path)?;
     }
     if args.json {
         let mut v = serde_json::to_value(&report).expect("a report serialises");

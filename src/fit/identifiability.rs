@@ -3,6 +3,7 @@
 //! singular values, whose ratio is the condition number, tell which combinations of
 //! the parameters the data fix and which they leave free).
 
+use super::model::Parameter;
 use nalgebra::DMatrix;
 use serde::Serialize;
 
@@ -64,13 +65,14 @@ pub struct Identifiability {
 /// identifiability judged at the weights given); `scales` whether each coordinate is a
 /// logarithm, `physical` each coordinate's value in SI.
 pub(crate) fn assess(
-    names: &[&'static str],
+    params: &[Parameter],
     jacobian: &DMatrix<f64>,
     variance_factor: Option<f64>,
     scales: &[bool],
     physical: &[f64],
     starts: &[f64],
 ) -> (Vec<ParameterEstimate>, Identifiability) {
+    let names: Vec<&'static str> = params.iter().map(|p| p.key()).collect();
     let n = names.len();
     let svd = jacobian.clone().svd(false, true);
     let v_t = svd.v_t.expect("asked for V");
@@ -153,8 +155,9 @@ pub(crate) fn assess(
         notes.push(if blind[j] {
             format!(
                 "{} does not change the data (the Jacobian has no component along it): \
-                 not identifiable, no value given",
-                names[j]
+                 not identifiable, no value given — {} would show it",
+                names[j],
+                params[j].seen_in()
             )
         } else {
             format!(

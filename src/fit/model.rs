@@ -16,17 +16,50 @@ pub enum Parameter {
     WorkOfAdhesion,
     /// Range ε of the Lennard-Jones law (the equilibrium gap), m.
     Range,
+    /// The DMT law's Hamaker constant H, J.
+    Hamaker,
+    /// A Kelvin–Voigt sample's viscosity η, Pa·s.
+    Viscosity,
+    /// A standard-linear-solid sample's relaxation time τ_r, s.
+    RelaxationTime,
     /// The offset of the piezo position: z_c = z_piezo + offset, m.
     ZOffset,
 }
 
 impl Parameter {
+    /// Every parameter.
+    pub const ALL: [Parameter; 7] = [
+        Parameter::Modulus,
+        Parameter::WorkOfAdhesion,
+        Parameter::Range,
+        Parameter::Hamaker,
+        Parameter::Viscosity,
+        Parameter::RelaxationTime,
+        Parameter::ZOffset,
+    ];
+
+    /// What it is, with its unit, as an axis names it.
+    pub fn label(self) -> &'static str {
+        match self {
+            Parameter::Modulus => "composite modulus E* (Pa)",
+            Parameter::WorkOfAdhesion => "work of adhesion Δγ (J/m²)",
+            Parameter::Range => "range ε (m)",
+            Parameter::Hamaker => "Hamaker constant H (J)",
+            Parameter::Viscosity => "sample viscosity η (Pa·s)",
+            Parameter::RelaxationTime => "relaxation time τ_r (s)",
+            Parameter::ZOffset => "piezo offset (m)",
+        }
+    }
+
     /// Its key in tables and JSON, unit included.
     pub fn key(self) -> &'static str {
         match self {
             Parameter::Modulus => "modulus_pa",
             Parameter::WorkOfAdhesion => "work_of_adhesion_j_m2",
             Parameter::Range => "range_m",
+            Parameter::Hamaker => "hamaker_j",
+            Parameter::Viscosity => "viscosity_pa_s",
+            Parameter::RelaxationTime => "relaxation_time_s",
             Parameter::ZOffset => "z_offset_m",
         }
     }
@@ -37,13 +70,66 @@ impl Parameter {
         !matches!(self, Parameter::ZOffset)
     }
 
-    /// Its value in `setup` (the offset is not a setup's: `offset_m`).
+    /// What data would show it, for a report that finds the data blind to it.
+    pub fn seen_in(self) -> &'static str {
+        match self {
+            Parameter::Modulus => {
+                "data where the tip presses into the sample (the repulsive branch)"
+            }
+            Parameter::WorkOfAdhesion | Parameter::Range => {
+                "data where the tip touches: the jump-in position, the attractive branch's \
+                 contact, the repulsive branch"
+            }
+            Parameter::Hamaker => "data where the tip feels the long-range attraction",
+            Parameter::Viscosity | Parameter::RelaxationTime => {
+                "data where the tip indents the sample (the repulsive branch), best at more \
+                 than one indentation rate (another drive frequency or amplitude)"
+            }
+            Parameter::ZOffset => "data where the tip feels the sample at all",
+        }
+    }
+
+    /// Its value in `setup` (the offset is not a setup's: `offset_m`); NaN for a law
+    /// parameter the setup does not have ([`Parameter::start`] refuses those).
     pub fn value(self, setup: &TapSetup, offset_m: f64) -> f64 {
+        let law = &setup.law;
         match self {
             Parameter::Modulus => setup.contact.modulus_pa,
             Parameter::WorkOfAdhesion => setup.contact.work_of_adhesion_j_m2,
             Parameter::Range => setup.contact.range_m,
+            Parameter::Hamaker => law.hamaker_j.unwrap_or_else(|| {
+                12.0 * std::f64::consts::PI
+                    * setup.contact.range_m.powi(2)
+                    * setup.contact.work_of_adhesion_j_m2
+            }),
+            Parameter::Viscosity => law.viscosity_pa_s.unwrap_or(f64::NAN),
+            Parameter::RelaxationTime => law.relaxation_time_s.unwrap_or(f64::NAN),
             Parameter::ZOffset => offset_m,
+        }
+    }
+
+    /// Its starting value in `setup`, or why it has none: a law parameter the setup's law
+    /// does not take or the setup does not set.
+    pub fn start(self, setup: &TapSetup, offset_m: f64) -> Result<f64> {
+        let law = &setup.law;
+        let missing = |what: &str| {
+            Err(Error::NotApplicable(format!(
+                "fitting {} needs {what}",
+                self.key()
+            )))
+        };
+        match self {
+            Parameter::Hamaker if law.kind != crate::law::LawKind::Dmt => {
+                missing("the dmt law, the one with a Hamaker constant")
+            }
+            Parameter::Viscosity if law.viscosity_pa_s.is_none() => {
+                missing("a viscous sample to start from: give the setup a viscosity")
+            }
+            Parameter::RelaxationTime if law.relaxing().is_none() => missing(
+                "a relaxing sample to start from: give the setup an unrelaxed modulus and a \
+                 relaxation time",
+            ),
+            _ => Ok(self.value(setup, offset_m)),
         }
     }
 
@@ -53,6 +139,9 @@ impl Parameter {
             Parameter::Modulus => setup.contact.modulus_pa = value,
             Parameter::WorkOfAdhesion => setup.contact.work_of_adhesion_j_m2 = value,
             Parameter::Range => setup.contact.range_m = value,
+            Parameter::Hamaker => setup.law.hamaker_j = Some(value),
+            Parameter::Viscosity => setup.law.viscosity_pa_s = Some(value),
+            Parameter::RelaxationTime => setup.law.relaxation_time_s = Some(value),
             Parameter::ZOffset => *offset_m = value,
         }
     }

@@ -100,8 +100,8 @@ pub fn fit(
     }
     let starts: Vec<f64> = params
         .iter()
-        .map(|p| p.value(setup, options.offset_start_m))
-        .collect();
+        .map(|p| p.start(setup, options.offset_start_m))
+        .collect::<Result<_>>()?;
     let problem = Problem {
         setup,
         numerics,
@@ -148,10 +148,9 @@ pub fn fit(
         .iter()
         .map(|p| p.value(&fitted_setup, offset))
         .collect();
-    let names: Vec<&'static str> = params.iter().map(|p| p.key()).collect();
     let scales: Vec<bool> = params.iter().map(|p| p.is_scale()).collect();
     let (estimates, identifiability) = assess(
-        &names,
+        params,
         &jacobian,
         match (options.estimate_sigma, reduced > RESOLVED_CHI_SQUARE) {
             (false, _) => Some(1.0),
@@ -174,7 +173,10 @@ pub fn fit(
     // where the standard deviations are given: the model does not describe the data.
     if !options.estimate_sigma && chi_square > dof as f64 + 5.0 * (2.0 * dof as f64).sqrt() {
         identifiability.notes.push(format!(
-            "χ²/dof = {reduced:.3} is far above 1: the fitted curve does not describe the data              (a local minimum reached from this start, a law or fixed parameters that cannot              describe them, or standard deviations set too small); the intervals assume a fit              that does"
+            "χ²/dof = {reduced:.3} is far above 1: the fitted curve does not describe the \
+             data (a local minimum reached from this start, a law or fixed parameters that \
+             cannot describe them, or standard deviations set too small); the intervals \
+             assume a fit that does"
         ));
     }
     Ok(FitReport {

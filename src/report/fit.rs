@@ -2,7 +2,8 @@
 //! they were fitted at, the fitted curve through them, and the weighted residuals.
 
 use super::chart::{Axis, Chart, Corner, Series, Style};
-use crate::fit::{FitReport, Measured};
+use crate::fit::{FitReport, Measured, Parameter, Profile};
+use serde::Serialize;
 
 /// The data (read from `source`), the fit and the residuals, three panels.
 pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Chart> {
@@ -88,4 +89,101 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
         residuals,
     ));
     out
+}
+
+/// One point of the data beside the fit, as `tapsim fit --csv` writes it.
+#[derive(Debug, Serialize)]
+pub struct Row {
+    /// The measured position, m.
+    pub position_m: f64,
+    /// The fitted rest separation there (position + fitted offset), m.
+    pub separation_m: f64,
+    /// Which approach of the data it belongs to (0 the first).
+    pub segment: usize,
+    /// Measured amplitude, m (empty where the data have none).
+    pub amplitude_m: Option<f64>,
+    /// Fitted amplitude, m.
+    pub fitted_amplitude_m: f64,
+    /// (fitted − measured)/σ of the amplitude.
+    pub amplitude_residual: Option<f64>,
+    /// Measured phase, degrees.
+    pub phase_deg: Option<f64>,
+    /// Fitted phase, degrees.
+    pub fitted_phase_deg: f64,
+    /// (fitted − measured)/σ of the phase.
+    pub phase_residual: Option<f64>,
+    /// Whether the fitted state is a stable period-1 orbit clear of the law's switches.
+    pub well_defined: bool,
+}
+
+/// The data beside the fit, point by point.
+pub fn rows(r: &FitReport, data: &Measured) -> Vec<Row> {
+    let n = data.position_m.len();
+    let (amp_at, phase_at) = match (data.amplitude_m.is_some(), data.phase_deg.is_some()) {
+        (true, true) => (Some(0), Some(n)),
+        (true, false) => (Some(0), None),
+        _ => (None, Some(0)),
+    };
+    (0..n)
+        .map(|i| Row {
+            position_m: data.position_m[i],
+            separation_m: r.fitted.separation_m[i],
+            segment: data.segments.iter().filter(|&&s| s <= i).count() - 1,
+            amplitude_m: data.amplitude_m.as_ref().map(|a| a[i]),
+            fitted_amplitude_m: r.fitted.amplitude_m[i],
+            amplitude_residual: amp_at.map(|k| r.residuals[k + i]),
+            phase_deg: data.phase_deg.as_ref().map(|p| p[i]),
+            fitted_phase_deg: r.fitted.phase_deg[i],
+            phase_residual: phase_at.map(|k| r.residuals[k + i]),
+            well_defined: r.fitted.well_defined[i],
+        })
+        .collect()
+}
+
+/// A profile's Δχ² against the parameter held, with the levels of the 68 % and 95 %
+/// intervals.
+pub fn profile_chart(p: &Profile) -> Chart {
+    let points: Vec<(f64, f64)> = p
+        .values
+        .iter()
+        .copied()
+        .zip(p.delta_chi_square.iter().copied())
+        .collect();
+    let (lo, hi) = (
+        p.values.first().copied().unwrap_or(0.0),
+        p.values.last().copied().unwrap_or(1.0),
+    );
+    let series = vec![
+        Series::new(
+            "profile: the others refitted at each value",
+            points,
+            Style::Markers,
+            0,
+        ),
+        Series::new(
+            "Δχ² = 1 (68 %)",
+            vec![(lo, 1.0), (hi, 1.0)],
+            Style::Dotted,
+            1,
+        ),
+        Series::new(
+            "Δχ² = 3.84 (95 %)",
+            vec![(lo, 3.84), (hi, 3.84)],
+            Style::Dashed,
+            2,
+        ),
+    ];
+    let label = Parameter::ALL
+        .iter()
+        .find(|q| q.key() == p.name)
+        .map_or(p.name, |q| q.label());
+    Chart {
+        name: format!("profile_{}", p.name),
+        title: format!("profile likelihood: {label}"),
+        x: Axis::linear(label, p.name),
+        y: Axis::linear("Δχ²", "delta_chi_square"),
+        legend: Corner::quietest(&series),
+        series,
+        labels: Vec::new(),
+    }
 }
