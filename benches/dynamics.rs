@@ -407,6 +407,7 @@ fn fit(c: &mut Criterion) {
     );
     let data = Measured {
         position_m: positions.clone(),
+        setpoint_ratio: None,
         segments: vec![0],
         amplitude_m: Some(
             clean

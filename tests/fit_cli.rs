@@ -217,3 +217,68 @@ fn approaches_joined_by_a_segment_column_are_fitted_together() {
     assert!((num(&params[2], "value") / 0.3e-9 - 1.0).abs() < 1e-5);
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// Phase against the amplitude setpoint (a `setpoint` column, no positions), as phase
+/// imaging records it: `tapsim approach --sweep setpoint` gives the phases; fitted for
+/// Δγ (E* known) they give it back; E* and Δγ together are flagged as trading off, with
+/// no values; the offset, which such data do not have, is refused.
+#[test]
+fn phases_at_setpoints_are_fitted() {
+    let dir = scratch("fit-setpoints");
+    let sweep = dir.join("sweep.csv");
+    let out = tapsim(&[
+        "approach",
+        "--sweep",
+        "setpoint",
+        "--from",
+        "0.75",
+        "--to",
+        "0.55",
+        "--points",
+        "5",
+        "--no-retract",
+        "-q",
+        "--csv",
+        sweep.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut r = csv::Reader::from_path(&sweep).unwrap();
+    let h = r.headers().unwrap().clone();
+    let col = |name: &str| h.iter().position(|x| x == name).unwrap();
+    let (a, p) = (col("amplitude_ratio"), col("phase_deg"));
+    let mut text = String::from("setpoint,phase_deg\n");
+    for row in r.records() {
+        let row = row.unwrap();
+        text.push_str(&format!("{},{}\n", &row[a], &row[p]));
+    }
+    let data = dir.join("phase_vs_setpoint.csv");
+    std::fs::write(&data, text).unwrap();
+    let data = data.to_str().unwrap();
+    let sigma = ["--sigma-phase", "0.05"];
+    let mut args = vec!["fit", data, "--fit", "work-of-adhesion"];
+    args.extend(["--work-of-adhesion", "0.08J/m^2", "--json"]);
+    args.extend(sigma);
+    let v = json(&args);
+    let params = v["parameters"].as_array().unwrap();
+    assert!(
+        (num(&params[0], "value") / 0.1 - 1.0).abs() < 1e-5,
+        "{params:?}"
+    );
+    let mut args = vec!["fit", data, "--json"];
+    args.extend(sigma);
+    let v = json(&args);
+    let params = v["parameters"].as_array().unwrap();
+    assert_eq!(params.len(), 2, "E* and Δγ, no offset by default");
+    assert!(params.iter().all(|p| p["value"].is_null()), "{params:?}");
+    assert!(
+        v["identifiability"]["notes"]
+            .to_string()
+            .contains("trade off along")
+    );
+    refused(&["fit", data, "--fit", "z-offset"], "no offset");
+    std::fs::remove_dir_all(dir).unwrap();
+}

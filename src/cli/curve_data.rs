@@ -16,6 +16,7 @@ enum Kind {
     Amplitude,
     AmplitudeRatio,
     Phase,
+    Setpoint,
     Deflection,
     MeanForce,
     Direction,
@@ -38,6 +39,7 @@ fn column_kind(name: &str) -> Option<(Kind, f64)> {
         "amplitude_nm" => Some((Kind::Amplitude, 1e-9)),
         "amplitude_ratio" => Some((Kind::AmplitudeRatio, 1.0)),
         "phase_deg" => Some((Kind::Phase, 1.0)),
+        "setpoint" | "setpoint_ratio" => Some((Kind::Setpoint, 1.0)),
         "deflection_m" => Some((Kind::Deflection, 1.0)),
         "deflection_nm" => Some((Kind::Deflection, 1e-9)),
         "mean_force_n" => Some((Kind::MeanForce, 1.0)),
@@ -49,8 +51,11 @@ fn column_kind(name: &str) -> Option<(Kind, f64)> {
 
 /// The columns of a data file, in SI.
 pub struct Columns {
-    /// Positions, m, in the file's order.
+    /// Positions, m, in the file's order (empty where the file gives setpoints
+    /// instead).
     pub position_m: Vec<f64>,
+    /// Amplitude setpoints A/A₀, where the file gives them and no position.
+    pub setpoint_ratio: Option<Vec<f64>>,
     /// Where each segment (a run of one `segment` label) begins.
     pub segments: Vec<usize>,
     /// Amplitudes, m.
@@ -90,10 +95,17 @@ pub fn read_curve(path: &Path, cantilever: &Cantilever, direction: &str) -> Resu
             }
         }
     }
-    let Some(&position) = at.get(&Kind::Position) else {
+    // Positions, or (without them) the setpoints the phases were read at.
+    let position = at.get(&Kind::Position).copied();
+    let setpoint = if position.is_none() {
+        at.get(&Kind::Setpoint).copied()
+    } else {
+        None
+    };
+    let Some(abscissa) = position.or(setpoint) else {
         return Err(fail(
             "no position column (z_nm, z_m, z_c_nm, z_c_m, separation_nm, separation_m, \
-             position_nm or position_m)"
+             position_nm or position_m) nor a setpoint column (setpoint, A/A₀)"
                 .into(),
         ));
     };
@@ -141,7 +153,14 @@ pub fn read_curve(path: &Path, cantilever: &Cantilever, direction: &str) -> Resu
             segments.push(z.len());
             label = this;
         }
-        z.push(value(position, "position")?);
+        z.push(value(
+            abscissa,
+            if setpoint.is_some() {
+                "setpoint"
+            } else {
+                "position"
+            },
+        )?);
         if let Some(c) = amp {
             a.push(value(c, "amplitude")?);
         }
@@ -158,8 +177,13 @@ pub fn read_curve(path: &Path, cantilever: &Cantilever, direction: &str) -> Resu
             None => "no data rows".into(),
         }));
     }
+    let (position_m, setpoint_ratio) = match setpoint {
+        Some(_) => (Vec::new(), Some(z)),
+        None => (z, None),
+    };
     Ok(Columns {
-        position_m: z,
+        position_m,
+        setpoint_ratio,
         segments,
         amplitude_m: amp.map(|_| a),
         phase_deg: phase.map(|_| p),

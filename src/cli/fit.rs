@@ -25,8 +25,11 @@ use std::path::PathBuf;
 /// several approaches: a new one begins where its label changes, each simulated from
 /// the free oscillation at its first position (as `tapsim approach --from` starts) — an
 /// approach begun near the sample reaches the repulsive branch, one from far stays on
-/// the attractive. Every parameter not
-/// fitted is the setup's (the usual flags), and the fitted ones start there.
+/// the attractive. Or phase against amplitude setpoint, as phase imaging records it: a
+/// `setpoint` column (A/A₀) with phase_deg and no position — each point the state a z
+/// feedback finds at that setpoint on the branch its phase shows (no offset then).
+/// Every parameter not fitted is the setup's (the usual flags), and the fitted ones
+/// start there.
 ///
 /// Reported: each parameter with its linearised standard error and 68 % and 95 %
 /// intervals; χ²/dof; the Jacobian's singular values and condition number; the
@@ -126,6 +129,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     let numerics = crate::sweep::sweep_numerics(numerics, (false, false));
     let Columns {
         position_m,
+        setpoint_ratio,
         segments,
         amplitude_m,
         phase_deg,
@@ -142,8 +146,10 @@ pub fn run(args: FitArgs) -> Result<()> {
                 .into(),
         ));
     }
+    let at_setpoints = setpoint_ratio.is_some();
     let data = Measured {
         position_m,
+        setpoint_ratio,
         segments,
         amplitude_m,
         phase_deg,
@@ -151,11 +157,11 @@ pub fn run(args: FitArgs) -> Result<()> {
         sigma_phase_deg: args.sigma_phase.unwrap_or(0.05),
     };
     let parameters: Vec<Parameter> = if args.fit.is_empty() {
-        vec![
-            Parameter::Modulus,
-            Parameter::WorkOfAdhesion,
-            Parameter::ZOffset,
-        ]
+        let mut default = vec![Parameter::Modulus, Parameter::WorkOfAdhesion];
+        if !at_setpoints {
+            default.push(Parameter::ZOffset);
+        }
+        default
     } else {
         args.fit.iter().map(|&p| p.into()).collect()
     };
@@ -264,7 +270,7 @@ fn text(r: &FitReport, law: &str, data: &Measured) -> String {
     let _ = writeln!(
         s,
         "fit of {} points ({channels}), {law} law: {} simulated curves, {} ({})",
-        data.position_m.len(),
+        data.len(),
         r.curves,
         if r.converged {
             "converged"

@@ -106,11 +106,19 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
     };
     let Columns {
         position_m,
+        setpoint_ratio,
         amplitude_m,
         phase_deg,
         mean_deflection_m,
         ..
     } = read_curve(&args.data, &setup.cantilever, direction)?;
+    if setpoint_ratio.is_some() {
+        return Err(Error::NotApplicable(format!(
+            "{}: a reconstruction needs the positions the curve was taken at (setpoints \
+             alone do not place the tip)",
+            args.data.display()
+        )));
+    }
     let (Some(amplitude_m), Some(phase_deg)) = (amplitude_m, phase_deg) else {
         return Err(Error::NotApplicable(format!(
             "{}: a reconstruction needs both the amplitude and the phase",

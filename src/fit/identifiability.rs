@@ -146,7 +146,7 @@ pub(crate) fn assess(
                 .collect()
         })
         .collect();
-    let weakest = order
+    let weakest: Vec<f64> = order
         .last()
         .map(|&k| v_t.row(k).iter().copied().collect())
         .unwrap_or_default();
@@ -167,6 +167,24 @@ pub(crate) fn assess(
                 sigma[j].exp()
             )
         });
+    }
+    // Parameters the data see, but too weakly to be given a value: name the direction
+    // along which they trade off (the data fix the combination across it).
+    let weak: Vec<usize> = (0..n).filter(|&j| !identifiable[j] && !blind[j]).collect();
+    if !weak.is_empty() && n > 1 {
+        let terms: Vec<String> = weakest
+            .iter()
+            .zip(&names)
+            .filter(|(c, _)| c.abs() > 0.1)
+            .map(|(c, name)| format!("{c:+.2}·{name}"))
+            .collect();
+        notes.push(format!(
+            "the parameters trade off along {} (in their logarithms; the Jacobian's weakest \
+             direction): the data fix what lies across it, not the parameters themselves — \
+             data that move them differently (the other branch, positions as well as \
+             setpoints, the jump-in, a second mode) would separate them",
+            terms.join(" ")
+        ));
     }
     for a in 0..n {
         for b in a + 1..n {

@@ -149,11 +149,16 @@ impl Parameter {
 
 /// A measured approach curve — or several, one after another — : piezo positions (any
 /// zero; far to near in each) with the amplitude and/or the phase read there, and each
-/// channel's standard deviation (the weights of the least squares).
+/// channel's standard deviation (the weights of the least squares). Or phases read at
+/// amplitude setpoints, as a z feedback holds them (`setpoint_ratio`): no positions
+/// then, each point the state at its setpoint on the branch its phase shows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measured {
-    /// Piezo positions, m, decreasing within each approach.
+    /// Piezo positions, m, decreasing within each approach (empty for setpoint data).
     pub position_m: Vec<f64>,
+    /// Amplitude setpoints A/A₀ the phases were read at, in place of positions (None
+    /// for an approach curve). The amplitude is then the setpoint, not a measurement.
+    pub setpoint_ratio: Option<Vec<f64>>,
     /// Where each approach begins (indices into the positions, the first 0): each is
     /// simulated from the free oscillation at its first position, as `approach` starts
     /// — a second approach begun close to the sample reaches the repulsive branch where
@@ -174,6 +179,9 @@ impl Measured {
     /// one channel at least, all finite, positions strictly decreasing, standard
     /// deviations positive.
     pub fn validated(self) -> Result<Self> {
+        if let Some(n) = self.setpoint_ratio.as_ref().map(Vec::len) {
+            return self.validated_setpoints(n);
+        }
         let n = self.position_m.len();
         if !(3..=MAX_SWEEP_POINTS).contains(&n) {
             return Err(Error::OutOfRange(format!(
@@ -238,9 +246,71 @@ impl Measured {
         Ok(self)
     }
 
+    /// Validate setpoint data of `n` points: 3 to the sweep's most, setpoints in (0, 1),
+    /// a phase for each and no amplitude (it is the setpoint), the phase's standard
+    /// deviation positive.
+    fn validated_setpoints(self, n: usize) -> Result<Self> {
+        if !(3..=MAX_SWEEP_POINTS).contains(&n) {
+            return Err(Error::OutOfRange(format!(
+                "a fit takes 3 to {MAX_SWEEP_POINTS} measured points, not {n}"
+            )));
+        }
+        if !self.position_m.is_empty() {
+            return Err(Error::NotApplicable(
+                "give positions or setpoints, not both".into(),
+            ));
+        }
+        if self.amplitude_m.is_some() {
+            return Err(Error::NotApplicable(
+                "at a setpoint the amplitude is the setpoint the feedback holds, not a \
+                 measurement: fit the phase"
+                    .into(),
+            ));
+        }
+        let Some(phase) = &self.phase_deg else {
+            return Err(Error::NotApplicable(
+                "setpoint data need the phase read at each setpoint".into(),
+            ));
+        };
+        if phase.len() != n {
+            return Err(Error::NotApplicable(format!(
+                "{} phase values for {n} setpoints",
+                phase.len()
+            )));
+        }
+        if let Some((i, v)) = phase.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(Error::NotApplicable(format!(
+                "phase of point {} is {v}: every value must be finite",
+                i + 1
+            )));
+        }
+        for &r in self.setpoint_ratio.iter().flatten() {
+            crate::setpoint::check_ratio(r)?;
+        }
+        crate::error::positive("phase standard deviation", self.sigma_phase_deg)?;
+        Ok(self)
+    }
+
+    /// How many points the data hold.
+    pub fn len(&self) -> usize {
+        self.setpoint_ratio
+            .as_ref()
+            .map_or(self.position_m.len(), Vec::len)
+    }
+
+    /// Whether the data hold no point.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
     /// The curves of `setup` at the measured positions shifted by `offset_m`, each
-    /// approach from the free oscillation at its first position, joined.
+    /// approach from the free oscillation at its first position, joined; for setpoint
+    /// data the state at each setpoint on the branch the measured phase shows (the
+    /// offset plays no part).
     pub fn simulate(&self, setup: &TapSetup, numerics: &Numerics, offset_m: f64) -> Result<Curve> {
+        if let (Some(ratios), Some(phases)) = (&self.setpoint_ratio, &self.phase_deg) {
+            return at_setpoints(setup, numerics, ratios, phases);
+        }
         let n = self.position_m.len();
         let mut joined: Option<Curve> = None;
         for (k, &start) in self.segments.iter().enumerate() {
@@ -266,7 +336,7 @@ impl Measured {
 
     /// The weighted residuals (model − measured)/σ of `curve`, amplitudes first.
     pub fn residuals(&self, curve: &Curve) -> Vec<f64> {
-        let mut r = Vec::with_capacity(self.channels() * self.position_m.len());
+        let mut r = Vec::with_capacity(self.channels() * self.len());
         if let Some(a) = &self.amplitude_m {
             r.extend(
                 a.iter()
@@ -285,10 +355,11 @@ impl Measured {
     }
 }
 
-/// A simulated approach curve at the measured positions.
+/// A simulated approach curve at the measured positions (or the states at the measured
+/// setpoints).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Curve {
-    /// Rest separations z_c = position + offset, m.
+    /// Rest separations z_c = position + offset, m (at a setpoint: where its state is).
     pub separation_m: Vec<f64>,
     /// Amplitudes, m.
     pub amplitude_m: Vec<f64>,
@@ -322,4 +393,36 @@ pub fn curve(
             .map(|p| p.observables.regime == "period-1" && !p.observables.grazing)
             .collect(),
     })
+}
+
+/// The states of `setup` at the amplitude setpoints `ratios`, each on the branch its
+/// measured phase in `phases` shows (above the free phase attractive, below
+/// repulsive); where that branch has no stable period-1 state at the setpoint, an
+/// error saying so.
+pub fn at_setpoints(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    ratios: &[f64],
+    phases: &[f64],
+) -> Result<Curve> {
+    let free = crate::setpoint::free_phase_deg(setup);
+    let mut c = Curve {
+        separation_m: Vec::with_capacity(ratios.len()),
+        amplitude_m: Vec::with_capacity(ratios.len()),
+        phase_deg: Vec::with_capacity(ratios.len()),
+        well_defined: Vec::with_capacity(ratios.len()),
+    };
+    for (&r, &phi) in ratios.iter().zip(phases) {
+        crate::interrupt::check()?;
+        let branch = crate::setpoint::PhaseBranch::of(phi, free);
+        let states = crate::setpoint::states_at_setpoint(setup, numerics, r, Some(branch))?;
+        let s = states.first().ok_or_else(|| {
+            Error::NotApplicable(format!("no {branch} state at the setpoint {r}"))
+        })?;
+        c.separation_m.push(s.separation_m);
+        c.amplitude_m.push(s.observables.amplitude_m);
+        c.phase_deg.push(s.observables.phase_deg);
+        c.well_defined.push(!s.observables.grazing);
+    }
+    Ok(c)
 }

@@ -91,7 +91,12 @@ pub fn fit(
         )));
     }
     crate::error::finite("offset start", options.offset_start_m)?;
-    let m = data.channels() * data.position_m.len();
+    if data.setpoint_ratio.is_some() && params.contains(&Parameter::ZOffset) {
+        return Err(Error::NotApplicable(
+            "setpoint data have no piezo positions: there is no offset to fit".into(),
+        ));
+    }
+    let m = data.channels() * data.len();
     if m <= params.len() {
         return Err(Error::NotApplicable(format!(
             "{m} measured values cannot fix {} parameters",

@@ -8,11 +8,29 @@ use serde::Serialize;
 /// The data (read from `source`), the fit and the residuals, three panels.
 pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Chart> {
     let measured_name = format!("measured ({source})");
-    let z: Vec<f64> = r.fitted.separation_m.iter().map(|z| z * 1e9).collect();
+    // Against z_c; setpoint data against the setpoint, the fit joined in its order.
+    let (z, x_axis): (Vec<f64>, Axis) = match &data.setpoint_ratio {
+        Some(s) => (
+            s.clone(),
+            Axis::linear("amplitude setpoint A/A₀", "setpoint"),
+        ),
+        None => (
+            r.fitted.separation_m.iter().map(|z| z * 1e9).collect(),
+            Axis::linear(
+                "rest separation z_c = position + fitted offset (nm)",
+                "separation_nm",
+            ),
+        ),
+    };
     let n = z.len();
     // The fitted curve drawn per approach: a gap where the next begins.
     let line = |ys: &[f64]| -> Vec<(f64, f64)> {
         let mut points = Vec::with_capacity(n + data.segments.len());
+        if data.setpoint_ratio.is_some() {
+            points.extend(z.iter().copied().zip(ys.iter().copied()));
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            return points;
+        }
         for i in 0..n {
             if i > 0 && data.segments.contains(&i) {
                 points.push((f64::NAN, f64::NAN));
@@ -26,10 +44,7 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
     let chart = |name: &str, title: String, y: Axis, series: Vec<Series>| Chart {
         name: name.into(),
         title,
-        x: Axis::linear(
-            "rest separation z_c = position + fitted offset (nm)",
-            "separation_nm",
-        ),
+        x: x_axis.clone(),
         y,
         legend: Corner::quietest(&series),
         series,
@@ -94,23 +109,31 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
 /// One point of the data beside the fit, as `tapsim fit --csv` writes it.
 #[derive(Debug, Serialize)]
 pub struct Row {
-    /// The measured position, m.
-    pub position_m: f64,
+    /// The measured position, m (empty for setpoint data).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position_m: Option<f64>,
+    /// The amplitude setpoint A/A₀ (empty for an approach curve).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub setpoint_ratio: Option<f64>,
     /// The fitted rest separation there (position + fitted offset), m.
     pub separation_m: f64,
     /// Which approach of the data it belongs to (0 the first).
     pub segment: usize,
     /// Measured amplitude, m (empty where the data have none).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub amplitude_m: Option<f64>,
     /// Fitted amplitude, m.
     pub fitted_amplitude_m: f64,
     /// (fitted − measured)/σ of the amplitude.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub amplitude_residual: Option<f64>,
     /// Measured phase, degrees.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub phase_deg: Option<f64>,
     /// Fitted phase, degrees.
     pub fitted_phase_deg: f64,
     /// (fitted − measured)/σ of the phase.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub phase_residual: Option<f64>,
     /// Whether the fitted state is a stable period-1 orbit clear of the law's switches.
     pub well_defined: bool,
@@ -118,7 +141,7 @@ pub struct Row {
 
 /// The data beside the fit, point by point.
 pub fn rows(r: &FitReport, data: &Measured) -> Vec<Row> {
-    let n = data.position_m.len();
+    let n = data.len();
     let (amp_at, phase_at) = match (data.amplitude_m.is_some(), data.phase_deg.is_some()) {
         (true, true) => (Some(0), Some(n)),
         (true, false) => (Some(0), None),
@@ -126,7 +149,8 @@ pub fn rows(r: &FitReport, data: &Measured) -> Vec<Row> {
     };
     (0..n)
         .map(|i| Row {
-            position_m: data.position_m[i],
+            position_m: data.position_m.get(i).copied(),
+            setpoint_ratio: data.setpoint_ratio.as_ref().map(|s| s[i]),
             separation_m: r.fitted.separation_m[i],
             segment: data.segments.iter().filter(|&&s| s <= i).count() - 1,
             amplitude_m: data.amplitude_m.as_ref().map(|a| a[i]),
