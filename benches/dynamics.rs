@@ -436,6 +436,7 @@ fn fit(c: &mut Criterion) {
             Parameter::ZOffset,
         ],
         offset_start_m: offset - 1e-9,
+        sensitivity_start: 1.0,
         estimate_sigma: false,
         max_curves: 400,
     };

@@ -5,7 +5,7 @@
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use tapsim::dynamics::setup::{Numerics, TapSetup, default_setup};
-use tapsim::fit::{FitOptions, Measured, Parameter, fit, model::curve};
+use tapsim::fit::{FitOptions, Measured, Nuisance, Parameter, fit, model::curve};
 use tapsim::sweep::sweep_numerics;
 
 /// The true offset of the piezo's zero: z_c = position + 3 nm.
@@ -64,6 +64,7 @@ fn options(offset_start_m: f64) -> FitOptions {
             Parameter::ZOffset,
         ],
         offset_start_m,
+        sensitivity_start: 1.0,
         estimate_sigma: false,
         max_curves: 400,
     }
@@ -188,7 +189,9 @@ fn a_curve_over_both_branches_is_fitted_back_within_one_percent_from_three_start
         sigma_amplitude_m: SIGMA_A_M,
         sigma_phase_deg: SIGMA_PHI_DEG,
     };
-    let c = data.simulate(&truth, &numerics(), OFFSET_M).unwrap();
+    let c = data
+        .simulate(&truth, &numerics(), &Nuisance::offset(OFFSET_M))
+        .unwrap();
     assert!(c.well_defined.iter().all(|&w| w));
     assert!(c.phase_deg[..30].iter().all(|&p| p > 90.0));
     assert!(c.phase_deg[30..].iter().all(|&p| p < 90.0));
@@ -306,6 +309,7 @@ fn a_viscosity_the_tip_never_indents_is_given_no_value() {
             Parameter::Viscosity,
         ],
         offset_start_m: 0.0,
+        sensitivity_start: 1.0,
         estimate_sigma: false,
         max_curves: 40,
     };
@@ -319,7 +323,9 @@ fn a_viscosity_the_tip_never_indents_is_given_no_value() {
             sigma_amplitude_m: SIGMA_A_M,
             sigma_phase_deg: SIGMA_PHI_DEG,
         };
-        let c = data.simulate(&truth, &numerics(), 0.0).unwrap();
+        let c = data
+            .simulate(&truth, &numerics(), &Nuisance::offset(0.0))
+            .unwrap();
         data.amplitude_m = Some(c.amplitude_m);
         data.phase_deg = Some(c.phase_deg.clone());
         (
@@ -383,6 +389,7 @@ fn phases_at_setpoints_fix_the_loss_not_modulus_and_adhesion_apart() {
     let opts = |parameters: Vec<Parameter>| FitOptions {
         parameters,
         offset_start_m: 0.0,
+        sensitivity_start: 1.0,
         estimate_sigma: false,
         max_curves: 100,
     };
@@ -427,6 +434,104 @@ fn phases_at_setpoints_fix_the_loss_not_modulus_and_adhesion_apart() {
     )
     .unwrap_err();
     assert!(err.to_string().contains("no offset"), "{err}");
+}
+
+/// Nuisance parameters. A detector reading amplitudes 3 % high (the free amplitude it
+/// reports, 20.6 nm, included): with the sensitivity fitted beside E* and Δγ on an
+/// approach over both branches (noise-free, 20 + 20 points), all three come back to
+/// 1e-6. Add the spring constant k and the model has an exact symmetry, which the
+/// report finds: scaling E*,
+/// Δγ and k by one factor leaves the Tabor parameter and every force over kA₀ — so the
+/// motion — unchanged; the three get no value and the direction along which they trade
+/// off is (1, 1, 1)/√3 in their logarithms, while the sensitivity keeps its value.
+#[test]
+fn nuisance_parameters_are_fitted_and_the_stiffness_symmetry_is_found() {
+    let truth = default_setup();
+    let span = |from: f64, to: f64, n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|i| from - (from - to) * i as f64 / (n - 1) as f64)
+            .collect()
+    };
+    let s = 1.03;
+    let (far, near) = (span(18.5e-9, 8e-9, 20), span(12e-9, 4e-9, 20));
+    // The true motion, read 3 % high.
+    let (cf, cn) = (
+        curve(&truth, &numerics(), &far, 0.0).unwrap(),
+        curve(&truth, &numerics(), &near, 0.0).unwrap(),
+    );
+    let read = |c: &tapsim::fit::Curve| c.amplitude_m.iter().map(|a| a * s).collect::<Vec<_>>();
+    let data = Measured {
+        position_m: [far, near].concat(),
+        setpoint_ratio: None,
+        segments: vec![0, 20],
+        amplitude_m: Some([read(&cf), read(&cn)].concat()),
+        phase_deg: Some([cf.phase_deg, cn.phase_deg].concat()),
+        sigma_amplitude_m: SIGMA_A_M,
+        sigma_phase_deg: SIGMA_PHI_DEG,
+    };
+    let mut start = truth.clone();
+    start.cantilever.free_amplitude_m = 20e-9 * s;
+    start.contact.modulus_pa *= 1.2;
+    let opts = |parameters: Vec<Parameter>| FitOptions {
+        parameters,
+        offset_start_m: 0.0,
+        sensitivity_start: 1.0,
+        estimate_sigma: false,
+        max_curves: 200,
+    };
+    let r = fit(
+        &start,
+        &numerics(),
+        &data,
+        &opts(vec![
+            Parameter::Modulus,
+            Parameter::WorkOfAdhesion,
+            Parameter::Sensitivity,
+        ]),
+        |_| {},
+    )
+    .unwrap();
+    let truths = [truth.contact.modulus_pa, 0.1, s];
+    for (p, t) in r.parameters.iter().zip(truths) {
+        let v = p.value.unwrap();
+        assert!((v / t - 1.0).abs() < 1e-6, "{}: {v} against {t}", p.name);
+    }
+    let r = fit(
+        &start,
+        &numerics(),
+        &data,
+        &opts(vec![
+            Parameter::Modulus,
+            Parameter::WorkOfAdhesion,
+            Parameter::Stiffness,
+            Parameter::Sensitivity,
+        ]),
+        |_| {},
+    )
+    .unwrap();
+    assert!(
+        r.parameters[..3].iter().all(|p| p.value.is_none()),
+        "{:?}",
+        r.parameters
+    );
+    assert!((r.parameters[3].value.unwrap() / s - 1.0).abs() < 1e-6);
+    let w = &r.identifiability.weakest_direction;
+    let sign = w[0].signum();
+    for (k, c) in w[..3].iter().enumerate() {
+        assert!(
+            (sign * c - 1.0 / 3f64.sqrt()).abs() < 0.05,
+            "component {k}: {w:?}"
+        );
+    }
+    assert!(w[3].abs() < 0.05, "{w:?}");
+    assert!(
+        r.identifiability
+            .notes
+            .iter()
+            .any(|n| n.contains("trade off along")),
+        "{:?}",
+        r.identifiability.notes
+    );
 }
 
 /// The profile likelihood of E* and Δγ (each held, the others refitted) against the
@@ -516,6 +621,7 @@ fn a_degeneracy_on_the_repulsive_branch_is_flagged_and_the_attractive_branch_lif
             Parameter::Range,
         ],
         offset_start_m: 0.0,
+        sensitivity_start: 1.0,
         estimate_sigma: false,
         max_curves: 60,
     };
@@ -529,7 +635,9 @@ fn a_degeneracy_on_the_repulsive_branch_is_flagged_and_the_attractive_branch_lif
             sigma_amplitude_m: SIGMA_A_M,
             sigma_phase_deg: SIGMA_PHI_DEG,
         };
-        let c = data.simulate(&truth, &numerics(), 0.0).unwrap();
+        let c = data
+            .simulate(&truth, &numerics(), &Nuisance::offset(0.0))
+            .unwrap();
         assert!(c.well_defined.iter().all(|&w| w));
         data.amplitude_m = Some(c.amplitude_m);
         data.phase_deg = Some(c.phase_deg.clone());

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 
 /// From a measured approach curve back to the material: which modulus and work of
 /// adhesion (and piezo offset; or, with --fit, the range ε, the dmt law's Hamaker
-/// constant, a viscous sample's viscosity, a relaxing one's relaxation time) make the
+/// constant, a viscous sample's viscosity, a relaxing one's relaxation time, and the
+/// nuisance parameters k, Q and the detector's sensitivity) make the
 /// simulated approach — each point a converged
 /// steady state, started from the last as an approach goes — match the amplitude and
 /// phase measured, by weighted least squares (Levenberg–Marquardt), and how sure the
@@ -104,6 +105,13 @@ enum FitParameter {
     /// A relaxing sample's relaxation time (start from --relaxation-time, with
     /// --unrelaxed-modulus).
     RelaxationTime,
+    /// The cantilever's spring constant k (a nuisance parameter, from --stiffness).
+    Stiffness,
+    /// The cantilever's quality factor Q (a nuisance parameter, from --quality).
+    Quality,
+    /// The detector's sensitivity: amplitudes read over true amplitudes, A₀ included
+    /// (a nuisance parameter, from 1).
+    Sensitivity,
     /// The positions' offset.
     ZOffset,
 }
@@ -117,6 +125,9 @@ impl From<FitParameter> for Parameter {
             FitParameter::Hamaker => Parameter::Hamaker,
             FitParameter::Viscosity => Parameter::Viscosity,
             FitParameter::RelaxationTime => Parameter::RelaxationTime,
+            FitParameter::Stiffness => Parameter::Stiffness,
+            FitParameter::Quality => Parameter::Quality,
+            FitParameter::Sensitivity => Parameter::Sensitivity,
             FitParameter::ZOffset => Parameter::ZOffset,
         }
     }
@@ -173,6 +184,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     let options = FitOptions {
         parameters,
         offset_start_m: args.offset.unwrap_or(0.0),
+        sensitivity_start: 1.0,
         estimate_sigma: !given,
         max_curves: args.max_curves,
     };

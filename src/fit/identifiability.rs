@@ -160,11 +160,16 @@ pub(crate) fn assess(
                 params[j].seen_in()
             )
         } else {
+            let factor = sigma[j].exp();
             format!(
                 "{} is not identifiable from these data: its standard error would be a \
-                 factor {:.3} — no value given",
+                 factor {} — no value given",
                 names[j],
-                sigma[j].exp()
+                if factor < 1e3 {
+                    format!("{factor:.3}")
+                } else {
+                    "above 1000".into()
+                }
             )
         });
     }

@@ -22,19 +22,50 @@ pub enum Parameter {
     Viscosity,
     /// A standard-linear-solid sample's relaxation time τ_r, s.
     RelaxationTime,
+    /// The cantilever's spring constant k, N/m (a nuisance parameter).
+    Stiffness,
+    /// The cantilever's quality factor Q (a nuisance parameter).
+    Quality,
+    /// The detector's sensitivity relative to its calibration: amplitudes read are this
+    /// times the true ones, the free amplitude A₀ the setup gives included (a nuisance
+    /// parameter; 1 where the calibration holds).
+    Sensitivity,
     /// The offset of the piezo position: z_c = z_piezo + offset, m.
     ZOffset,
 }
 
+/// What a fit adjusts besides the setup: the piezo offset and the detector's
+/// sensitivity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Nuisance {
+    /// z_c = position + offset, m.
+    pub offset_m: f64,
+    /// Amplitudes read over true amplitudes (1: the calibration holds).
+    pub sensitivity: f64,
+}
+
+impl Nuisance {
+    /// An offset, the calibration holding.
+    pub fn offset(offset_m: f64) -> Self {
+        Self {
+            offset_m,
+            sensitivity: 1.0,
+        }
+    }
+}
+
 impl Parameter {
     /// Every parameter.
-    pub const ALL: [Parameter; 7] = [
+    pub const ALL: [Parameter; 10] = [
         Parameter::Modulus,
         Parameter::WorkOfAdhesion,
         Parameter::Range,
         Parameter::Hamaker,
         Parameter::Viscosity,
         Parameter::RelaxationTime,
+        Parameter::Stiffness,
+        Parameter::Quality,
+        Parameter::Sensitivity,
         Parameter::ZOffset,
     ];
 
@@ -47,6 +78,9 @@ impl Parameter {
             Parameter::Hamaker => "Hamaker constant H (J)",
             Parameter::Viscosity => "sample viscosity η (Pa·s)",
             Parameter::RelaxationTime => "relaxation time τ_r (s)",
+            Parameter::Stiffness => "spring constant k (N/m)",
+            Parameter::Quality => "quality factor Q",
+            Parameter::Sensitivity => "detector sensitivity (read / true amplitude)",
             Parameter::ZOffset => "piezo offset (m)",
         }
     }
@@ -60,6 +94,9 @@ impl Parameter {
             Parameter::Hamaker => "hamaker_j",
             Parameter::Viscosity => "viscosity_pa_s",
             Parameter::RelaxationTime => "relaxation_time_s",
+            Parameter::Stiffness => "stiffness_n_m",
+            Parameter::Quality => "quality",
+            Parameter::Sensitivity => "sensitivity",
             Parameter::ZOffset => "z_offset_m",
         }
     }
@@ -85,13 +122,19 @@ impl Parameter {
                 "data where the tip indents the sample (the repulsive branch), best at more \
                  than one indentation rate (another drive frequency or amplitude)"
             }
+            Parameter::Stiffness | Parameter::Quality => {
+                "data where the tip feels the sample, on both branches"
+            }
+            Parameter::Sensitivity => {
+                "amplitudes in length units (a ratio A/A₀ cancels the sensitivity)"
+            }
             Parameter::ZOffset => "data where the tip feels the sample at all",
         }
     }
 
-    /// Its value in `setup` (the offset is not a setup's: `offset_m`); NaN for a law
-    /// parameter the setup does not have ([`Parameter::start`] refuses those).
-    pub fn value(self, setup: &TapSetup, offset_m: f64) -> f64 {
+    /// Its value in `setup` or `nuisance`; NaN for a law parameter the setup does not
+    /// have ([`Parameter::start`] refuses those).
+    pub fn value(self, setup: &TapSetup, nuisance: &Nuisance) -> f64 {
         let law = &setup.law;
         match self {
             Parameter::Modulus => setup.contact.modulus_pa,
@@ -104,13 +147,16 @@ impl Parameter {
             }),
             Parameter::Viscosity => law.viscosity_pa_s.unwrap_or(f64::NAN),
             Parameter::RelaxationTime => law.relaxation_time_s.unwrap_or(f64::NAN),
-            Parameter::ZOffset => offset_m,
+            Parameter::Stiffness => setup.cantilever.stiffness_n_m,
+            Parameter::Quality => setup.cantilever.quality,
+            Parameter::Sensitivity => nuisance.sensitivity,
+            Parameter::ZOffset => nuisance.offset_m,
         }
     }
 
     /// Its starting value in `setup`, or why it has none: a law parameter the setup's law
     /// does not take or the setup does not set.
-    pub fn start(self, setup: &TapSetup, offset_m: f64) -> Result<f64> {
+    pub fn start(self, setup: &TapSetup, nuisance: &Nuisance) -> Result<f64> {
         let law = &setup.law;
         let missing = |what: &str| {
             Err(Error::NotApplicable(format!(
@@ -129,12 +175,12 @@ impl Parameter {
                 "a relaxing sample to start from: give the setup an unrelaxed modulus and a \
                  relaxation time",
             ),
-            _ => Ok(self.value(setup, offset_m)),
+            _ => Ok(self.value(setup, nuisance)),
         }
     }
 
-    /// Set it to `value` in `setup` or `offset_m`.
-    pub fn set(self, setup: &mut TapSetup, offset_m: &mut f64, value: f64) {
+    /// Set it to `value` in `setup` or `nuisance`.
+    pub fn set(self, setup: &mut TapSetup, nuisance: &mut Nuisance, value: f64) {
         match self {
             Parameter::Modulus => setup.contact.modulus_pa = value,
             Parameter::WorkOfAdhesion => setup.contact.work_of_adhesion_j_m2 = value,
@@ -142,7 +188,10 @@ impl Parameter {
             Parameter::Hamaker => setup.law.hamaker_j = Some(value),
             Parameter::Viscosity => setup.law.viscosity_pa_s = Some(value),
             Parameter::RelaxationTime => setup.law.relaxation_time_s = Some(value),
-            Parameter::ZOffset => *offset_m = value,
+            Parameter::Stiffness => setup.cantilever.stiffness_n_m = value,
+            Parameter::Quality => setup.cantilever.quality = value,
+            Parameter::Sensitivity => nuisance.sensitivity = value,
+            Parameter::ZOffset => nuisance.offset_m = value,
         }
     }
 }
@@ -303,11 +352,32 @@ impl Measured {
         self.len() == 0
     }
 
-    /// The curves of `setup` at the measured positions shifted by `offset_m`, each
+    /// The curves of `setup` at the measured positions shifted by the offset, each
     /// approach from the free oscillation at its first position, joined; for setpoint
     /// data the state at each setpoint on the branch the measured phase shows (the
-    /// offset plays no part).
-    pub fn simulate(&self, setup: &TapSetup, numerics: &Numerics, offset_m: f64) -> Result<Curve> {
+    /// offset plays no part). Amplitudes as the detector reads them: the motion is
+    /// simulated with the true free amplitude A₀/s and its amplitudes read times s.
+    pub fn simulate(
+        &self,
+        setup: &TapSetup,
+        numerics: &Numerics,
+        nuisance: &Nuisance,
+    ) -> Result<Curve> {
+        let s = nuisance.sensitivity;
+        if s == 1.0 {
+            return self.simulate_true(setup, numerics, nuisance.offset_m);
+        }
+        let mut true_setup = setup.clone();
+        true_setup.cantilever.free_amplitude_m /= s;
+        let mut c = self.simulate_true(&true_setup, numerics, nuisance.offset_m)?;
+        for a in &mut c.amplitude_m {
+            *a *= s;
+        }
+        Ok(c)
+    }
+
+    /// [`Measured::simulate`] with the calibration holding.
+    fn simulate_true(&self, setup: &TapSetup, numerics: &Numerics, offset_m: f64) -> Result<Curve> {
         if let (Some(ratios), Some(phases)) = (&self.setpoint_ratio, &self.phase_deg) {
             return at_setpoints(setup, numerics, ratios, phases);
         }

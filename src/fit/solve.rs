@@ -3,7 +3,7 @@
 //! simulated curves (each point a converged steady state, started from the last).
 
 use super::identifiability::{Identifiability, ParameterEstimate, assess};
-use super::model::{Curve, Measured, Parameter};
+use super::model::{Curve, Measured, Nuisance, Parameter};
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
@@ -29,6 +29,9 @@ pub struct FitOptions {
     pub parameters: Vec<Parameter>,
     /// The offset's starting value, m (z_c = position + offset).
     pub offset_start_m: f64,
+    /// The detector sensitivity's starting value (1: the calibration holds); it stays
+    /// there unless [`Parameter::Sensitivity`] is fitted.
+    pub sensitivity_start: f64,
     /// Whether the data's standard deviations are estimated from the residuals (the
     /// covariance scaled by χ²/dof) rather than taken as given.
     pub estimate_sigma: bool,
@@ -103,12 +106,20 @@ pub fn fit(
             params.len()
         )));
     }
+    crate::error::positive("sensitivity start", options.sensitivity_start)?;
+    // What the fit does not adjust stays at its start: the offset too (z_c = position
+    // + the offset given).
+    let base = Nuisance {
+        offset_m: options.offset_start_m,
+        sensitivity: options.sensitivity_start,
+    };
     let starts: Vec<f64> = params
         .iter()
-        .map(|p| p.start(setup, options.offset_start_m))
+        .map(|p| p.start(setup, &base))
         .collect::<Result<_>>()?;
     let problem = Problem {
         setup,
+        base,
         numerics,
         data: &data,
         params,
@@ -148,10 +159,10 @@ pub fn fit(
     let chi_square = residuals.norm_squared();
     let dof = m - params.len();
     let reduced = chi_square / dof as f64;
-    let (fitted_setup, offset) = problem.physical(&x);
+    let (fitted_setup, nuisance) = problem.physical(&x);
     let physical: Vec<f64> = params
         .iter()
-        .map(|p| p.value(&fitted_setup, offset))
+        .map(|p| p.value(&fitted_setup, &nuisance))
         .collect();
     let scales: Vec<bool> = params.iter().map(|p| p.is_scale()).collect();
     let (estimates, identifiability) = assess(
@@ -211,6 +222,8 @@ type Evaluated = (DVector<f64>, Curve, DVector<f64>);
 /// start), the residuals a simulated curve's.
 struct Problem<'a, F: Fn(usize)> {
     setup: &'a TapSetup,
+    /// The offset and sensitivity where the fit does not adjust them.
+    base: Nuisance,
     numerics: &'a Numerics,
     data: &'a Measured,
     params: &'a [Parameter],
@@ -226,22 +239,19 @@ struct Problem<'a, F: Fn(usize)> {
 }
 
 impl<F: Fn(usize)> Problem<'_, F> {
-    /// The setup and offset at coordinates `x`.
-    fn physical(&self, x: &DVector<f64>) -> (TapSetup, f64) {
+    /// The setup and the offset and sensitivity at coordinates `x`.
+    fn physical(&self, x: &DVector<f64>) -> (TapSetup, Nuisance) {
         let mut setup = self.setup.clone();
-        let mut offset = 0.0;
+        let mut nuisance = self.base;
         for ((p, &start), &xi) in self.params.iter().zip(self.starts).zip(x.iter()) {
             let value = if p.is_scale() {
                 start * xi.exp()
             } else {
                 start + xi * 1e-9
             };
-            p.set(&mut setup, &mut offset, value);
+            p.set(&mut setup, &mut nuisance, value);
         }
-        if !self.params.contains(&Parameter::ZOffset) {
-            offset = 0.0;
-        }
-        (setup, offset)
+        (setup, nuisance)
     }
 
     /// The weighted residuals at `x` (None, with the failure kept, where the curve
@@ -258,8 +268,8 @@ impl<F: Fn(usize)> Problem<'_, F> {
         if self.curves.get() >= self.max_curves + self.params.len() + 2 {
             return None;
         }
-        let (setup, offset) = self.physical(x);
-        let simulated = self.data.simulate(&setup, self.numerics, offset);
+        let (setup, nuisance) = self.physical(x);
+        let simulated = self.data.simulate(&setup, self.numerics, &nuisance);
         self.curves.set(self.curves.get() + 1);
         (self.progress)(self.curves.get());
         match simulated {
@@ -335,12 +345,17 @@ pub struct Profile {
     pub interval_95: [Option<f64>; 2],
 }
 
-/// Put the values `fitted` found for `parameters` into `setup` and `offset_m` (a
+/// Put the values `fitted` found for `parameters` into `setup` and `nuisance` (a
 /// parameter given no value keeps its own).
-fn apply(parameters: &[Parameter], fitted: &FitReport, setup: &mut TapSetup, offset_m: &mut f64) {
+fn apply(
+    parameters: &[Parameter],
+    fitted: &FitReport,
+    setup: &mut TapSetup,
+    nuisance: &mut Nuisance,
+) {
     for (p, e) in parameters.iter().zip(&fitted.parameters) {
         if let Some(v) = e.value {
-            p.set(setup, offset_m, v);
+            p.set(setup, nuisance, v);
         }
     }
 }
@@ -375,8 +390,8 @@ pub fn profile(
     };
     // The best fit's setup and offset: every fitted value in place.
     let mut at_best = setup.clone();
-    let mut offset = options.offset_start_m;
-    apply(&options.parameters, best, &mut at_best, &mut offset);
+    let mut nuisance = Nuisance::offset(options.offset_start_m);
+    apply(&options.parameters, best, &mut at_best, &mut nuisance);
     let others: Vec<Parameter> = options
         .parameters
         .iter()
@@ -389,16 +404,17 @@ pub fn profile(
         1.0
     };
     let curves = Cell::new(0usize);
-    // χ² with `which` held at `v`, the others refitted from `start` (setup, offset).
-    let held = |v: f64, start: &(TapSetup, f64)| -> Result<(f64, (TapSetup, f64))> {
-        let (mut s, mut off) = start.clone();
-        which.set(&mut s, &mut off, v);
+    // χ² with `which` held at `v`, the others refitted from `start` (setup, offset and
+    // sensitivity).
+    let held = |v: f64, start: &(TapSetup, Nuisance)| -> Result<(f64, (TapSetup, Nuisance))> {
+        let (mut s, mut n) = start.clone();
+        which.set(&mut s, &mut n, v);
         let r = if others.is_empty() {
-            let c = data.simulate(&s, numerics, off)?;
+            let c = data.simulate(&s, numerics, &n)?;
             curves.set(curves.get() + 1);
             progress(curves.get());
             let chi: f64 = data.residuals(&c).iter().map(|r| r * r).sum();
-            return Ok((chi, (s, off)));
+            return Ok((chi, (s, n)));
         } else {
             let done = curves.get();
             fit(
@@ -407,7 +423,8 @@ pub fn profile(
                 data,
                 &FitOptions {
                     parameters: others.clone(),
-                    offset_start_m: off,
+                    offset_start_m: n.offset_m,
+                    sensitivity_start: n.sensitivity,
                     estimate_sigma: false,
                     max_curves: options.max_curves,
                 },
@@ -415,8 +432,8 @@ pub fn profile(
             )?
         };
         curves.set(curves.get() + r.curves);
-        apply(&others, &r, &mut s, &mut off);
-        Ok((r.chi_square, (s, off)))
+        apply(&others, &r, &mut s, &mut n);
+        Ok((r.chi_square, (s, n)))
     };
     let step = |i: f64| {
         if which.is_scale() {
@@ -427,7 +444,7 @@ pub fn profile(
     };
     let mut points = vec![(value, 0.0)];
     for side in [-1.0, 1.0] {
-        let mut start = (at_best.clone(), offset);
+        let mut start = (at_best.clone(), nuisance);
         for i in 1..=PROFILE_STEPS {
             let v = step(side * i as f64);
             let (chi, next) = held(v, &start)?;
