@@ -408,6 +408,7 @@ fn fit(c: &mut Criterion) {
     let data = Measured {
         position_m: positions.clone(),
         setpoint_ratio: None,
+        second_mode: None,
         segments: vec![0],
         amplitude_m: Some(
             clean

@@ -38,6 +38,7 @@ fn measured(truth: &TapSetup, positions: &[f64], seed: u64) -> Measured {
     Measured {
         position_m: positions.to_vec(),
         setpoint_ratio: None,
+        second_mode: None,
         segments: vec![0],
         amplitude_m: Some(
             c.amplitude_m
@@ -183,6 +184,7 @@ fn a_curve_over_both_branches_is_fitted_back_within_one_percent_from_three_start
     let mut data = Measured {
         position_m,
         setpoint_ratio: None,
+        second_mode: None,
         segments: vec![0, 30],
         amplitude_m: None,
         phase_deg: None,
@@ -267,6 +269,7 @@ fn a_parameter_the_data_do_not_see_is_given_no_value() {
     let data = Measured {
         position_m: far,
         setpoint_ratio: None,
+        second_mode: None,
         segments: vec![0],
         amplitude_m: Some(c.amplitude_m),
         phase_deg: Some(c.phase_deg),
@@ -317,6 +320,7 @@ fn a_viscosity_the_tip_never_indents_is_given_no_value() {
         let mut data = Measured {
             position_m,
             setpoint_ratio: None,
+            second_mode: None,
             segments: vec![0],
             amplitude_m: None,
             phase_deg: None,
@@ -380,6 +384,7 @@ fn phases_at_setpoints_fix_the_loss_not_modulus_and_adhesion_apart() {
     let data = Measured {
         position_m: Vec::new(),
         setpoint_ratio: Some(ratios),
+        second_mode: None,
         segments: vec![0],
         amplitude_m: None,
         phase_deg: Some(c.phase_deg),
@@ -463,6 +468,7 @@ fn nuisance_parameters_are_fitted_and_the_stiffness_symmetry_is_found() {
     let data = Measured {
         position_m: [far, near].concat(),
         setpoint_ratio: None,
+        second_mode: None,
         segments: vec![0, 20],
         amplitude_m: Some([read(&cf), read(&cn)].concat()),
         phase_deg: Some([cf.phase_deg, cn.phase_deg].concat()),
@@ -532,6 +538,103 @@ fn nuisance_parameters_are_fitted_and_the_stiffness_symmetry_is_found() {
         "{:?}",
         r.identifiability.notes
     );
+}
+
+/// A second eigenmode lifts the trade-off (bimodal AFM; the issue's "mode-2
+/// channels"): an approach of the hybrid defaults with the beam's second mode driven to
+/// 0.5 nm (16 points from 16.5 to 8.5 nm, both modes simulated, noise-free), fitted
+/// for E*, Δγ and ε from the truth. With the first mode's amplitude and phase alone, E*
+/// and Δγ correlate above 0.95 (a trade-off, named); adding the second mode's amplitude
+/// and phase brings that below 0.8 and shrinks both standard errors more than fivefold
+/// (the second mode's phase follows the force gradient the first averages over). From
+/// a start 20 % off in E* and Δγ the fit with both modes gives back the truth to 1e-6.
+#[test]
+#[ignore = "slow (two-mode approach curves, about 16 s in release): run with cargo test --release --test fit -- --ignored"]
+fn a_second_mode_lifts_the_trade_off_between_modulus_and_adhesion() {
+    use tapsim::dynamics::modes::ModeSet;
+    use tapsim::fit::SecondMode;
+    let truth = default_setup();
+    let modes = ModeSet::euler_bernoulli(&truth.cantilever, 2).unwrap();
+    let position_m: Vec<f64> = (0..16).map(|i| 16.5e-9 - 8e-9 * i as f64 / 15.0).collect();
+    let c = tapsim::fit::model::modal_curve(&truth, &numerics(), &modes, &position_m, 0.0).unwrap();
+    assert!(c.well_defined.iter().all(|&w| w));
+    let data = |with_second: bool| Measured {
+        position_m: position_m.clone(),
+        setpoint_ratio: None,
+        segments: vec![0],
+        amplitude_m: Some(c.amplitude_m.clone()),
+        phase_deg: Some(c.phase_deg.clone()),
+        sigma_amplitude_m: SIGMA_A_M,
+        sigma_phase_deg: SIGMA_PHI_DEG,
+        second_mode: Some(SecondMode {
+            modes: modes.clone(),
+            amplitude_m: with_second.then(|| c.amplitude2_m.clone()),
+            phase_deg: with_second.then(|| c.phase2_deg.clone()),
+            sigma_amplitude_m: SIGMA_A_M,
+            sigma_phase_deg: SIGMA_PHI_DEG,
+        }),
+    };
+    let opts = FitOptions {
+        parameters: vec![
+            Parameter::Modulus,
+            Parameter::WorkOfAdhesion,
+            Parameter::Range,
+        ],
+        offset_start_m: 0.0,
+        sensitivity_start: 1.0,
+        estimate_sigma: false,
+        max_curves: 100,
+    };
+    let first = fit(&truth, &numerics(), &data(false), &opts, |_| {}).unwrap();
+    let both = fit(&truth, &numerics(), &data(true), &opts, |_| {}).unwrap();
+    let corr = |r: &tapsim::fit::FitReport| r.identifiability.correlations[0][1].unwrap();
+    let rel = |r: &tapsim::fit::FitReport, k: usize| {
+        r.parameters[k].std_err.unwrap() / r.parameters[k].value.unwrap()
+    };
+    eprintln!(
+        "first mode: corr {:+.3}, E* ±{:.2} %, Δγ ±{:.2} %; both: corr {:+.3}, E* ±{:.2} %, \
+         Δγ ±{:.2} %",
+        corr(&first),
+        100.0 * rel(&first, 0),
+        100.0 * rel(&first, 1),
+        corr(&both),
+        100.0 * rel(&both, 0),
+        100.0 * rel(&both, 1)
+    );
+    assert!(corr(&first).abs() > 0.95);
+    // README: +0.978 and −0.590; ±1.16 %, ±1.34 % and ±0.14 %, ±0.14 %.
+    assert_eq!(
+        format!(
+            "{:+.3} {:+.3} {:.2} {:.2} {:.2} {:.2}",
+            corr(&first),
+            corr(&both),
+            100.0 * rel(&first, 0),
+            100.0 * rel(&first, 1),
+            100.0 * rel(&both, 0),
+            100.0 * rel(&both, 1)
+        ),
+        "+0.978 -0.590 1.16 1.34 0.14 0.14"
+    );
+    assert!(
+        first
+            .identifiability
+            .notes
+            .iter()
+            .any(|n| n.contains("trade off"))
+    );
+    assert!(corr(&both).abs() < 0.8);
+    for k in 0..2 {
+        assert!(rel(&both, k) < rel(&first, k) / 5.0);
+    }
+    let mut start = truth.clone();
+    start.contact.modulus_pa *= 1.2;
+    start.contact.work_of_adhesion_j_m2 *= 0.8;
+    let r = fit(&start, &numerics(), &data(true), &opts, |_| {}).unwrap();
+    let truths = [truth.contact.modulus_pa, 0.1, 0.3e-9];
+    for (p, t) in r.parameters.iter().zip(truths) {
+        let v = p.value.unwrap();
+        assert!((v / t - 1.0).abs() < 1e-6, "{}: {v} against {t}", p.name);
+    }
 }
 
 /// The profile likelihood of E* and Δγ (each held, the others refitted) against the
@@ -629,6 +732,7 @@ fn a_degeneracy_on_the_repulsive_branch_is_flagged_and_the_attractive_branch_lif
         let mut data = Measured {
             position_m,
             setpoint_ratio: None,
+            second_mode: None,
             segments,
             amplitude_m: None,
             phase_deg: None,

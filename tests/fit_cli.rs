@@ -154,6 +154,11 @@ fn bad_data_are_refused_with_why() {
         &["fit", &good, "--plot", "fit.txt"],
         "must end in .png or .svg",
     );
+    let second = write(
+        "second.csv",
+        "z_nm,amplitude_nm,phase_deg,phase2_deg\n10,15,120,30\n9,14,121,29\n8,13,122,28\n",
+    );
+    refused(&["fit", &second], "simulate the modes too (--modes 2)");
     refused(
         &["fit", &good, "--fit", "viscosity"],
         "needs a viscous sample to start from",

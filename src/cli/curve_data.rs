@@ -16,6 +16,9 @@ enum Kind {
     Amplitude,
     AmplitudeRatio,
     Phase,
+    Amplitude2,
+    Amplitude2Ratio,
+    Phase2,
     Setpoint,
     Deflection,
     MeanForce,
@@ -35,10 +38,15 @@ fn column_kind(name: &str) -> Option<(Kind, f64)> {
         }
     }
     match n.as_str() {
-        "amplitude_m" => Some((Kind::Amplitude, 1.0)),
-        "amplitude_nm" => Some((Kind::Amplitude, 1e-9)),
-        "amplitude_ratio" => Some((Kind::AmplitudeRatio, 1.0)),
-        "phase_deg" => Some((Kind::Phase, 1.0)),
+        // The first mode's (a several-mode approach names it amplitude1_…, phase1_…).
+        "amplitude_m" | "amplitude1_m" => Some((Kind::Amplitude, 1.0)),
+        "amplitude_nm" | "amplitude1_nm" => Some((Kind::Amplitude, 1e-9)),
+        "amplitude_ratio" | "amplitude1_ratio" => Some((Kind::AmplitudeRatio, 1.0)),
+        "phase_deg" | "phase1_deg" => Some((Kind::Phase, 1.0)),
+        "amplitude2_m" => Some((Kind::Amplitude2, 1.0)),
+        "amplitude2_nm" => Some((Kind::Amplitude2, 1e-9)),
+        "amplitude2_ratio" => Some((Kind::Amplitude2Ratio, 1.0)),
+        "phase2_deg" => Some((Kind::Phase2, 1.0)),
         "setpoint" | "setpoint_ratio" => Some((Kind::Setpoint, 1.0)),
         "deflection_m" => Some((Kind::Deflection, 1.0)),
         "deflection_nm" => Some((Kind::Deflection, 1e-9)),
@@ -64,12 +72,21 @@ pub struct Columns {
     pub phase_deg: Option<Vec<f64>>,
     /// Mean deflections, m (a deflection column, or the mean force over k).
     pub mean_deflection_m: Option<Vec<f64>>,
+    /// The second eigenmode's amplitudes, m.
+    pub amplitude2_m: Option<Vec<f64>>,
+    /// Its phases, degrees.
+    pub phase2_deg: Option<Vec<f64>>,
 }
 
 /// Read the curve of `path`: the rows whose `direction` column (if any) is `direction`;
-/// amplitudes given as ratios are made m with the cantilever's A₀, a mean force is made a
-/// deflection with its k.
-pub fn read_curve(path: &Path, cantilever: &Cantilever, direction: &str) -> Result<Columns> {
+/// amplitudes given as ratios are made m with the cantilever's A₀ (the second mode's
+/// with `second_free_amplitude_m`, A₀₂), a mean force is made a deflection with its k.
+pub fn read_curve(
+    path: &Path,
+    cantilever: &Cantilever,
+    second_free_amplitude_m: Option<f64>,
+    direction: &str,
+) -> Result<Columns> {
     let fail = |reason: String| Error::Parse {
         name: "data file",
         text: path.display().to_string(),
@@ -125,9 +142,31 @@ pub fn read_curve(path: &Path, cantilever: &Cantilever, direction: &str) -> Resu
         at.get(&Kind::MeanForce)
             .map(|&(i, _)| (i, 1.0 / cantilever.stiffness_n_m))
     });
+    if at.contains_key(&Kind::Amplitude2) {
+        at.remove(&Kind::Amplitude2Ratio);
+    }
+    let amp2 = match (
+        at.get(&Kind::Amplitude2).copied(),
+        at.get(&Kind::Amplitude2Ratio),
+    ) {
+        (Some(c), _) => Some(c),
+        (None, Some(&(i, _))) => match second_free_amplitude_m {
+            Some(a02) => Some((i, a02)),
+            None => {
+                return Err(fail(
+                    "amplitude2_ratio is A₂/A₀₂: the second mode's free amplitude is needed \
+                     (simulate two modes)"
+                        .into(),
+                ));
+            }
+        },
+        (None, None) => None,
+    };
+    let phase2 = at.get(&Kind::Phase2).copied();
     let direction_col = at.get(&Kind::Direction).map(|&(i, _)| i);
     let segment = at.get(&Kind::Segment).map(|&(i, _)| i);
     let (mut z, mut a, mut p, mut d) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut a2, mut p2) = (Vec::new(), Vec::new());
     let mut segments = Vec::new();
     let mut label: Option<String> = None;
     for (row, record) in reader.records().enumerate() {
@@ -170,6 +209,12 @@ pub fn read_curve(path: &Path, cantilever: &Cantilever, direction: &str) -> Resu
         if let Some(c) = deflection {
             d.push(value(c, "deflection")?);
         }
+        if let Some(c) = amp2 {
+            a2.push(value(c, "second mode's amplitude")?);
+        }
+        if let Some(c) = phase2 {
+            p2.push(value(c, "second mode's phase")?);
+        }
     }
     if z.is_empty() {
         return Err(fail(match direction_col {
@@ -188,5 +233,7 @@ pub fn read_curve(path: &Path, cantilever: &Cantilever, direction: &str) -> Resu
         amplitude_m: amp.map(|_| a),
         phase_deg: phase.map(|_| p),
         mean_deflection_m: deflection.map(|_| d),
+        amplitude2_m: amp2.map(|_| a2),
+        phase2_deg: phase2.map(|_| p2),
     })
 }

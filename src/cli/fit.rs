@@ -4,7 +4,7 @@
 use super::curve_data::{Columns, read_curve};
 use crate::config::{TapInputs, length, number};
 use crate::error::{Error, Result};
-use crate::fit::{FitOptions, FitReport, Measured, Parameter, Profile, fit, profile};
+use crate::fit::{FitOptions, FitReport, Measured, Parameter, Profile, SecondMode, fit, profile};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -60,6 +60,13 @@ pub struct FitArgs {
     /// The phase's standard deviation [degrees].
     #[arg(long, allow_hyphen_values = true, value_parser = number)]
     sigma_phase: Option<f64>,
+    /// The second mode's amplitude standard deviation [m; default as the first's
+    /// relative weight, 0.02 nm].
+    #[arg(long, allow_hyphen_values = true, value_parser = length)]
+    sigma_amplitude2: Option<f64>,
+    /// The second mode's phase standard deviation [degrees; default 0.05].
+    #[arg(long, allow_hyphen_values = true, value_parser = number)]
+    sigma_phase2: Option<f64>,
     /// Also profile each identifiable material parameter: χ² with it held at values
     /// about the estimate and the others refitted, and the intervals where χ² rises
     /// by 1 and 3.84 — exact where the linearised ones assume the model straight (each
@@ -70,6 +77,10 @@ pub struct FitArgs {
     /// [default 400].
     #[arg(long, default_value_t = 400)]
     max_curves: usize,
+    /// The higher eigenmodes, for second-mode channels (amplitude2_nm, amplitude2_m or
+    /// amplitude2_ratio; phase2_deg) read beside the first mode's.
+    #[command(flatten)]
+    modes: crate::config::ModeInputs,
     #[command(flatten)]
     inputs: TapInputs,
     /// Plot the measured and fitted amplitude and phase against z_c, the weighted
@@ -136,29 +147,76 @@ impl From<FitParameter> for Parameter {
 /// Run the subcommand.
 pub fn run(args: FitArgs) -> Result<()> {
     super::check_plot_path(args.plot.as_deref())?;
-    let (setup, numerics) = args.inputs.resolve()?;
+    let mut inputs = args.inputs.clone().with_config()?;
+    inputs.takes_modes = true;
+    let (setup, numerics) = inputs.resolve()?;
+    let modes = args.modes.mode_set(&inputs.mode_file, &setup.cantilever)?;
     let numerics = crate::sweep::sweep_numerics(numerics, (false, false));
+    let second_a0 = modes
+        .as_ref()
+        .and_then(|m| m.higher.first())
+        .map(|m| m.free_amplitude_m);
     let Columns {
         position_m,
         setpoint_ratio,
         segments,
         amplitude_m,
         phase_deg,
+        amplitude2_m,
+        phase2_deg,
         ..
-    } = read_curve(&args.data, &setup.cantilever, "approach")?;
-    let given = args.sigma_amplitude.is_some() || args.sigma_phase.is_some();
-    if given
-        && ((amplitude_m.is_some() && args.sigma_amplitude.is_none())
-            || (phase_deg.is_some() && args.sigma_phase.is_none()))
-    {
+    } = read_curve(&args.data, &setup.cantilever, second_a0, "approach")?;
+    // Several modes simulated (--modes 2) whether or not the data hold the second's
+    // channels; those channels without the modes are refused.
+    let second_mode = match (amplitude2_m.is_some() || phase2_deg.is_some(), modes) {
+        (false, None) => None,
+        (true, None) => {
+            return Err(Error::NotApplicable(
+                "the data hold second-mode channels: simulate the modes too (--modes 2)".into(),
+            ));
+        }
+        (_, Some(modes)) => Some(SecondMode {
+            modes,
+            amplitude_m: amplitude2_m,
+            phase_deg: phase2_deg,
+            sigma_amplitude_m: args.sigma_amplitude2.unwrap_or(0.02e-9),
+            sigma_phase_deg: args.sigma_phase2.unwrap_or(0.05),
+        }),
+    };
+    let given = [
+        args.sigma_amplitude,
+        args.sigma_phase,
+        args.sigma_amplitude2,
+        args.sigma_phase2,
+    ]
+    .iter()
+    .any(Option::is_some);
+    let second = second_mode.as_ref();
+    let missing = [
+        (amplitude_m.is_some(), args.sigma_amplitude),
+        (phase_deg.is_some(), args.sigma_phase),
+        (
+            second.is_some_and(|m| m.amplitude_m.is_some()),
+            args.sigma_amplitude2,
+        ),
+        (
+            second.is_some_and(|m| m.phase_deg.is_some()),
+            args.sigma_phase2,
+        ),
+    ]
+    .iter()
+    .any(|(held, sigma)| *held && sigma.is_none());
+    if given && missing {
         return Err(Error::NotApplicable(
             "give the standard deviation of every channel the data hold (--sigma-amplitude \
-             and --sigma-phase), or neither (then estimated from the residuals)"
+             and --sigma-phase, and for the second mode --sigma-amplitude2 and \
+             --sigma-phase2), or none (then estimated from the residuals)"
                 .into(),
         ));
     }
     let at_setpoints = setpoint_ratio.is_some();
     let data = Measured {
+        second_mode,
         position_m,
         setpoint_ratio,
         segments,

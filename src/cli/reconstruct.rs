@@ -111,7 +111,7 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
         phase_deg,
         mean_deflection_m,
         ..
-    } = read_curve(&args.data, &setup.cantilever, direction)?;
+    } = read_curve(&args.data, &setup.cantilever, None, direction)?;
     if setpoint_ratio.is_some() {
         return Err(Error::NotApplicable(format!(
             "{}: a reconstruction needs the positions the curve was taken at (setpoints \

@@ -16,5 +16,5 @@ pub mod model;
 pub mod solve;
 
 pub use identifiability::{Identifiability, ParameterEstimate};
-pub use model::{Curve, Measured, Nuisance, Parameter};
+pub use model::{Curve, Measured, Nuisance, Parameter, SecondMode};
 pub use solve::{FitOptions, FitReport, Profile, fit, profile};

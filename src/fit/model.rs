@@ -1,6 +1,7 @@
 //! The forward model of a fit: the parameters it may adjust, the measured curve, and the
 //! approach curve a parameter set gives at the measured piezo positions.
 
+use crate::dynamics::modes::ModeSet;
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
 use crate::sweep::{Direction, MAX_SWEEP_POINTS, approach_curve};
@@ -221,6 +222,25 @@ pub struct Measured {
     pub sigma_amplitude_m: f64,
     /// The phase's, degrees.
     pub sigma_phase_deg: f64,
+    /// The second eigenmode's channels, read with the first (bimodal AFM).
+    pub second_mode: Option<SecondMode>,
+}
+
+/// What a second eigenmode read at each point (bimodal AFM: the first mode's amplitude
+/// and phase above, the second's here), with the modes simulated; with neither channel
+/// the modes are simulated and only the first mode read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SecondMode {
+    /// The higher modes (their stiffness, resonance, Q and drive), as given.
+    pub modes: ModeSet,
+    /// The second mode's amplitudes, m.
+    pub amplitude_m: Option<Vec<f64>>,
+    /// Its phases, degrees.
+    pub phase_deg: Option<Vec<f64>>,
+    /// The standard deviation of its amplitude, m.
+    pub sigma_amplitude_m: f64,
+    /// Of its phase, degrees.
+    pub sigma_phase_deg: f64,
 }
 
 impl Measured {
@@ -292,6 +312,9 @@ impl Measured {
         if self.phase_deg.is_some() {
             crate::error::positive("phase standard deviation", self.sigma_phase_deg)?;
         }
+        if let Some(m) = &self.second_mode {
+            m.check(n)?;
+        }
         Ok(self)
     }
 
@@ -307,6 +330,13 @@ impl Measured {
         if !self.position_m.is_empty() {
             return Err(Error::NotApplicable(
                 "give positions or setpoints, not both".into(),
+            ));
+        }
+        if self.second_mode.is_some() {
+            return Err(Error::NotApplicable(
+                "second-mode channels are fitted along an approach curve (positions), not \
+                 at setpoints"
+                    .into(),
             ));
         }
         if self.amplitude_m.is_some() {
@@ -369,8 +399,14 @@ impl Measured {
         }
         let mut true_setup = setup.clone();
         true_setup.cantilever.free_amplitude_m /= s;
-        let mut c = self.simulate_true(&true_setup, numerics, nuisance.offset_m)?;
-        for a in &mut c.amplitude_m {
+        let mut data = self.clone();
+        if let Some(m) = &mut data.second_mode {
+            for mode in &mut m.modes.higher {
+                mode.free_amplitude_m /= s;
+            }
+        }
+        let mut c = data.simulate_true(&true_setup, numerics, nuisance.offset_m)?;
+        for a in c.amplitude_m.iter_mut().chain(&mut c.amplitude2_m) {
             *a *= s;
         }
         Ok(c)
@@ -385,7 +421,11 @@ impl Measured {
         let mut joined: Option<Curve> = None;
         for (k, &start) in self.segments.iter().enumerate() {
             let end = self.segments.get(k + 1).copied().unwrap_or(n);
-            let c = curve(setup, numerics, &self.position_m[start..end], offset_m)?;
+            let positions = &self.position_m[start..end];
+            let c = match &self.second_mode {
+                Some(m) => modal_curve(setup, numerics, &m.modes, positions, offset_m)?,
+                None => curve(setup, numerics, positions, offset_m)?,
+            };
             match joined.as_mut() {
                 None => joined = Some(c),
                 Some(j) => {
@@ -393,6 +433,8 @@ impl Measured {
                     j.amplitude_m.extend(c.amplitude_m);
                     j.phase_deg.extend(c.phase_deg);
                     j.well_defined.extend(c.well_defined);
+                    j.amplitude2_m.extend(c.amplitude2_m);
+                    j.phase2_deg.extend(c.phase2_deg);
                 }
             }
         }
@@ -401,7 +443,10 @@ impl Measured {
 
     /// Residuals per point: one per channel measured.
     pub fn channels(&self) -> usize {
-        usize::from(self.amplitude_m.is_some()) + usize::from(self.phase_deg.is_some())
+        let second = self.second_mode.as_ref().map_or(0, |m| {
+            usize::from(m.amplitude_m.is_some()) + usize::from(m.phase_deg.is_some())
+        });
+        usize::from(self.amplitude_m.is_some()) + usize::from(self.phase_deg.is_some()) + second
     }
 
     /// The weighted residuals (model − measured)/σ of `curve`, amplitudes first.
@@ -421,6 +466,22 @@ impl Measured {
                     .map(|(m, s)| (s - m) / self.sigma_phase_deg),
             );
         }
+        if let Some(m) = &self.second_mode {
+            if let Some(a) = &m.amplitude_m {
+                r.extend(
+                    a.iter()
+                        .zip(&curve.amplitude2_m)
+                        .map(|(x, s)| (s - x) / m.sigma_amplitude_m),
+                );
+            }
+            if let Some(p) = &m.phase_deg {
+                r.extend(
+                    p.iter()
+                        .zip(&curve.phase2_deg)
+                        .map(|(x, s)| (s - x) / m.sigma_phase_deg),
+                );
+            }
+        }
         r
     }
 }
@@ -438,6 +499,12 @@ pub struct Curve {
     /// Whether each point is a stable period-1 orbit that does not graze a switch (else
     /// its values are averages over motion that perturbations can change).
     pub well_defined: Vec<bool>,
+    /// The second mode's amplitudes, m (empty without one).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub amplitude2_m: Vec<f64>,
+    /// Its phases, degrees (empty without one).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub phase2_deg: Vec<f64>,
 }
 
 /// The approach curve of `setup` at the piezo positions `position_m` shifted by
@@ -462,6 +529,8 @@ pub fn curve(
             .iter()
             .map(|p| p.observables.regime == "period-1" && !p.observables.grazing)
             .collect(),
+        amplitude2_m: Vec::new(),
+        phase2_deg: Vec::new(),
     })
 }
 
@@ -481,6 +550,8 @@ pub fn at_setpoints(
         amplitude_m: Vec::with_capacity(ratios.len()),
         phase_deg: Vec::with_capacity(ratios.len()),
         well_defined: Vec::with_capacity(ratios.len()),
+        amplitude2_m: Vec::new(),
+        phase2_deg: Vec::new(),
     };
     for (&r, &phi) in ratios.iter().zip(phases) {
         crate::interrupt::check()?;
@@ -493,6 +564,92 @@ pub fn at_setpoints(
         c.amplitude_m.push(s.observables.amplitude_m);
         c.phase_deg.push(s.observables.phase_deg);
         c.well_defined.push(!s.observables.grazing);
+    }
+    Ok(c)
+}
+
+impl SecondMode {
+    /// Validate for `n` points: each channel given of `n` finite values, its standard
+    /// deviation positive (none given: the modes are simulated, only the first read).
+    fn check(&self, n: usize) -> Result<()> {
+        if self.modes.higher.is_empty() {
+            return Err(Error::NotApplicable(
+                "second-mode channels need a second mode to simulate".into(),
+            ));
+        }
+        for (name, column, sigma) in [
+            (
+                "second mode's amplitude",
+                self.amplitude_m.as_ref(),
+                self.sigma_amplitude_m,
+            ),
+            (
+                "second mode's phase",
+                self.phase_deg.as_ref(),
+                self.sigma_phase_deg,
+            ),
+        ] {
+            let Some(column) = column else { continue };
+            if column.len() != n {
+                return Err(Error::NotApplicable(format!(
+                    "{} {name} values for {n} positions",
+                    column.len()
+                )));
+            }
+            if let Some((i, v)) = column.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(Error::NotApplicable(format!(
+                    "{name} of point {} is {v}: every value must be finite",
+                    i + 1
+                )));
+            }
+            if !(sigma.is_finite() && sigma > 0.0) {
+                return Err(Error::NotApplicable(format!(
+                    "the {name}'s standard deviation must be positive, not {sigma}"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The several-mode approach curve of `setup` with the higher modes `modes` at the
+/// positions `position_m` shifted by `offset_m`, each point's orbit continued from the
+/// last ([`crate::bimodal::approach`]); the first two modes' amplitudes and phases. A
+/// point where the modes settle on no orbit of their common period is an error naming
+/// it (such points are left out of the data).
+pub fn modal_curve(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    modes: &ModeSet,
+    position_m: &[f64],
+    offset_m: f64,
+) -> Result<Curve> {
+    let (p, modal) = crate::dynamics::modes::prepare(setup, modes, numerics)?;
+    let separations: Vec<f64> = position_m.iter().map(|z| z + offset_m).collect();
+    let points = crate::bimodal::approach(&p, &modal, numerics, &separations, || {})?;
+    let mut c = Curve {
+        separation_m: separations,
+        amplitude_m: Vec::with_capacity(points.len()),
+        phase_deg: Vec::with_capacity(points.len()),
+        well_defined: Vec::with_capacity(points.len()),
+        amplitude2_m: Vec::with_capacity(points.len()),
+        phase2_deg: Vec::with_capacity(points.len()),
+    };
+    for point in points {
+        let Some(state) = point.state else {
+            return Err(Error::NotApplicable(format!(
+                "at z_c = {:.4} nm the modes settle on no orbit of their common period ({}): \
+                 leave such points out of the data",
+                point.separation_m * 1e9,
+                point.note.unwrap_or_default()
+            )));
+        };
+        let (first, second) = (&state.modes[0], &state.modes[1]);
+        c.amplitude_m.push(first.amplitude_m);
+        c.phase_deg.push(first.phase_deg);
+        c.amplitude2_m.push(second.amplitude_m);
+        c.phase2_deg.push(second.phase_deg);
+        c.well_defined.push(state.stable);
     }
     Ok(c)
 }

@@ -76,9 +76,36 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
             ],
         ));
     }
-    // The residuals, amplitudes first (as the report lists them).
+    if let Some(m) = &data.second_mode {
+        if let Some(a) = &m.amplitude_m {
+            let measured: Vec<f64> = a.iter().map(|v| v * 1e9).collect();
+            let fitted: Vec<f64> = r.fitted.amplitude2_m.iter().map(|v| v * 1e9).collect();
+            out.push(chart(
+                "amplitude2",
+                "second mode's amplitude: measured and fitted".into(),
+                Axis::linear("amplitude A₂ (nm)", "amplitude2_nm"),
+                vec![
+                    Series::new(&measured_name, marks(&measured), Style::Markers, 0),
+                    Series::new(&fitted_name, line(&fitted), Style::Line, 1),
+                ],
+            ));
+        }
+        if let Some(p) = &m.phase_deg {
+            out.push(chart(
+                "phase2",
+                "second mode's phase: measured and fitted".into(),
+                Axis::linear("phase lag φ₂ (deg)", "phase2_deg"),
+                vec![
+                    Series::new(&measured_name, marks(p), Style::Markers, 0),
+                    Series::new(&fitted_name, line(&r.fitted.phase2_deg), Style::Line, 1),
+                ],
+            ));
+        }
+    }
+    // The residuals, in the report's order: amplitude, phase, then the second mode's.
     let mut residuals = Vec::new();
     let mut k = 0;
+    let second = data.second_mode.as_ref();
     for (present, name, style) in [
         (
             data.amplitude_m.is_some(),
@@ -86,6 +113,16 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
             Style::Markers,
         ),
         (data.phase_deg.is_some(), "phase residual", Style::Squares),
+        (
+            second.is_some_and(|m| m.amplitude_m.is_some()),
+            "second mode's amplitude residual",
+            Style::Crosses,
+        ),
+        (
+            second.is_some_and(|m| m.phase_deg.is_some()),
+            "second mode's phase residual",
+            Style::Triangles,
+        ),
     ] {
         if present {
             residuals.push(Series::new(
@@ -135,6 +172,18 @@ pub struct Row {
     /// (fitted − measured)/σ of the phase.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub phase_residual: Option<f64>,
+    /// The second mode's measured amplitude, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub amplitude2_m: Option<f64>,
+    /// Its fitted amplitude, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fitted_amplitude2_m: Option<f64>,
+    /// The second mode's measured phase, degrees.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub phase2_deg: Option<f64>,
+    /// Its fitted phase, degrees.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fitted_phase2_deg: Option<f64>,
     /// Whether the fitted state is a stable period-1 orbit clear of the law's switches.
     pub well_defined: bool,
 }
@@ -159,6 +208,18 @@ pub fn rows(r: &FitReport, data: &Measured) -> Vec<Row> {
             phase_deg: data.phase_deg.as_ref().map(|p| p[i]),
             fitted_phase_deg: r.fitted.phase_deg[i],
             phase_residual: phase_at.map(|k| r.residuals[k + i]),
+            amplitude2_m: data
+                .second_mode
+                .as_ref()
+                .and_then(|m| m.amplitude_m.as_ref())
+                .map(|a| a[i]),
+            fitted_amplitude2_m: r.fitted.amplitude2_m.get(i).copied(),
+            phase2_deg: data
+                .second_mode
+                .as_ref()
+                .and_then(|m| m.phase_deg.as_ref())
+                .map(|p| p[i]),
+            fitted_phase2_deg: r.fitted.phase2_deg.get(i).copied(),
             well_defined: r.fitted.well_defined[i],
         })
         .collect()
