@@ -332,11 +332,25 @@ fn profile_text(r: &FitReport, profiles: &[Profile]) -> String {
 fn text(r: &FitReport, law: &str, data: &Measured) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
-    let channels = match (data.amplitude_m.is_some(), data.phase_deg.is_some()) {
+    let first = match (data.amplitude_m.is_some(), data.phase_deg.is_some()) {
         (true, true) => "amplitude and phase",
         (true, false) => "amplitude",
         _ => "phase",
     };
+    let second = data.second_mode.as_ref().map_or("", |m| {
+        match (m.amplitude_m.is_some(), m.phase_deg.is_some()) {
+            (true, true) => "; the second mode's amplitude and phase",
+            (true, false) => "; the second mode's amplitude",
+            (false, true) => "; the second mode's phase",
+            (false, false) => "; two modes simulated",
+        }
+    });
+    let at = if data.setpoint_ratio.is_some() {
+        " at amplitude setpoints"
+    } else {
+        ""
+    };
+    let channels = format!("{first}{at}{second}");
     let _ = writeln!(
         s,
         "fit of {} points ({channels}), {law} law: {} simulated curves, {} ({})",
