@@ -18,11 +18,19 @@ fn numerics() -> Numerics {
     sweep_numerics(Numerics::default(), (false, false))
 }
 
+/// `n` points from `from` down to `to`, evenly spaced.
+fn span(from: f64, to: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| from - (from - to) * i as f64 / (n - 1) as f64)
+        .collect()
+}
+
 /// Piezo positions of an approach from z_c = 18.5 nm to 8 nm in `n` points (the hybrid
 /// defaults tap period-1 there, on the attractive branch).
 fn positions(n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| 18.5e-9 - 10.5e-9 * i as f64 / (n - 1) as f64 - OFFSET_M)
+    span(18.5e-9, 8e-9, n)
+        .iter()
+        .map(|z| z - OFFSET_M)
         .collect()
 }
 
@@ -174,13 +182,11 @@ fn a_noisy_approach_curve_is_fitted_back_from_three_starts() {
 #[ignore = "slow (three fits of some 60 curves of 60 points, about 20 s in release): run with cargo test --release --test fit -- --ignored"]
 fn a_curve_over_both_branches_is_fitted_back_within_one_percent_from_three_starts() {
     let truth = default_setup();
-    let span = |from: f64, to: f64, n: usize| -> Vec<f64> {
-        (0..n)
-            .map(|i| from - (from - to) * i as f64 / (n - 1) as f64 - OFFSET_M)
-            .collect()
-    };
-    let mut position_m = span(18.5e-9, 8e-9, 30);
-    position_m.extend(span(12e-9, 4e-9, 30));
+    let position_m: Vec<f64> = [span(18.5e-9, 8e-9, 30), span(12e-9, 4e-9, 30)]
+        .concat()
+        .iter()
+        .map(|z| z - OFFSET_M)
+        .collect();
     let mut data = Measured {
         position_m,
         setpoint_ratio: None,
@@ -300,11 +306,6 @@ fn a_parameter_the_data_do_not_see_is_given_no_value() {
 fn a_viscosity_the_tip_never_indents_is_given_no_value() {
     let mut truth = default_setup();
     truth.law.viscosity_pa_s = Some(10.0);
-    let span = |from: f64, to: f64, n: usize| -> Vec<f64> {
-        (0..n)
-            .map(|i| from - (from - to) * i as f64 / (n - 1) as f64)
-            .collect()
-    };
     let opts = FitOptions {
         parameters: vec![
             Parameter::Modulus,
@@ -452,11 +453,6 @@ fn phases_at_setpoints_fix_the_loss_not_modulus_and_adhesion_apart() {
 #[test]
 fn nuisance_parameters_are_fitted_and_the_stiffness_symmetry_is_found() {
     let truth = default_setup();
-    let span = |from: f64, to: f64, n: usize| -> Vec<f64> {
-        (0..n)
-            .map(|i| from - (from - to) * i as f64 / (n - 1) as f64)
-            .collect()
-    };
     let s = 1.03;
     let (far, near) = (span(18.5e-9, 8e-9, 20), span(12e-9, 4e-9, 20));
     // The true motion, read 3 % high.
@@ -555,7 +551,7 @@ fn a_second_mode_lifts_the_trade_off_between_modulus_and_adhesion() {
     use tapsim::fit::SecondMode;
     let truth = default_setup();
     let modes = ModeSet::euler_bernoulli(&truth.cantilever, 2).unwrap();
-    let position_m: Vec<f64> = (0..16).map(|i| 16.5e-9 - 8e-9 * i as f64 / 15.0).collect();
+    let position_m = span(16.5e-9, 8.5e-9, 16);
     let c = tapsim::fit::model::modal_curve(&truth, &numerics(), &modes, &position_m, 0.0).unwrap();
     assert!(c.well_defined.iter().all(|&w| w));
     let data = |with_second: bool| Measured {
@@ -712,11 +708,6 @@ fn the_68_percent_intervals_cover_the_truth_in_68_percent_of_replicas() {
 #[test]
 fn a_degeneracy_on_the_repulsive_branch_is_flagged_and_the_attractive_branch_lifts_it() {
     let truth = default_setup();
-    let span = |from: f64, to: f64, n: usize| -> Vec<f64> {
-        (0..n)
-            .map(|i| from - (from - to) * i as f64 / (n - 1) as f64)
-            .collect()
-    };
     let opts = FitOptions {
         parameters: vec![
             Parameter::Modulus,

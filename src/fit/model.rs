@@ -441,6 +441,39 @@ impl Measured {
         joined.ok_or_else(|| Error::NotApplicable("no approach to simulate".into()))
     }
 
+    /// Each channel measured with its standard deviation and the simulated values it is
+    /// compared with in `curve`: amplitude, phase, then the second mode's.
+    fn channel_list<'a>(&'a self, curve: &'a Curve) -> Vec<(&'a [f64], &'a [f64], f64)> {
+        let second = self.second_mode.as_ref();
+        [
+            (
+                self.amplitude_m.as_deref(),
+                &curve.amplitude_m,
+                self.sigma_amplitude_m,
+            ),
+            (
+                self.phase_deg.as_deref(),
+                &curve.phase_deg,
+                self.sigma_phase_deg,
+            ),
+            (
+                second.and_then(|m| m.amplitude_m.as_deref()),
+                &curve.amplitude2_m,
+                second.map_or(0.0, |m| m.sigma_amplitude_m),
+            ),
+            (
+                second.and_then(|m| m.phase_deg.as_deref()),
+                &curve.phase2_deg,
+                second.map_or(0.0, |m| m.sigma_phase_deg),
+            ),
+        ]
+        .into_iter()
+        .filter_map(|(measured, simulated, sigma)| {
+            measured.map(|m| (m, simulated.as_slice(), sigma))
+        })
+        .collect()
+    }
+
     /// Residuals per point: one per channel measured.
     pub fn channels(&self) -> usize {
         let second = self.second_mode.as_ref().map_or(0, |m| {
@@ -449,40 +482,18 @@ impl Measured {
         usize::from(self.amplitude_m.is_some()) + usize::from(self.phase_deg.is_some()) + second
     }
 
-    /// The weighted residuals (model − measured)/σ of `curve`, amplitudes first.
+    /// The weighted residuals (model − measured)/σ of `curve`: the amplitudes, the
+    /// phases, then the second mode's.
     pub fn residuals(&self, curve: &Curve) -> Vec<f64> {
-        let mut r = Vec::with_capacity(self.channels() * self.len());
-        if let Some(a) = &self.amplitude_m {
-            r.extend(
-                a.iter()
-                    .zip(&curve.amplitude_m)
-                    .map(|(m, s)| (s - m) / self.sigma_amplitude_m),
-            );
-        }
-        if let Some(p) = &self.phase_deg {
-            r.extend(
-                p.iter()
-                    .zip(&curve.phase_deg)
-                    .map(|(m, s)| (s - m) / self.sigma_phase_deg),
-            );
-        }
-        if let Some(m) = &self.second_mode {
-            if let Some(a) = &m.amplitude_m {
-                r.extend(
-                    a.iter()
-                        .zip(&curve.amplitude2_m)
-                        .map(|(x, s)| (s - x) / m.sigma_amplitude_m),
-                );
-            }
-            if let Some(p) = &m.phase_deg {
-                r.extend(
-                    p.iter()
-                        .zip(&curve.phase2_deg)
-                        .map(|(x, s)| (s - x) / m.sigma_phase_deg),
-                );
-            }
-        }
-        r
+        self.channel_list(curve)
+            .into_iter()
+            .flat_map(|(measured, simulated, sigma)| {
+                measured
+                    .iter()
+                    .zip(simulated)
+                    .map(move |(m, s)| (s - m) / sigma)
+            })
+            .collect()
     }
 }
 
