@@ -29,6 +29,10 @@ use crate::law::{Branch, ForceLaw};
 use serde::Serialize;
 use std::f64::consts::PI;
 
+/// Most points a reconstruction takes (each force integrates over every farther point:
+/// the work grows as the square of their number, 10⁸ steps here, well under a second).
+pub const MAX_POINTS: usize = 10_000;
+
 /// The cantilever as the reconstruction needs it (SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Probe {
@@ -185,6 +189,12 @@ pub fn reconstruct(probe: &Probe, curve: &AmCurve) -> Result<Reconstruction> {
             "a reconstruction needs at least 3 points of the curve ({n} given)"
         )));
     }
+    if n > MAX_POINTS {
+        return Err(Error::OutOfRange(format!(
+            "a reconstruction takes at most {MAX_POINTS} points (its integrals grow as the \
+             square of their number), not {n}"
+        )));
+    }
     let zero = vec![0.0; n];
     let deflection = curve.mean_deflection_m.as_deref().unwrap_or(&zero);
     let mut points = Vec::with_capacity(n);
@@ -261,7 +271,7 @@ pub fn reconstruct(probe: &Probe, curve: &AmCurve) -> Result<Reconstruction> {
         ));
     }
     kept.reverse();
-    let points = kept;
+    let mut points = kept;
     let n = points.len();
     let d: Vec<f64> = points.iter().map(|p| p.closest_m).collect();
     let a: Vec<f64> = points.iter().map(|p| p.amplitude_m).collect();
@@ -272,7 +282,6 @@ pub fn reconstruct(probe: &Probe, curve: &AmCurve) -> Result<Reconstruction> {
     let energy_floor =
         1e-9 * PI * probe.stiffness_n_m * probe.free_amplitude_m.powi(2) / probe.quality;
     let resolved = |v: f64, floor: f64| if v.abs() <= floor { 0.0 } else { v };
-    let mut points = points;
     for (p, f) in points
         .iter_mut()
         .zip(sader_jarvis(probe.stiffness_n_m, &d, &a, &shift))

@@ -220,8 +220,8 @@ fn the_loss_from_the_phase_meets_the_integrated_loss_of_a_hysteretic_law() {
     );
 }
 
-/// Input it cannot invert is refused with a reason: too few points, columns of unequal
-/// length, a non-positive amplitude, two points at one position.
+/// Input it cannot invert is refused with a reason: too few points or too many, columns
+/// of unequal length, a non-positive amplitude, two points at one position.
 #[test]
 fn curves_it_cannot_invert_are_refused() {
     let probe = probe_of(&default_setup());
@@ -233,6 +233,9 @@ fn curves_it_cannot_invert_are_refused() {
     };
     let msg = |c: AmCurve| reconstruct(&probe, &c).unwrap_err().to_string();
     assert!(msg(curve(vec![1e-8, 2e-8], vec![1e-8; 2], vec![90.0; 2])).contains("at least 3"));
+    let many = tapsim::reconstruct::MAX_POINTS + 1;
+    let z: Vec<f64> = (0..many).map(|i| 1e-8 + 1e-12 * i as f64).collect();
+    assert!(msg(curve(z, vec![1e-8; many], vec![90.0; many])).contains("at most"));
     assert!(msg(curve(vec![1e-8, 2e-8, 3e-8], vec![1e-8; 2], vec![90.0; 3])).contains("length"));
     assert!(
         msg(curve(
