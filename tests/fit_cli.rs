@@ -75,6 +75,22 @@ fn an_approach_curve_is_fitted_back() {
     ] {
         assert!(svg.contains(label), "{label}");
     }
+    // A law that cannot describe the data: the fit's steps leave the plausible range
+    // (E* below 1 kPa) and it stops, saying why, instead of printing a fit.
+    refused(
+        &[
+            "fit",
+            csv,
+            "--law",
+            "dmt",
+            "--work-of-adhesion",
+            "0.02",
+            "--fit",
+            "modulus",
+            "-q",
+        ],
+        "the fit stopped where a trial curve could not be simulated",
+    );
     // --csv: the data beside the fit, one row per point; the fitted values are the
     // JSON's curve, the residuals its residuals (amplitudes first).
     let rows = dir.join("fit.csv");

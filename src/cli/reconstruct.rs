@@ -99,7 +99,7 @@ const LAW_GRID: usize = 800;
 /// Run the subcommand.
 pub fn run(args: ReconstructArgs) -> Result<()> {
     super::check_plot_path(args.plot.as_deref())?;
-    let (setup, numerics) = args.inputs.resolve()?;
+    let (setup, numerics) = args.inputs.clone().with_config()?.resolve()?;
     let direction = match args.direction {
         Branch::Approach => "approach",
         Branch::Retract => "retract",

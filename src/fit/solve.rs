@@ -137,7 +137,11 @@ pub fn fit(
     // The solution's curve and Jacobian, beyond the optimiser's budget.
     problem.max_curves = usize::MAX - params.len() - 2;
     if let Some(e) = problem.failure.borrow_mut().take() {
-        return Err(e);
+        return Err(Error::NotApplicable(format!(
+            "the fit stopped where a trial curve could not be simulated ({e}). Such a step \
+             means the data pull the parameters far from the start: the law or the fixed \
+             parameters may not describe these data, or the start is far off"
+        )));
     }
     let x = problem.x.clone();
     let residuals = problem
