@@ -11,11 +11,11 @@ use std::path::PathBuf;
 /// From a measured approach curve back to the material: which modulus and work of
 /// adhesion (and piezo offset; or, with --fit, the range ε, the dmt law's Hamaker
 /// constant, a viscous sample's viscosity, a relaxing one's relaxation time, and the
-/// nuisance parameters k, Q and the detector's sensitivity) make the
-/// simulated approach — each point a converged
-/// steady state, started from the last as an approach goes — match the amplitude and
-/// phase measured, by weighted least squares (Levenberg–Marquardt), and how sure the
-/// data let one be.
+/// nuisance parameters k, Q and the detector's sensitivity) make the simulated
+/// approach — each point a converged steady state, started from the last as an
+/// approach goes — match the amplitude and phase measured, by weighted least squares
+/// (Levenberg–Marquardt), and how sure the data let one be. With --modes 2 both modes
+/// are simulated and the second's channels (amplitude2_*, phase2_deg) fitted too.
 ///
 /// DATA is a CSV whose header names the columns with their units: a position
 /// (z_nm, z_m, z_c_nm, z_c_m, separation_nm, separation_m, position_nm or position_m;
