@@ -65,17 +65,30 @@ fn measured(truth: &TapSetup, positions: &[f64], seed: u64) -> Measured {
     }
 }
 
-fn options(offset_start_m: f64) -> FitOptions {
+/// A fit of `parameters` with the standard deviations as given, at most `max_curves`
+/// simulated curves, the offset from 0 and the calibration holding.
+fn fitting(parameters: Vec<Parameter>, max_curves: usize) -> FitOptions {
     FitOptions {
-        parameters: vec![
-            Parameter::Modulus,
-            Parameter::WorkOfAdhesion,
-            Parameter::ZOffset,
-        ],
-        offset_start_m,
+        parameters,
+        offset_start_m: 0.0,
         sensitivity_start: 1.0,
         estimate_sigma: false,
-        max_curves: 400,
+        max_curves,
+    }
+}
+
+/// E*, Δγ and the offset, the offset from `offset_start_m`.
+fn options(offset_start_m: f64) -> FitOptions {
+    FitOptions {
+        offset_start_m,
+        ..fitting(
+            vec![
+                Parameter::Modulus,
+                Parameter::WorkOfAdhesion,
+                Parameter::ZOffset,
+            ],
+            400,
+        )
     }
 }
 
@@ -306,17 +319,14 @@ fn a_parameter_the_data_do_not_see_is_given_no_value() {
 fn a_viscosity_the_tip_never_indents_is_given_no_value() {
     let mut truth = default_setup();
     truth.law.viscosity_pa_s = Some(10.0);
-    let opts = FitOptions {
-        parameters: vec![
+    let opts = fitting(
+        vec![
             Parameter::Modulus,
             Parameter::WorkOfAdhesion,
             Parameter::Viscosity,
         ],
-        offset_start_m: 0.0,
-        sensitivity_start: 1.0,
-        estimate_sigma: false,
-        max_curves: 40,
-    };
+        40,
+    );
     let fitted = |position_m: Vec<f64>| {
         let mut data = Measured {
             position_m,
@@ -392,13 +402,7 @@ fn phases_at_setpoints_fix_the_loss_not_modulus_and_adhesion_apart() {
         sigma_amplitude_m: SIGMA_A_M,
         sigma_phase_deg: SIGMA_PHI_DEG,
     };
-    let opts = |parameters: Vec<Parameter>| FitOptions {
-        parameters,
-        offset_start_m: 0.0,
-        sensitivity_start: 1.0,
-        estimate_sigma: false,
-        max_curves: 100,
-    };
+    let opts = |parameters: Vec<Parameter>| fitting(parameters, 100);
     let mut start = truth.clone();
     start.contact.work_of_adhesion_j_m2 *= 0.8;
     let both = fit(
@@ -474,13 +478,7 @@ fn nuisance_parameters_are_fitted_and_the_stiffness_symmetry_is_found() {
     let mut start = truth.clone();
     start.cantilever.free_amplitude_m = 20e-9 * s;
     start.contact.modulus_pa *= 1.2;
-    let opts = |parameters: Vec<Parameter>| FitOptions {
-        parameters,
-        offset_start_m: 0.0,
-        sensitivity_start: 1.0,
-        estimate_sigma: false,
-        max_curves: 200,
-    };
+    let opts = |parameters: Vec<Parameter>| fitting(parameters, 200);
     let r = fit(
         &start,
         &numerics(),
@@ -570,17 +568,14 @@ fn a_second_mode_lifts_the_trade_off_between_modulus_and_adhesion() {
             sigma_phase_deg: SIGMA_PHI_DEG,
         }),
     };
-    let opts = FitOptions {
-        parameters: vec![
+    let opts = fitting(
+        vec![
             Parameter::Modulus,
             Parameter::WorkOfAdhesion,
             Parameter::Range,
         ],
-        offset_start_m: 0.0,
-        sensitivity_start: 1.0,
-        estimate_sigma: false,
-        max_curves: 100,
-    };
+        100,
+    );
     let first = fit(&truth, &numerics(), &data(false), &opts, |_| {}).unwrap();
     let both = fit(&truth, &numerics(), &data(true), &opts, |_| {}).unwrap();
     let corr = |r: &tapsim::fit::FitReport| r.identifiability.correlations[0][1].unwrap();
@@ -708,17 +703,14 @@ fn the_68_percent_intervals_cover_the_truth_in_68_percent_of_replicas() {
 #[test]
 fn a_degeneracy_on_the_repulsive_branch_is_flagged_and_the_attractive_branch_lifts_it() {
     let truth = default_setup();
-    let opts = FitOptions {
-        parameters: vec![
+    let opts = fitting(
+        vec![
             Parameter::Modulus,
             Parameter::WorkOfAdhesion,
             Parameter::Range,
         ],
-        offset_start_m: 0.0,
-        sensitivity_start: 1.0,
-        estimate_sigma: false,
-        max_curves: 60,
-    };
+        60,
+    );
     let assess = |position_m: Vec<f64>, segments: Vec<usize>| {
         let mut data = Measured {
             position_m,

@@ -268,18 +268,7 @@ impl Measured {
             ("phase", self.phase_deg.as_ref()),
         ] {
             let Some(column) = column else { continue };
-            if column.len() != n {
-                return Err(Error::NotApplicable(format!(
-                    "{} {name} values for {n} positions",
-                    column.len()
-                )));
-            }
-            if let Some((i, v)) = column.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-                return Err(Error::NotApplicable(format!(
-                    "{name} of point {} is {v}: every value must be finite",
-                    i + 1
-                )));
-            }
+            check_column(name, column, n, "positions")?;
         }
         if self.segments.first() != Some(&0)
             || self.segments.windows(2).any(|w| w[1] <= w[0])
@@ -351,18 +340,7 @@ impl Measured {
                 "setpoint data need the phase read at each setpoint".into(),
             ));
         };
-        if phase.len() != n {
-            return Err(Error::NotApplicable(format!(
-                "{} phase values for {n} setpoints",
-                phase.len()
-            )));
-        }
-        if let Some((i, v)) = phase.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(Error::NotApplicable(format!(
-                "phase of point {} is {v}: every value must be finite",
-                i + 1
-            )));
-        }
+        check_column("phase", phase, n, "setpoints")?;
         for &r in self.setpoint_ratio.iter().flatten() {
             crate::setpoint::check_ratio(r)?;
         }
@@ -579,6 +557,24 @@ pub fn at_setpoints(
     Ok(c)
 }
 
+/// Refuse a measured channel `name` that does not hold one finite value for each of the
+/// `n` points (`per`: what the points are, positions or setpoints).
+fn check_column(name: &str, column: &[f64], n: usize, per: &str) -> Result<()> {
+    if column.len() != n {
+        return Err(Error::NotApplicable(format!(
+            "{} {name} values for {n} {per}",
+            column.len()
+        )));
+    }
+    if let Some((i, v)) = column.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(Error::NotApplicable(format!(
+            "{name} of point {} is {v}: every value must be finite",
+            i + 1
+        )));
+    }
+    Ok(())
+}
+
 impl SecondMode {
     /// Validate for `n` points: each channel given of `n` finite values, its standard
     /// deviation positive (none given: the modes are simulated, only the first read).
@@ -601,18 +597,7 @@ impl SecondMode {
             ),
         ] {
             let Some(column) = column else { continue };
-            if column.len() != n {
-                return Err(Error::NotApplicable(format!(
-                    "{} {name} values for {n} positions",
-                    column.len()
-                )));
-            }
-            if let Some((i, v)) = column.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-                return Err(Error::NotApplicable(format!(
-                    "{name} of point {} is {v}: every value must be finite",
-                    i + 1
-                )));
-            }
+            check_column(name, column, n, "positions")?;
             if !(sigma.is_finite() && sigma > 0.0) {
                 return Err(Error::NotApplicable(format!(
                     "the {name}'s standard deviation must be positive, not {sigma}"
