@@ -168,12 +168,18 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
         let grid: Vec<f64> = (0..=LAW_GRID)
             .map(|i| lo + (hi - lo) * i as f64 / LAW_GRID as f64)
             .collect();
-        let drawn = grid.iter().map(|&d| at(d));
+        let (approach_nn, retract_nn) = grid
+            .iter()
+            .map(|&d| {
+                let (a, b) = at(d);
+                (a * 1e9, b * 1e9)
+            })
+            .unzip();
         let curves = LawCurves {
             name: setup.law.to_string(),
             closest_nm: grid.iter().map(|d| d * 1e9).collect(),
-            approach_nn: drawn.clone().map(|f| f.0 * 1e9).collect(),
-            retract_nn: drawn.map(|f| f.1 * 1e9).collect(),
+            approach_nn,
+            retract_nn,
         };
         Some((curves, forces, notes))
     } else {
