@@ -392,7 +392,7 @@ fn modes(c: &mut Criterion) {
 fn fit(c: &mut Criterion) {
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
-    use tapsim::fit::{FitOptions, Measured, Parameter, model::curve};
+    use tapsim::fit::{FitOptions, Measured, Nuisance, Parameter, Search, model::curve};
     let truth = default_setup();
     let numerics = tapsim::sweep::sweep_numerics(Numerics::default(), (false, false));
     let offset = 3e-9;
@@ -436,10 +436,10 @@ fn fit(c: &mut Criterion) {
             Parameter::WorkOfAdhesion,
             Parameter::ZOffset,
         ],
-        offset_start_m: offset - 1e-9,
-        sensitivity_start: 1.0,
+        start: Nuisance::offset(offset - 1e-9),
         estimate_sigma: false,
         max_curves: 400,
+        search: Search::Local,
     };
     let mut group = c.benchmark_group("fit");
     group.sample_size(10);

@@ -276,9 +276,10 @@ pub struct TapInputs {
     /// Flags override it.
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// Tip–sample force law.
-    #[arg(long, value_enum, ignore_case = true)]
-    pub law: Option<LawKind>,
+    /// Tip–sample force law (`tapsim fit` takes several, comma-separated, and ranks
+    /// them).
+    #[arg(long, value_enum, ignore_case = true, value_delimiter = ',')]
+    pub law: Vec<LawKind>,
     /// The contact.
     #[command(flatten)]
     pub contact: ContactInputs,
@@ -529,11 +530,11 @@ impl TapInputs {
             }
             if key == "law" {
                 let name = value.as_str().unwrap_or_default();
-                inputs.law = Some(LawKind::from_name(name).ok_or_else(|| Error::Parse {
+                inputs.law = vec![LawKind::from_name(name).ok_or_else(|| Error::Parse {
                     name: "law",
                     text: value.to_string(),
                     reason: format!("expected one of {}", LawKind::names().join(", ")),
-                })?);
+                })?];
                 continue;
             }
             inputs.set(key, &value_text(value, key, "config value")?)?;
@@ -582,7 +583,11 @@ impl TapInputs {
             || self.amplitude_setpoint.is_some();
         Self {
             config: self.config.or(base.config),
-            law: self.law.or(base.law),
+            law: if self.law.is_empty() {
+                base.law
+            } else {
+                self.law
+            },
             contact: self.contact.or(base.contact),
             law_params: self.law_params.or(base.law_params),
             stiffness: self.stiffness.or(base.stiffness),
@@ -667,6 +672,13 @@ impl TapInputs {
     /// The setup and numerics: these inputs over the built-in defaults
     /// ([`default_setup`], [`Numerics::default`]).
     pub fn resolve(&self) -> Result<(TapSetup, Numerics)> {
+        if self.law.len() > 1 {
+            return Err(Error::NotApplicable(format!(
+                "one law at a time here, not {}: `tapsim fit --law a,b` fits several and \
+                 ranks them",
+                self.law.len()
+            )));
+        }
         if !self.takes_modes
             && self
                 .mode_file
@@ -702,7 +714,7 @@ impl TapInputs {
             cantilever,
             separation_m: self.separation.unwrap_or(d.separation_m),
             law: LawSpec::from_values(
-                self.law.unwrap_or(d.law.kind),
+                self.law.first().copied().unwrap_or(d.law.kind),
                 self.law_params.or(LawParamInputs::of(&d.law)).0,
             ),
         };

@@ -121,6 +121,32 @@ pub fn approach_curve_at(
     thermal: Option<&AverageRequest>,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Vec<SweepPoint>> {
+    sweep_points(setup, numerics, ramp, thermal, |i, _| {
+        progress(i + 1, ramp.len());
+        true
+    })
+}
+
+/// [`approach_curve`] that stops after the first point `keep` (given its index and the
+/// point) refuses: the points up to and including that one. A fit screening a
+/// parameter set stops a curve once it is out of the running.
+pub fn approach_curve_while(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    ramp: &[(f64, Direction)],
+    keep: impl FnMut(usize, &SweepPoint) -> bool,
+) -> Result<Vec<SweepPoint>> {
+    sweep_points(setup, numerics, ramp, None, keep)
+}
+
+/// The sweep behind [`approach_curve_at`] and [`approach_curve_while`].
+fn sweep_points(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    ramp: &[(f64, Direction)],
+    thermal: Option<&AverageRequest>,
+    mut keep: impl FnMut(usize, &SweepPoint) -> bool,
+) -> Result<Vec<SweepPoint>> {
     if let Some(request) = thermal {
         request.check()?;
     }
@@ -144,7 +170,9 @@ pub fn approach_curve_at(
             observables,
             thermal_average,
         });
-        progress(i + 1, ramp.len());
+        if !keep(i, out.last().expect("just pushed")) {
+            break;
+        }
     }
     Ok(out)
 }

@@ -5,7 +5,7 @@
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use tapsim::dynamics::setup::{Numerics, TapSetup, default_setup};
-use tapsim::fit::{FitOptions, Measured, Nuisance, Parameter, fit, model::curve};
+use tapsim::fit::{FitOptions, Measured, Nuisance, Parameter, Search, fit, model::curve};
 use tapsim::sweep::sweep_numerics;
 
 /// The true offset of the piezo's zero: z_c = position + 3 nm.
@@ -70,17 +70,17 @@ fn measured(truth: &TapSetup, positions: &[f64], seed: u64) -> Measured {
 fn fitting(parameters: Vec<Parameter>, max_curves: usize) -> FitOptions {
     FitOptions {
         parameters,
-        offset_start_m: 0.0,
-        sensitivity_start: 1.0,
+        start: Nuisance::offset(0.0),
         estimate_sigma: false,
         max_curves,
+        search: Search::Local,
     }
 }
 
 /// E*, Δγ and the offset, the offset from `offset_start_m`.
 fn options(offset_start_m: f64) -> FitOptions {
     FitOptions {
-        offset_start_m,
+        start: Nuisance::offset(offset_start_m),
         ..fitting(
             vec![
                 Parameter::Modulus,

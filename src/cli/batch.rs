@@ -207,7 +207,7 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
                 }
             }
             "law" => {
-                inputs.law = Some(crate::law::LawKind::from_name(text).ok_or_else(|| {
+                inputs.law = vec![crate::law::LawKind::from_name(text).ok_or_else(|| {
                     at(Error::Parse {
                         name: "law",
                         text: text.clone(),
@@ -216,7 +216,7 @@ fn case(index: usize, row: &Row, base: &TapInputs) -> Result<Case> {
                             crate::law::LawKind::names().join(", ")
                         ),
                     })
-                })?)
+                })?]
             }
             other => inputs.set(other, text).map_err(|e| match e {
                 Error::Parse { name: "key", .. } => at(Error::Parse {

@@ -9,11 +9,45 @@ use std::path::Path;
 /// The largest data file read.
 const MAX_DATA_BYTES: u64 = 64 << 20;
 
+/// How a data file's phase is defined (it is read into tapsim's: the lag).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum PhaseConvention {
+    /// The tip's lag behind the drive: 90° free at resonance, above 90° where the tip
+    /// feels attraction (tapsim's).
+    #[default]
+    Lag,
+    /// The negative of the lag: −90° free.
+    Lead,
+    /// 90° − lag: 0 free, negative where the tip feels attraction.
+    Shift,
+}
+
+impl PhaseConvention {
+    /// The lag of a phase read in this convention, degrees.
+    pub fn lag_deg(self, read: f64) -> f64 {
+        match self {
+            PhaseConvention::Lag => read,
+            PhaseConvention::Lead => -read,
+            PhaseConvention::Shift => 90.0 - read,
+        }
+    }
+}
+
+/// How to read a file's channels.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Reading {
+    /// The phase columns' convention.
+    pub phase: PhaseConvention,
+    /// The deflection sensitivity for amplitudes in volts, m/V.
+    pub invols_m_per_v: Option<f64>,
+}
+
 /// What a column holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 enum Kind {
     Position,
     Amplitude,
+    AmplitudeVolts,
     AmplitudeRatio,
     Phase,
     Amplitude2,
@@ -42,6 +76,7 @@ fn column_kind(name: &str) -> Option<(Kind, f64)> {
         "amplitude_m" | "amplitude1_m" => Some((Kind::Amplitude, 1.0)),
         "amplitude_nm" | "amplitude1_nm" => Some((Kind::Amplitude, 1e-9)),
         "amplitude_ratio" | "amplitude1_ratio" => Some((Kind::AmplitudeRatio, 1.0)),
+        "amplitude_v" | "amplitude1_v" => Some((Kind::AmplitudeVolts, 1.0)),
         "phase_deg" | "phase1_deg" => Some((Kind::Phase, 1.0)),
         "amplitude2_m" => Some((Kind::Amplitude2, 1.0)),
         "amplitude2_nm" => Some((Kind::Amplitude2, 1e-9)),
@@ -80,12 +115,14 @@ pub struct Columns {
 
 /// Read the curve of `path`: the rows whose `direction` column (if any) is `direction`;
 /// amplitudes given as ratios are made m with the cantilever's A₀ (the second mode's
-/// with `second_free_amplitude_m`, A₀₂), a mean force is made a deflection with its k.
+/// with `second_free_amplitude_m`, A₀₂), in volts with the InvOLS of `reading`; phases
+/// made lags from its convention; a mean force is made a deflection with its k.
 pub fn read_curve(
     path: &Path,
     cantilever: &Cantilever,
     second_free_amplitude_m: Option<f64>,
     direction: &str,
+    reading: &Reading,
 ) -> Result<Columns> {
     let fail = |reason: String| Error::Parse {
         name: "data file",
@@ -126,15 +163,40 @@ pub fn read_curve(
                 .into(),
         ));
     };
-    let amp = at.get(&Kind::Amplitude).copied().or_else(|| {
-        at.get(&Kind::AmplitudeRatio)
-            .map(|&(i, _)| (i, cantilever.free_amplitude_m))
-    });
+    let volts = match (at.get(&Kind::AmplitudeVolts), reading.invols_m_per_v) {
+        (None, _) => None,
+        (Some(&(i, _)), Some(invols)) if invols.is_finite() && invols > 0.0 => Some((i, invols)),
+        (Some(_), Some(invols)) => {
+            return Err(fail(format!(
+                "the deflection sensitivity must be positive, not {invols} m/V"
+            )));
+        }
+        (Some(_), None) => {
+            return Err(fail(
+                "amplitude_v is in volts: give the deflection sensitivity (--invols, m/V, \
+                 e.g. 50nm)"
+                    .into(),
+            ));
+        }
+    };
+    if volts.is_some()
+        && (at.contains_key(&Kind::Amplitude) || at.contains_key(&Kind::AmplitudeRatio))
+    {
+        return Err(fail("two columns give the amplitude".into()));
+    }
+    let amp = at
+        .get(&Kind::Amplitude)
+        .copied()
+        .or_else(|| {
+            at.get(&Kind::AmplitudeRatio)
+                .map(|&(i, _)| (i, cantilever.free_amplitude_m))
+        })
+        .or(volts);
     let phase = at.get(&Kind::Phase).copied();
     if amp.is_none() && phase.is_none() {
         return Err(fail(
-            "no amplitude (amplitude_nm, amplitude_m, amplitude_ratio) or phase (phase_deg) \
-             column"
+            "no amplitude (amplitude_nm, amplitude_m, amplitude_ratio, amplitude_v) or phase \
+             (phase_deg) column"
                 .into(),
         ));
     }
@@ -204,7 +266,7 @@ pub fn read_curve(
             a.push(value(c, "amplitude")?);
         }
         if let Some(c) = phase {
-            p.push(value(c, "phase")?);
+            p.push(reading.phase.lag_deg(value(c, "phase")?));
         }
         if let Some(c) = deflection {
             d.push(value(c, "deflection")?);
@@ -213,7 +275,7 @@ pub fn read_curve(
             a2.push(value(c, "second mode's amplitude")?);
         }
         if let Some(c) = phase2 {
-            p2.push(value(c, "second mode's phase")?);
+            p2.push(reading.phase.lag_deg(value(c, "second mode's phase")?));
         }
     }
     if z.is_empty() {

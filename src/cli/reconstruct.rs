@@ -111,7 +111,13 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
         phase_deg,
         mean_deflection_m,
         ..
-    } = read_curve(&args.data, &setup.cantilever, None, direction)?;
+    } = read_curve(
+        &args.data,
+        &setup.cantilever,
+        None,
+        direction,
+        &super::curve_data::Reading::default(),
+    )?;
     if setpoint_ratio.is_some() {
         return Err(Error::NotApplicable(format!(
             "{}: a reconstruction needs the positions the curve was taken at (setpoints \

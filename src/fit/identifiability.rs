@@ -62,16 +62,16 @@ pub struct Identifiability {
 /// the fitted coordinates `x`, `variance_factor` 1 where the standard deviations are
 /// known, χ²/dof where they are estimated from the residuals, and none where they
 /// cannot be (residuals at the simulation's own precision: no intervals then, the
-/// identifiability judged at the weights given); `scales` whether each coordinate is a
-/// logarithm, `physical` each coordinate's value in SI.
+/// identifiability judged at the weights given; likewise where the fit does not
+/// describe its data), `physical` each coordinate's value in SI.
 pub(crate) fn assess(
     params: &[Parameter],
     jacobian: &DMatrix<f64>,
     variance_factor: Option<f64>,
-    scales: &[bool],
     physical: &[f64],
     starts: &[f64],
 ) -> (Vec<ParameterEstimate>, Identifiability) {
+    let scales: Vec<bool> = params.iter().map(|p| p.is_scale()).collect();
     let names: Vec<&'static str> = params.iter().map(|p| p.key()).collect();
     let n = names.len();
     let svd = jacobian.clone().svd(false, true);
@@ -115,8 +115,9 @@ pub(crate) fn assess(
                 if scales[j] {
                     [v * (-z * sigma[j]).exp(), v * (z * sigma[j]).exp()]
                 } else {
-                    // The offset's coordinate is in nm.
-                    [v - z * sigma[j] * 1e-9, v + z * sigma[j] * 1e-9]
+                    // An offset's coordinate is in its unit (nm, degrees).
+                    let u = params[j].unit();
+                    [v - z * sigma[j] * u, v + z * sigma[j] * u]
                 }
             };
             ParameterEstimate {
@@ -127,7 +128,7 @@ pub(crate) fn assess(
                     if scales[j] {
                         v * sigma[j]
                     } else {
-                        sigma[j] * 1e-9
+                        sigma[j] * params[j].unit()
                     }
                 }),
                 interval_68: (ok && intervals).then(|| interval(1.0)),

@@ -11,10 +11,19 @@
 //! [`model`] is the forward model (the curve of a parameter set), [`solve`] the fit and
 //! [`identifiability`] what its Jacobian says.
 
+pub mod diagnose;
 pub mod identifiability;
+mod local;
 pub mod model;
+pub mod progress;
+pub mod search;
+pub mod select;
 pub mod solve;
 
+pub use diagnose::Diagnosis;
 pub use identifiability::{Identifiability, ParameterEstimate};
 pub use model::{Curve, Measured, Nuisance, Parameter, SecondMode};
-pub use solve::{FitOptions, FitReport, Profile, fit, profile};
+pub use progress::{Progress, Stage};
+pub use search::Search;
+pub use select::{LawComparison, compare};
+pub use solve::{FitOptions, FitReport, Minimum, Profile, fit, profile};

@@ -4,7 +4,7 @@
 use crate::dynamics::modes::ModeSet;
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
-use crate::sweep::{Direction, MAX_SWEEP_POINTS, approach_curve};
+use crate::sweep::{Direction, MAX_SWEEP_POINTS, approach_curve_while};
 use serde::Serialize;
 
 /// A parameter a fit may adjust (the others stay as the setup gives them).
@@ -31,33 +31,40 @@ pub enum Parameter {
     /// times the true ones, the free amplitude A₀ the setup gives included (a nuisance
     /// parameter; 1 where the calibration holds).
     Sensitivity,
+    /// An offset added to every phase the instrument reads, degrees (a nuisance
+    /// parameter: a phase channel's zero is set by the electronics, not the physics).
+    PhaseOffset,
     /// The offset of the piezo position: z_c = z_piezo + offset, m.
     ZOffset,
 }
 
-/// What a fit adjusts besides the setup: the piezo offset and the detector's
-/// sensitivity.
+/// What a fit adjusts besides the setup: the piezo offset, the detector's sensitivity
+/// and the phase channel's offset.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Nuisance {
     /// z_c = position + offset, m.
     pub offset_m: f64,
     /// Amplitudes read over true amplitudes (1: the calibration holds).
     pub sensitivity: f64,
+    /// Phases read minus true phases, degrees (0: the phase channel is zeroed as
+    /// tapsim's is, 90° free at resonance).
+    pub phase_offset_deg: f64,
 }
 
 impl Nuisance {
-    /// An offset, the calibration holding.
+    /// An offset, the calibration holding and the phase channel zeroed.
     pub fn offset(offset_m: f64) -> Self {
         Self {
             offset_m,
             sensitivity: 1.0,
+            phase_offset_deg: 0.0,
         }
     }
 }
 
 impl Parameter {
     /// Every parameter.
-    pub const ALL: [Parameter; 10] = [
+    pub const ALL: [Parameter; 11] = [
         Parameter::Modulus,
         Parameter::WorkOfAdhesion,
         Parameter::Range,
@@ -67,6 +74,7 @@ impl Parameter {
         Parameter::Stiffness,
         Parameter::Quality,
         Parameter::Sensitivity,
+        Parameter::PhaseOffset,
         Parameter::ZOffset,
     ];
 
@@ -82,6 +90,7 @@ impl Parameter {
             Parameter::Stiffness => "spring constant k (N/m)",
             Parameter::Quality => "quality factor Q",
             Parameter::Sensitivity => "detector sensitivity (read / true amplitude)",
+            Parameter::PhaseOffset => "phase offset (deg)",
             Parameter::ZOffset => "piezo offset (m)",
         }
     }
@@ -98,14 +107,38 @@ impl Parameter {
             Parameter::Stiffness => "stiffness_n_m",
             Parameter::Quality => "quality",
             Parameter::Sensitivity => "sensitivity",
+            Parameter::PhaseOffset => "phase_offset_deg",
             Parameter::ZOffset => "z_offset_m",
         }
     }
 
     /// Whether it is a positive scale, fitted as its logarithm (a relative step means
-    /// the same anywhere), or a position, fitted as it is (in nm).
+    /// the same anywhere), or an offset, fitted as it is (in [`Parameter::unit`]s).
     pub fn is_scale(self) -> bool {
-        !matches!(self, Parameter::ZOffset)
+        !matches!(self, Parameter::ZOffset | Parameter::PhaseOffset)
+    }
+
+    /// An offset's coordinate unit in SI (the piezo offset in nm, the phase offset in
+    /// degrees); 1 for a scale, whose coordinate is its logarithm.
+    pub fn unit(self) -> f64 {
+        match self {
+            Parameter::ZOffset => 1e-9,
+            _ => 1.0,
+        }
+    }
+
+    /// Whether it belongs to the material or its law (what the global search spreads
+    /// its design over), not the instrument's calibration.
+    pub fn is_material(self) -> bool {
+        matches!(
+            self,
+            Parameter::Modulus
+                | Parameter::WorkOfAdhesion
+                | Parameter::Range
+                | Parameter::Hamaker
+                | Parameter::Viscosity
+                | Parameter::RelaxationTime
+        )
     }
 
     /// What data would show it, for a report that finds the data blind to it.
@@ -129,6 +162,7 @@ impl Parameter {
             Parameter::Sensitivity => {
                 "amplitudes in length units (a ratio A/A₀ cancels the sensitivity)"
             }
+            Parameter::PhaseOffset => "a phase channel",
             Parameter::ZOffset => "data where the tip feels the sample at all",
         }
     }
@@ -151,6 +185,7 @@ impl Parameter {
             Parameter::Stiffness => setup.cantilever.stiffness_n_m,
             Parameter::Quality => setup.cantilever.quality,
             Parameter::Sensitivity => nuisance.sensitivity,
+            Parameter::PhaseOffset => nuisance.phase_offset_deg,
             Parameter::ZOffset => nuisance.offset_m,
         }
     }
@@ -192,6 +227,7 @@ impl Parameter {
             Parameter::Stiffness => setup.cantilever.stiffness_n_m = value,
             Parameter::Quality => setup.cantilever.quality = value,
             Parameter::Sensitivity => nuisance.sensitivity = value,
+            Parameter::PhaseOffset => nuisance.phase_offset_deg = value,
             Parameter::ZOffset => nuisance.offset_m = value,
         }
     }
@@ -348,6 +384,25 @@ impl Measured {
         Ok(self)
     }
 
+    /// These data with their approach from far split where its phase jumps from above
+    /// its first (free) value to below it — from the attractive to the repulsive branch
+    /// — the points after the jump simulated as an approach begun there from the free
+    /// oscillation (which reaches the repulsive branch): each point is then simulated on
+    /// the branch the data show, and the residuals are smooth in the parameters however
+    /// far the model's own jump lies from the data's. None where there is no such jump
+    /// (or the data are already split into approaches, or are setpoint data).
+    pub fn split_at_branch_jump(&self) -> Option<Measured> {
+        if self.setpoint_ratio.is_some() || self.segments.len() != 1 {
+            return None;
+        }
+        let phase = self.phase_deg.as_deref()?;
+        let j = super::search::Features::of(self, Some(phase), None).jump?;
+        (phase[j] > phase[0] && phase[j + 1] < phase[0]).then(|| Measured {
+            segments: vec![0, j + 1],
+            ..self.clone()
+        })
+    }
+
     /// How many points the data hold.
     pub fn len(&self) -> usize {
         self.setpoint_ratio
@@ -364,8 +419,25 @@ impl Measured {
     /// approach from the free oscillation at its first position, joined; for setpoint
     /// data the state at each setpoint on the branch the measured phase shows (the
     /// offset plays no part). Amplitudes as the detector reads them: the motion is
-    /// simulated with the true free amplitude A₀/s and its amplitudes read times s.
+    /// simulated with the true free amplitude A₀/s and its amplitudes read times s;
+    /// phases with the phase channel's offset added (the first mode's).
     pub fn simulate(
+        &self,
+        setup: &TapSetup,
+        numerics: &Numerics,
+        nuisance: &Nuisance,
+    ) -> Result<Curve> {
+        let mut c = self.simulate_calibrated(setup, numerics, nuisance)?;
+        if nuisance.phase_offset_deg != 0.0 {
+            for p in c.phase_deg.iter_mut() {
+                *p += nuisance.phase_offset_deg;
+            }
+        }
+        Ok(c)
+    }
+
+    /// [`Measured::simulate`] with the phase channel zeroed.
+    fn simulate_calibrated(
         &self,
         setup: &TapSetup,
         numerics: &Numerics,
@@ -373,7 +445,7 @@ impl Measured {
     ) -> Result<Curve> {
         let s = nuisance.sensitivity;
         if s == 1.0 {
-            return self.simulate_true(setup, numerics, nuisance.offset_m);
+            return self.simulate_true(setup, numerics, nuisance);
         }
         let mut true_setup = setup.clone();
         true_setup.cantilever.free_amplitude_m /= s;
@@ -383,17 +455,28 @@ impl Measured {
                 mode.free_amplitude_m /= s;
             }
         }
-        let mut c = data.simulate_true(&true_setup, numerics, nuisance.offset_m)?;
+        let mut c = data.simulate_true(&true_setup, numerics, nuisance)?;
         for a in c.amplitude_m.iter_mut().chain(&mut c.amplitude2_m) {
             *a *= s;
         }
         Ok(c)
     }
 
-    /// [`Measured::simulate`] with the calibration holding.
-    fn simulate_true(&self, setup: &TapSetup, numerics: &Numerics, offset_m: f64) -> Result<Curve> {
+    /// [`Measured::simulate`] with the calibration holding and the phase channel zeroed
+    /// (its offset only tells setpoint data's branches).
+    fn simulate_true(
+        &self,
+        setup: &TapSetup,
+        numerics: &Numerics,
+        nuisance: &Nuisance,
+    ) -> Result<Curve> {
+        let offset_m = nuisance.offset_m;
         if let (Some(ratios), Some(phases)) = (&self.setpoint_ratio, &self.phase_deg) {
-            return at_setpoints(setup, numerics, ratios, phases);
+            let zeroed: Vec<f64> = phases
+                .iter()
+                .map(|p| p - nuisance.phase_offset_deg)
+                .collect();
+            return at_setpoints(setup, numerics, ratios, &zeroed);
         }
         let n = self.position_m.len();
         let mut joined: Option<Curve> = None;
@@ -419,9 +502,26 @@ impl Measured {
         joined.ok_or_else(|| Error::NotApplicable("no approach to simulate".into()))
     }
 
-    /// Each channel measured with its standard deviation and the simulated values it is
-    /// compared with in `curve`: amplitude, phase, then the second mode's.
-    fn channel_list<'a>(&'a self, curve: &'a Curve) -> Vec<(&'a [f64], &'a [f64], f64)> {
+    /// The names of the channels measured, in the residuals' order.
+    pub fn channel_names(&self) -> Vec<&'static str> {
+        let second = self.second_mode.as_ref();
+        [
+            ("amplitude_m", self.amplitude_m.is_some()),
+            ("phase_deg", self.phase_deg.is_some()),
+            (
+                "amplitude2_m",
+                second.is_some_and(|m| m.amplitude_m.is_some()),
+            ),
+            ("phase2_deg", second.is_some_and(|m| m.phase_deg.is_some())),
+        ]
+        .into_iter()
+        .filter_map(|(name, held)| held.then_some(name))
+        .collect()
+    }
+
+    /// Each channel measured, the simulated values it is compared with in `curve`, and
+    /// its standard deviation: amplitude, phase, then the second mode's.
+    pub fn channel_values<'a>(&'a self, curve: &'a Curve) -> Vec<(&'a [f64], &'a [f64], f64)> {
         let second = self.second_mode.as_ref();
         [
             (
@@ -463,7 +563,7 @@ impl Measured {
     /// The weighted residuals (model − measured)/σ of `curve`: the amplitudes, the
     /// phases, then the second mode's.
     pub fn residuals(&self, curve: &Curve) -> Vec<f64> {
-        self.channel_list(curve)
+        self.channel_values(curve)
             .into_iter()
             .flat_map(|(measured, simulated, sigma)| {
                 measured
@@ -477,7 +577,7 @@ impl Measured {
 
 /// A simulated approach curve at the measured positions (or the states at the measured
 /// setpoints).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Curve {
     /// Rest separations z_c = position + offset, m (at a setpoint: where its state is).
     pub separation_m: Vec<f64>,
@@ -505,13 +605,27 @@ pub fn curve(
     position_m: &[f64],
     offset_m: f64,
 ) -> Result<Curve> {
+    curve_while(setup, numerics, position_m, offset_m, |_, _, _| true)
+}
+
+/// [`curve`] that stops after the first point `keep` (given its index, amplitude in m
+/// and phase in degrees) refuses: the points up to and including it.
+pub fn curve_while(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    position_m: &[f64],
+    offset_m: f64,
+    mut keep: impl FnMut(usize, f64, f64) -> bool,
+) -> Result<Curve> {
     let ramp: Vec<(f64, Direction)> = position_m
         .iter()
         .map(|z| (z + offset_m, Direction::Approach))
         .collect();
-    let points = approach_curve(setup, numerics, &ramp, |_, _| {})?;
+    let points = approach_curve_while(setup, numerics, &ramp, |i, p| {
+        keep(i, p.observables.amplitude_m, p.observables.phase_deg)
+    })?;
     Ok(Curve {
-        separation_m: ramp.iter().map(|r| r.0).collect(),
+        separation_m: ramp.iter().take(points.len()).map(|r| r.0).collect(),
         amplitude_m: points.iter().map(|p| p.observables.amplitude_m).collect(),
         phase_deg: points.iter().map(|p| p.observables.phase_deg).collect(),
         well_defined: points

@@ -1,25 +1,27 @@
-//! The fit: Levenberg–Marquardt over the chosen parameters, each scale fitted as its
-//! logarithm and the piezo offset in nm, the Jacobian by forward differences of whole
-//! simulated curves (each point a converged steady state, started from the last).
+//! The fit: a global stage ([`super::search`]) whose best design points start
+//! Levenberg–Marquardt runs ([`super::local`]), every distinct local minimum kept; at
+//! the best one the Jacobian's account of the parameters ([`super::identifiability`])
+//! and the verdict on whether the fit describes the data ([`super::diagnose`]).
 
+use super::diagnose::{Diagnosis, STALL_DECREASE, diagnose, gauss_newton_decrease};
 use super::identifiability::{Identifiability, ParameterEstimate, assess};
+use super::local::{self, LocalRun};
 use super::model::{Curve, Measured, Nuisance, Parameter};
+use super::progress::{Progress, Stage, Tracker};
+use super::search::{self, Search};
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use nalgebra::DVector;
 use serde::Serialize;
-use std::cell::{Cell, RefCell};
-
-/// Forward-difference steps: 1e-4 in the logarithm of a scale (a relative change of
-/// 1e-4), 1e-3 nm in the offset — far above the steady states' own error (their orbits
-/// are converged to 1e-7 of A₀ and better), far below the data's resolution.
-const LOG_STEP: f64 = 1e-4;
-const OFFSET_STEP_NM: f64 = 1e-3;
+use std::cell::Cell;
 
 /// χ²/dof at or below which residuals are the simulation's own round-off and
 /// tolerance, not a measurement's noise (at the default weights, 1e-6 of 0.02 nm).
 const RESOLVED_CHI_SQUARE: f64 = 1e-6;
+
+/// Two local runs ended on one minimum where every coordinate agrees to this (a
+/// relative 2e-3 in a scale, 2e-3 of an offset's unit).
+const SAME_MINIMUM: f64 = 2e-3;
 
 /// What to fit and how hard to try.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,16 +29,58 @@ pub struct FitOptions {
     /// The parameters adjusted (at least one, each once); the setup gives their
     /// starting values and the values of all others.
     pub parameters: Vec<Parameter>,
-    /// The offset's starting value, m (z_c = position + offset).
-    pub offset_start_m: f64,
-    /// The detector sensitivity's starting value (1: the calibration holds); it stays
-    /// there unless [`Parameter::Sensitivity`] is fitted.
-    pub sensitivity_start: f64,
+    /// The piezo offset, sensitivity and phase offset to start from (each stays there
+    /// unless fitted).
+    pub start: Nuisance,
     /// Whether the data's standard deviations are estimated from the residuals (the
     /// covariance scaled by χ²/dof) rather than taken as given.
     pub estimate_sigma: bool,
-    /// Most simulated curves (each residual or Jacobian column is one).
+    /// Most simulated curves of each local run (each residual or Jacobian column is
+    /// one).
     pub max_curves: usize,
+    /// How the minimum is looked for.
+    pub search: Search,
+}
+
+impl FitOptions {
+    /// Fit `parameters` from the setup's values, the offset from `offset_start_m`, the
+    /// calibration holding, the standard deviations as given, the global search on
+    /// its defaults and 400 curves a local run.
+    pub fn new(parameters: Vec<Parameter>, offset_start_m: f64) -> Self {
+        Self {
+            parameters,
+            start: Nuisance::offset(offset_start_m),
+            estimate_sigma: false,
+            max_curves: 400,
+            search: Search::default(),
+        }
+    }
+}
+
+/// A local minimum the fit found.
+#[derive(Debug, Clone, Serialize)]
+pub struct Minimum {
+    /// The fitted parameters' values there, in the options' order (SI).
+    pub values: Vec<f64>,
+    /// χ² there.
+    pub chi_square: f64,
+    /// χ² over the degrees of freedom.
+    pub reduced_chi_square: f64,
+    /// How many local runs ended there.
+    pub runs: usize,
+    /// Why the optimiser stopped (the first run that ended there).
+    pub termination: String,
+}
+
+/// The standard deviations the residuals imply, per channel (where they are estimated).
+#[derive(Debug, Clone, Serialize)]
+pub struct SigmaEstimate {
+    /// The channel (amplitude_m, phase_deg, amplitude2_m, phase2_deg).
+    pub channel: &'static str,
+    /// The standard deviation its residuals imply (its unit).
+    pub sigma: f64,
+    /// The relative weight it was fitted with.
+    pub weight_sigma: f64,
 }
 
 /// A fit's outcome.
@@ -54,11 +98,23 @@ pub struct FitReport {
     pub reduced_chi_square: f64,
     /// Whether the standard deviations were estimated from the residuals.
     pub sigma_estimated: bool,
-    /// Whether Levenberg–Marquardt ended on a convergence test.
+    /// Where they were: what each channel's residuals imply.
+    pub sigma_estimates: Vec<SigmaEstimate>,
+    /// Whether the fit ended at a minimum that describes the data: the optimiser's
+    /// convergence test passed, no Gauss–Newton step would still lower χ², and the
+    /// diagnosis finds no misfit.
     pub converged: bool,
-    /// Why it ended.
+    /// Why the optimiser stopped, in words (and why it is not called converged).
     pub termination: String,
-    /// Simulated curves.
+    /// The decrease of χ² a Gauss–Newton step from the end would still bring.
+    pub remaining_decrease: f64,
+    /// Whether the fitted curve describes the data, and where it does not.
+    pub diagnosis: Diagnosis,
+    /// Every distinct local minimum the local runs ended on, best first.
+    pub minima: Vec<Minimum>,
+    /// How the minimum was looked for.
+    pub search: Search,
+    /// Simulated curves in all (design, local runs, Jacobian).
     pub curves: usize,
     /// The fitted curve at the measured positions.
     pub fitted: Curve,
@@ -66,17 +122,8 @@ pub struct FitReport {
     pub residuals: Vec<f64>,
 }
 
-/// Fit `options.parameters` of `setup` (starting values; every other parameter fixed as
-/// it gives it) to `data` by weighted least squares; `progress` is called after each
-/// simulated curve with the number so far.
-pub fn fit(
-    setup: &TapSetup,
-    numerics: &Numerics,
-    data: &Measured,
-    options: &FitOptions,
-    progress: impl Fn(usize),
-) -> Result<FitReport> {
-    let data = data.clone().validated()?;
+/// Refuse options that cannot fit `data`.
+fn check(data: &Measured, options: &FitOptions) -> Result<()> {
     let params = &options.parameters;
     if params.is_empty() {
         return Err(Error::NotApplicable(
@@ -93,10 +140,17 @@ pub fn fit(
             p.1.key()
         )));
     }
-    crate::error::finite("offset start", options.offset_start_m)?;
+    crate::error::finite("offset start", options.start.offset_m)?;
+    crate::error::finite("phase offset start", options.start.phase_offset_deg)?;
+    crate::error::positive("sensitivity start", options.start.sensitivity)?;
     if data.setpoint_ratio.is_some() && params.contains(&Parameter::ZOffset) {
         return Err(Error::NotApplicable(
             "setpoint data have no piezo positions: there is no offset to fit".into(),
+        ));
+    }
+    if params.contains(&Parameter::PhaseOffset) && data.phase_deg.is_none() {
+        return Err(Error::NotApplicable(
+            "a phase offset needs a phase channel to fit".into(),
         ));
     }
     let m = data.channels() * data.len();
@@ -106,98 +160,175 @@ pub fn fit(
             params.len()
         )));
     }
-    crate::error::positive("sensitivity start", options.sensitivity_start)?;
-    // What the fit does not adjust stays at its start: the offset too (z_c = position
-    // + the offset given).
-    let base = Nuisance {
-        offset_m: options.offset_start_m,
-        sensitivity: options.sensitivity_start,
-    };
+    if let Search::Global {
+        factor,
+        points,
+        starts,
+    } = options.search
+    {
+        if !(factor.is_finite() && factor > 1.0 && factor <= 1e3) {
+            return Err(Error::OutOfRange(format!(
+                "the search factor must lie in (1, 1000], not {factor}"
+            )));
+        }
+        if points > 10_000 || !(1..=100).contains(&starts) {
+            return Err(Error::OutOfRange(format!(
+                "the search takes at most 10 000 design points and 1 to 100 starts, not                  {points} and {starts}"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Fit `options.parameters` of `setup` (starting values; every other parameter fixed as
+/// it gives it) to `data` by weighted least squares; `progress` hears of each simulated
+/// curve and stage.
+pub fn fit(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    data: &Measured,
+    options: &FitOptions,
+    progress: impl Fn(&Progress) + Sync,
+) -> Result<FitReport> {
+    let data = data.clone().validated()?;
+    check(&data, options)?;
+    let params = &options.parameters;
     let starts: Vec<f64> = params
         .iter()
-        .map(|p| p.start(setup, &base))
+        .map(|p| p.start(setup, &options.start))
         .collect::<Result<_>>()?;
-    let problem = Problem {
+    let tracker = Tracker::new(&progress);
+    // Each point on the branch the data show while searching; the approach as it goes
+    // (jumping where the model jumps) for the verdict.
+    let split = data.split_at_branch_jump();
+    let working = split.as_ref().unwrap_or(&data);
+    let candidates = search::starts(
         setup,
-        base,
+        &options.start,
         numerics,
-        data: &data,
+        working,
         params,
-        starts: &starts,
-        x: DVector::zeros(params.len()),
-        curves: Cell::new(0),
-        max_curves: options.max_curves,
-        failure: RefCell::new(None),
-        cache: RefCell::new(None),
-        progress: &progress,
-    };
-    let (mut problem, report) = LevenbergMarquardt::new()
-        .with_patience(options.max_curves.div_ceil(params.len() + 1).max(1))
-        .minimize(problem);
-    // The solution's curve and Jacobian, beyond the optimiser's budget.
-    problem.max_curves = usize::MAX - params.len() - 2;
-    if let Some(e) = problem.failure.borrow_mut().take() {
-        return Err(Error::NotApplicable(format!(
-            "the fit stopped where a trial curve could not be simulated ({e}). Such a step \
-             means the data pull the parameters far from the start: the law or the fixed \
-             parameters may not describe these data, or the start is far off"
-        )));
-    }
-    let x = problem.x.clone();
-    let residuals = problem
-        .evaluate(&x)
-        .ok_or_else(|| Error::Numerical("the fitted curve could not be simulated".into()))?;
-    // The fitted curve is the one just evaluated (the Jacobian's columns replace it).
-    let fitted = problem
-        .cache
-        .borrow()
-        .as_ref()
-        .map(|(_, c, _)| c.clone())
-        .expect("the solution was just evaluated");
-    let jacobian = problem
-        .jacobian_at(&x, &residuals)
-        .ok_or_else(|| Error::Numerical("the fit's Jacobian could not be simulated".into()))?;
-    if let Some(e) = problem.failure.borrow_mut().take() {
-        return Err(e);
-    }
-    let chi_square = residuals.norm_squared();
-    let dof = m - params.len();
-    let reduced = chi_square / dof as f64;
-    let (fitted_setup, nuisance) = problem.physical(&x);
-    let physical: Vec<f64> = params
-        .iter()
-        .map(|p| p.value(&fitted_setup, &nuisance))
-        .collect();
-    let scales: Vec<bool> = params.iter().map(|p| p.is_scale()).collect();
-    let (estimates, identifiability) = assess(
-        params,
-        &jacobian,
-        match (options.estimate_sigma, reduced > RESOLVED_CHI_SQUARE) {
-            (false, _) => Some(1.0),
-            (true, true) => Some(reduced),
-            (true, false) => None,
-        },
-        &scales,
-        &physical,
-        &starts,
+        &options.search,
+        &tracker,
     );
-    let mut identifiability = identifiability;
-    if options.estimate_sigma && reduced <= RESOLVED_CHI_SQUARE {
+    // Levenberg–Marquardt from each start; every run's end kept.
+    let mut runs: Vec<LocalRun> = Vec::new();
+    let mut first_error = None;
+    let per_run = 10 * (params.len() + 1);
+    for (i, c) in candidates.iter().enumerate() {
+        tracker.stage(
+            Stage::Local {
+                index: i + 1,
+                of: candidates.len(),
+            },
+            per_run,
+            (candidates.len() - i - 1) * per_run + params.len(),
+        );
+        match local::run(
+            &c.setup,
+            c.nuisance,
+            numerics,
+            working,
+            params,
+            options.max_curves,
+            &tracker,
+        ) {
+            Ok(r) => {
+                // A minimum that describes the data ends the search (later starts are
+                // worse by the screening): it is the answer, and no other can fit
+                // better than the noise.
+                let chi: f64 = r.residuals.norm_squared();
+                let dof = data.channels() * data.len() - params.len();
+                let d = diagnose(
+                    working,
+                    &r.curve,
+                    r.residuals.as_slice(),
+                    dof,
+                    options.estimate_sigma,
+                );
+                let fine = r.lm_converged && d.describes_data;
+                runs.push(r);
+                if fine && chi.is_finite() {
+                    break;
+                }
+            }
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    if runs.is_empty() {
+        return Err(first_error.expect("a run that failed says why"));
+    }
+    runs.sort_by(|a, b| {
+        a.residuals
+            .norm_squared()
+            .total_cmp(&b.residuals.norm_squared())
+    });
+    let m = data.channels() * data.len();
+    let dof = m - params.len();
+    let minima = distinct_minima(&runs, params, dof);
+    let best = &runs[0];
+    tracker.stage(Stage::Assess, params.len() + 1, 0);
+    let jacobian = local::jacobian(best, numerics, working, params, &tracker)?;
+    // The approach as it goes at the best parameters: where it jumps where the data
+    // do, the same curve (to the steady states' tolerance); where not, the verdict
+    // says so.
+    let fitted = match split {
+        Some(_) => {
+            let c = data.simulate(&best.setup, numerics, &best.nuisance)?;
+            tracker.curve(None);
+            c
+        }
+        None => best.curve.clone(),
+    };
+    let residuals = &DVector::from_vec(data.residuals(&fitted));
+    let chi_square = residuals.norm_squared();
+    let reduced = chi_square / dof as f64;
+    let resolved = reduced <= RESOLVED_CHI_SQUARE;
+    let residual_list: Vec<f64> = residuals.iter().copied().collect();
+    let mut diagnosis = diagnose(&data, &fitted, &residual_list, dof, options.estimate_sigma);
+    if resolved {
+        // Residuals at the simulation's precision have no noise to test for runs.
+        diagnosis = Diagnosis {
+            describes_data: true,
+            reasons: Vec::new(),
+            ..diagnosis
+        };
+    }
+    let factor = if options.estimate_sigma { reduced } else { 1.0 };
+    let remaining = gauss_newton_decrease(&jacobian, residuals);
+    let stalled = !resolved && remaining > STALL_DECREASE * factor;
+    let variance_factor = match (diagnosis.describes_data, options.estimate_sigma, resolved) {
+        (false, _, _) => None,
+        (true, false, _) => Some(1.0),
+        (true, true, false) => Some(reduced),
+        (true, true, true) => None,
+    };
+    let (estimates, mut identifiability) =
+        assess(params, &jacobian, variance_factor, &best.values, &starts);
+    if options.estimate_sigma && resolved {
         identifiability.notes.push(format!(
             "the residuals are at the simulation's own precision (χ²/dof = {reduced:.1e}): \
              the data carry no noise to estimate their standard deviations from, so no \
              intervals are given (give the standard deviations to have them)"
         ));
     }
-    // χ² beyond five standard deviations of its distribution (mean dof, variance 2 dof)
-    // where the standard deviations are given: the model does not describe the data.
-    if !options.estimate_sigma && chi_square > dof as f64 + 5.0 * (2.0 * dof as f64).sqrt() {
-        identifiability.notes.push(format!(
-            "χ²/dof = {reduced:.3} is far above 1: the fitted curve does not describe the \
-             data (a local minimum reached from this start, a law or fixed parameters that \
-             cannot describe them, or standard deviations set too small); the intervals \
-             assume a fit that does"
-        ));
+    let sigma_estimates = if options.estimate_sigma && !resolved {
+        sigma_estimates(&data, &residual_list, dof, m)
+    } else {
+        Vec::new()
+    };
+    let mut termination = best.termination.clone();
+    if stalled {
+        termination = format!(
+            "{termination}, but a Gauss–Newton step would still lower χ² by {remaining:.3e}: \
+             the search stalled short of a minimum (the curve may be switching between \
+             states as the parameters move)"
+        );
+    }
+    if !diagnosis.describes_data {
+        termination = format!("{termination}; the fit does not describe the data");
     }
     Ok(FitReport {
         parameters: estimates,
@@ -206,128 +337,73 @@ pub fn fit(
         degrees_of_freedom: dof,
         reduced_chi_square: reduced,
         sigma_estimated: options.estimate_sigma,
-        converged: matches!(
-            report.termination,
-            levenberg_marquardt::TerminationReason::Converged { .. }
-                | levenberg_marquardt::TerminationReason::Orthogonal
-                | levenberg_marquardt::TerminationReason::ResidualsZero
-        ),
-        termination: format!("{:?}", report.termination),
-        curves: problem.curves.get(),
+        sigma_estimates,
+        converged: best.lm_converged && !stalled && diagnosis.describes_data,
+        termination,
+        remaining_decrease: remaining,
+        diagnosis,
+        minima,
+        search: options.search,
+        curves: tracker.curves(),
         fitted,
-        residuals: residuals.iter().copied().collect(),
+        residuals: residual_list,
     })
 }
 
-/// Coordinates, the curve simulated there and its weighted residuals.
-type Evaluated = (DVector<f64>, Curve, DVector<f64>);
-
-/// The least-squares problem the optimiser sees: x the fitted coordinates (0 at the
-/// start), the residuals a simulated curve's.
-struct Problem<'a, F: Fn(usize)> {
-    setup: &'a TapSetup,
-    /// The offset and sensitivity where the fit does not adjust them.
-    base: Nuisance,
-    numerics: &'a Numerics,
-    data: &'a Measured,
-    params: &'a [Parameter],
-    starts: &'a [f64],
-    x: DVector<f64>,
-    curves: Cell<usize>,
-    max_curves: usize,
-    /// The first failure (a curve that could not be simulated), reported as the fit's.
-    failure: RefCell<Option<Error>>,
-    /// The last coordinates evaluated, their curve and its residuals.
-    cache: RefCell<Option<Evaluated>>,
-    progress: &'a F,
+/// The distinct minima of `runs` (sorted by χ²): runs whose coordinates agree to
+/// [`SAME_MINIMUM`] are one.
+fn distinct_minima(runs: &[LocalRun], params: &[Parameter], dof: usize) -> Vec<Minimum> {
+    let mut out: Vec<Minimum> = Vec::new();
+    for r in runs {
+        let same = out.iter_mut().find(|m| {
+            params
+                .iter()
+                .zip(m.values.iter().zip(&r.values))
+                .all(|(p, (&a, &b))| {
+                    if p.is_scale() {
+                        (a / b).ln().abs() < SAME_MINIMUM
+                    } else {
+                        (a - b).abs() < SAME_MINIMUM * p.unit()
+                    }
+                })
+        });
+        match same {
+            Some(m) => m.runs += 1,
+            None => {
+                let chi = r.residuals.norm_squared();
+                out.push(Minimum {
+                    values: r.values.clone(),
+                    chi_square: chi,
+                    reduced_chi_square: chi / dof as f64,
+                    runs: 1,
+                    termination: r.termination.clone(),
+                });
+            }
+        }
+    }
+    out
 }
 
-impl<F: Fn(usize)> Problem<'_, F> {
-    /// The setup and the offset and sensitivity at coordinates `x`.
-    fn physical(&self, x: &DVector<f64>) -> (TapSetup, Nuisance) {
-        let mut setup = self.setup.clone();
-        let mut nuisance = self.base;
-        for ((p, &start), &xi) in self.params.iter().zip(self.starts).zip(x.iter()) {
-            let value = if p.is_scale() {
-                start * xi.exp()
-            } else {
-                start + xi * 1e-9
-            };
-            p.set(&mut setup, &mut nuisance, value);
-        }
-        (setup, nuisance)
-    }
-
-    /// The weighted residuals at `x` (None, with the failure kept, where the curve
-    /// cannot be simulated or the budget of curves is spent).
-    fn evaluate(&self, x: &DVector<f64>) -> Option<DVector<f64>> {
-        if let Some((at, _, r)) = self.cache.borrow().as_ref() {
-            if at == x {
-                return Some(r.clone());
+/// Each channel's standard deviation as its residuals imply it: the weight it was
+/// fitted with times the rms of its weighted residuals, over its share of the degrees
+/// of freedom.
+fn sigma_estimates(data: &Measured, residuals: &[f64], dof: usize, m: usize) -> Vec<SigmaEstimate> {
+    let n = data.len();
+    let share = dof as f64 / m as f64;
+    data.channel_names()
+        .into_iter()
+        .zip(data.channel_values(&Curve::default()))
+        .enumerate()
+        .map(|(c, (channel, (_, _, weight)))| {
+            let r = &residuals[c * n..(c + 1) * n];
+            let ss: f64 = r.iter().map(|v| v * v).sum();
+            SigmaEstimate {
+                channel,
+                sigma: weight * (ss / (n as f64 * share)).sqrt(),
+                weight_sigma: weight,
             }
-        }
-        if self.failure.borrow().is_some() {
-            return None;
-        }
-        if self.curves.get() >= self.max_curves + self.params.len() + 2 {
-            return None;
-        }
-        let (setup, nuisance) = self.physical(x);
-        let simulated = self.data.simulate(&setup, self.numerics, &nuisance);
-        self.curves.set(self.curves.get() + 1);
-        (self.progress)(self.curves.get());
-        match simulated {
-            Ok(c) => {
-                let r = DVector::from_vec(self.data.residuals(&c));
-                *self.cache.borrow_mut() = Some((x.clone(), c, r.clone()));
-                Some(r)
-            }
-            Err(e) => {
-                *self.failure.borrow_mut() = Some(e);
-                None
-            }
-        }
-    }
-
-    /// Forward differences of the residuals at `x` (whose residuals are `r0`).
-    fn jacobian_at(&self, x: &DVector<f64>, r0: &DVector<f64>) -> Option<DMatrix<f64>> {
-        let mut j = DMatrix::zeros(r0.len(), self.params.len());
-        for (col, p) in self.params.iter().enumerate() {
-            let h = if p.is_scale() {
-                LOG_STEP
-            } else {
-                OFFSET_STEP_NM
-            };
-            let mut shifted = x.clone();
-            shifted[col] += h;
-            let r = self.evaluate(&shifted)?;
-            j.set_column(col, &((r - r0) / h));
-        }
-        Some(j)
-    }
-}
-
-impl<F: Fn(usize)> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, F> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.x.copy_from(x);
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.x.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        self.evaluate(&self.x)
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let r0 = self.evaluate(&self.x)?;
-        self.jacobian_at(&self.x, &r0)
-    }
+        })
+        .collect()
 }
 
 /// A parameter's profile: the best χ² with it held at each value and the others
@@ -347,6 +423,9 @@ pub struct Profile {
     pub interval_68: [Option<f64>; 2],
     /// Where Δχ² = 3.84.
     pub interval_95: [Option<f64>; 2],
+    /// Values at which the held fit could not be simulated (a trial outside the law's
+    /// range): points without a value, where that side of the profile stops.
+    pub unavailable: Vec<f64>,
 }
 
 /// Put the values `fitted` found for `parameters` into `setup` and `nuisance` (a
@@ -378,7 +457,7 @@ pub fn profile(
     options: &FitOptions,
     best: &FitReport,
     which: Parameter,
-    progress: impl Fn(usize),
+    progress: impl Fn(&Progress) + Sync,
 ) -> Result<Profile> {
     let k = options
         .parameters
@@ -394,7 +473,7 @@ pub fn profile(
     };
     // The best fit's setup and offset: every fitted value in place.
     let mut at_best = setup.clone();
-    let mut nuisance = Nuisance::offset(options.offset_start_m);
+    let mut nuisance = options.start;
     apply(&options.parameters, best, &mut at_best, &mut nuisance);
     let others: Vec<Parameter> = options
         .parameters
@@ -408,36 +487,27 @@ pub fn profile(
         1.0
     };
     let curves = Cell::new(0usize);
-    // χ² with `which` held at `v`, the others refitted from `start` (setup, offset and
-    // sensitivity).
+    let tracker = Tracker::new(&progress);
+    tracker.stage(
+        Stage::Profile,
+        2 * PROFILE_STEPS * 4 * (others.len() + 1),
+        0,
+    );
+    // χ² with `which` held at `v`, the others refitted from `start` (setup and nuisance
+    // values).
     let held = |v: f64, start: &(TapSetup, Nuisance)| -> Result<(f64, (TapSetup, Nuisance))> {
         let (mut s, mut n) = start.clone();
         which.set(&mut s, &mut n, v);
-        let r = if others.is_empty() {
-            let c = data.simulate(&s, numerics, &n)?;
+        if others.is_empty() {
+            let c = data.simulate(&s, numerics, &n);
             curves.set(curves.get() + 1);
-            progress(curves.get());
-            let chi: f64 = data.residuals(&c).iter().map(|r| r * r).sum();
+            let chi: f64 = data.residuals(&c?).iter().map(|r| r * r).sum();
+            tracker.curve(Some(chi));
             return Ok((chi, (s, n)));
-        } else {
-            let done = curves.get();
-            fit(
-                &s,
-                numerics,
-                data,
-                &FitOptions {
-                    parameters: others.clone(),
-                    offset_start_m: n.offset_m,
-                    sensitivity_start: n.sensitivity,
-                    estimate_sigma: false,
-                    max_curves: options.max_curves,
-                },
-                |n| progress(done + n),
-            )?
-        };
+        }
+        let r = local::run(&s, n, numerics, data, &others, options.max_curves, &tracker)?;
         curves.set(curves.get() + r.curves);
-        apply(&others, &r, &mut s, &mut n);
-        Ok((r.chi_square, (s, n)))
+        Ok((r.residuals.norm_squared(), (r.setup, r.nuisance)))
     };
     let step = |i: f64| {
         if which.is_scale() {
@@ -447,11 +517,17 @@ pub fn profile(
         }
     };
     let mut points = vec![(value, 0.0)];
+    let mut unavailable = Vec::new();
     for side in [-1.0, 1.0] {
         let mut start = (at_best.clone(), nuisance);
         for i in 1..=PROFILE_STEPS {
             let v = step(side * i as f64);
-            let (chi, next) = held(v, &start)?;
+            let Ok((chi, next)) = held(v, &start) else {
+                // A trial the law cannot take (or a curve that cannot be simulated): a
+                // point without a value; this side stops here.
+                unavailable.push(v);
+                break;
+            };
             let delta = ((chi - best.chi_square) / factor).max(0.0);
             points.push((v, delta));
             start = next;
@@ -483,5 +559,6 @@ pub fn profile(
         delta_chi_square: points.iter().map(|p| p.1).collect(),
         interval_68: [crossing(1.0, -1.0), crossing(1.0, 1.0)],
         interval_95: [crossing(1.96, -1.0), crossing(1.96, 1.0)],
+        unavailable,
     })
 }

@@ -7,6 +7,7 @@ pub mod chart;
 pub mod contrast;
 pub mod display;
 pub mod fit;
+pub mod fit_text;
 pub mod heatmap;
 pub mod hysteresis;
 pub mod lj;

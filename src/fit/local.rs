@@ -1,0 +1,286 @@
+//! The local stage of a fit: Levenberg–Marquardt (the `levenberg-marquardt` crate, a
+//! port of MINPACK's lmder; Moré, 1978) from one start, each scale fitted as its
+//! logarithm and each offset in its unit, the Jacobian by forward differences of whole
+//! simulated curves (each point a converged steady state, started from the last).
+
+use super::model::{Curve, Measured, Nuisance, Parameter};
+use super::progress::Tracker;
+use crate::dynamics::setup::{Numerics, TapSetup};
+use crate::error::Error;
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use std::cell::{Cell, RefCell};
+
+/// Forward-difference steps: 1e-4 in the logarithm of a scale (a relative change of
+/// 1e-4), 1e-3 of an offset's unit (1 pm, 0.001°) — far above the steady states' own
+/// error (their orbits are converged to 1e-7 of A₀ and better), far below the data's
+/// resolution.
+const LOG_STEP: f64 = 1e-4;
+const OFFSET_STEP: f64 = 1e-3;
+/// The length of the residual vector a trial that cannot be simulated is given: larger
+/// than any curve's, finite.
+const UNSIMULATED: f64 = 1e100;
+
+/// Where one local run ended.
+pub(crate) struct LocalRun {
+    /// The setup and nuisance values at the end.
+    pub setup: TapSetup,
+    pub nuisance: Nuisance,
+    /// The fitted parameters' values there (SI).
+    pub values: Vec<f64>,
+    /// The curve there and its weighted residuals.
+    pub curve: Curve,
+    pub residuals: DVector<f64>,
+    /// Why the optimiser stopped, and whether that was one of its convergence tests.
+    pub termination: String,
+    pub lm_converged: bool,
+    /// Curves this run simulated.
+    pub curves: usize,
+}
+
+/// What the optimiser's reason to stop means, in words.
+fn termination_words(t: &TerminationReason) -> String {
+    match t {
+        TerminationReason::Converged { ftol, xtol } => match (ftol, xtol) {
+            (true, true) => "χ² and the steps both stopped changing".into(),
+            (true, false) => "χ² stopped changing".into(),
+            _ => "the steps became smaller than their tolerance".into(),
+        },
+        TerminationReason::Orthogonal => {
+            "the residuals are orthogonal to every direction the parameters move them".into()
+        }
+        TerminationReason::ResidualsZero => "the residuals are zero".into(),
+        TerminationReason::LostPatience => "the budget of simulated curves ran out".into(),
+        TerminationReason::NoImprovementPossible(what) => {
+            format!("no step lowers χ² any further ({what} at round-off)")
+        }
+        TerminationReason::User(_) => "a trial curve could not be simulated".into(),
+        TerminationReason::Numerical(what) => format!("a non-finite {what} was met"),
+        other => format!("{other:?}"),
+    }
+}
+
+/// Levenberg–Marquardt over `params` from `setup` and `nuisance` (the start), at most
+/// `max_curves` simulated curves besides the final curve's; an error where a trial
+/// curve could not be simulated.
+pub(crate) fn run(
+    setup: &TapSetup,
+    nuisance: Nuisance,
+    numerics: &Numerics,
+    data: &Measured,
+    params: &[Parameter],
+    max_curves: usize,
+    tracker: &Tracker,
+) -> crate::error::Result<LocalRun> {
+    let starts: Vec<f64> = params.iter().map(|p| p.value(setup, &nuisance)).collect();
+    let problem = Problem {
+        setup,
+        base: nuisance,
+        numerics,
+        data,
+        params,
+        starts: &starts,
+        x: DVector::zeros(params.len()),
+        curves: Cell::new(0),
+        max_curves,
+        failure: RefCell::new(None),
+        cache: RefCell::new(None),
+        tracker,
+    };
+    let (problem, report) = LevenbergMarquardt::new()
+        .with_patience(max_curves.div_ceil(params.len() + 1).max(1))
+        .minimize(problem);
+    if let Some(e) = problem.failure.borrow_mut().take() {
+        return Err(Error::NotApplicable(format!(
+            "the fit stopped where a trial curve could not be simulated ({e}). Such a step \
+             means the data pull the parameters far from the start: the law or the fixed \
+             parameters may not describe these data, or the start is far off"
+        )));
+    }
+    let spent = problem.curves.get() >= max_curves + params.len() + 2;
+    let termination = match report.termination {
+        TerminationReason::User(_) if spent => TerminationReason::LostPatience,
+        t => t,
+    };
+    let x = problem.x.clone();
+    let (setup, nuisance) = problem.physical(&x);
+    // The curve at the end (cached where the optimiser evaluated it last).
+    let mut p = problem;
+    p.max_curves = usize::MAX / 2;
+    p.evaluate(&x)
+        .ok_or_else(|| Error::Numerical("the fitted curve could not be simulated".into()))?;
+    let curve = p
+        .cache
+        .borrow()
+        .as_ref()
+        .map(|(_, c, _)| c.clone())
+        .expect("the solution was just evaluated");
+    let residuals = DVector::from_vec(data.residuals(&curve));
+    Ok(LocalRun {
+        values: params.iter().map(|q| q.value(&setup, &nuisance)).collect(),
+        setup,
+        nuisance,
+        curve,
+        residuals,
+        termination: termination_words(&termination),
+        lm_converged: termination.was_successful(),
+        curves: p.curves.get(),
+    })
+}
+
+/// The weighted Jacobian in the fitted coordinates at the end of `run` (forward
+/// differences of simulated curves), and the curves it took.
+pub(crate) fn jacobian(
+    run: &LocalRun,
+    numerics: &Numerics,
+    data: &Measured,
+    params: &[Parameter],
+    tracker: &Tracker,
+) -> crate::error::Result<DMatrix<f64>> {
+    let starts = run.values.clone();
+    let problem = Problem {
+        setup: &run.setup,
+        base: run.nuisance,
+        numerics,
+        data,
+        params,
+        starts: &starts,
+        x: DVector::zeros(params.len()),
+        curves: Cell::new(0),
+        max_curves: usize::MAX / 2,
+        failure: RefCell::new(None),
+        cache: RefCell::new(None),
+        tracker,
+    };
+    let j = problem.jacobian_at(&problem.x, &run.residuals);
+    if let Some(e) = problem.failure.borrow_mut().take() {
+        return Err(e);
+    }
+    j.ok_or_else(|| Error::Numerical("the fit's Jacobian could not be simulated".into()))
+}
+
+/// Coordinates, the curve simulated there and its weighted residuals.
+type Evaluated = (DVector<f64>, Curve, DVector<f64>);
+
+/// The least-squares problem the optimiser sees: x the fitted coordinates (0 at the
+/// start), the residuals a simulated curve's.
+struct Problem<'a> {
+    setup: &'a TapSetup,
+    /// The nuisance values where the fit does not adjust them.
+    base: Nuisance,
+    numerics: &'a Numerics,
+    data: &'a Measured,
+    params: &'a [Parameter],
+    starts: &'a [f64],
+    x: DVector<f64>,
+    curves: Cell<usize>,
+    max_curves: usize,
+    /// The first failure (a curve that could not be simulated), reported as the fit's.
+    failure: RefCell<Option<Error>>,
+    /// The last coordinates evaluated, their curve and its residuals.
+    cache: RefCell<Option<Evaluated>>,
+    tracker: &'a Tracker<'a>,
+}
+
+impl Problem<'_> {
+    /// The setup and the nuisance values at coordinates `x`.
+    fn physical(&self, x: &DVector<f64>) -> (TapSetup, Nuisance) {
+        let mut setup = self.setup.clone();
+        let mut nuisance = self.base;
+        for ((p, &start), &xi) in self.params.iter().zip(self.starts).zip(x.iter()) {
+            let value = if p.is_scale() {
+                start * xi.exp()
+            } else {
+                start + xi * p.unit()
+            };
+            p.set(&mut setup, &mut nuisance, value);
+        }
+        (setup, nuisance)
+    }
+
+    /// The weighted residuals at `x` (None, with the failure kept, where the curve
+    /// cannot be simulated or the budget of curves is spent).
+    fn evaluate(&self, x: &DVector<f64>) -> Option<DVector<f64>> {
+        if let Some((at, _, r)) = self.cache.borrow().as_ref() {
+            if at == x {
+                return Some(r.clone());
+            }
+        }
+        if self.failure.borrow().is_some() {
+            return None;
+        }
+        if self.curves.get() >= self.max_curves + self.params.len() + 2 {
+            return None;
+        }
+        let (setup, nuisance) = self.physical(x);
+        let simulated = self.data.simulate(&setup, self.numerics, &nuisance);
+        self.curves.set(self.curves.get() + 1);
+        match simulated {
+            Ok(c) => {
+                let r = DVector::from_vec(self.data.residuals(&c));
+                self.tracker.curve(Some(r.norm_squared()));
+                *self.cache.borrow_mut() = Some((x.clone(), c, r.clone()));
+                Some(r)
+            }
+            Err(e) if !matches!(e, Error::Interrupted) && self.cache.borrow().is_some() => {
+                // A trial the law cannot take (outside its range of μ, say): a step the
+                // optimiser must refuse, not the end of the fit — residuals larger than
+                // any curve's. (The start itself must simulate: see below.)
+                self.tracker.curve(None);
+                let m = self.data.channels() * self.data.len();
+                Some(DVector::from_element(m, UNSIMULATED / (m as f64).sqrt()))
+            }
+            Err(e) => {
+                self.tracker.curve(None);
+                *self.failure.borrow_mut() = Some(e);
+                None
+            }
+        }
+    }
+
+    /// Forward differences of the residuals at `x` (whose residuals are `r0`).
+    fn jacobian_at(&self, x: &DVector<f64>, r0: &DVector<f64>) -> Option<DMatrix<f64>> {
+        let mut j = DMatrix::zeros(r0.len(), self.params.len());
+        for (col, p) in self.params.iter().enumerate() {
+            let h = if p.is_scale() { LOG_STEP } else { OFFSET_STEP };
+            let mut shifted = x.clone();
+            shifted[col] += h;
+            let mut r = self.evaluate(&shifted)?;
+            let mut step = h;
+            if r.norm() >= UNSIMULATED * 0.5 {
+                // The law's range ends within the step: difference backward.
+                shifted[col] -= 2.0 * h;
+                r = self.evaluate(&shifted)?;
+                step = -h;
+                if r.norm() >= UNSIMULATED * 0.5 {
+                    return None;
+                }
+            }
+            j.set_column(col, &((r - r0) / step));
+        }
+        Some(j)
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.x.copy_from(x);
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.x.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        self.evaluate(&self.x)
+    }
+
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let r0 = self.evaluate(&self.x)?;
+        self.jacobian_at(&self.x, &r0)
+    }
+}
