@@ -77,20 +77,29 @@ fn an_approach_curve_is_fitted_back() {
     }
     // A law that cannot describe the data: the fit's steps leave the plausible range
     // (E* below 1 kPa) and it stops, saying why, instead of printing a fit.
-    refused(
-        &[
-            "fit",
-            csv,
-            "--law",
-            "dmt",
-            "--work-of-adhesion",
-            "0.02",
-            "--fit",
-            "modulus",
-            "-q",
-        ],
-        "the fit stopped where a trial curve could not be simulated",
+    // Hybrid data fitted with a law that cannot describe them: a verdict, not an
+    // interval — its trials outside the law's range refused as steps.
+    let out = tapsim(&[
+        "fit",
+        csv,
+        "--law",
+        "dmt",
+        "--work-of-adhesion",
+        "0.02",
+        "--fit",
+        "modulus",
+        "-q",
+    ]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("NOT converged"), "{text}");
+    assert!(
+        text.contains("THE FIT DOES NOT DESCRIBE THE DATA"),
+        "{text}"
     );
+    assert!(text.contains("worst points"), "{text}");
+    let row = text.lines().find(|l| l.starts_with("modulus_pa")).unwrap();
+    assert!(row.trim_end().ends_with('-') && !row.contains('['), "{row}");
     // --csv: the data beside the fit, one row per point; the fitted values are the
     // JSON's curve, the residuals its residuals (amplitudes first).
     let rows = dir.join("fit.csv");

@@ -85,7 +85,7 @@ fn runs_test(channel: &'static str, r: &[f64]) -> Option<RunsTest> {
             channel,
             runs: 1,
             expected: 1.0,
-            z: f64::NEG_INFINITY,
+            z: -(n.sqrt()),
         });
     }
     let runs = 1 + r
@@ -127,7 +127,7 @@ pub fn diagnose(
     let at = |i: usize| {
         data.setpoint_ratio
             .as_ref()
-            .map_or(data.position_m[i], |s| s[i])
+            .map_or_else(|| data.position_m[i], |s| s[i])
     };
     // Each channel's residuals in the data's order, tested for runs.
     let mut runs = Vec::new();
@@ -137,7 +137,12 @@ pub fn diagnose(
         let r = &residuals[c * n..(c + 1) * n];
         if data.setpoint_ratio.is_none() {
             if let Some(t) = runs_test(name, r) {
-                if t.z < RUNS_Z {
+                if t.runs == 1 {
+                    reasons.push(format!(
+                        "the {name} residuals all have one sign: the fitted curve misses the \
+                         data's shape, not their noise"
+                    ));
+                } else if t.z < RUNS_Z {
                     reasons.push(format!(
                         "the {name} residuals run in long stretches of one sign ({} runs \
                          where independent noise would give {:.1}, z = {:.1}): the fitted \

@@ -17,6 +17,11 @@ use std::cell::{Cell, RefCell};
 /// resolution.
 const LOG_STEP: f64 = 1e-4;
 const OFFSET_STEP: f64 = 1e-3;
+/// A local run keeps each material parameter within this of its start in the
+/// logarithm (a factor 100 either way): beyond, a trial is refused like one that cannot
+/// be simulated (without the bound a fit of a law that cannot describe the data walks
+/// to absurd values, 1 kPa say).
+const MAX_LOG_STEP: f64 = 4.605_170_185_988_091;
 /// The length of the residual vector a trial that cannot be simulated is given: larger
 /// than any curve's, finite.
 const UNSIMULATED: f64 = 1e100;
@@ -211,6 +216,15 @@ impl Problem<'_> {
         }
         if self.curves.get() >= self.max_curves + self.params.len() + 2 {
             return None;
+        }
+        if x.iter()
+            .zip(self.params)
+            .any(|(&xi, p)| p.is_material() && xi.abs() > MAX_LOG_STEP)
+        {
+            // Beyond any plausible value: refused like a trial that cannot be simulated.
+            self.tracker.curve(None);
+            let m = self.data.channels() * self.data.len();
+            return Some(DVector::from_element(m, UNSIMULATED / (m as f64).sqrt()));
         }
         let (setup, nuisance) = self.physical(x);
         let simulated = self.data.simulate(&setup, self.numerics, &nuisance);

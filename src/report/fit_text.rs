@@ -145,13 +145,13 @@ pub fn report(r: &FitReport, law: &str, data: &Measured) -> String {
             format!("{:.1e}", r.reduced_chi_square)
         },
         r.degrees_of_freedom,
-        if r.sigma_estimated {
-            "estimated from the residuals: the intervals are scaled by √(χ²/dof)"
-        } else {
-            "as given"
+        match (r.sigma_estimated, r.diagnosis.describes_data) {
+            (true, true) => "estimated from the residuals: the intervals are scaled by √(χ²/dof)",
+            (true, false) => "not given: relative to the default weights 0.02 nm and 0.05°",
+            (false, _) => "as given",
         }
     );
-    if !r.sigma_estimates.is_empty() {
+    if !r.sigma_estimates.is_empty() && r.diagnosis.describes_data {
         let unit = |c: &str| match c {
             "amplitude_m" | "amplitude2_m" => (1e9, "nm"),
             _ => (1.0, "°"),

@@ -1,0 +1,236 @@
+//! The fit on the curve users record most (issue 43): an approach from far that jumps
+//! from the attractive to the repulsive branch on the way in. The global stage and the
+//! split at the data's branch jump bring every start back; a law that cannot describe
+//! the data gets a verdict, not intervals; the laws are ranked by AIC.
+
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use tapsim::dynamics::setup::{Numerics, TapSetup, default_setup};
+use tapsim::fit::{FitOptions, Measured, Nuisance, Parameter, Search, compare, fit, model::curve};
+use tapsim::law::{LawKind, LawSpec};
+use tapsim::sweep::sweep_numerics;
+
+/// The piezo's zero lies 3 nm from the rest separation's.
+const OFFSET_M: f64 = 3e-9;
+const SIGMA_A_M: f64 = 0.02e-9;
+const SIGMA_PHI_DEG: f64 = 0.05;
+
+fn numerics() -> Numerics {
+    sweep_numerics(Numerics::default(), (false, false))
+}
+
+/// The issue's setup: E* = 0.8 GPa, Δγ = 0.07 J/m², the hybrid law, the built-in lever.
+fn issue_setup(modulus_pa: f64, work_j_m2: f64) -> TapSetup {
+    let mut s = default_setup();
+    s.contact.modulus_pa = modulus_pa;
+    s.contact.work_of_adhesion_j_m2 = work_j_m2;
+    s
+}
+
+/// `n` piezo positions of an approach from z_c = 24 nm to 8 nm.
+fn positions(n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| 24e-9 - 16e-9 * i as f64 / (n - 1) as f64 - OFFSET_M)
+        .collect()
+}
+
+/// The approach of `truth` at `positions`, noise from `seed` (none for seed 0).
+fn measured(truth: &TapSetup, positions: &[f64], seed: u64) -> Measured {
+    let c = curve(truth, &numerics(), positions, OFFSET_M).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let (na, np) = (
+        Normal::new(0.0, SIGMA_A_M).unwrap(),
+        Normal::new(0.0, SIGMA_PHI_DEG).unwrap(),
+    );
+    let noisy = seed != 0;
+    Measured {
+        position_m: positions.to_vec(),
+        setpoint_ratio: None,
+        second_mode: None,
+        segments: vec![0],
+        amplitude_m: Some(
+            c.amplitude_m
+                .iter()
+                .map(|a| a + if noisy { na.sample(&mut rng) } else { 0.0 })
+                .collect(),
+        ),
+        phase_deg: Some(
+            c.phase_deg
+                .iter()
+                .map(|p| p + if noisy { np.sample(&mut rng) } else { 0.0 })
+                .collect(),
+        ),
+        sigma_amplitude_m: SIGMA_A_M,
+        sigma_phase_deg: SIGMA_PHI_DEG,
+    }
+}
+
+fn options() -> FitOptions {
+    FitOptions::new(
+        vec![
+            Parameter::Modulus,
+            Parameter::WorkOfAdhesion,
+            Parameter::ZOffset,
+        ],
+        0.0,
+    )
+}
+
+/// The phase falls from above the free phase to below it once on the way in.
+fn jumps_once(data: &Measured) -> bool {
+    let p = data.phase_deg.as_ref().unwrap();
+    p.windows(2).filter(|w| w[0] > 95.0 && w[1] < 85.0).count() == 1
+}
+
+/// The issue's curve (E* 0.8 GPa, Δγ 0.07 J/m², 40 points 24 → 8 nm, 0.02 nm and
+/// 0.05° of noise) and one whose jump lies elsewhere (E* 0.5 GPa, Δγ 0.05 J/m²), each
+/// fitted from starts 0.5× and 2× the truth in both parameters (the offset from 0, 3 nm
+/// off): every start ends within 1 % of the truth, χ²/dof within [0.5, 2], the 95 %
+/// intervals hold the truth, and the fit is called converged. Before the global stage
+/// these fits ended at E* ≈ 0.35 GPa with χ²/dof ≈ 8·10⁵ and called it converged.
+#[test]
+#[ignore = "slow (eight fits with their global stage, about two minutes in release): run with cargo test --release --test fit_global -- --ignored"]
+fn a_branch_jumping_curve_is_fitted_back_from_starts_half_and_twice_the_truth() {
+    for (e, w, seed) in [(0.8e9, 0.07, 11), (0.5e9, 0.05, 12)] {
+        let truth = issue_setup(e, w);
+        let data = measured(&truth, &positions(40), seed);
+        assert!(jumps_once(&data), "{:?}", data.phase_deg);
+        for (fe, fw) in [(0.5, 0.5), (2.0, 2.0), (0.5, 2.0), (2.0, 0.5)] {
+            let start = issue_setup(e * fe, w * fw);
+            let r = fit(&start, &numerics(), &data, &options(), |_| {}).unwrap();
+            let v: Vec<f64> = r.parameters.iter().map(|p| p.value.unwrap()).collect();
+            eprintln!(
+                "truth ({e:e}, {w}) start ×({fe}, {fw}): {v:?}, χ²/dof {:.3}, {} curves",
+                r.reduced_chi_square, r.curves
+            );
+            assert!(r.converged, "{}", r.termination);
+            assert!((v[0] / e - 1.0).abs() < 0.01, "{v:?}");
+            assert!((v[1] / w - 1.0).abs() < 0.01, "{v:?}");
+            assert!((0.5..=2.0).contains(&r.reduced_chi_square));
+            for (p, t) in r.parameters.iter().zip([e, w, OFFSET_M]) {
+                let [lo, hi] = p.interval_95.unwrap();
+                assert!(lo <= t && t <= hi, "{}: {t} outside [{lo}, {hi}]", p.name);
+            }
+        }
+    }
+}
+
+/// `tapsim fit --help`'s own example: the hybrid defaults' attractive branch (18.5 → 8
+/// nm, 30 points, noise-free) fitted from E* = 1 GPa and Δγ = 0.2 J/m² (truth 0.593 GPa
+/// and 0.1 J/m²): back to 1 % — it used to stall at the start after 138 curves and call
+/// that convergence.
+#[test]
+#[ignore = "slow (a fit with its global stage, some 5 s in release): run with cargo test --release --test fit_global -- --ignored"]
+fn the_help_example_fits_to_one_percent() {
+    let truth = default_setup();
+    let z: Vec<f64> = (0..30)
+        .map(|i| 18.5e-9 - 10.5e-9 * i as f64 / 29.0)
+        .collect();
+    let c = curve(&truth, &numerics(), &z, 0.0).unwrap();
+    let data = Measured {
+        amplitude_m: Some(c.amplitude_m),
+        phase_deg: Some(c.phase_deg),
+        ..measured(&truth, &z, 0)
+    };
+    let start = issue_setup(1e9, 0.2);
+    let r = fit(&start, &numerics(), &data, &options(), |_| {}).unwrap();
+    let v: Vec<f64> = r.parameters.iter().map(|p| p.value.unwrap()).collect();
+    assert!(
+        (v[0] / truth.contact.modulus_pa - 1.0).abs() < 0.01,
+        "{v:?}"
+    );
+    assert!((v[1] / 0.1 - 1.0).abs() < 0.01, "{v:?}");
+    assert!(r.converged, "{}", r.termination);
+}
+
+/// Data from the hybrid law fitted with DMT, a law that cannot describe them: the fit
+/// is not called converged, gives no interval, and says why (residuals of one sign, the
+/// worst points) — its trials outside the law's range refused as steps.
+#[test]
+fn a_law_that_cannot_describe_the_data_gets_a_verdict_not_intervals() {
+    let truth = default_setup();
+    let z: Vec<f64> = (0..12).map(|i| 18.5e-9 - 0.95e-9 * i as f64).collect();
+    let data = measured(&truth, &z, 5);
+    let mut dmt = truth.clone();
+    dmt.law = LawSpec::from_values(LawKind::Dmt, [None; tapsim::law::LAW_PARAMS.len()]);
+    dmt.contact.work_of_adhesion_j_m2 = 0.02;
+    let options = FitOptions {
+        search: Search::Local,
+        max_curves: 60,
+        ..FitOptions::new(vec![Parameter::Modulus], OFFSET_M)
+    };
+    let r = fit(&dmt, &numerics(), &data, &options, |_| {}).unwrap();
+    assert!(!r.converged);
+    assert!(!r.diagnosis.describes_data);
+    assert!(!r.diagnosis.reasons.is_empty());
+    assert_eq!(r.diagnosis.worst_points.len(), 3);
+    assert!(r.parameters.iter().all(|p| p.interval_95.is_none()));
+    // χ² far above its distribution, said in words.
+    assert!(r.reduced_chi_square > 100.0);
+    assert!(
+        r.diagnosis.reasons.iter().any(|s| s.contains("χ²/dof")),
+        "{:?}",
+        r.diagnosis.reasons
+    );
+}
+
+/// A phase channel with an offset (3°, as electronics set it) is fitted back as a
+/// nuisance parameter beside E* (noise-free, to 1e-3° and a fifth of its standard
+/// error): the free points far from the sample fix it.
+#[test]
+fn a_phase_offset_is_fitted_back() {
+    let truth = default_setup();
+    let z: Vec<f64> = (0..12).map(|i| 24e-9 - 1.4e-9 * i as f64).collect();
+    let mut data = measured(&truth, &z, 0);
+    for p in data.phase_deg.iter_mut().flatten() {
+        *p += 3.0;
+    }
+    let mut start = truth.clone();
+    start.contact.modulus_pa *= 1.1;
+    let options = FitOptions {
+        search: Search::Local,
+        ..FitOptions::new(vec![Parameter::Modulus, Parameter::PhaseOffset], OFFSET_M)
+    };
+    let r = fit(&start, &numerics(), &data, &options, |_| {}).unwrap();
+    let v: Vec<f64> = r.parameters.iter().map(|p| p.value.unwrap()).collect();
+    let why = format!("{v:?}: {} (χ² {:e})", r.termination, r.chi_square);
+    assert!(r.converged, "{why}");
+    // Noise-free: at the truth to a small fraction of the standard errors 0.02 nm and
+    // 0.05° of noise would give.
+    for (p, t) in r.parameters.iter().zip([truth.contact.modulus_pa, 3.0]) {
+        let e = p.std_err.unwrap();
+        assert!(
+            (p.value.unwrap() - t).abs() < 0.2 * e,
+            "{}: {why}, σ {e}",
+            p.name
+        );
+    }
+    assert!((v[1] - 3.0).abs() < 1e-3, "{why}");
+}
+
+/// Law selection: data simulated with the hybrid law and fitted with hybrid and JKR
+/// prefer the hybrid law decisively; data simulated with JKR prefer JKR.
+#[test]
+#[ignore = "slow (four fits, JKR's with mode locks: several minutes in release): run with cargo test --release --test fit_global -- --ignored"]
+fn the_law_that_made_the_data_is_preferred() {
+    for made_by in [LawKind::Hybrid, LawKind::Jkr] {
+        let mut truth = issue_setup(0.8e9, 0.07);
+        truth.law = LawSpec::from_values(made_by, [None; tapsim::law::LAW_PARAMS.len()]);
+        let data = measured(&truth, &positions(40), 21);
+        let mut fits = Vec::new();
+        for law in [LawKind::Hybrid, LawKind::Jkr] {
+            let mut start = issue_setup(0.6e9, 0.1);
+            start.law = LawSpec::from_values(law, [None; tapsim::law::LAW_PARAMS.len()]);
+            let r = fit(&start, &numerics(), &data, &options(), |_| {}).unwrap();
+            fits.push((start.law.to_string(), r));
+        }
+        let c = compare(&fits.iter().map(|(n, r)| (n.clone(), r)).collect::<Vec<_>>());
+        eprintln!("made by {made_by:?}: {}", c.verdict);
+        assert_eq!(
+            c.ranking[0].law,
+            LawSpec::from_values(made_by, [None; tapsim::law::LAW_PARAMS.len()]).to_string()
+        );
+        assert!(c.decided, "{}", c.verdict);
+        assert!(c.ranking[1].delta_aic > 10.0, "{}", c.verdict);
+    }
+}
