@@ -6,7 +6,7 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use tapsim::dynamics::numeric::Ignore;
 use tapsim::dynamics::observables::TapObservables;
-use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};
+use tapsim::dynamics::setup::{Numerics, Prepared, TapSetup, default_setup};
 
 const CYCLES: u64 = 200;
 
@@ -386,27 +386,28 @@ fn modes(c: &mut Criterion) {
     group.finish();
 }
 
-/// The issue's round trip (`tapsim fit`): 30 points of the hybrid defaults' approach
-/// with 0.02 nm and 0.05° of noise (seed 7), E*, Δγ and the offset fitted from E*
-/// doubled, Δγ halved and the offset 1 nm off (the issue's target: under 10 s).
-fn fit(c: &mut Criterion) {
+/// A noisy approach curve: `n` points from z_c = `from` to 8 nm of `truth`, the piezo's
+/// zero 3 nm off, 0.02 nm and 0.05° of noise (seed 7).
+fn noisy_curve(
+    truth: &TapSetup,
+    numerics: &Numerics,
+    from_m: f64,
+    n: u32,
+) -> tapsim::fit::Measured {
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
-    use tapsim::fit::{FitOptions, Measured, Nuisance, Parameter, Search, model::curve};
-    let truth = default_setup();
-    let numerics = tapsim::sweep::sweep_numerics(Numerics::default(), (false, false));
     let offset = 3e-9;
-    let positions: Vec<f64> = (0..30)
-        .map(|i| 18.5e-9 - 10.5e-9 * f64::from(i) / 29.0 - offset)
+    let positions: Vec<f64> = (0..n)
+        .map(|i| from_m - (from_m - 8e-9) * f64::from(i) / f64::from(n - 1) - offset)
         .collect();
-    let clean = curve(&truth, &numerics, &positions, offset).expect("defaults");
+    let clean = tapsim::fit::model::curve(truth, numerics, &positions, offset).expect("curve");
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     let (na, np) = (
         Normal::new(0.0, 0.02e-9).expect("sigma"),
         Normal::new(0.0, 0.05).expect("sigma"),
     );
-    let data = Measured {
-        position_m: positions.clone(),
+    tapsim::fit::Measured {
+        position_m: positions,
         setpoint_ratio: None,
         second_mode: None,
         segments: vec![0],
@@ -426,26 +427,59 @@ fn fit(c: &mut Criterion) {
         ),
         sigma_amplitude_m: 0.02e-9,
         sigma_phase_deg: 0.05,
-    };
+    }
+}
+
+/// `tapsim fit`: the issue-32 round trip (30 points of the hybrid defaults' attractive
+/// branch, E*, Δγ and the offset fitted from E* doubled, Δγ halved, the offset 1 nm off,
+/// local search; target under 10 s), and issue 43's branch-jumping curve (E* 0.8 GPa,
+/// Δγ 0.07 J/m², 40 points from 24 nm to 8 nm) fitted from half and twice the truth
+/// with the global stage, on one thread (target under 10 s on one core).
+fn fit(c: &mut Criterion) {
+    use tapsim::fit::{FitOptions, Nuisance, Parameter, Search};
+    let numerics = tapsim::sweep::sweep_numerics(Numerics::default(), (false, false));
+    let truth = default_setup();
+    let data = noisy_curve(&truth, &numerics, 18.5e-9, 30);
     let mut start = truth.clone();
     start.contact.modulus_pa *= 2.0;
     start.contact.work_of_adhesion_j_m2 *= 0.5;
+    let parameters = vec![
+        Parameter::Modulus,
+        Parameter::WorkOfAdhesion,
+        Parameter::ZOffset,
+    ];
     let options = FitOptions {
-        parameters: vec![
-            Parameter::Modulus,
-            Parameter::WorkOfAdhesion,
-            Parameter::ZOffset,
-        ],
-        start: Nuisance::offset(offset - 1e-9),
-        estimate_sigma: false,
-        max_curves: 400,
+        start: Nuisance::offset(2e-9),
         search: Search::Local,
+        ..FitOptions::new(parameters.clone(), 0.0)
     };
     let mut group = c.benchmark_group("fit");
     group.sample_size(10);
     group.bench_function("round trip, 30 points, start 2x off", |b| {
         b.iter(|| tapsim::fit::fit(&start, &numerics, &data, &options, |_| {}).expect("fit"))
     });
+    let mut truth = default_setup();
+    truth.contact.modulus_pa = 0.8e9;
+    truth.contact.work_of_adhesion_j_m2 = 0.07;
+    let data = noisy_curve(&truth, &numerics, 24e-9, 40);
+    let mut start = truth.clone();
+    start.contact.modulus_pa *= 0.5;
+    start.contact.work_of_adhesion_j_m2 *= 2.0;
+    let options = FitOptions::new(parameters, 0.0);
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a thread pool");
+    group.bench_function(
+        "branch jump, 40 points, global stage, start 0.5x/2x, one thread",
+        |b| {
+            b.iter(|| {
+                one.install(|| {
+                    tapsim::fit::fit(&start, &numerics, &data, &options, |_| {}).expect("fit")
+                })
+            })
+        },
+    );
     group.finish();
 }
 

@@ -312,3 +312,13 @@ fn phases_at_setpoints_are_fitted() {
     refused(&["fit", data, "--fit", "z-offset"], "no offset");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// Several laws are for `tapsim fit` alone: another command refuses them and says
+/// where they belong.
+#[test]
+fn several_laws_are_refused_outside_fit() {
+    refused(
+        &["tap", "--law", "hybrid,jkr", "-q"],
+        "tapsim fit --law a,b",
+    );
+}

@@ -103,7 +103,11 @@ fn a_branch_jumping_curve_is_fitted_back_from_starts_half_and_twice_the_truth() 
                 "truth ({e:e}, {w}) start ×({fe}, {fw}): {v:?}, χ²/dof {:.3}, {} curves",
                 r.reduced_chi_square, r.curves
             );
-            assert!(r.converged, "{}", r.termination);
+            assert!(
+                r.converged,
+                "{}: {:?} {:?}",
+                r.termination, r.diagnosis.reasons, r.minima
+            );
             assert!((v[0] / e - 1.0).abs() < 0.01, "{v:?}");
             assert!((v[1] / w - 1.0).abs() < 0.01, "{v:?}");
             assert!((0.5..=2.0).contains(&r.reduced_chi_square));
@@ -208,29 +212,102 @@ fn a_phase_offset_is_fitted_back() {
     assert!((v[1] - 3.0).abs() < 1e-3, "{why}");
 }
 
-/// Law selection: data simulated with the hybrid law and fitted with hybrid and JKR
-/// prefer the hybrid law decisively; data simulated with JKR prefer JKR.
+/// Law selection: data simulated with the hybrid law (the issue's curve) and fitted
+/// with hybrid and JKR prefer the hybrid law decisively; data simulated with JKR (E*
+/// 0.3 GPa, Δγ 0.02 J/m², μ = 1.49: period-1 along the curve) prefer JKR; a curve
+/// that never reaches the sample (both laws give the free oscillation) cannot tell
+/// them apart, and the verdict says so.
 #[test]
-#[ignore = "slow (four fits, JKR's with mode locks: several minutes in release): run with cargo test --release --test fit_global -- --ignored"]
+#[ignore = "slow (six fits, about three minutes in release): run with cargo test --release --test fit_global -- --ignored"]
 fn the_law_that_made_the_data_is_preferred() {
-    for made_by in [LawKind::Hybrid, LawKind::Jkr] {
-        let mut truth = issue_setup(0.8e9, 0.07);
-        truth.law = LawSpec::from_values(made_by, [None; tapsim::law::LAW_PARAMS.len()]);
-        let data = measured(&truth, &positions(40), 21);
+    let law = |k| LawSpec::from_values(k, [None; tapsim::law::LAW_PARAMS.len()]);
+    let cases = [
+        (
+            LawKind::Hybrid,
+            (0.8e9, 0.07),
+            (0.6e9, 0.1),
+            (24e-9, 8e-9),
+            Some(LawKind::Hybrid),
+        ),
+        (
+            LawKind::Jkr,
+            (0.3e9, 0.02),
+            (0.4e9, 0.03),
+            (24e-9, 8e-9),
+            Some(LawKind::Jkr),
+        ),
+        (
+            LawKind::Hybrid,
+            (0.8e9, 0.07),
+            (0.6e9, 0.1),
+            (40e-9, 30e-9),
+            None,
+        ),
+    ];
+    for (made_by, (e, w), (e0, w0), (from, to), preferred) in cases {
+        let mut truth = issue_setup(e, w);
+        truth.law = law(made_by);
+        let z: Vec<f64> = (0..40)
+            .map(|i| from - (from - to) * i as f64 / 39.0 - OFFSET_M)
+            .collect();
+        let data = measured(&truth, &z, 21);
         let mut fits = Vec::new();
-        for law in [LawKind::Hybrid, LawKind::Jkr] {
-            let mut start = issue_setup(0.6e9, 0.1);
-            start.law = LawSpec::from_values(law, [None; tapsim::law::LAW_PARAMS.len()]);
+        for k in [LawKind::Hybrid, LawKind::Jkr] {
+            let mut start = issue_setup(e0, w0);
+            start.law = law(k);
             let r = fit(&start, &numerics(), &data, &options(), |_| {}).unwrap();
             fits.push((start.law.to_string(), r));
         }
         let c = compare(&fits.iter().map(|(n, r)| (n.clone(), r)).collect::<Vec<_>>());
-        eprintln!("made by {made_by:?}: {}", c.verdict);
-        assert_eq!(
-            c.ranking[0].law,
-            LawSpec::from_values(made_by, [None; tapsim::law::LAW_PARAMS.len()]).to_string()
-        );
-        assert!(c.decided, "{}", c.verdict);
-        assert!(c.ranking[1].delta_aic > 10.0, "{}", c.verdict);
+        eprintln!("made by {made_by:?}, {from:e} to {to:e} m: {}", c.verdict);
+        match preferred {
+            Some(k) => {
+                assert_eq!(c.ranking[0].law, law(k).to_string(), "{}", c.verdict);
+                assert!(c.decided, "{}", c.verdict);
+                assert!(c.ranking[1].delta_aic > 10.0, "{}", c.verdict);
+            }
+            None => {
+                assert!(!c.decided, "{}", c.verdict);
+                assert!(c.verdict.contains("cannot tell"), "{}", c.verdict);
+            }
+        }
     }
+}
+
+/// A profile whose trials leave the law's range (the hybrid law at μ ≈ 1.24, near its
+/// lower end, with noise of 1 nm and 3° making the steps wide) is not the end of the
+/// fit: the values the law cannot take are points without a value, that side of the
+/// profile stops, and the other side still gives its interval.
+#[test]
+#[ignore = "slow (a profile of some ten fits, about 10 s in release): run with cargo test --release --test fit_global -- --ignored"]
+fn a_profile_survives_a_trial_outside_the_law() {
+    let truth = issue_setup(default_setup().contact.modulus_pa, 0.03);
+    let z: Vec<f64> = (0..20).map(|i| 24e-9 - 16e-9 * i as f64 / 19.0).collect();
+    let mut data = measured(&truth, &z, 0);
+    data.sigma_amplitude_m = 1e-9;
+    data.sigma_phase_deg = 3.0;
+    let options = FitOptions {
+        search: Search::Local,
+        ..options()
+    };
+    let options = FitOptions {
+        start: Nuisance::offset(OFFSET_M),
+        ..options
+    };
+    let best = fit(&truth, &numerics(), &data, &options, |_| {}).unwrap();
+    let p = tapsim::fit::profile(
+        &truth,
+        &numerics(),
+        &data,
+        &options,
+        &best,
+        Parameter::WorkOfAdhesion,
+        |_| {},
+    )
+    .unwrap();
+    eprintln!("{p:?}");
+    assert!(!p.unavailable.is_empty(), "{p:?}");
+    // Below the estimate the law ends (μ falls with Δγ); above, the interval closes.
+    assert!(p.unavailable.iter().all(|&v| v < 0.03));
+    assert!(p.interval_68[1].is_some_and(|hi| hi > 0.03));
 }

@@ -309,7 +309,10 @@ def fit(data: Any, setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
     with units in the header, as ``tapsim fit`` reads it) fitted by the simulator
     (``tapsim fit``): ``parameters`` (value, std_err, interval_68, interval_95,
     identifiable), ``identifiability`` (singular_values, condition_number, correlations,
-    notes), chi_square, the fitted curve; ``profile=True`` adds ``profiles``."""
+    notes), chi_square, ``converged``, ``diagnosis`` (describes_data, reasons,
+    worst_points), the ``minima`` found, the fitted curve; ``profile=True`` adds
+    ``profiles``. ``law=["hybrid", "jkr"]`` fits each law: ``laws`` (one report per
+    law) and ``comparison`` (ranking by AIC and BIC, ``verdict`` in words)."""
     args = _argv("fit", _options(setup, kwargs))
     return Result("fit", _tapsim.run([args[0], _os.fspath(data)] + args[1:]))
 

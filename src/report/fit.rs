@@ -23,7 +23,18 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
         ),
     };
     let n = z.len();
-    // The fitted curve drawn per approach: a gap where the next begins.
+    // Where the fitted curve jumps (its phase by more than 10° between two points: the
+    // onset of contact, the branch jump): a jump, not a ramp, so a gap.
+    let jumps: Vec<usize> = (1..n)
+        .filter(|&i| {
+            r.fitted
+                .phase_deg
+                .get(i)
+                .zip(r.fitted.phase_deg.get(i - 1))
+                .is_some_and(|(a, b)| (a - b).abs() > 10.0)
+        })
+        .collect();
+    // The fitted curve drawn per approach: a gap where the next begins or it jumps.
     let line = |ys: &[f64]| -> Vec<(f64, f64)> {
         let mut points = Vec::with_capacity(n + data.segments.len());
         if data.setpoint_ratio.is_some() {
@@ -32,7 +43,7 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
             return points;
         }
         for i in 0..n {
-            if i > 0 && data.segments.contains(&i) {
+            if i > 0 && (data.segments.contains(&i) || jumps.contains(&i)) {
                 points.push((f64::NAN, f64::NAN));
             }
             points.push((z[i], ys[i]));
