@@ -311,3 +311,59 @@ fn a_profile_survives_a_trial_outside_the_law() {
     assert!(p.unavailable.iter().all(|&v| v < 0.03));
     assert!(p.interval_68[1].is_some_and(|hi| hi > 0.03));
 }
+
+/// Coverage on the branch-jumping curve: over 100 noisy replicas of the issue's curve
+/// (E* 0.8 GPa, Δγ 0.07 J/m², 40 points, 0.02 nm and 0.05°), fitted from near the
+/// truth, every fit converges and E*'s 68 % interval holds the truth in 68 ± 7 % of
+/// them (a binomial's standard deviation at 100 replicas is 4.7 %; measured: 67, pulls
+/// +0.25 ± 1.12). Δγ's does NOT yet: 58 of 100, its pulls +0.28 ± 2.02 with tails to
+/// −11 and +5.5 — the curve's first touching point grazes the jump-in (the onset is a
+/// switch the linearised intervals do not see), and Δγ sets the jump-in distance. It is
+/// printed, not asserted, until intervals carry the spread of such points (issue 43,
+/// item 5).
+#[test]
+#[ignore = "slow (100 fits, about two minutes in release on two cores): run with cargo test --release --test fit_global -- --ignored"]
+fn the_modulus_intervals_cover_the_branch_jumping_truth_in_68_percent_of_replicas() {
+    use rayon::prelude::*;
+    let (e, w) = (0.8e9, 0.07);
+    let truth = issue_setup(e, w);
+    let z = positions(40);
+    let start = issue_setup(e * 1.05, w * 0.95);
+    let options = FitOptions {
+        search: Search::Local,
+        start: Nuisance::offset(OFFSET_M + 0.1e-9),
+        ..options()
+    };
+    // Per replica: whether each 68 % interval holds the truth, and the pull
+    // (estimate − truth)/standard error.
+    let held: Vec<([bool; 2], [f64; 2])> = (0..100u64)
+        .into_par_iter()
+        .map(|seed| {
+            let data = measured(&truth, &z, 1000 + seed);
+            let r = fit(&start, &numerics(), &data, &options, |_| {}).unwrap();
+            assert!(r.converged, "seed {seed}: {}", r.termination);
+            let inside = |k: usize, t: f64| {
+                let [lo, hi] = r.parameters[k].interval_68.unwrap();
+                lo <= t && t <= hi
+            };
+            let pull = |k: usize, t: f64| {
+                let p = &r.parameters[k];
+                (p.value.unwrap() - t) / p.std_err.unwrap()
+            };
+            ([inside(0, e), inside(1, w)], [pull(0, e), pull(1, w)])
+        })
+        .collect();
+    for (k, name) in ["E*", "Δγ"].iter().enumerate() {
+        let n = held.iter().filter(|h| h.0[k]).count();
+        let pulls: Vec<f64> = held.iter().map(|h| h.1[k]).collect();
+        let mean = pulls.iter().sum::<f64>() / 100.0;
+        let sd = (pulls.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / 99.0).sqrt();
+
+        eprintln!(
+            "{name}: the 68 % interval holds the truth in {n} of 100 replicas; pulls {mean:+.3} ± {sd:.3}"
+        );
+        if k == 0 {
+            assert!((61..=75).contains(&n), "{name}: {n} of 100");
+        }
+    }
+}

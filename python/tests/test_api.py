@@ -187,6 +187,23 @@ def test_fit_reads_the_curve_approach_writes_and_gives_it_back(cli, tmp_path):
         tapsim.fit(rising)
 
 
+def test_fit_ranks_several_laws(cli, tmp_path):
+    # A DMT curve fitted with DMT and Hertz (a list is several --law flags): the data
+    # prefer DMT, its attraction being in them; the same ranking as the command line's.
+    path = tmp_path / "dmt.csv"
+    law = dict(law="dmt", work_of_adhesion=0.02)
+    tapsim.approach(**{"from": "24nm"}, to="12nm", points=12, no_retract=True, csv=str(path), **law)
+    r = tapsim.fit(path, law=["dmt", "hertz"], work_of_adhesion=0.02, fit="modulus",
+                   sigma_amplitude="0.02nm", sigma_phase=0.05)
+    expected = cli("fit", str(path), "--law=dmt,hertz", "--work-of-adhesion=0.02",
+                   "--fit=modulus", "--sigma-amplitude=0.02nm", "--sigma-phase=0.05")
+    ranking = [row["law"] for row in r.comparison["ranking"]]
+    assert ranking == [row["law"] for row in expected["comparison"]["ranking"]]
+    assert ranking[0] == "dmt"
+    assert "prefer dmt over hertz" in r.comparison["verdict"]
+    assert r.laws["dmt"]["converged"]
+
+
 def test_reconstruct_gives_the_force_of_the_curve_approach_writes(cli, tmp_path):
     path = tmp_path / "dmt.csv"
     law = dict(law="dmt", work_of_adhesion=0.02)

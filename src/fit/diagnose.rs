@@ -212,15 +212,25 @@ pub fn diagnose(
     }
 }
 
-/// The decrease of χ² a Gauss–Newton step from the end would still bring, in the
-/// weighted residuals `r` with Jacobian `j`: the squared length of r's projection on
-/// the directions the parameters move the residuals (zero at a stationary point).
-pub fn gauss_newton_decrease(j: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
-    let svd = j.clone().svd(true, false);
+/// The Gauss–Newton step from the end (weighted residuals `r`, Jacobian `j`, in the
+/// fitted coordinates): −J⁺r over the directions the parameters move the residuals,
+/// and the decrease of χ² it predicts (the squared length of r's projection on them;
+/// zero at a stationary point).
+pub fn gauss_newton_step(j: &DMatrix<f64>, r: &DVector<f64>) -> (DVector<f64>, f64) {
+    let svd = j.clone().svd(true, true);
     let u = svd.u.expect("asked for U");
+    let v_t = svd.v_t.expect("asked for V");
     let largest = svd.singular_values.max();
-    (0..svd.singular_values.len())
-        .filter(|&k| svd.singular_values[k] > 1e-8 * largest)
-        .map(|k| u.column(k).dot(r).powi(2))
-        .sum()
+    let mut step = DVector::zeros(j.ncols());
+    let mut decrease = 0.0;
+    for k in 0..svd.singular_values.len() {
+        let s = svd.singular_values[k];
+        if s <= 1e-8 * largest || s == 0.0 {
+            continue;
+        }
+        let c = u.column(k).dot(r);
+        decrease += c * c;
+        step -= v_t.row(k).transpose() * (c / s);
+    }
+    (step, decrease)
 }

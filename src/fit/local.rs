@@ -164,6 +164,25 @@ pub(crate) fn jacobian(
     j.ok_or_else(|| Error::Numerical("the fit's Jacobian could not be simulated".into()))
 }
 
+/// The setup and nuisance values `step` (in the fitted coordinates) away from the end
+/// of `run`.
+pub(crate) fn stepped(
+    run: &LocalRun,
+    params: &[Parameter],
+    step: &DVector<f64>,
+) -> (TapSetup, Nuisance) {
+    let (mut setup, mut nuisance) = (run.setup.clone(), run.nuisance);
+    for ((p, &v), &d) in params.iter().zip(&run.values).zip(step.iter()) {
+        let value = if p.is_scale() {
+            v * d.exp()
+        } else {
+            v + d * p.unit()
+        };
+        p.set(&mut setup, &mut nuisance, value);
+    }
+    (setup, nuisance)
+}
+
 /// Coordinates, the curve simulated there and its weighted residuals.
 type Evaluated = (DVector<f64>, Curve, DVector<f64>);
 

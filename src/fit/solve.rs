@@ -3,7 +3,7 @@
 //! the best one the Jacobian's account of the parameters ([`super::identifiability`])
 //! and the verdict on whether the fit describes the data ([`super::diagnose`]).
 
-use super::diagnose::{Diagnosis, STALL_DECREASE, diagnose, gauss_newton_decrease};
+use super::diagnose::{Diagnosis, STALL_DECREASE, diagnose, gauss_newton_step};
 use super::identifiability::{Identifiability, ParameterEstimate, assess};
 use super::local::{self, LocalRun};
 use super::model::{Curve, Measured, Nuisance, Parameter};
@@ -267,10 +267,48 @@ pub fn fit(
     });
     let m = data.channels() * data.len();
     let dof = m - params.len();
-    let minima = distinct_minima(&runs, params, dof);
-    let best = &runs[0];
-    tracker.stage(Stage::Assess, params.len() + 1, 0);
-    let jacobian = local::jacobian(best, numerics, working, params, &tracker)?;
+    let mut best = runs.remove(0);
+    // Is the end a minimum? Try the Gauss–Newton step from it: where it lowers χ² by
+    // more than the variance factor the optimiser stalled (a step refused at a kink,
+    // say) — go on from there, twice at most; where it does not (the prediction met a
+    // switch in the forward differences), the end stands.
+    let factor_of = |r: &LocalRun| {
+        if options.estimate_sigma {
+            r.residuals.norm_squared() / dof as f64
+        } else {
+            1.0
+        }
+    };
+    let mut continuations = 0;
+    let (remaining, stalled, jacobian) = loop {
+        tracker.stage(Stage::Assess, params.len() + 2, 0);
+        let jacobian = local::jacobian(&best, numerics, working, params, &tracker)?;
+        let (step, predicted) = gauss_newton_step(&jacobian, &best.residuals);
+        let chi = best.residuals.norm_squared();
+        if predicted <= STALL_DECREASE * factor_of(&best) {
+            break (predicted, false, jacobian);
+        }
+        let (s, n) = local::stepped(&best, params, &step);
+        let found = data_chi_square(working, &s, numerics, &n);
+        tracker.curve(found);
+        let gained = found.map_or(0.0, |c| chi - c).max(0.0);
+        let stalled = gained > STALL_DECREASE * factor_of(&best);
+        if !stalled || continuations == 2 {
+            break (gained, stalled, jacobian);
+        }
+        continuations += 1;
+        best = local::run(
+            &s,
+            n,
+            numerics,
+            working,
+            params,
+            options.max_curves,
+            &tracker,
+        )?;
+    };
+    let minima = distinct_minima(std::iter::once(&best).chain(&runs), params, dof);
+    let best = &best;
     // The approach as it goes at the best parameters: where it jumps where the data
     // do, the same curve (to the steady states' tolerance); where not, the verdict
     // says so.
@@ -296,9 +334,7 @@ pub fn fit(
             ..diagnosis
         };
     }
-    let factor = if options.estimate_sigma { reduced } else { 1.0 };
-    let remaining = gauss_newton_decrease(&jacobian, residuals);
-    let stalled = !resolved && remaining > STALL_DECREASE * factor;
+    let stalled = stalled && !resolved;
     let variance_factor = match (diagnosis.describes_data, options.estimate_sigma, resolved) {
         (false, _, _) => None,
         (true, false, _) => Some(1.0),
@@ -322,9 +358,9 @@ pub fn fit(
     let mut termination = best.termination.clone();
     if stalled {
         termination = format!(
-            "{termination}, but a Gauss–Newton step would still lower χ² by {remaining:.3e}: \
-             the search stalled short of a minimum (the curve may be switching between \
-             states as the parameters move)"
+            "{termination}, but a Gauss–Newton step from there still lowers χ² by \
+             {remaining:.3e}: the search stalled short of a minimum (the curve may be \
+             switching between states as the parameters move)"
         );
     }
     if !diagnosis.describes_data {
@@ -350,9 +386,24 @@ pub fn fit(
     })
 }
 
+/// χ² of `data` simulated with `setup` and `nuisance` (None where it cannot be).
+fn data_chi_square(
+    data: &Measured,
+    setup: &TapSetup,
+    numerics: &Numerics,
+    nuisance: &Nuisance,
+) -> Option<f64> {
+    let c = data.simulate(setup, numerics, nuisance).ok()?;
+    Some(data.residuals(&c).iter().map(|r| r * r).sum())
+}
+
 /// The distinct minima of `runs` (sorted by χ²): runs whose coordinates agree to
 /// [`SAME_MINIMUM`] are one.
-fn distinct_minima(runs: &[LocalRun], params: &[Parameter], dof: usize) -> Vec<Minimum> {
+fn distinct_minima<'a>(
+    runs: impl Iterator<Item = &'a LocalRun>,
+    params: &[Parameter],
+    dof: usize,
+) -> Vec<Minimum> {
     let mut out: Vec<Minimum> = Vec::new();
     for r in runs {
         let same = out.iter_mut().find(|m| {
