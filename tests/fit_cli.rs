@@ -38,6 +38,8 @@ fn an_approach_curve_is_fitted_back() {
         "0.8GPa",
         "--work-of-adhesion",
         "0.12J/m^2",
+        "--search",
+        "local",
         "--offset",
         "0.3nm",
         "--json",
@@ -60,6 +62,8 @@ fn an_approach_curve_is_fitted_back() {
             "0.8GPa",
             "--work-of-adhesion",
             "0.12J/m^2",
+            "--search",
+            "local",
             "--plot",
             plot.to_str().unwrap(),
         ])
@@ -88,6 +92,10 @@ fn an_approach_curve_is_fitted_back() {
         "0.02",
         "--fit",
         "modulus",
+        "--search",
+        "local",
+        "--max-curves",
+        "60",
         "-q",
     ]);
     let text = String::from_utf8(out.stdout).unwrap();
@@ -110,6 +118,8 @@ fn an_approach_curve_is_fitted_back() {
         "0.8GPa",
         "--work-of-adhesion",
         "0.12J/m^2",
+        "--search",
+        "local",
         "--offset",
         "0.3nm",
         "-q",
@@ -289,7 +299,14 @@ fn phases_at_setpoints_are_fitted() {
     std::fs::write(&data, text).unwrap();
     let data = data.to_str().unwrap();
     let sigma = ["--sigma-phase", "0.05"];
-    let mut args = vec!["fit", data, "--fit", "work-of-adhesion"];
+    let mut args = vec![
+        "fit",
+        data,
+        "--search",
+        "local",
+        "--fit",
+        "work-of-adhesion",
+    ];
     args.extend(["--work-of-adhesion", "0.08J/m^2", "--json"]);
     args.extend(sigma);
     let v = json(&args);
@@ -298,7 +315,7 @@ fn phases_at_setpoints_are_fitted() {
         (num(&params[0], "value") / 0.1 - 1.0).abs() < 1e-5,
         "{params:?}"
     );
-    let mut args = vec!["fit", data, "--json"];
+    let mut args = vec!["fit", data, "--search", "local", "--json"];
     args.extend(sigma);
     let v = json(&args);
     let params = v["parameters"].as_array().unwrap();
