@@ -52,7 +52,7 @@ use std::sync::Mutex;
 ///
 ///   tapsim approach --from 18.5nm --to 8nm --points 30 --no-retract --csv curve.csv
 ///   tapsim fit curve.csv --modulus 1GPa --work-of-adhesion 0.2J/m^2
-///   tapsim fit curve.csv --law hybrid,jkr,dmt
+///   tapsim fit curve.csv --law hybrid,dmt
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct FitArgs {

@@ -171,14 +171,21 @@ pub(crate) fn stepped(
     params: &[Parameter],
     step: &DVector<f64>,
 ) -> (TapSetup, Nuisance) {
-    let (mut setup, mut nuisance) = (run.setup.clone(), run.nuisance);
-    for ((p, &v), &d) in params.iter().zip(&run.values).zip(step.iter()) {
-        let value = if p.is_scale() {
-            v * d.exp()
-        } else {
-            v + d * p.unit()
-        };
-        p.set(&mut setup, &mut nuisance, value);
+    at_coordinates(&run.setup, run.nuisance, params, &run.values, step)
+}
+
+/// `setup` and `nuisance` with each of `params` `x` away from its value in `starts`
+/// (in the fitted coordinates).
+fn at_coordinates(
+    setup: &TapSetup,
+    nuisance: Nuisance,
+    params: &[Parameter],
+    starts: &[f64],
+    x: &DVector<f64>,
+) -> (TapSetup, Nuisance) {
+    let (mut setup, mut nuisance) = (setup.clone(), nuisance);
+    for ((p, &start), &xi) in params.iter().zip(starts).zip(x.iter()) {
+        p.set(&mut setup, &mut nuisance, p.shifted(start, xi));
     }
     (setup, nuisance)
 }
@@ -209,17 +216,7 @@ struct Problem<'a> {
 impl Problem<'_> {
     /// The setup and the nuisance values at coordinates `x`.
     fn physical(&self, x: &DVector<f64>) -> (TapSetup, Nuisance) {
-        let mut setup = self.setup.clone();
-        let mut nuisance = self.base;
-        for ((p, &start), &xi) in self.params.iter().zip(self.starts).zip(x.iter()) {
-            let value = if p.is_scale() {
-                start * xi.exp()
-            } else {
-                start + xi * p.unit()
-            };
-            p.set(&mut setup, &mut nuisance, value);
-        }
-        (setup, nuisance)
+        at_coordinates(self.setup, self.base, self.params, self.starts, x)
     }
 
     /// The weighted residuals at `x` (None, with the failure kept, where the curve

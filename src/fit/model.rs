@@ -127,6 +127,25 @@ impl Parameter {
         }
     }
 
+    /// Its value `coordinate` away from `start` in the fitted coordinates (a scale's
+    /// logarithm, an offset in its unit).
+    pub fn shifted(self, start: f64, coordinate: f64) -> f64 {
+        if self.is_scale() {
+            start * coordinate.exp()
+        } else {
+            start + coordinate * self.unit()
+        }
+    }
+
+    /// How far apart two of its values lie in the fitted coordinates.
+    pub fn coordinate_gap(self, a: f64, b: f64) -> f64 {
+        if self.is_scale() {
+            (a / b).ln().abs()
+        } else {
+            (a - b).abs() / self.unit()
+        }
+    }
+
     /// Whether it belongs to the material or its law (what the global search spreads
     /// its design over), not the instrument's calibration.
     pub fn is_material(self) -> bool {

@@ -476,11 +476,7 @@ pub(crate) fn starts(
                     p.value(&c.setup, &c.nuisance),
                     p.value(&d.setup, &d.nuisance),
                 );
-                if p.is_scale() {
-                    (a / b).ln().abs() > 1e-3
-                } else {
-                    (a - b).abs() > 1e-3 * p.unit()
-                }
+                p.coordinate_gap(a, b) > 1e-3
             })
         });
         if distinct {

@@ -410,13 +410,7 @@ fn distinct_minima<'a>(
             params
                 .iter()
                 .zip(m.values.iter().zip(&r.values))
-                .all(|(p, (&a, &b))| {
-                    if p.is_scale() {
-                        (a / b).ln().abs() < SAME_MINIMUM
-                    } else {
-                        (a - b).abs() < SAME_MINIMUM * p.unit()
-                    }
-                })
+                .all(|(p, (&a, &b))| p.coordinate_gap(a, b) < SAME_MINIMUM)
         });
         match same {
             Some(m) => m.runs += 1,
