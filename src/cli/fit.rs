@@ -23,9 +23,10 @@ use std::sync::Mutex;
 /// squares, and says how sure the data let one be.
 ///
 /// How: a global stage first — a design of starts spread over ×/÷ --search-factor
-/// about your start, each with the offset that puts its curve's branch jump (or onset
-/// of contact) where the data's is — then Levenberg–Marquardt from the best few; every
-/// distinct minimum found is listed. A fit that does not describe the data (χ² far
+/// about your start, each with the offset that puts its onset of contact where the
+/// data's is — then Levenberg–Marquardt from the best few, each point simulated on the
+/// branch the data show (the points after the data's branch jump as an approach begun
+/// there); every distinct minimum found is listed. A fit that does not describe the data (χ² far
 /// above its noise, residuals in runs of one sign, the branch jump in the wrong place)
 /// says so, shows the worst points and gives no intervals. With --law a,b,... each law
 /// is fitted and the laws are ranked by AIC and BIC, with a verdict in words. With
