@@ -53,7 +53,7 @@ const JUMP_AMPLITUDE: f64 = 0.02;
 const ALIGNMENTS: usize = 3;
 /// Cycles at most per steady state while screening (the local stage uses the fit's own
 /// numerics: screening only ranks the design points).
-const SCREEN_MAX_CYCLES: usize = 2_000;
+const SCREEN_MAX_CYCLES: usize = 500;
 /// Where the data have no feature to align, the offset joins the design over ± this
 /// fraction of the free amplitude about its start.
 const OFFSET_SPAN: f64 = 0.5;
@@ -394,7 +394,7 @@ fn screen_plain(
 /// Design points screened at once before the best χ² among them bounds the rest.
 const FIRST_BATCH: usize = 8;
 /// A design point is given up once its χ² passes this many times the best so far.
-const BOUND_FACTOR: f64 = 10.0;
+const BOUND_FACTOR: f64 = 3.0;
 
 /// The starts for the local stage: the design's points screened (in parallel) and the
 /// best `starts` distinct ones, best first (the start itself alone with
