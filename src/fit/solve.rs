@@ -1,7 +1,8 @@
 //! The fit: a global stage ([`super::search`]) whose best design points start
-//! Levenberg–Marquardt runs ([`super::local`]), every distinct local minimum kept; at
-//! the best one the Jacobian's account of the parameters ([`super::identifiability`])
-//! and the verdict on whether the fit describes the data ([`super::diagnose`]).
+//! Levenberg–Marquardt runs (the private `local` module), every distinct local minimum
+//! kept; at the best one the Jacobian's account of the parameters
+//! ([`super::identifiability`]) and the verdict on whether the fit describes the data
+//! ([`super::diagnose`]).
 
 use super::diagnose::{Diagnosis, STALL_DECREASE, diagnose, gauss_newton_step};
 use super::identifiability::{Identifiability, ParameterEstimate, assess};
