@@ -8,8 +8,11 @@
 //! parameter the data do not determine (Chandrashekar et al., Soft Matter 18, 8748,
 //! 2022, on why the inverse problem of AM-AFM needs one).
 //!
-//! [`model`] is the forward model (the curve of a parameter set), [`solve`] the fit and
-//! [`identifiability`] what its Jacobian says.
+//! [`model`] is the forward model (the curve of a parameter set), [`search`] the global
+//! stage (a design of starts, each aligned on the data's onset of contact), [`solve`]
+//! the fit (local Levenberg–Marquardt runs from the best starts), [`identifiability`]
+//! what its Jacobian says, [`diagnose`] whether the fit describes the data, [`select`]
+//! which law the data support (AIC, BIC) and [`progress`] what a running fit reports.
 
 pub mod diagnose;
 pub mod identifiability;
