@@ -39,8 +39,13 @@ pub(crate) struct LocalRun {
     /// Why the optimiser stopped, and whether that was one of its convergence tests.
     pub termination: String,
     pub lm_converged: bool,
-    /// Curves this run simulated.
-    pub curves: usize,
+}
+
+impl LocalRun {
+    /// χ² at the end.
+    pub fn chi_square(&self) -> f64 {
+        self.residuals.norm_squared()
+    }
 }
 
 /// What the optimiser's reason to stop means, in words.
@@ -129,7 +134,6 @@ pub(crate) fn run(
         residuals,
         termination: termination_words(&termination),
         lm_converged: termination.was_successful(),
-        curves: p.curves.get(),
     })
 }
 

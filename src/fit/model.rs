@@ -579,6 +579,11 @@ impl Measured {
         usize::from(self.amplitude_m.is_some()) + usize::from(self.phase_deg.is_some()) + second
     }
 
+    /// χ² of `curve`: the sum of its weighted residuals' squares.
+    pub fn chi_square(&self, curve: &Curve) -> f64 {
+        self.residuals(curve).iter().map(|r| r * r).sum()
+    }
+
     /// The weighted residuals (model − measured)/σ of `curve`: the amplitudes, the
     /// phases, then the second mode's.
     pub fn residuals(&self, curve: &Curve) -> Vec<f64> {

@@ -215,7 +215,7 @@ fn screened_chi_square(
         }
         nuisance.phase_offset_deg += mean;
     }
-    data.residuals(curve).iter().map(|r| r * r).sum()
+    data.chi_square(curve)
 }
 
 /// Screen one design point: simulate, align the offset on the data's features (where

@@ -14,7 +14,6 @@ use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
 use nalgebra::DVector;
 use serde::Serialize;
-use std::cell::Cell;
 
 /// χ²/dof at or below which residuals are the simulation's own round-off and
 /// tolerance, not a measurement's noise (at the default weights, 1e-6 of 0.02 nm).
@@ -174,7 +173,8 @@ fn check(data: &Measured, options: &FitOptions) -> Result<()> {
         }
         if points > 10_000 || !(1..=100).contains(&starts) {
             return Err(Error::OutOfRange(format!(
-                "the search takes at most 10 000 design points and 1 to 100 starts, not                  {points} and {starts}"
+                "the search takes at most 10 000 design points and 1 to 100 starts, not \
+                 {points} and {starts}"
             )));
         }
     }
@@ -212,6 +212,8 @@ pub fn fit(
         &options.search,
         &tracker,
     );
+    let m = data.channels() * data.len();
+    let dof = m - params.len();
     // Levenberg–Marquardt from each start; every run's end kept.
     let mut runs: Vec<LocalRun> = Vec::new();
     let mut first_error = None;
@@ -238,8 +240,7 @@ pub fn fit(
                 // A minimum that describes the data ends the search (later starts are
                 // worse by the screening): it is the answer, and no other can fit
                 // better than the noise.
-                let chi: f64 = r.residuals.norm_squared();
-                let dof = data.channels() * data.len() - params.len();
+                let chi = r.chi_square();
                 let d = diagnose(
                     working,
                     &r.curve,
@@ -261,13 +262,7 @@ pub fn fit(
     if runs.is_empty() {
         return Err(first_error.expect("a run that failed says why"));
     }
-    runs.sort_by(|a, b| {
-        a.residuals
-            .norm_squared()
-            .total_cmp(&b.residuals.norm_squared())
-    });
-    let m = data.channels() * data.len();
-    let dof = m - params.len();
+    runs.sort_by(|a, b| a.chi_square().total_cmp(&b.chi_square()));
     let mut best = runs.remove(0);
     // Is the end a minimum? Try the Gauss–Newton step from it: where it lowers χ² by
     // more than the variance factor the optimiser stalled (a step refused at a kink,
@@ -275,7 +270,7 @@ pub fn fit(
     // switch in the forward differences), the end stands.
     let factor_of = |r: &LocalRun| {
         if options.estimate_sigma {
-            r.residuals.norm_squared() / dof as f64
+            r.chi_square() / dof as f64
         } else {
             1.0
         }
@@ -285,7 +280,7 @@ pub fn fit(
         tracker.stage(Stage::Assess, params.len() + 2, 0);
         let jacobian = local::jacobian(&best, numerics, working, params, &tracker)?;
         let (step, predicted) = gauss_newton_step(&jacobian, &best.residuals);
-        let chi = best.residuals.norm_squared();
+        let chi = best.chi_square();
         if predicted <= STALL_DECREASE * factor_of(&best) {
             break (predicted, false, jacobian);
         }
@@ -395,7 +390,7 @@ fn data_chi_square(
     nuisance: &Nuisance,
 ) -> Option<f64> {
     let c = data.simulate(setup, numerics, nuisance).ok()?;
-    Some(data.residuals(&c).iter().map(|r| r * r).sum())
+    Some(data.chi_square(&c))
 }
 
 /// The distinct minima of `runs` (sorted by χ²): runs whose coordinates agree to
@@ -416,7 +411,7 @@ fn distinct_minima<'a>(
         match same {
             Some(m) => m.runs += 1,
             None => {
-                let chi = r.residuals.norm_squared();
+                let chi = r.chi_square();
                 out.push(Minimum {
                     values: r.values.clone(),
                     chi_square: chi,
@@ -532,7 +527,6 @@ pub fn profile(
     } else {
         1.0
     };
-    let curves = Cell::new(0usize);
     let tracker = Tracker::new(&progress);
     tracker.stage(
         Stage::Profile,
@@ -545,15 +539,12 @@ pub fn profile(
         let (mut s, mut n) = start.clone();
         which.set(&mut s, &mut n, v);
         if others.is_empty() {
-            let c = data.simulate(&s, numerics, &n);
-            curves.set(curves.get() + 1);
-            let chi: f64 = data.residuals(&c?).iter().map(|r| r * r).sum();
+            let chi = data.chi_square(&data.simulate(&s, numerics, &n)?);
             tracker.curve(Some(chi));
             return Ok((chi, (s, n)));
         }
         let r = local::run(&s, n, numerics, data, &others, options.max_curves, &tracker)?;
-        curves.set(curves.get() + r.curves);
-        Ok((r.residuals.norm_squared(), (r.setup, r.nuisance)))
+        Ok((r.chi_square(), (r.setup, r.nuisance)))
     };
     let step = |i: f64| {
         if which.is_scale() {
