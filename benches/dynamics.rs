@@ -483,7 +483,46 @@ fn fit(c: &mut Criterion) {
     group.finish();
 }
 
+/// `tapsim tap` as a whole process (what a script pays per call): on the defaults and
+/// on issue 44's soft sample. With `TAPSIM_BEFORE` naming another build's binary (the
+/// one before the search for coexisting states, issue 44), that build side by side.
+fn process(c: &mut Criterion) {
+    use std::process::{Command, Stdio};
+    let soft = [
+        "--radius",
+        "10nm",
+        "--modulus",
+        "50MPa",
+        "--work-of-adhesion",
+        "0.05",
+        "--separation",
+        "10nm",
+    ];
+    let cases: [(&str, &[&str]); 2] = [("defaults", &[]), ("soft sample, z_c 10 nm", &soft)];
+    let mut binaries = vec![("", env!("CARGO_BIN_EXE_tapsim").to_string())];
+    if let Ok(before) = std::env::var("TAPSIM_BEFORE") {
+        binaries.push((", before", before));
+    }
+    let mut group = c.benchmark_group("process");
+    for (tag, binary) in &binaries {
+        for (name, args) in cases {
+            let run = || {
+                let status = Command::new(binary)
+                    .arg("tap")
+                    .args(args)
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::null())
+                    .status()
+                    .expect("tapsim runs");
+                assert!(status.success());
+            };
+            group.bench_function(format!("tap, {name}{tag}"), |b| b.iter(run));
+        }
+    }
+    group.finish();
+}
+
 criterion_group!(
-    benches, bench, settle, map, setpoint, march, scan_line, noise, modes, fit
+    benches, bench, settle, map, setpoint, march, scan_line, noise, modes, fit, process
 );
 criterion_main!(benches);

@@ -12,6 +12,7 @@
 
 // The physics library: no file system, no environment, no command line.
 pub mod bimodal;
+pub mod coexist;
 pub mod contact;
 pub mod contrast;
 pub mod dynamics;

@@ -6,8 +6,9 @@
 use std::path::{Path, PathBuf};
 
 /// The library's modules (everything outside the `app` feature).
-const LIBRARY: [&str; 18] = [
+const LIBRARY: [&str; 19] = [
     "src/bimodal.rs",
+    "src/coexist.rs",
     "src/lib.rs",
     "src/contact",
     "src/contrast.rs",

@@ -1,5 +1,6 @@
 //! `tapsim tap`: one tapping-mode simulation to its steady state.
 
+use crate::coexist::{Search, coexisting};
 use crate::config::{BranchChoice, TapInputs, length, number};
 use crate::dynamics::observables::{Observe, Starts, tap};
 use crate::error::{Error, Result};
@@ -41,7 +42,10 @@ use std::path::PathBuf;
 ///
 /// Where another stable period-1 state exists at the same rest separation (a bistable
 /// setpoint: the attractive and the repulsive branch), tap names it (JSON `coexisting`),
-/// from the period-1 families continued through z_c.
+/// or says in one line that none is known. It looks where the first-harmonic balance
+/// of the cantilever puts a steady state (about a millisecond; each state verified on
+/// the exact dynamics); --all-states also follows every family of period-1 orbits in
+/// from far past z_c (some 0.1–3 s).
 ///
 /// Near the onset of contact a turning point of the tip can pass a switch of the force
 /// law (the jump-in, the pull-off) by less than the thermal motion of the cantilever
@@ -105,6 +109,11 @@ pub struct TapArgs {
     /// 6 starts without it. At most 64.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=64), help_heading = "Numerics")]
     starts: Option<u64>,
+    /// Look for other stable period-1 states at z_c also by following every family of
+    /// period-1 orbits in from 1.2 A₀ (besides the default search from the roots of the
+    /// first-harmonic balance; about a hundred times slower).
+    #[arg(long, help_heading = "Numerics")]
+    all_states: bool,
     /// Amplitude setpoint A/A₀ (between 0 and 1), as an AFM's z feedback holds it,
     /// instead of a rest separation: every stable period-1 steady state whose amplitude
     /// is the setpoint, on each branch (--branch), with the rest separation z_c that
@@ -197,7 +206,12 @@ pub fn run(args: TapArgs) -> Result<()> {
     // Another stable period-1 state at this z_c (a bistable setpoint: the free
     // oscillation settles on one, an approach or a retract may sit on the other).
     let searching = spinner("looking for other stable states at this z_c", args.quiet);
-    let coexisting = crate::setpoint::coexisting(&setup, &numerics, &run.observables);
+    let search = if args.all_states {
+        Search::Thorough
+    } else {
+        Search::HarmonicBalance
+    };
+    let coexisting = coexisting(&setup, &numerics, &run.observables, search);
     searching.finish_and_clear();
     let coexisting = coexisting?;
     let noise = match args.noise.request() {
@@ -227,6 +241,10 @@ pub fn run(args: TapArgs) -> Result<()> {
                 "coexisting".into(),
                 serde_json::to_value(&coexisting).expect("states serialise"),
             );
+            m.insert(
+                "coexisting_search".into(),
+                serde_json::to_value(search).expect("a name serialises"),
+            );
             if let Some(noise) = &noise {
                 m.insert(
                     "thermal_noise".into(),
@@ -243,7 +261,7 @@ pub fn run(args: TapArgs) -> Result<()> {
         outln!("{}", crate::report::records::document(&v)?);
     } else {
         out!("{}", report::to_text(&setup, &run));
-        out!("{}", report::coexisting_text(&coexisting));
+        out!("{}", report::coexisting_text(&coexisting, search));
         match noise {
             Some(Some(n)) => outln!(
                 "thermal noise at {} K through a lock-in of order {}, ENBW {} Hz (T_f = \

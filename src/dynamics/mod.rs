@@ -11,6 +11,7 @@ mod dopri5;
 pub mod free;
 pub mod gradient;
 pub mod grazing;
+pub mod harmonic_balance;
 pub mod harmonics;
 pub mod march;
 pub mod model;

@@ -3,6 +3,7 @@
 
 use super::chart::{Axis, Chart, Corner, Label, Series, Style};
 use super::display::{fixed, sci};
+use crate::coexist::Search;
 use crate::dynamics::attractors::Attractor;
 use crate::dynamics::harmonics::Harmonic;
 use crate::dynamics::observables::{TapObservables, TapRun, TrajectorySample};
@@ -499,8 +500,24 @@ pub fn setpoint_text(
 
 /// Lines naming the other stable period-1 states at the same rest separation (none:
 /// nothing).
-pub fn coexisting_text(states: &[crate::setpoint::SetpointState]) -> String {
+pub fn coexisting_text(states: &[crate::setpoint::SetpointState], search: Search) -> String {
     let mut s = String::new();
+    if states.is_empty() {
+        let _ = writeln!(
+            s,
+            "{}",
+            match search {
+                Search::HarmonicBalance =>
+                    "note: no other stable period-1 state known at this z_c (looked for where \
+                     the first-harmonic balance puts one; --all-states follows every family \
+                     of orbits from far)",
+                Search::Thorough =>
+                    "note: no other stable period-1 state known at this z_c (looked for \
+                     where the first-harmonic balance puts one and along every family of \
+                     orbits followed in from 1.2 A₀)",
+            }
+        );
+    }
     for st in states {
         let o = &st.observables;
         let _ = writeln!(
