@@ -254,6 +254,7 @@ fn scan_line(c: &mut Criterion) {
     use tapsim::config::TapInputs;
     use tapsim::instrument::feedback::PiController;
     use tapsim::instrument::lockin::LockIn;
+    use tapsim::instrument::repeats::{DEFAULT_TOLERANCE, Repeats};
     use tapsim::instrument::scan::row;
     use tapsim::sample::{BLEND, Sample};
     let sample = Sample::from_toml(BLEND, &TapInputs::default()).unwrap();
@@ -270,24 +271,34 @@ fn scan_line(c: &mut Criterion) {
     let per_pixel = (300e3_f64 / 256.0).round() as usize;
     let mut group = c.benchmark_group("scan");
     group.sample_size(10);
-    group.bench_function("256-pixel line at 1 line/s", |b| {
-        b.iter(|| {
-            row(
-                &prepared,
-                &regions,
-                (sample.length_m, 256, per_pixel),
-                (
-                    lockin,
-                    controller,
-                    tapsim::instrument::thermal::ThermalForce::none(),
-                ),
-                10_000,
-                false,
-                |_| {},
-            )
-            .unwrap()
-        })
-    });
+    for (name, exact) in [
+        ("256-pixel line at 1 line/s", false),
+        ("256-pixel line at 1 line/s, --exact", true),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let mut repeats = if exact {
+                    Repeats::exact()
+                } else {
+                    Repeats::within(DEFAULT_TOLERANCE)
+                };
+                row(
+                    &prepared,
+                    &regions,
+                    (sample.length_m, 256, per_pixel),
+                    (
+                        lockin,
+                        controller,
+                        tapsim::instrument::thermal::ThermalForce::none(),
+                    ),
+                    (10_000, &mut repeats),
+                    false,
+                    |_| {},
+                )
+                .unwrap()
+            })
+        });
+    }
     group.finish();
 }
 

@@ -7,6 +7,7 @@ mod common;
 use tapsim::dynamics::observables::TapObservables;
 use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};
 use tapsim::instrument::lockin::{LockIn, step_response};
+use tapsim::instrument::repeats::Repeats;
 use tapsim::instrument::thermal::ThermalForce;
 
 #[test]
@@ -256,7 +257,7 @@ fn a_slow_scan_images_material_contrast_and_a_height_step() {
             regions,
             (1e-6, 4, 6000),
             (&mut lockin, &mut controller, &mut ThermalForce::none()),
-            z,
+            (z, &mut Repeats::exact()),
             &mut phase,
             |_| {},
         )

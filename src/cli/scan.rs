@@ -6,6 +6,7 @@ use crate::error::{Error, Result};
 use crate::instrument::feedback::PiController;
 use crate::instrument::lockin::LockIn;
 use crate::instrument::modal::ModalProbe;
+use crate::instrument::repeats::{DEFAULT_TOLERANCE, Repeats};
 use crate::instrument::scan::{
     MAX_IMAGE_PIXELS, MAX_PIXELS, Pixel, row, row_probe, settled_material,
 };
@@ -104,6 +105,15 @@ pub struct ScanArgs {
     /// Trace only.
     #[arg(long)]
     no_retrace: bool,
+    /// March every drive period. By default, over a stretch of sample that does not
+    /// change, once the whole loop (oscillator, lock-in, piezo, controller) repeats
+    /// itself to 1e-7 A₀ (its distance from the loop's fixed point, bounded from how fast
+    /// it approached it), the periods up to the next change are taken as repeats of the
+    /// last: images agree with --exact to far below 1 pm and 1e-3° (tested), many times
+    /// faster. Motion that does not repeat each period (near the onset of contact, a
+    /// second mode) and a thermal force are always marched.
+    #[arg(long)]
+    exact: bool,
     /// Temperature [K; default none]: the cantilever shaken by the thermal force of its
     /// damping (S_F = 4k_BT·k/(ω₀Q), held over 64 steps a period), each line drawing
     /// from its own stream of --seed; the table then ends with each material's
@@ -252,6 +262,12 @@ pub fn run(args: ScanArgs) -> Result<()> {
             mine.par_iter()
                 .map(|&j| {
                     bar.inc(1);
+                    let mut repeats = if args.exact {
+                        Repeats::exact()
+                    } else {
+                        Repeats::within(DEFAULT_TOLERANCE)
+                    };
+                    let engage = (ENGAGE_PERIODS, &mut repeats);
                     if let Some(modal) = &modal {
                         let mut probe =
                             ModalProbe::new(modal, lockin.order(), lockin.time_constant_hat())?;
@@ -260,7 +276,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
                             &lines[j].1,
                             shape,
                             controller,
-                            ENGAGE_PERIODS,
+                            engage,
                             !args.no_retrace,
                             |_| bar.inc(1),
                         );
@@ -272,7 +288,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
                         &lines[j].1,
                         shape,
                         (lockin, controller, force),
-                        ENGAGE_PERIODS,
+                        engage,
                         !args.no_retrace,
                         |_| bar.inc(1),
                     )
@@ -315,7 +331,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
             &numerics,
             (per_pixel, args.lockin_order, args.lockin_periods),
             (args.proportional_gain, args.integral_gain),
-            (args.temperature, args.seed),
+            (args.temperature, args.seed, args.exact),
             &set,
         ))
         .expect("a configuration serialises");

@@ -148,6 +148,17 @@ impl LockIn {
         )
     }
 
+    /// Its state: the filter stages of both channels and the last mixer output (zero
+    /// before the first), what the next samples are filtered from.
+    pub fn state(&self) -> impl Iterator<Item = f64> + '_ {
+        let (i, q) = self.last_input.unwrap_or((0.0, 0.0));
+        self.in_phase[..self.order]
+            .iter()
+            .chain(&self.quadrature[..self.order])
+            .copied()
+            .chain([i, q])
+    }
+
     /// The amplitude read, in the deflection's units.
     pub fn amplitude(&self) -> f64 {
         let (x, y) = self.output();

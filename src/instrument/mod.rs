@@ -8,6 +8,7 @@ pub mod lockin;
 pub mod modal;
 pub mod noise;
 pub mod probe;
+pub mod repeats;
 pub mod scan;
 pub mod spectrum;
 pub mod thermal;

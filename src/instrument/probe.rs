@@ -5,6 +5,7 @@
 //! or several eigenmodes ([`super::modal::ModalProbe`]).
 
 use super::lockin::LockIn;
+use super::repeats::LoopState;
 use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
 use crate::dynamics::modes::MAX_MODES;
@@ -30,6 +31,13 @@ pub trait Probe {
     /// March `periods` drive periods of the first mode over material `material` at rest
     /// separation `separation_m`; the lock-ins' readings after the last.
     fn march(&mut self, material: usize, separation_m: f64, periods: usize) -> Result<Readings>;
+    /// Write its state after the last march into the first entries of `out` (the rest
+    /// left alone), in units of A₀, and say how many; none (the default) where periods
+    /// must all be marched (a random force, a state that repeats only after several
+    /// periods). What [`super::repeats::Repeats`] watches.
+    fn loop_state(&self, _out: &mut LoopState) -> Option<usize> {
+        None
+    }
 }
 
 /// Drive periods (of period `period_hat`) a lock-in needs to settle
@@ -75,5 +83,22 @@ impl Probe for OneMode<'_> {
         // The deflection is in units of A₀: the amplitude read is A/A₀.
         out[0] = (self.lockin.amplitude(), self.lockin.phase_deg());
         Ok(out)
+    }
+
+    fn loop_state(&self, out: &mut LoopState) -> Option<usize> {
+        if self.force.intensity_hat() > 0.0 {
+            return None;
+        }
+        let p = &*self.phase;
+        let parts = [p.x, p.v]
+            .into_iter()
+            .chain(p.internal.iter().copied())
+            .chain(self.lockin.state());
+        let mut n = 0;
+        for (o, v) in out.iter_mut().zip(parts) {
+            *o = v;
+            n += 1;
+        }
+        Some(n)
     }
 }

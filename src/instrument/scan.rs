@@ -11,7 +11,8 @@
 
 use super::feedback::PiController;
 use super::lockin::LockIn;
-use super::probe::{OneMode, Probe};
+use super::probe::{OneMode, Probe, Readings};
+use super::repeats::{Repeats, STATE_LEN};
 use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
 use crate::dynamics::modes::MAX_MODES;
@@ -76,7 +77,7 @@ pub fn line(
     regions: &[Region],
     shape: (f64, usize, usize),
     (lockin, controller, force): (&mut LockIn, &mut PiController, &mut ThermalForce),
-    start_z_m: f64,
+    (start_z_m, repeats): (f64, &mut Repeats),
     phase: &mut Phase,
     progress: impl FnMut(usize),
 ) -> Result<(Vec<Pixel>, f64)> {
@@ -86,7 +87,8 @@ pub fn line(
         lockin,
         force,
     };
-    line_probe(&mut probe, regions, shape, controller, start_z_m, progress)
+    let loop_ = (controller, repeats);
+    line_probe(&mut probe, regions, shape, loop_, start_z_m, progress)
 }
 
 /// Refuse a layout without regions or naming a material beyond `materials`.
@@ -102,13 +104,15 @@ fn check_regions(regions: &[Region], materials: usize) -> Result<()> {
 /// Scan a line of length `length_m` in `pixels` pixels of `periods_per_pixel` drive
 /// periods each with `probe` over its materials laid out by `regions`, the loop holding
 /// the setpoint from the piezo position `start_z_m`. Each drive period is marched at the
-/// material and height under the tip at its start. `progress` is told each pixel done.
-/// Returns the pixels and the piezo position at the end.
+/// material and height under the tip at its start, unless `repeats` finds the loop
+/// repeating itself over the region: the periods up to the next region are then the
+/// last one's repeats ([`Repeats`]; [`Repeats::exact`] marches every one). `progress` is
+/// told each pixel done. Returns the pixels and the piezo position at the end.
 pub fn line_probe<P: Probe>(
     probe: &mut P,
     regions: &[Region],
     (length_m, pixels, periods_per_pixel): (f64, usize, usize),
-    controller: &mut PiController,
+    (controller, repeats): (&mut PiController, &mut Repeats),
     start_z_m: f64,
     mut progress: impl FnMut(usize),
 ) -> Result<(Vec<Pixel>, f64)> {
@@ -126,6 +130,10 @@ pub fn line_probe<P: Probe>(
     let mut under = 0;
     let mut z = start_z_m;
     let mut out = Vec::with_capacity(pixels);
+    // What the last marched period read, once the loop repeats itself over the region.
+    let mut repeating: Option<(Readings, f64)> = None;
+    repeats.restart();
+    let mut state = [0.0; STATE_LEN];
     for i in 0..pixels {
         let mut sum = [0.0; 4];
         let mut higher = [(0.0, 0.0); MAX_MODES];
@@ -133,19 +141,40 @@ pub fn line_probe<P: Probe>(
             let x = step * (i * periods_per_pixel + j) as f64;
             while under + 1 < regions.len() && x >= regions[under].until_m {
                 under += 1;
+                repeats.restart();
+                repeating = None;
             }
             let region = &regions[under];
-            let read = probe.march(region.material, z - region.height_m, 1)?;
+            // The piezo during the period (the controller moves it at its end).
+            let during = z;
+            let (read, error) = match repeating {
+                Some(last) => {
+                    repeats.skip();
+                    last
+                }
+                None => {
+                    let read = probe.march(region.material, z - region.height_m, 1)?;
+                    let (dz, error) = controller.update(read[0].0);
+                    z += dz * a0;
+                    let known = probe.loop_state(&mut state).map(|n| {
+                        state[n] = z / a0;
+                        state[n + 1] = error;
+                        &state
+                    });
+                    if repeats.settled(known) {
+                        repeating = Some((read, error));
+                    }
+                    (read, error)
+                }
+            };
             let (amplitude, phase_deg) = read[0];
-            let (dz, error) = controller.update(amplitude);
-            for (s, v) in sum.iter_mut().zip([z, amplitude, error, phase_deg]) {
+            for (s, v) in sum.iter_mut().zip([during, amplitude, error, phase_deg]) {
                 *s += v;
             }
             for (s, r) in higher.iter_mut().zip(&read).take(modes).skip(1) {
                 s.0 += r.0;
                 s.1 += r.1;
             }
-            z += dz * a0;
         }
         let n = periods_per_pixel as f64;
         out.push(Pixel {
@@ -321,7 +350,7 @@ pub fn row(
     regions: &[Region],
     shape: (f64, usize, usize),
     (lockin, controller, force): (LockIn, PiController, ThermalForce),
-    engage_periods: usize,
+    engage: (usize, &mut Repeats),
     retrace: bool,
     progress: impl FnMut(usize),
 ) -> Result<(Vec<Pixel>, Option<Vec<Pixel>>)> {
@@ -337,26 +366,20 @@ pub fn row(
         force: &mut force,
     };
     row_probe(
-        &mut probe,
-        regions,
-        shape,
-        controller,
-        engage_periods,
-        retrace,
-        progress,
+        &mut probe, regions, shape, controller, engage, retrace, progress,
     )
 }
 
 /// One line of an image: the loop engaged over the first region from 1.2 A₀
 /// (`engage_periods` drive periods, [`super::feedback::hold_probe`]), then the line
-/// scanned ([`line_probe`]) and, with `retrace`, scanned back (its pixels in the
-/// trace's x).
+/// scanned ([`line_probe`], periods where the loop repeats itself skipped as `repeats`
+/// says) and, with `retrace`, scanned back (its pixels in the trace's x).
 pub fn row_probe<P: Probe>(
     probe: &mut P,
     regions: &[Region],
     (length_m, pixels, periods_per_pixel): (f64, usize, usize),
     controller: PiController,
-    engage_periods: usize,
+    (engage_periods, repeats): (usize, &mut Repeats),
     retrace: bool,
     mut progress: impl FnMut(usize),
 ) -> Result<(Vec<Pixel>, Option<Vec<Pixel>>)> {
@@ -373,12 +396,14 @@ pub fn row_probe<P: Probe>(
     // The loop holds the rest separation; the piezo stands that much above the surface.
     let z = rest + regions[0].height_m;
     let shape = (length_m, pixels, periods_per_pixel);
-    let (trace, end) = line_probe(probe, regions, shape, &mut controller, z, &mut progress)?;
+    let loop_ = (&mut controller, &mut *repeats);
+    let (trace, end) = line_probe(probe, regions, shape, loop_, z, &mut progress)?;
     if !retrace {
         return Ok((trace, None));
     }
     let back = mirrored(regions, length_m);
-    let (mut retrace, _) = line_probe(probe, &back, shape, &mut controller, end, progress)?;
+    let loop_ = (&mut controller, repeats);
+    let (mut retrace, _) = line_probe(probe, &back, shape, loop_, end, progress)?;
     for p in &mut retrace {
         p.x_m = length_m - p.x_m;
     }

@@ -1,0 +1,180 @@
+//! Drive periods not marched because the loop repeats itself (issue 44).
+//!
+//! Over a stretch of sample that does not change (one material at one height), the
+//! whole loop — the oscillator's state at the drive phase, the lock-in's filters, the
+//! piezo and the controller — is a map applied once a drive period, and it settles on
+//! a fixed point: from there every period repeats the last. [`Repeats`] watches the
+//! loop's state after each marched period; once the state moves by a gap d a period
+//! that has shrunk geometrically for [`WINDOW`] periods at a rate no slower than ρ (the
+//! largest ratio of successive gaps seen), the state lies within d·ρ/(1 − ρ) of the
+//! fixed point, and once that bound is below the tolerance the periods that follow
+//! over the same stretch are taken as repeats of the last, not marched. Motion that is
+//! not period-1 (a long lock grazing a switch, a bimodal orbit over a common period of
+//! several drive periods) never shrinks its gap and is always marched; so is a probe
+//! under a thermal force. The exact march is [`Repeats::exact`].
+
+/// The loop state watched: the probe's (deflection, velocity, a law's internal state,
+/// the lock-in's filter stages and last input) then the piezo and the controller's last
+/// error, each in units of A₀ (or of the amplitude ratio).
+pub const STATE_LEN: usize = 32;
+
+/// The loop's state after a drive period ([`STATE_LEN`] entries, unused ones zero).
+pub type LoopState = [f64; STATE_LEN];
+
+/// Periods over which the gap must shrink before periods are skipped.
+pub const WINDOW: usize = 16;
+
+/// The default bound on the distance from the fixed point at which periods are skipped,
+/// in units of A₀: 2e-15 m of piezo on a 20 nm amplitude, 6e-6° of phase — some
+/// thousand times below what a skipped period may change of an image (1 pm of
+/// topography, 1e-3° of phase, tested against the exact march).
+pub const DEFAULT_TOLERANCE: f64 = 1e-7;
+
+/// The slowest contraction trusted: a loop whose gap shrinks by less than this a period
+/// is marched on.
+const SLOWEST: f64 = 0.9999;
+
+/// Watches the loop's state and says when the periods that follow repeat the last.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Repeats {
+    /// The bound on the distance from the fixed point (none: never skip).
+    tolerance: Option<f64>,
+    last: Option<LoopState>,
+    /// The last gaps, newest at `seen % WINDOW`.
+    gaps: [f64; WINDOW],
+    /// Gaps recorded since the stretch began.
+    seen: usize,
+    /// Periods marched.
+    pub marched: u64,
+    /// Periods taken as repeats.
+    pub skipped: u64,
+}
+
+impl Repeats {
+    /// Every period marched.
+    pub fn exact() -> Self {
+        Self::skipping(None)
+    }
+
+    /// Periods skipped where the state is within `tolerance` (units of A₀) of the
+    /// loop's fixed point.
+    pub fn within(tolerance: f64) -> Self {
+        Self::skipping(Some(tolerance))
+    }
+
+    fn skipping(tolerance: Option<f64>) -> Self {
+        Self {
+            tolerance,
+            last: None,
+            gaps: [0.0; WINDOW],
+            seen: 0,
+            marched: 0,
+            skipped: 0,
+        }
+    }
+
+    /// Whether periods are ever skipped.
+    pub fn is_exact(&self) -> bool {
+        self.tolerance.is_none()
+    }
+
+    /// A new stretch of sample begins: what was seen says nothing about it.
+    pub fn restart(&mut self) {
+        self.last = None;
+        self.seen = 0;
+    }
+
+    /// Record the state after a marched period (`None`: a probe that cannot be skipped);
+    /// whether the loop now repeats itself to the tolerance.
+    pub fn settled(&mut self, state: Option<&LoopState>) -> bool {
+        self.marched += 1;
+        let (Some(tolerance), Some(state)) = (self.tolerance, state) else {
+            self.restart();
+            return false;
+        };
+        let Some(last) = self.last.replace(*state) else {
+            return false;
+        };
+        let gap = state
+            .iter()
+            .zip(&last)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        self.gaps[self.seen % WINDOW] = gap;
+        self.seen += 1;
+        if self.seen < WINDOW {
+            return false;
+        }
+        // The slowest contraction over the window (oldest to newest).
+        let mut rho: f64 = 0.0;
+        for k in 1..WINDOW {
+            let (older, newer) = (
+                self.gaps[(self.seen + k - 1) % WINDOW],
+                self.gaps[(self.seen + k) % WINDOW],
+            );
+            if newer > 0.0 {
+                rho = rho.max(newer / older);
+            }
+        }
+        if gap == 0.0 {
+            return true;
+        }
+        rho < SLOWEST && gap * rho / (1.0 - rho) <= tolerance
+    }
+
+    /// Count a period taken as a repeat.
+    pub fn skip(&mut self) {
+        self.skipped += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(x: f64) -> LoopState {
+        let mut s = [0.0; STATE_LEN];
+        s[0] = x;
+        s[5] = -0.5 * x;
+        s
+    }
+
+    #[test]
+    fn a_geometric_approach_settles_once_its_bound_is_below_the_tolerance() {
+        // x_j = 0.9^j: gap 0.1·0.9^(j−1), bound gap·9 = 0.9^j, the true distance.
+        let mut r = Repeats::within(1e-6);
+        let mut settled_at = None;
+        for j in 0..400 {
+            if r.settled(Some(&state(0.9f64.powi(j)))) {
+                settled_at = Some(j);
+                break;
+            }
+        }
+        // 0.9^j ≤ 1e-6 from j = 132 on.
+        assert_eq!(settled_at, Some(132));
+    }
+
+    #[test]
+    fn motion_that_does_not_shrink_its_gap_is_never_skipped() {
+        // A period-2 alternation of 1e-12: tiny, but not contracting.
+        let mut r = Repeats::within(1e-6);
+        for j in 0..1000 {
+            assert!(!r.settled(Some(&state(1e-12 * (j % 2) as f64))));
+        }
+        // A probe that cannot say its state, and the exact march, never settle.
+        assert!(!(0..100).any(|_| r.settled(None)));
+        let mut exact = Repeats::exact();
+        assert!(!(0..100).any(|_| exact.settled(Some(&state(0.0)))));
+    }
+
+    #[test]
+    fn a_restart_forgets_the_stretch_before() {
+        let mut r = Repeats::within(1e-3);
+        for j in 0..200 {
+            r.settled(Some(&state(0.5f64.powi(j))));
+        }
+        assert!(r.settled(Some(&state(0.0))));
+        r.restart();
+        assert!(!r.settled(Some(&state(0.0))));
+    }
+}
