@@ -299,6 +299,34 @@ fn scan_line(c: &mut Criterion) {
             })
         });
     }
+    // The same line with two modes (`scan --modes 2`): the loop repeats over the common
+    // period of four drive periods.
+    use tapsim::dynamics::modes::{ModeSet, with_modes};
+    use tapsim::instrument::modal::ModalProbe;
+    use tapsim::instrument::scan::row_probe;
+    let set = ModeSet::euler_bernoulli(&prepared[0].setup.cantilever, 2).unwrap();
+    let modal: Vec<_> = prepared
+        .iter()
+        .map(|p| with_modes(p.clone(), &set).unwrap())
+        .collect();
+    group.bench_function("256-pixel bimodal line at 1 line/s", |b| {
+        b.iter(|| {
+            let mut probe = ModalProbe::new(&modal, 4, lockin.time_constant_hat()).unwrap();
+            let mut repeats = Repeats::within(DEFAULT_TOLERANCE);
+            let shape = (sample.length_m, 256, per_pixel);
+            let engage = (10_000, &mut repeats);
+            row_probe(
+                &mut probe,
+                &regions,
+                shape,
+                controller,
+                engage,
+                false,
+                |_| {},
+            )
+            .unwrap()
+        })
+    });
     group.finish();
 }
 
@@ -380,6 +408,7 @@ fn modes(c: &mut Criterion) {
     use tapsim::instrument::feedback::{PiController, hold_probe};
     use tapsim::instrument::modal::ModalProbe;
     use tapsim::instrument::probe::Probe;
+    use tapsim::instrument::repeats::Repeats;
     const PERIODS: u64 = 100;
     let set = ModeSet::euler_bernoulli(&setup.cantilever, 2).expect("defaults");
     let materials = [prepare(&setup, &set, &march_numerics()).expect("defaults")];
@@ -387,7 +416,14 @@ fn modes(c: &mut Criterion) {
     let mut probe = ModalProbe::new(&materials, 4, 2.0 * period).expect("defaults");
     let mut controller = PiController::new(0.8, 0.0, 0.002).expect("defaults");
     let a0 = setup.cantilever.free_amplitude_m;
-    let (_, z) = hold_probe(&mut probe, 0, 1.2 * a0, &mut controller, 6000).expect("engaged");
+    let (_, z) = hold_probe(
+        &mut probe,
+        0,
+        1.2 * a0,
+        (&mut controller, &mut Repeats::exact()),
+        6000,
+    )
+    .expect("engaged");
     let mut group = c.benchmark_group("scan");
     group.throughput(Throughput::Elements(PERIODS));
     group.sample_size(10);

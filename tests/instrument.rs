@@ -173,7 +173,14 @@ fn the_bimodal_feedback_rests_where_the_modal_steady_state_is() {
     let mut controller = PiController::new(0.8, 0.0, 0.002).unwrap();
     let a0 = setup.cantilever.free_amplitude_m;
     let started = std::time::Instant::now();
-    let (samples, _) = hold_probe(&mut probe, 0, 1.2 * a0, &mut controller, 6000).unwrap();
+    let (samples, _) = hold_probe(
+        &mut probe,
+        0,
+        1.2 * a0,
+        (&mut controller, &mut Repeats::exact()),
+        6000,
+    )
+    .unwrap();
     eprintln!("6000 periods in {:?}", started.elapsed());
     assert!((samples[0].amplitude_ratio - 1.0).abs() < 1e-4);
     let tail = &samples[5500..];

@@ -1,6 +1,7 @@
 //! Drive periods skipped where the loop repeats itself (issue 44): images against the
-//! exact march (`scan --exact`) on the blend, the step sample scanned fast and the discs
-//! image, and no period skipped where the motion does not repeat each period.
+//! exact march (`scan --exact`) on the blend (one mode and two), the step sample
+//! scanned fast and the discs image, and no period skipped where the motion does not
+//! repeat each period.
 
 mod common;
 
@@ -59,6 +60,28 @@ fn against_exact(args: &[&str]) -> (serde_json::Value, serde_json::Value) {
 fn the_blend_images_as_the_exact_march_does() {
     against_exact(&["--pixels", "256", "--line-rate", "1", "--no-retrace"]);
     against_exact(&[]);
+}
+
+#[test]
+#[ignore = "release: about 10 s in all (cargo test --release --test repeats -- --ignored)"]
+fn the_bimodal_blend_images_as_the_exact_march_does() {
+    // Two modes over a common period of four drive periods: the loop repeats every four.
+    let (fast, exact) = against_exact(&["--modes", "2", "--pixels", "16", "--line-rate", "20"]);
+    let second = |v: &serde_json::Value| -> Vec<f64> {
+        v["modes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m[0]["phase_deg"].as_f64().unwrap())
+            .collect()
+    };
+    let (a, b) = (second(&fast), second(&exact));
+    let d = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(d < 1e-3, "second mode's phase off by {d:e}°");
 }
 
 #[test]

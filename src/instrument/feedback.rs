@@ -10,6 +10,7 @@
 
 use super::lockin::LockIn;
 use super::probe::{OneMode, Probe};
+use super::repeats::{Repeats, STATE_LEN};
 use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
 use crate::dynamics::setup::Prepared;
@@ -112,27 +113,38 @@ pub fn hold(
         lockin,
         force,
     };
-    hold_probe(&mut probe, 0, start_m, controller, periods)
+    hold_probe(
+        &mut probe,
+        0,
+        start_m,
+        (controller, &mut Repeats::exact()),
+        periods,
+    )
 }
 
 /// Run the z feedback on `probe` over its material `material` for `periods` drive
 /// periods from rest separation `start_m`: the lock-ins first settle there with the
 /// loop open ([`Probe::settling_periods`]), then each period is marched at the current
-/// z_c and `controller` moves z_c on the first mode's amplitude. Returns every
+/// z_c and `controller` moves z_c on the first mode's amplitude — unless `repeats`
+/// finds the loop repeating itself ([`Repeats`]): the whole cycles left are then the
+/// last one's repeats ([`Repeats::exact`] marches every period). Returns every
 /// closed-loop period's sample and the rest separation the loop has moved to.
 pub fn hold_probe<P: Probe>(
     probe: &mut P,
     material: usize,
     start_m: f64,
-    controller: &mut PiController,
+    (controller, repeats): (&mut PiController, &mut Repeats),
     periods: usize,
 ) -> Result<(Vec<LoopSample>, f64)> {
     let a0 = probe.free_amplitude_m();
+    let cycle = probe.cycle();
     let mut z = start_m;
     let settle = probe.settling_periods();
     probe.march(material, z, settle)?;
-    let mut out = Vec::with_capacity(periods);
-    for _ in 0..periods {
+    repeats.restart();
+    let mut state = [0.0; STATE_LEN];
+    let mut out: Vec<LoopSample> = Vec::with_capacity(periods);
+    while out.len() < periods {
         let (amplitude_ratio, phase_deg) = probe.march(material, z, 1)?[0];
         let (dz, error) = controller.update(amplitude_ratio);
         out.push(LoopSample {
@@ -142,6 +154,20 @@ pub fn hold_probe<P: Probe>(
             error,
         });
         z += dz * a0;
+        let known = probe.loop_state(&mut state).map(|n| {
+            state[n] = z / a0;
+            state[n + 1] = error;
+            &state
+        });
+        if repeats.settled(known, cycle) && out.len() >= cycle {
+            // The whole cycles left repeat the last.
+            let last = out.len() - cycle;
+            let left = (periods - out.len()) / cycle * cycle;
+            for k in 0..left {
+                out.push(out[last + k % cycle]);
+                repeats.skip();
+            }
+        }
     }
     Ok((out, z))
 }

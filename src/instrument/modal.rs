@@ -12,6 +12,7 @@
 
 use super::lockin::{LockIn, LockIns};
 use super::probe::{Probe, Readings, settling_periods};
+use super::repeats::LoopState;
 use crate::dynamics::model::State;
 use crate::dynamics::modes::MAX_MODES;
 use crate::dynamics::modes::orbit::free_section;
@@ -137,5 +138,25 @@ impl Probe for ModalProbe<'_> {
             *o = (l.amplitude() / m.free_amplitude(), l.phase_deg());
         }
         Ok(out)
+    }
+
+    fn loop_state(&self, out: &mut LoopState) -> Option<usize> {
+        // Without a common period the motion never repeats.
+        self.materials[0].1.periods?;
+        let modes = self.lockins.len();
+        let parts = self.section[..2 * modes]
+            .iter()
+            .copied()
+            .chain(self.lockins.iter().flat_map(LockIn::state));
+        let mut n = 0;
+        for (o, v) in out.iter_mut().zip(parts) {
+            *o = v;
+            n += 1;
+        }
+        Some(n)
+    }
+
+    fn cycle(&self) -> usize {
+        self.materials[0].1.periods.map_or(1, |q| q as usize)
     }
 }

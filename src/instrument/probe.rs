@@ -38,6 +38,11 @@ pub trait Probe {
     fn loop_state(&self, _out: &mut LoopState) -> Option<usize> {
         None
     }
+    /// Drive periods after which its motion can repeat: 1, or the common period of
+    /// several modes' drives.
+    fn cycle(&self) -> usize {
+        1
+    }
 }
 
 /// Drive periods (of period `period_hat`) a lock-in needs to settle

@@ -2,27 +2,33 @@
 //!
 //! Over a stretch of sample that does not change (one material at one height), the
 //! whole loop — the oscillator's state at the drive phase, the lock-in's filters, the
-//! piezo and the controller — is a map applied once a drive period, and it settles on
-//! a fixed point: from there every period repeats the last. [`Repeats`] watches the
-//! loop's state after each marched period; once the state moves by a gap d a period
-//! that has shrunk geometrically for [`WINDOW`] periods at a rate no slower than ρ (the
-//! largest ratio of successive gaps seen), the state lies within d·ρ/(1 − ρ) of the
-//! fixed point, and once that bound is below the tolerance the periods that follow
-//! over the same stretch are taken as repeats of the last, not marched. Motion that is
-//! not period-1 (a long lock grazing a switch, a bimodal orbit over a common period of
-//! several drive periods) never shrinks its gap and is always marched; so is a probe
-//! under a thermal force. The exact march is [`Repeats::exact`].
+//! piezo and the controller — is a map applied once a cycle (a drive period; the
+//! common period of several modes' drives, q drive periods), and it settles on a fixed
+//! point: from there every cycle repeats the last. [`Repeats`] watches the loop's state
+//! after each marched period; once the state moves by a gap d a cycle (against the
+//! state a cycle before) that has shrunk geometrically for [`WINDOW`] periods at a rate
+//! no slower than ρ (the largest ratio of successive gaps a cycle apart), the state
+//! lies within d·ρ/(1 − ρ) of the fixed point, and once that bound is below the
+//! tolerance the whole cycles that follow over the same stretch are taken as repeats
+//! of the last, not marched. Motion that does not repeat each cycle (a long lock
+//! grazing a switch) never shrinks its gap and is always marched; so is a probe under
+//! a thermal force or one whose drives have no common period. The exact march is
+//! [`Repeats::exact`].
 
 /// The loop state watched: the probe's (deflection, velocity, a law's internal state,
 /// the lock-in's filter stages and last input) then the piezo and the controller's last
 /// error, each in units of A₀ (or of the amplitude ratio).
-pub const STATE_LEN: usize = 32;
+pub const STATE_LEN: usize = 48;
 
 /// The loop's state after a drive period ([`STATE_LEN`] entries, unused ones zero).
 pub type LoopState = [f64; STATE_LEN];
 
 /// Periods over which the gap must shrink before periods are skipped.
-pub const WINDOW: usize = 16;
+pub const WINDOW: usize = 32;
+
+/// The longest cycle watched (in drive periods): a loop that repeats only after more is
+/// always marched.
+pub const LONGEST_CYCLE: usize = WINDOW / 4;
 
 /// The default bound on the distance from the fixed point at which periods are skipped,
 /// in units of A₀: 2e-15 m of piezo on a 20 nm amplitude, 6e-6° of phase — some
@@ -39,7 +45,9 @@ const SLOWEST: f64 = 0.9999;
 pub struct Repeats {
     /// The bound on the distance from the fixed point (none: never skip).
     tolerance: Option<f64>,
-    last: Option<LoopState>,
+    /// The states of the last cycle, oldest first (as many as periods seen, up to the
+    /// cycle).
+    last: Vec<LoopState>,
     /// The last gaps, newest at `seen % WINDOW`.
     gaps: [f64; WINDOW],
     /// Gaps recorded since the stretch began.
@@ -65,7 +73,7 @@ impl Repeats {
     fn skipping(tolerance: Option<f64>) -> Self {
         Self {
             tolerance,
-            last: None,
+            last: Vec::new(),
             gaps: [0.0; WINDOW],
             seen: 0,
             marched: 0,
@@ -80,24 +88,32 @@ impl Repeats {
 
     /// A new stretch of sample begins: what was seen says nothing about it.
     pub fn restart(&mut self) {
-        self.last = None;
+        self.last.clear();
         self.seen = 0;
     }
 
-    /// Record the state after a marched period (`None`: a probe that cannot be skipped);
-    /// whether the loop now repeats itself to the tolerance.
-    pub fn settled(&mut self, state: Option<&LoopState>) -> bool {
+    /// Record the state after a marched period of a loop that repeats every `cycle`
+    /// periods (`None`: a probe that cannot be skipped); whether the loop now repeats
+    /// itself to the tolerance.
+    pub fn settled(&mut self, state: Option<&LoopState>, cycle: usize) -> bool {
         self.marched += 1;
         let (Some(tolerance), Some(state)) = (self.tolerance, state) else {
             self.restart();
             return false;
         };
-        let Some(last) = self.last.replace(*state) else {
+        if cycle > LONGEST_CYCLE {
             return false;
-        };
+        }
+        if self.last.len() < cycle.max(1) {
+            self.last.push(*state);
+            return false;
+        }
+        // The state a cycle before, and this one in its place.
+        let before = self.last.remove(0);
+        self.last.push(*state);
         let gap = state
             .iter()
-            .zip(&last)
+            .zip(&before)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         self.gaps[self.seen % WINDOW] = gap;
@@ -107,9 +123,9 @@ impl Repeats {
         }
         // The slowest contraction over the window (oldest to newest).
         let mut rho: f64 = 0.0;
-        for k in 1..WINDOW {
+        for k in cycle..WINDOW {
             let (older, newer) = (
-                self.gaps[(self.seen + k - 1) % WINDOW],
+                self.gaps[(self.seen + k - cycle) % WINDOW],
                 self.gaps[(self.seen + k) % WINDOW],
             );
             if newer > 0.0 {
@@ -145,7 +161,7 @@ mod tests {
         let mut r = Repeats::within(1e-6);
         let mut settled_at = None;
         for j in 0..400 {
-            if r.settled(Some(&state(0.9f64.powi(j)))) {
+            if r.settled(Some(&state(0.9f64.powi(j))), 1) {
                 settled_at = Some(j);
                 break;
             }
@@ -159,22 +175,39 @@ mod tests {
         // A period-2 alternation of 1e-12: tiny, but not contracting.
         let mut r = Repeats::within(1e-6);
         for j in 0..1000 {
-            assert!(!r.settled(Some(&state(1e-12 * (j % 2) as f64))));
+            assert!(!r.settled(Some(&state(1e-12 * (j % 2) as f64)), 1));
         }
         // A probe that cannot say its state, and the exact march, never settle.
-        assert!(!(0..100).any(|_| r.settled(None)));
+        assert!(!(0..100).any(|_| r.settled(None, 1)));
         let mut exact = Repeats::exact();
-        assert!(!(0..100).any(|_| exact.settled(Some(&state(0.0)))));
+        assert!(!(0..100).any(|_| exact.settled(Some(&state(0.0)), 1)));
     }
 
     #[test]
     fn a_restart_forgets_the_stretch_before() {
         let mut r = Repeats::within(1e-3);
         for j in 0..200 {
-            r.settled(Some(&state(0.5f64.powi(j))));
+            r.settled(Some(&state(0.5f64.powi(j))), 1);
         }
-        assert!(r.settled(Some(&state(0.0))));
+        assert!(r.settled(Some(&state(0.0)), 1));
         r.restart();
-        assert!(!r.settled(Some(&state(0.0))));
+        assert!(!r.settled(Some(&state(0.0)), 1));
+    }
+
+    #[test]
+    fn a_loop_that_repeats_every_second_period_settles_watched_over_two() {
+        // ±1 alternating, plus a decaying 0.8^j: over one period it never repeats; over
+        // two the gap is 0.36·0.8^(j−2), shrinking by ρ = 0.64 a cycle, and the bound
+        // gap·ρ/(1 − ρ) = 0.8^j is the true distance from the cycle.
+        let x = |j: i32| if j % 2 == 0 { 1.0 } else { -1.0 } + 0.8f64.powi(j);
+        let mut one = Repeats::within(1e-6);
+        assert!(!(0..400).any(|j| one.settled(Some(&state(x(j))), 1)));
+        let mut two = Repeats::within(1e-6);
+        let at = (0..400).find(|&j| two.settled(Some(&state(x(j))), 2));
+        // 0.8^j ≤ 1e-6 from j = 62 on.
+        assert_eq!(at, Some(62));
+        // A cycle longer than watched is never skipped.
+        let mut long = Repeats::within(1.0);
+        assert!(!(0..400).any(|_| long.settled(Some(&state(0.0)), LONGEST_CYCLE + 1)));
     }
 }

@@ -125,57 +125,83 @@ pub fn line_probe<P: Probe>(
     }
     let a0 = probe.free_amplitude_m();
     let modes = probe.modes();
+    let cycle = probe.cycle();
     let step = length_m / (pixels * periods_per_pixel) as f64;
+    let total = pixels * periods_per_pixel;
+    // The first period whose start lies at or past `until_m` (the next region's first).
+    let first_past = |until_m: f64| {
+        let mut g = ((until_m / step).ceil().max(0.0) as usize).min(total);
+        while g > 0 && step * (g - 1) as f64 >= until_m {
+            g -= 1;
+        }
+        while g < total && step * (g as f64) < until_m {
+            g += 1;
+        }
+        g
+    };
     // The region under the tip: x only grows, so the index only moves on.
     let mut under = 0;
     let mut z = start_z_m;
     let mut out = Vec::with_capacity(pixels);
-    // What the last marched period read, once the loop repeats itself over the region.
-    let mut repeating: Option<(Readings, f64)> = None;
+    // The last cycle's readings, oldest first; while repeating, replayed in order.
+    let mut recent: Vec<(Readings, f64)> = Vec::with_capacity(cycle);
+    let (mut repeat_until, mut replayed) = (0, 0);
     repeats.restart();
     let mut state = [0.0; STATE_LEN];
-    for i in 0..pixels {
-        let mut sum = [0.0; 4];
-        let mut higher = [(0.0, 0.0); MAX_MODES];
-        for j in 0..periods_per_pixel {
-            let x = step * (i * periods_per_pixel + j) as f64;
-            while under + 1 < regions.len() && x >= regions[under].until_m {
-                under += 1;
-                repeats.restart();
-                repeating = None;
-            }
-            let region = &regions[under];
-            // The piezo during the period (the controller moves it at its end).
-            let during = z;
-            let (read, error) = match repeating {
-                Some(last) => {
-                    repeats.skip();
-                    last
-                }
-                None => {
-                    let read = probe.march(region.material, z - region.height_m, 1)?;
-                    let (dz, error) = controller.update(read[0].0);
-                    z += dz * a0;
-                    let known = probe.loop_state(&mut state).map(|n| {
-                        state[n] = z / a0;
-                        state[n + 1] = error;
-                        &state
-                    });
-                    if repeats.settled(known) {
-                        repeating = Some((read, error));
-                    }
-                    (read, error)
-                }
-            };
-            let (amplitude, phase_deg) = read[0];
-            for (s, v) in sum.iter_mut().zip([during, amplitude, error, phase_deg]) {
-                *s += v;
-            }
-            for (s, r) in higher.iter_mut().zip(&read).take(modes).skip(1) {
-                s.0 += r.0;
-                s.1 += r.1;
-            }
+    let mut sum = [0.0; 4];
+    let mut higher = [(0.0, 0.0); MAX_MODES];
+    for g in 0..total {
+        let x = step * g as f64;
+        while under + 1 < regions.len() && x >= regions[under].until_m {
+            under += 1;
+            repeats.restart();
+            recent.clear();
+            repeat_until = 0;
         }
+        let region = &regions[under];
+        // The piezo during the period (the controller moves it at its end).
+        let during = z;
+        let (read, error) = if g < repeat_until {
+            repeats.skip();
+            replayed += 1;
+            recent[(replayed - 1) % cycle]
+        } else {
+            let read = probe.march(region.material, z - region.height_m, 1)?;
+            let (dz, error) = controller.update(read[0].0);
+            z += dz * a0;
+            if recent.len() == cycle {
+                recent.remove(0);
+            }
+            recent.push((read, error));
+            let known = probe.loop_state(&mut state).map(|n| {
+                state[n] = z / a0;
+                state[n + 1] = error;
+                &state
+            });
+            if repeats.settled(known, cycle) && recent.len() == cycle {
+                // Whole cycles up to the next region (or the line's end) repeat this one.
+                let end = if under + 1 < regions.len() {
+                    first_past(region.until_m)
+                } else {
+                    total
+                };
+                repeat_until = g + 1 + (end - g - 1) / cycle * cycle;
+                replayed = 0;
+            }
+            (read, error)
+        };
+        let (amplitude, phase_deg) = read[0];
+        for (s, v) in sum.iter_mut().zip([during, amplitude, error, phase_deg]) {
+            *s += v;
+        }
+        for (s, r) in higher.iter_mut().zip(&read).take(modes).skip(1) {
+            s.0 += r.0;
+            s.1 += r.1;
+        }
+        if (g + 1) % periods_per_pixel != 0 {
+            continue;
+        }
+        let i = g / periods_per_pixel;
         let n = periods_per_pixel as f64;
         out.push(Pixel {
             x_m: step * periods_per_pixel as f64 * (i as f64 + 0.5),
@@ -196,6 +222,8 @@ pub fn line_probe<P: Probe>(
                 })
                 .collect(),
         });
+        sum = [0.0; 4];
+        higher = [(0.0, 0.0); MAX_MODES];
         progress(i + 1);
     }
     Ok((out, z))
@@ -390,7 +418,7 @@ pub fn row_probe<P: Probe>(
         probe,
         regions[0].material,
         1.2 * a0,
-        &mut controller,
+        (&mut controller, &mut *repeats),
         engage_periods,
     )?;
     // The loop holds the rest separation; the piezo stands that much above the surface.
