@@ -52,9 +52,11 @@ use std::path::PathBuf;
 /// (√(k_BT/k) at 300 K, 10 pm on the defaults). Whether the tip touches in a period is
 /// then decided by perturbations nothing controls, several long mode locks can coexist,
 /// and the deterministic answer is not defined. Such a state is flagged "grazing a
-/// switch" (its grazing margin is printed beside the thermal rms); tapsim then marches
-/// from six documented starts and lists every attractor reached, with how many starts
-/// reached each, and says whether the answer is well defined (--starts N for any state).
+/// switch" (its grazing margin is printed beside the thermal rms) and not well defined,
+/// even where every start reaches one lock (another integrator or tolerance may reach
+/// another); tapsim marches from six documented starts and lists every attractor
+/// reached, with how many starts reached each (--starts N for any state). What an
+/// instrument reads there is the average over the thermal motion: --temperature 300K.
 ///
 /// Several eigenmodes (--modes 2 or 3; bimodal AFM): the higher modes, driven at their
 /// own resonances with small amplitudes (a rectangular beam's by default: f₂ = 6.267 f₀,

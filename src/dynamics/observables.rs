@@ -449,11 +449,14 @@ pub struct TapRun {
     /// oscillation's first; null where none were looked for (a state that does not
     /// graze a switch, without `starts`).
     pub attractors: Option<Vec<Attractor>>,
-    /// Whether the deterministic answer is defined: every start reached the same
-    /// attractor, or those reached coexist without grazing a switch (a bistability: which
-    /// one is reached depends on the history, each is well defined). False where
-    /// attractors that graze coexist (their basins can be finer than the thermal
-    /// motion); null where only one start was tried.
+    /// Whether the deterministic answer is defined: the state does not graze a switch,
+    /// and every start reached the same attractor or those reached coexist without
+    /// grazing (a bistability: which one is reached depends on the history, each is well
+    /// defined). False for a state that grazes a switch (its margin below the thermal
+    /// motion: which touches a period makes is then set by perturbations, even where
+    /// every start of one integrator reaches one lock; what an instrument reads is the
+    /// thermal average, `--temperature`) and where attractors that graze coexist; null
+    /// where only one start was tried for a state that does not graze.
     pub well_defined: Option<bool>,
     /// Trajectory samples (empty unless recorded).
     #[serde(skip)]
@@ -553,14 +556,22 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<Ta
     }
     let scale = setup.contact.separation_scale_m();
     let a0 = setup.cantilever.free_amplitude_m;
+    let grazing = observables.grazing;
     Ok(TapRun {
         thermal_rms_m: p.steady.grazing_threshold * a0,
         integration_error_m: sim.resolution(&p.steady, &state.motion) * a0,
         observables,
-        well_defined: attractors
-            .as_ref()
-            .filter(|_| starts > 1)
-            .map(|list| list.len() == 1 || list.iter().all(|a| !a.grazing)),
+        // A state that grazes a switch closer than the thermal motion is not defined by
+        // the deterministic equation, whatever the starts of one integrator reach (issue
+        // 45: independent integrators reach other locks from the same start).
+        well_defined: if grazing {
+            Some(false)
+        } else {
+            attractors
+                .as_ref()
+                .filter(|_| starts > 1)
+                .map(|list| list.len() == 1 || list.iter().all(|a| !a.grazing))
+        },
         attractors,
         harmonics,
         mean_force_gradient_n_m,

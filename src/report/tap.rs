@@ -251,9 +251,16 @@ fn attractors_text(s: &mut String, list: &[Attractor], well_defined: Option<bool
     let starts: usize = list.iter().map(|a| a.count).sum();
     let verdict = match (well_defined, list.len()) {
         (None, _) => "one start",
+        (Some(false), 1) => {
+            "every start reached one state, but it grazes a switch closer than the \
+             thermal motion: the deterministic answer is not defined here (another \
+             integrator or tolerance may reach another lock); what an instrument reads \
+             is the thermal average, --temperature 300K"
+        }
         (Some(false), _) => {
             "the deterministic answer is not defined here: states that graze a switch \
-             coexist, their basins finer than the thermal motion"
+             coexist, their basins finer than the thermal motion (what an instrument \
+             reads: --temperature 300K)"
         }
         (Some(true), 1) => "every start reached the same state",
         (Some(true), _) => "coexisting states: which one is reached depends on the history",
