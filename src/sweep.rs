@@ -160,7 +160,9 @@ fn sweep_points(
         let observables = TapObservables::new(&p, &state)?;
         let thermal_average = match thermal {
             Some(request) if reads_as_average(&observables) => {
-                Some(thermal_average_from(&p, &sim, &phase, request)?)
+                // Each point its own noise (its place along the curve).
+                let request = request.at(&[i as u64]);
+                Some(thermal_average_from(&p, &sim, &phase, &request)?)
             }
             _ => None,
         };
@@ -340,7 +342,8 @@ pub fn map_cells(
         )?;
         let thermal_average = match thermal {
             Some(request) if reads_as_average(&run.observables) => {
-                Some(thermal_average(s, numerics, request)?)
+                // Each cell its own noise (its place: its parameters).
+                Some(thermal_average(s, numerics, &request.for_state(s))?)
             }
             _ => None,
         };

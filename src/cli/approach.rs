@@ -75,6 +75,9 @@ pub struct ApproachArgs {
     temperature: Option<f64>,
     /// Drive periods of each thermal average: eight independent records of an eighth
     /// each (after ten decay times of settling), whose spread gives the standard errors.
+    /// Each point draws noise of its own (a seed derived from its place along the
+    /// curve, JSON thermal_average.seed): the errors of neighbouring points are
+    /// independent.
     #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
     thermal_periods: usize,
     #[command(flatten)]

@@ -82,6 +82,9 @@ pub struct MapArgs {
     noise: super::NoiseArgs,
     /// Drive periods of each thermal average (--temperature at one z_c): eight
     /// independent records of an eighth each, whose spread gives the standard errors.
+    /// Each cell draws noise of its own (a seed derived from its parameters, as `tap
+    /// --temperature` at them draws: JSON thermal_average.seed), so the errors of
+    /// neighbouring cells are independent.
     #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
     thermal_periods: usize,
     #[command(flatten)]

@@ -230,7 +230,7 @@ pub fn run(args: TapArgs) -> Result<()> {
                 periods: args.thermal_periods,
                 seed: 1,
             };
-            let average = thermal_average(&setup, &numerics, &request);
+            let average = thermal_average(&setup, &numerics, &request.for_state(&setup));
             busy.finish_and_clear();
             Some(average?)
         }

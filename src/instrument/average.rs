@@ -46,6 +46,10 @@ pub struct ThermalAverage {
     pub touch_fraction: f64,
     /// Its standard error.
     pub touch_fraction_std_err: f64,
+    /// The seed whose streams its records drew: in a sweep, derived from the request's
+    /// seed and the point's place ([`AverageRequest::at`]), so that no two points share
+    /// their noise and their errors are independent.
+    pub seed: u64,
 }
 
 /// Independent records a thermal average is made of.
@@ -64,6 +68,36 @@ pub struct AverageRequest {
 }
 
 impl AverageRequest {
+    /// The request for a state of `setup` alone: at the place its work of adhesion,
+    /// modulus and rest separation give it ([`AverageRequest::at`]), so that `tap` at a
+    /// map cell's parameters draws the cell's noise.
+    pub fn for_state(&self, setup: &TapSetup) -> Self {
+        let c = &setup.contact;
+        self.at(&[
+            c.work_of_adhesion_j_m2.to_bits(),
+            c.modulus_pa.to_bits(),
+            setup.separation_m.to_bits(),
+        ])
+    }
+
+    /// The request for the point at `place` of a sweep (its index along a curve, its
+    /// parameters in a map): the same temperature and length, a seed of its own derived
+    /// from this one and the place (SplitMix64, Steele, Lea & Flood, OOPSLA 2014, over
+    /// the words), so that the points' records draw unrelated streams and the errors of
+    /// neighbouring points do not move together. The same place gives the same seed on
+    /// any machine, shard or thread count.
+    pub fn at(&self, place: &[u64]) -> Self {
+        let mix = |z: u64| {
+            let z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            let z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            z ^ (z >> 31)
+        };
+        let seed = place.iter().fold(mix(self.seed), |h, &w| {
+            mix(h.wrapping_add(0x9e37_79b9_7f4a_7c15).wrapping_add(mix(w)))
+        });
+        Self { seed, ..*self }
+    }
+
     /// Refuse a temperature that is negative or not finite, or a length with fewer than
     /// 100 periods a record or more than [`MAX_THERMAL_PERIODS`] in all.
     pub fn check(&self) -> Result<()> {
@@ -162,5 +196,40 @@ pub fn thermal_average_from(
         amplitude_ratio_std_err: a_se,
         touch_fraction: t,
         touch_fraction_std_err: t_se,
+        seed: request.seed,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_place_draws_its_own_seed_and_the_same_place_the_same() {
+        let r = AverageRequest {
+            temperature_k: 300.0,
+            periods: 1600,
+            seed: 1,
+        };
+        let seeds: Vec<u64> = (0..1000).map(|i| r.at(&[i]).seed).collect();
+        let mut distinct = seeds.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        assert_eq!(distinct.len(), seeds.len());
+        assert!(!seeds.contains(&1));
+        assert_eq!(r.at(&[7, 3]).seed, r.at(&[7, 3]).seed);
+        assert_ne!(r.at(&[7, 3]).seed, r.at(&[3, 7]).seed);
+        assert_ne!(
+            r.at(&[7]).seed,
+            AverageRequest { seed: 2, ..r }.at(&[7]).seed
+        );
+        // Only the seed moves.
+        assert_eq!(
+            AverageRequest {
+                seed: 1,
+                ..r.at(&[5])
+            },
+            r
+        );
+    }
 }
