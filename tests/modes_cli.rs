@@ -61,6 +61,22 @@ fn bimodal_tap_reports_every_mode_and_the_readme_numbers() {
 /// Drives with no common period (`--ratio-tolerance 0`: the beam's f₂ = 6.266893 f₀ as
 /// it is): `tap` reports window averages, each with its error, and says what they are.
 /// README: φ₂ = 29.80° and A₂/A₀₂ = 0.4969 there (29.73° and 0.4955 at 25/4).
+/// The least separation is the orbit's, turning points inside integrator steps
+/// included (issue 45: it was taken at segment ends only, the jump-in level on the
+/// defaults). Against an independent integration of the same equations: −3.044 nm on
+/// the defaults, −1.905 nm under Hertz at 14 nm; the one-mode orbit reaches −2.845 nm.
+#[test]
+fn the_least_separation_of_several_modes_is_the_orbits() {
+    for (args, want_nm) in [
+        (&[][..], -3.044),
+        (&["--law", "hertz", "--separation", "14nm"][..], -1.905),
+    ] {
+        let v = json(&[&["tap", "--modes", "2", "--json"][..], args].concat());
+        let got = num(&v, "min_separation_m") * 1e9;
+        assert!((got - want_nm).abs() < 0.02, "{args:?}: {got} nm");
+    }
+}
+
 #[test]
 fn modes_without_a_common_period_are_averaged_over_windows() {
     let v = json(&["tap", "--modes", "2", "--ratio-tolerance", "0", "--json"]);

@@ -234,6 +234,9 @@ struct Segment<'m, 'a, 'o, L, const M: usize, const S: usize, O> {
     /// The step the crossing is in, where, and whether it is the level below.
     hit: Option<(StepEnd<S>, f64, bool)>,
     end: Option<State<S>>,
+    /// The lowest tip deflection over the steps taken whole (a turning point inside a
+    /// step from the Hermite cubic of Σqᵢ).
+    min_tip: f64,
 }
 
 impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
@@ -300,11 +303,45 @@ impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
             self.hit = Some((start, tau, near(self.below, -1.0)));
             return true;
         }
+        self.min_tip = self.min_tip.min(lowest_tip::<M, S>(&start, &end));
         if let Some(o) = self.observer.as_deref_mut() {
             o.step(&start, &end, self.branch);
         }
         false
     }
+}
+
+/// The lowest tip deflection Σqᵢ over a step: its ends, or a turning point inside it
+/// where the Hermite cubic's derivative (a quadratic in the step fraction) vanishes.
+fn lowest_tip<const M: usize, const S: usize>(a: &StepEnd<S>, b: &StepEnd<S>) -> f64 {
+    let h = b.tau - a.tau;
+    let sum = |e: &StepEnd<S>, part: fn(usize) -> usize| (0..M).map(|i| e.y[part(i)]).sum::<f64>();
+    let (x0, x1) = (sum(a, q), sum(b, q));
+    let (d0, d1) = (h * sum(a, v), h * sum(b, v));
+    let mut low = x0.min(x1);
+    if d0 < 0.0 && d1 > 0.0 {
+        // p′(t) = αt² + βt + γ for the cubic Hermite p through (x0, d0), (x1, d1).
+        let (al, be, ga) = (
+            6.0 * (x0 - x1) + 3.0 * (d0 + d1),
+            6.0 * (x1 - x0) - 4.0 * d0 - 2.0 * d1,
+            d0,
+        );
+        let roots = if al.abs() < 1e-300 {
+            [-ga / be, f64::NAN]
+        } else {
+            let disc = (be * be - 4.0 * al * ga).max(0.0).sqrt();
+            [(-be - disc) / (2.0 * al), (-be + disc) / (2.0 * al)]
+        };
+        for t in roots.into_iter().filter(|t| (0.0..=1.0).contains(t)) {
+            let (t2, t3) = (t * t, t * t * t);
+            let p = (2.0 * t3 - 3.0 * t2 + 1.0) * x0
+                + (t3 - 2.0 * t2 + t) * d0
+                + (-2.0 * t3 + 3.0 * t2) * x1
+                + (t3 - t2) * d1;
+            low = low.min(p);
+        }
+    }
+    low
 }
 
 /// Steps of one segment at most (a stalled integration ends with an error).
@@ -363,7 +400,8 @@ pub struct PassTally {
     pub contact_time: f64,
     /// Jumps into contact.
     pub jumps_in: u32,
-    /// The smallest tip deflection at a step end or a switch.
+    /// The smallest tip deflection: at a step end or a switch, or at a turning point
+    /// inside a step.
     pub min_tip: f64,
 }
 
@@ -425,6 +463,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 last: None,
                 hit: None,
                 end: None,
+                min_tip: f64::INFINITY,
             };
             seg.last = Some(StepEnd {
                 tau,
@@ -447,6 +486,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 )),
                 e => e,
             })?;
+            let seg_min = seg.min_tip;
             let (next_tau, next_y, next_branch) = match seg.hit {
                 Some((start, at, falling)) => {
                     // Integrate again from the step's start to the crossing.
@@ -459,6 +499,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                         last: None,
                         hit: None,
                         end: None,
+                        min_tip: f64::INFINITY,
                     };
                     let level =
                         if falling { seg.below } else { seg.above }.expect("a hit crosses a level");
@@ -518,7 +559,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             if branch == Branch::Contact {
                 tally.contact_time += next_tau - tau;
             }
-            tally.min_tip = tally.min_tip.min(Self::tip(&next_y));
+            tally.min_tip = tally.min_tip.min(Self::tip(&next_y)).min(seg_min);
             y = next_y;
             tau = next_tau;
             if next_branch != branch {
