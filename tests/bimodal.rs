@@ -38,8 +38,8 @@ struct Bimodal {
     second: bool,
 }
 
-/// What a march saw over its window: ∫ x cos, ∫ x sin for both modes (at their drive
-/// frequencies), ∫ ∂f/∂x dτ with the switches' steps, and the time.
+/// What a march saw over its window: ∫ x cos, ∫ x sin of the deflection x = q₁ + q₂ at
+/// both modes' drive frequencies, ∫ ∂f/∂x dτ with the switches' steps, and the time.
 #[derive(Default)]
 struct Window {
     mode1: (f64, f64),
@@ -151,10 +151,13 @@ impl Bimodal {
                     let weight = w.taper.map_or(1.0, |(start, length)| {
                         2.0 * (std::f64::consts::PI * (t - start) / length).sin().powi(2)
                     }) * piece;
-                    w.mode1.0 += mid[0] * (self.p.osc.omega * t).cos() * weight;
-                    w.mode1.1 += mid[0] * (self.p.osc.omega * t).sin() * weight;
-                    w.mode2.0 += mid[2] * (self.r * t).cos() * weight;
-                    w.mode2.1 += mid[2] * (self.r * t).sin() * weight;
+                    // What a lock-in at each mode's drive reads: the deflection, the
+                    // sum of the modes (issue 45: not each mode's own coordinate).
+                    let x = self.tip(&mid).0;
+                    w.mode1.0 += x * (self.p.osc.omega * t).cos() * weight;
+                    w.mode1.1 += x * (self.p.osc.omega * t).sin() * weight;
+                    w.mode2.0 += x * (self.r * t).cos() * weight;
+                    w.mode2.1 += x * (self.r * t).sin() * weight;
                     // ∫ f'(x(τ)) dτ over the piece: where the tip moves, Δf/ẋ (the
                     // slope's square-root singularity at a fold integrated exactly,
                     // with ẋ of the midpoint); near a turning point the midpoint rule.

@@ -64,8 +64,9 @@ pub struct LockIn {
     /// step observed (to follow the marcher's rewinds of τ by whole periods).
     next: i64,
     seen_until: Option<f64>,
-    /// The state component it demodulates (the deflection x; a mode's qᵢ).
-    component: usize,
+    /// How many modes' deflections it demodulates the sum of (the deflection x = Σqᵢ, at
+    /// state indices 0, 2, 4, …: the signal an instrument's lock-in sees).
+    deflections: usize,
 }
 
 impl LockIn {
@@ -112,15 +113,16 @@ impl LockIn {
             last_input: None,
             next: 0,
             seen_until: None,
-            component: X.index(),
+            deflections: 1,
         })
     }
 
-    /// The lock-in demodulating component `index` of the integrated state instead of the
-    /// deflection x: one eigenmode's deflection qᵢ ([`crate::dynamics::modes`]).
-    pub fn reading(self, index: usize) -> Self {
+    /// The lock-in reading the cantilever's deflection as the sum of the first `modes`
+    /// eigenmodes' deflections Σqᵢ ([`crate::dynamics::modes`]): what an instrument's
+    /// lock-in sees, each mode's at its own reference frequency.
+    pub fn summing(self, modes: usize) -> Self {
         Self {
-            component: index,
+            deflections: modes.max(1),
             ..self
         }
     }
@@ -259,7 +261,10 @@ impl StepObserver for LockIn {
     fn step<const N: usize>(&mut self, a: &StepEnd<N>, b: &StepEnd<N>, _: Branch) {
         for k in self.samples_in(a.tau, b.tau) {
             let tau = k as f64 * self.interval;
-            self.sample(k, hermite(a, b, self.component, tau));
+            let x = (0..self.deflections)
+                .map(|j| hermite(a, b, X.index() + 2 * j, tau))
+                .sum();
+            self.sample(k, x);
         }
     }
 

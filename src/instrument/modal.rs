@@ -17,7 +17,7 @@ use crate::dynamics::model::State;
 use crate::dynamics::modes::MAX_MODES;
 use crate::dynamics::modes::orbit::free_section;
 use crate::dynamics::modes::set::Modal;
-use crate::dynamics::modes::system::{Modes, plain_len, q};
+use crate::dynamics::modes::system::{Modes, plain_len};
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
 use crate::law::Branch;
@@ -60,11 +60,12 @@ impl<'a> ModalProbe<'a> {
                 k + 1
             )));
         }
+        // Each lock-in reads the deflection, the sum of the modes, at its mode's drive.
+        let count = modal.modes.len();
         let lockins = modal
             .modes
             .iter()
-            .enumerate()
-            .map(|(i, m)| Ok(LockIn::new(order, time_constant_hat, m.omega)?.reading(q(i))))
+            .map(|m| Ok(LockIn::new(order, time_constant_hat, m.omega)?.summing(count)))
             .collect::<Result<Vec<_>>>()?;
         let mut section = [0.0; 2 * MAX_MODES];
         let free = free_section(&modal.modes, None);

@@ -189,9 +189,9 @@ mod tests {
         for j in 0..200 {
             r.settled(Some(&state(0.5f64.powi(j))), 1);
         }
-        assert!(r.settled(Some(&state(0.0)), 1));
+        assert!(r.settled(Some(&state(0.5f64.powi(200))), 1));
         r.restart();
-        assert!(!r.settled(Some(&state(0.0)), 1));
+        assert!(!r.settled(Some(&state(0.5f64.powi(201))), 1));
     }
 
     #[test]

@@ -43,9 +43,11 @@ pub enum ModeIntegral {
     Exchange = 2,
     /// ∫ f_ts qᵢ dτ: the mode's virial.
     Virial = 3,
-    /// ∫ qᵢ cos Ωᵢτ dτ.
+    /// ∫ x cos Ωᵢτ dτ, x = Σⱼqⱼ the deflection: what a lock-in at mode i's drive
+    /// frequency reads (not qᵢ alone: the tip force puts every mode's motion at the
+    /// others' frequencies too).
     Cos = 4,
-    /// ∫ qᵢ sin Ωᵢτ dτ.
+    /// ∫ x sin Ωᵢτ dτ.
     Sin = 5,
 }
 
@@ -153,8 +155,8 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             dy[integral(M, i, ModeIntegral::Drive)] = c * vi;
             dy[integral(M, i, ModeIntegral::Exchange)] = f * vi;
             dy[integral(M, i, ModeIntegral::Virial)] = f * qi;
-            dy[integral(M, i, ModeIntegral::Cos)] = qi * c;
-            dy[integral(M, i, ModeIntegral::Sin)] = qi * s;
+            dy[integral(M, i, ModeIntegral::Cos)] = x * c;
+            dy[integral(M, i, ModeIntegral::Sin)] = x * s;
         }
         dy[force_integral(M)] = f;
         if S == tangent_len(M) {
