@@ -95,6 +95,12 @@ until = "1um"
 material = "B"
 "#;
 
+/// The shortest line and narrowest image a sample may describe, in m (a few atoms).
+pub const MIN_SIZE_M: f64 = 1e-9;
+/// The longest line and widest image, in m: a millimetre, ten times an AFM's largest
+/// scanner.
+pub const MAX_SIZE_M: f64 = 1e-3;
+
 impl Sample {
     /// Read a sample file (at most [`MAX_CONFIG_BYTES`]), each material over `base`; a
     /// mask it names is read from beside it.
@@ -106,6 +112,12 @@ impl Sample {
         };
         let text = read_text(path, MAX_CONFIG_BYTES, refuse)?;
         Self::from_toml_in(&text, base, path.parent()).map_err(|e| match e {
+            // The file's own faults name the file; a value's name the value, then the file.
+            Error::Parse { name, text, reason } if text.is_empty() => Error::Parse {
+                name,
+                text: path.display().to_string(),
+                reason,
+            },
             Error::Parse { name, text, reason } => Error::Parse {
                 name,
                 text,
@@ -153,15 +165,24 @@ impl Sample {
             Some(v) => crate::config::length(&value_text(v, "length")?).map_err(bad)?,
             None => return Err(bad("the line's length is missing (length = \"1um\")".into())),
         };
-        crate::error::positive("sample length", length_m)?;
         let width_m = match table.get("width") {
             Some(v) => crate::config::length(&value_text(v, "width")?).map_err(bad)?,
             None => length_m,
         };
-        crate::error::positive("sample width", width_m)?;
+        for (what, size) in [("length", length_m), ("width", width_m)] {
+            if !(MIN_SIZE_M..=MAX_SIZE_M).contains(&size) {
+                return Err(bad(format!(
+                    "the sample's {what} ({size:e} m) lies outside what an AFM scans: \
+                     {MIN_SIZE_M:e} to {MAX_SIZE_M:e} m"
+                )));
+            }
+        }
         let list = |key: &str| -> Result<Vec<toml::Table>> {
             match table.get(key) {
                 None if key == "disc" => Ok(Vec::new()),
+                Some(toml::Value::Array(items)) if items.is_empty() && key != "disc" => {
+                    Err(bad(format!("no [[{key}]] given (the list is empty)")))
+                }
                 Some(toml::Value::Array(items)) => items
                     .iter()
                     .map(|v| match v {

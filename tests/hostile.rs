@@ -672,3 +672,146 @@ fn each_reported_hostile_input_is_refused_with_its_reason() {
         assert!(r.stdout.is_empty(), "{args:?}: {}", r.stdout);
     }
 }
+
+/// Every file under `dir` with its bytes (what a refused command must leave alone).
+fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out: Vec<(PathBuf, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .map(|p| {
+            let bytes = std::fs::read(&p).unwrap();
+            (p, bytes)
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+/// Issue 45: the findings of an outside campaign over the last wave's surface, each
+/// refused at once with its reason, and no file changed (an output the command also
+/// asked for among them).
+#[test]
+fn the_outside_campaigns_findings_are_refused_and_change_no_file() {
+    let dir = scratch("campaign-45");
+    let write = |name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
+    write(
+        "empty.toml",
+        "length = \"1um\"\nregion = []\n[[material]]\nname = \"A\"\n",
+    );
+    write(
+        "wide.toml",
+        "length = \"1um\"\nwidth = \"1e300m\"\n[[material]]\nname = \"A\"\n\
+         [[region]]\nuntil = \"1um\"\nmaterial = \"A\"\n",
+    );
+    write("nothing.toml", "length = \"1um\"\nregion = 5\n");
+    // A curve a cantilever could give, then the same with one cell no cantilever gives.
+    let curve = "separation_m,amplitude_m,phase_deg\n2.4e-8,2e-8,90\n1.6e-8,1.88e-8,75.7\n\
+                 1.2e-8,1.56e-8,52.1\n8e-9,1.11e-8,37.1\n";
+    write("curve.csv", curve);
+    write("huge_amp.csv", &curve.replace("1.56e-8", "1e308"));
+    write("huge_phase.csv", &curve.replace("75.7", "-1e308"));
+    write("a.csv", "what was here before\n");
+    std::fs::create_dir_all(dir.join("adir")).unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["scan", "--sample", "empty.toml"],
+            "no [[region]] given",
+        ),
+        (
+            vec![
+                "scan",
+                "--sample",
+                "wide.toml",
+                "--lines",
+                "3",
+                "--plot",
+                "w.png",
+            ],
+            "outside what an AFM scans",
+        ),
+        // Errors of the file itself name the file, not "".
+        (vec!["scan", "--sample", "nothing.toml"], "\"nothing.toml\""),
+        (
+            vec!["fit", "huge_amp.csv"],
+            "lies outside what this cantilever",
+        ),
+        (
+            vec!["fit", "huge_phase.csv"],
+            "lies outside what this cantilever",
+        ),
+        (vec!["reconstruct", "huge_amp.csv"], "lies outside"),
+        (
+            vec!["reconstruct", "curve.csv", "--drive-frequency", "1e300"],
+            "drive frequency",
+        ),
+        (
+            vec!["reconstruct", "curve.csv", "--free-amplitude", "1e300"],
+            "free amplitude",
+        ),
+        (
+            vec!["reconstruct", "curve.csv", "--stiffness", "1e-300"],
+            "stiffness",
+        ),
+        // Outputs: a CSV beside a plot that cannot be written is not written either.
+        (
+            vec![
+                "approach", "--points", "3", "--csv", "a.csv", "--plot", "a.jpg",
+            ],
+            ".png or .svg",
+        ),
+        (
+            vec![
+                "approach",
+                "--points",
+                "3",
+                "--csv",
+                "a.csv",
+                "--plot",
+                "no/dir/a.png",
+            ],
+            "does not exist",
+        ),
+        (
+            vec!["map", "--steps", "2", "--csv", "a.csv", "--plot", "adir"],
+            ".png or .svg",
+        ),
+        (vec!["map", "--steps", "2", "--csv", "adir"], "directory"),
+        (
+            vec!["tap", "--trajectory", "a.csv", "--plot", "x.gif"],
+            ".png or .svg",
+        ),
+        (vec!["tap", "--enbw", "-1"], "give --temperature"),
+        (vec!["tap", "--enbw", "-1", "--temperature", "300K"], "ENBW"),
+    ];
+    let before = snapshot(&dir);
+    for (args, says) in cases {
+        let r = run(&args, &dir);
+        assert!(
+            r.elapsed < Duration::from_secs(5),
+            "{args:?}: {:?}",
+            r.elapsed
+        );
+        assert_eq!(r.code, Some(1), "{args:?}: {}", r.stderr);
+        assert!(r.stderr.contains(says), "{args:?}: {}", r.stderr);
+        assert!(!r.stderr.contains("panicked"), "{args:?}: {}", r.stderr);
+        assert_eq!(snapshot(&dir), before, "{args:?} changed a file");
+    }
+    // A part file with a key tapsim does not know is refused, not merged.
+    let part = dir.join("p0.json");
+    let r = run(
+        &[
+            "map", "--steps", "2", "--shard", "0/1", "--part", "p0.json", "-q",
+        ],
+        &dir,
+    );
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&part).unwrap()).unwrap();
+    v["extra"] = serde_json::json!(1);
+    std::fs::write(dir.join("p1.json"), v.to_string()).unwrap();
+    let r = run(&["merge", "p1.json", "--out", "m.csv"], &dir);
+    assert_eq!(r.code, Some(1));
+    assert!(r.stderr.contains("unknown field `extra`"), "{}", r.stderr);
+    assert!(!dir.join("m.csv").exists());
+}

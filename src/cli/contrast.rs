@@ -76,7 +76,7 @@ pub struct ContrastArgs {
     #[arg(long, allow_hyphen_values = true, default_value_t = 50)]
     points: usize,
     #[command(flatten)]
-    noise: super::NoiseArgs,
+    pub(super) noise: super::NoiseArgs,
     #[command(flatten)]
     modes: crate::config::ModeInputs,
 }

@@ -113,6 +113,11 @@ pub struct Columns {
     pub phase2_deg: Option<Vec<f64>>,
 }
 
+/// The farthest position a curve may give, in m: a scanner's range (100 µm).
+const MAX_POSITION_M: f64 = 1e-4;
+/// The largest phase (in degrees, either sign) a curve may give: two turns.
+const MAX_PHASE_DEG: f64 = 720.0;
+
 /// Read the curve of `path`: the rows whose `direction` column (if any) is `direction`;
 /// amplitudes given as ratios are made m with the cantilever's A₀ (the second mode's
 /// with `second_free_amplitude_m`, A₀₂), in volts with the InvOLS of `reading`; phases
@@ -249,33 +254,81 @@ pub fn read_curve(
                     ))
                 })
         };
+        // Values no cantilever of this free amplitude measures are refused at once (a
+        // cell of 1e308 would otherwise reach the fit as an overflow).
+        let a0 = cantilever.free_amplitude_m;
+        let within = |v: f64, (lo, hi): (f64, f64), what: &str, unit: &str| -> Result<f64> {
+            let shown = |v: f64| {
+                if v == 0.0 || (1e-3..1e4).contains(&v.abs()) {
+                    format!("{v}")
+                } else {
+                    format!("{v:e}")
+                }
+            };
+            if (lo..=hi).contains(&v) {
+                Ok(v)
+            } else {
+                Err(fail(format!(
+                    "row {}: the {what} {}{unit} lies outside what this cantilever (A₀ = \
+                     {} m) measures, {} to {}{unit}",
+                    row + 2,
+                    shown(v),
+                    shown(a0),
+                    shown(lo),
+                    shown(hi)
+                )))
+            }
+        };
         let this = segment.map(|c| record.get(c).unwrap_or("").to_string());
         if z.is_empty() || this != label {
             segments.push(z.len());
             label = this;
         }
-        z.push(value(
-            abscissa,
-            if setpoint.is_some() {
-                "setpoint"
-            } else {
-                "position"
-            },
-        )?);
+        z.push(if setpoint.is_some() {
+            within(value(abscissa, "setpoint")?, (0.0, 10.0), "setpoint", "")?
+        } else {
+            within(
+                value(abscissa, "position")?,
+                (-MAX_POSITION_M, MAX_POSITION_M),
+                "position",
+                " m",
+            )?
+        });
+        let amplitude = (0.0, 10.0 * a0);
         if let Some(c) = amp {
-            a.push(value(c, "amplitude")?);
+            a.push(within(
+                value(c, "amplitude")?,
+                amplitude,
+                "amplitude",
+                " m",
+            )?);
         }
+        let degrees = (-MAX_PHASE_DEG, MAX_PHASE_DEG);
         if let Some(c) = phase {
-            p.push(reading.phase.lag_deg(value(c, "phase")?));
+            let lag = reading.phase.lag_deg(value(c, "phase")?);
+            p.push(within(lag, degrees, "phase", "°")?);
         }
         if let Some(c) = deflection {
-            d.push(value(c, "deflection")?);
+            let deflection = (-10.0 * a0, 10.0 * a0);
+            d.push(within(
+                value(c, "deflection")?,
+                deflection,
+                "mean deflection",
+                " m",
+            )?);
         }
         if let Some(c) = amp2 {
-            a2.push(value(c, "second mode's amplitude")?);
+            let second = (0.0, 10.0 * second_free_amplitude_m.unwrap_or(a0));
+            a2.push(within(
+                value(c, "second mode's amplitude")?,
+                second,
+                "second mode's amplitude",
+                " m",
+            )?);
         }
         if let Some(c) = phase2 {
-            p2.push(reading.phase.lag_deg(value(c, "second mode's phase")?));
+            let lag = reading.phase.lag_deg(value(c, "second mode's phase")?);
+            p2.push(within(lag, degrees, "second mode's phase", "°")?);
         }
     }
     if z.is_empty() {

@@ -79,7 +79,7 @@ pub struct MapArgs {
     /// instrument reads it (thermal_average fields), and adds heat maps of E_ts and φ as
     /// read: the average where there is one, the steady state elsewhere.
     #[command(flatten)]
-    noise: super::NoiseArgs,
+    pub(super) noise: super::NoiseArgs,
     /// Drive periods of each thermal average (--temperature at one z_c): eight
     /// independent records of an eighth each, whose spread gives the standard errors.
     /// Each cell draws noise of its own (a seed derived from its parameters, as `tap

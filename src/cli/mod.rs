@@ -114,6 +114,50 @@ impl Command {
         };
         !quiet
     }
+
+    /// Refuse, before any work, an output path that cannot be written (a plot that is
+    /// neither .png nor .svg, a missing directory, a directory, a socket): the files a
+    /// run asks for, by flag; and lock-in settings given without a temperature.
+    fn check_early(&self) -> crate::Result<()> {
+        match self {
+            Command::Tap(a) => {
+                a.noise.check()?;
+                check_plot_path(a.plot.as_deref())?;
+                check_targets([a.plot.as_deref(), a.trajectory.as_deref()])
+            }
+            Command::Approach(a) => a.out.check(),
+            Command::Branches(a) => a.out.check(),
+            Command::Bifurcation(a) => a.out.check(),
+            Command::Contrast(a) => {
+                a.noise.check()?;
+                a.out.check()
+            }
+            Command::Map(a) => {
+                a.noise.check()?;
+                a.out.check()
+            }
+            Command::Scan(a) => a.out.check(),
+            Command::Thermal(a) => a.out.check(),
+            Command::Batch(a) => a.out.check(),
+            Command::Merge(a) => a.output.check(),
+            Command::Fit(_)
+            | Command::Reconstruct(_)
+            | Command::Hysteresis(_)
+            | Command::Lj(_)
+            | Command::Figure(_)
+            | Command::Reproduce(_) => Ok(()),
+        }
+    }
+}
+
+/// Refuse any of `paths` that cannot be written ([`crate::report::output::check_target`]).
+fn check_targets<'a>(
+    paths: impl IntoIterator<Item = Option<&'a std::path::Path>>,
+) -> crate::Result<()> {
+    paths
+        .into_iter()
+        .flatten()
+        .try_for_each(crate::report::output::check_target)
 }
 
 /// The range of rest separations of the commands that sweep it (approach, branches,
@@ -216,6 +260,22 @@ pub struct NoiseArgs {
 }
 
 impl NoiseArgs {
+    /// Refuse lock-in settings without the temperature they are for, and a bandwidth
+    /// that is not a positive number.
+    pub fn check(&self) -> crate::Result<()> {
+        if self.temperature.is_none() && (self.enbw.is_some() || self.lockin_order.is_some()) {
+            return Err(crate::Error::NotApplicable(
+                "--enbw and --lockin-order set the lock-in that reads the thermal noise: give \
+                 --temperature too, or leave them out"
+                    .into(),
+            ));
+        }
+        if let Some(enbw) = self.enbw {
+            crate::error::positive("lock-in bandwidth (ENBW)", enbw)?;
+        }
+        Ok(())
+    }
+
     /// The noise asked for (none without --temperature).
     pub fn request(&self) -> Option<crate::instrument::noise::NoiseRequest> {
         self.temperature
@@ -241,6 +301,13 @@ pub(crate) fn separation_and_setpoint() -> crate::Error {
 }
 
 impl SweepOutput {
+    /// Refuse, before any work, a --plot that is neither .png nor .svg and a --csv or
+    /// --plot that cannot be written.
+    pub fn check(&self) -> crate::Result<()> {
+        check_plot_path(self.plot.as_deref())?;
+        check_targets([self.csv.as_deref(), self.plot.as_deref()])
+    }
+
     /// A progress bar over `len` items on stderr, hidden with --quiet or when stderr is
     /// not a terminal.
     pub fn progress_bar(&self, len: usize) -> indicatif::ProgressBar {
@@ -422,8 +489,23 @@ pub fn run_captured(args: &[String]) -> std::result::Result<String, Refused> {
     }
 }
 
-/// Run one parsed command.
+/// Run one parsed command: its files are put in place only if it succeeds (a command
+/// that fails changes no file, [`crate::report::output::stage_writes`]).
 fn dispatch(command: Command) -> crate::Result<()> {
+    use crate::report::output;
+    command.check_early()?;
+    output::stage_writes();
+    match run_command(command) {
+        Ok(()) => output::commit_writes(),
+        Err(e) => {
+            output::discard_writes();
+            Err(e)
+        }
+    }
+}
+
+/// Run one parsed command, its writes staged.
+fn run_command(command: Command) -> crate::Result<()> {
     match command {
         Command::Tap(args) => tap::run(args),
         Command::Approach(args) => approach::run(args),

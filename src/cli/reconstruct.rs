@@ -100,6 +100,10 @@ const LAW_GRID: usize = 800;
 pub fn run(args: ReconstructArgs) -> Result<()> {
     super::check_plot_path(args.plot.as_deref())?;
     let (setup, numerics) = args.inputs.clone().with_config()?.resolve()?;
+    // The ranges `tap` enforces: a cantilever and a contact no instrument has give no
+    // reconstruction, only overflow.
+    setup.cantilever.validated()?;
+    setup.check_plausible()?;
     let direction = match args.direction {
         Branch::Approach => "approach",
         Branch::Retract => "retract",

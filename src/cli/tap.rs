@@ -91,11 +91,11 @@ pub struct TapArgs {
     /// Write the trajectory of the last cycles as CSV (t_s, z_m, v_m_s, alpha_m,
     /// force_n, branch).
     #[arg(long, help_heading = "Output")]
-    trajectory: Option<PathBuf>,
+    pub(super) trajectory: Option<PathBuf>,
     /// Plot deflection and force vs time, the force–separation loop and the phase
     /// portrait (.png or .svg).
     #[arg(long, help_heading = "Output")]
-    plot: Option<PathBuf>,
+    pub(super) plot: Option<PathBuf>,
     /// Cycles recorded for --trajectory and --plot.
     #[arg(
         long,
@@ -132,7 +132,7 @@ pub struct TapArgs {
     #[arg(long, value_enum, ignore_case = true)]
     branch: Option<BranchChoice>,
     #[command(flatten)]
-    noise: super::NoiseArgs,
+    pub(super) noise: super::NoiseArgs,
     #[command(flatten)]
     modes: crate::config::ModeInputs,
     /// Drive periods a --temperature run averages over where the deterministic state

@@ -10,6 +10,12 @@
 //!
 //! Temporary files are registered while they exist: [`remove_partial_files`] deletes
 //! them, and the command line calls it when it is interrupted (SIGINT, SIGTERM).
+//!
+//! While a command runs, its writes are staged ([`stage_writes`]): each file is
+//! written whole to its temporary file, and only when the command has succeeded are
+//! they all put in place ([`commit_writes`]); a command that fails after writing some
+//! of its outputs (a plot it cannot draw after its CSV) changes no file
+//! ([`discard_writes`]).
 
 use crate::error::{Error, Result};
 use std::fs;
@@ -28,6 +34,75 @@ pub fn announce_writes(on: bool) {
 
 /// Temporary files being written.
 static PARTIAL: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// A file written whole to its temporary file, to be put in place when the command
+/// succeeds: the temporary file, how its target is written, and the path the user gave.
+struct Staged {
+    tmp: PathBuf,
+    target: Target,
+    shown: PathBuf,
+}
+
+/// The writes staged while a command runs (none: writes go in place at once).
+static STAGED: Mutex<Option<Vec<Staged>>> = Mutex::new(None);
+
+fn staged() -> std::sync::MutexGuard<'static, Option<Vec<Staged>>> {
+    STAGED
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// From now on, hold every file written until [`commit_writes`] or [`discard_writes`].
+pub fn stage_writes() {
+    *staged() = Some(Vec::new());
+}
+
+/// Put every staged file in place, in the order written (each renamed over its target,
+/// or copied into a device or FIFO), announcing each as [`write_with`] does; writes go
+/// in place at once again.
+pub fn commit_writes() -> Result<()> {
+    let list = staged().take().unwrap_or_default();
+    let mut result = Ok(());
+    for s in list {
+        let done = if result.is_ok() {
+            place(&s.tmp, &s.target, &s.shown)
+        } else {
+            Ok(())
+        };
+        let _ = fs::remove_file(&s.tmp);
+        partial_files().retain(|p| p != &s.tmp);
+        match done {
+            Ok(()) if ANNOUNCE.load(Ordering::Relaxed) => eprintln!("wrote {}", s.shown.display()),
+            Ok(()) => {}
+            Err(e) => result = Err(e),
+        }
+    }
+    result
+}
+
+/// Drop every staged file (the command failed): no target is touched.
+pub fn discard_writes() {
+    for s in staged().take().unwrap_or_default() {
+        let _ = fs::remove_file(&s.tmp);
+        partial_files().retain(|p| p != &s.tmp);
+    }
+}
+
+/// Put the temporary file `tmp` in place of `target` (`shown` names it in errors).
+fn place(tmp: &Path, target: &Target, shown: &Path) -> Result<()> {
+    match target {
+        Target::Replace(target) => fs::rename(tmp, target).map_err(|e| io(shown, e)),
+        Target::WriteThrough(target) => {
+            let mut from = fs::File::open(tmp).map_err(|e| io(shown, e))?;
+            let mut to = fs::OpenOptions::new()
+                .write(true)
+                .open(target)
+                .map_err(|e| io(shown, e))?;
+            std::io::copy(&mut from, &mut to).map_err(|e| io(shown, e))?;
+            Ok(())
+        }
+    }
+}
 
 fn partial_files() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     PARTIAL
@@ -171,6 +246,13 @@ fn target(path: &Path) -> Result<Target> {
     }
 }
 
+/// Refuse `path` as an output if it cannot be written: its directory missing or not a
+/// directory, or the path a directory, a block device or a socket (what a write would
+/// refuse, checked before any work).
+pub fn check_target(path: &Path) -> Result<()> {
+    target(path).map(|_| ())
+}
+
 /// An error about the temporary file told about `path` instead.
 fn about(path: &Path, tmp: &Path, e: Error) -> Error {
     match e {
@@ -190,8 +272,8 @@ fn about(path: &Path, tmp: &Path, e: Error) -> Error {
 /// (see the module documentation). On any failure the temporary file is removed and
 /// `path` is left untouched; errors name `path`, never the temporary file.
 pub fn write_with(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    put(path, write)?;
-    if ANNOUNCE.load(Ordering::Relaxed) {
+    // (A staged file is announced when it is put in place.)
+    if put(path, write)? && ANNOUNCE.load(Ordering::Relaxed) {
         eprintln!("wrote {}", path.display());
     }
     Ok(())
@@ -200,31 +282,34 @@ pub fn write_with(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Resul
 /// Write `bytes` to `path` as [`write_bytes`] does, never announced: a file the user
 /// did not ask for (the on-disk cache).
 pub fn write_unannounced(path: &Path, bytes: &[u8]) -> Result<()> {
-    put(path, |tmp| fs::write(tmp, bytes).map_err(|e| io(tmp, e)))
+    put(path, |tmp| fs::write(tmp, bytes).map_err(|e| io(tmp, e))).map(|_| ())
 }
 
-/// [`write_with`] without the announcement.
-fn put(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    match target(path)? {
-        Target::Replace(target) => {
-            let tmp = Partial::new(&target, true);
-            write(&tmp.path).map_err(|e| about(path, &tmp.path, e))?;
-            fs::rename(&tmp.path, &target).map_err(|e| io(path, e))?;
-            tmp.forget();
-            Ok(())
-        }
-        Target::WriteThrough(target) => {
-            let tmp = Partial::new(&target, false);
-            write(&tmp.path).map_err(|e| about(path, &tmp.path, e))?;
-            let mut from = fs::File::open(&tmp.path).map_err(|e| io(path, e))?;
-            let mut to = fs::OpenOptions::new()
-                .write(true)
-                .open(&target)
-                .map_err(|e| io(path, e))?;
-            std::io::copy(&mut from, &mut to).map_err(|e| io(path, e))?;
-            Ok(())
-        }
+/// [`write_with`] without the announcement: whether the file is in place now (false:
+/// staged until the command succeeds).
+fn put(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<bool> {
+    let target = target(path)?;
+    let (beside, at) = match &target {
+        Target::Replace(t) => (true, t),
+        Target::WriteThrough(t) => (false, t),
+    };
+    let tmp = Partial::new(at, beside);
+    write(&tmp.path).map_err(|e| about(path, &tmp.path, e))?;
+    if let Some(list) = staged().as_mut() {
+        // Kept (and still registered for an interrupt) until the command ends.
+        list.push(Staged {
+            tmp: tmp.path.clone(),
+            target,
+            shown: path.to_path_buf(),
+        });
+        std::mem::forget(tmp);
+        return Ok(false);
     }
+    place(&tmp.path, &target, path)?;
+    if beside {
+        tmp.forget();
+    }
+    Ok(true)
 }
 
 /// Write `bytes` to `path` (see [`write_with`]).

@@ -29,6 +29,7 @@ pub const FORMAT: &str = "tapsim-part";
 /// The amplitude setpoint of a map: every cell solved where A/A₀ is `amplitude_ratio`
 /// on `branch`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct MapSetpoint {
     /// A/A₀.
     pub amplitude_ratio: f64,
@@ -45,7 +46,7 @@ impl MapSetpoint {
 
 /// The job a part belongs to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case")]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum Job {
     /// `tapsim map`: one record per cell.
     Map {
@@ -216,8 +217,10 @@ pub enum Config {
     PerItem(Vec<Value>),
 }
 
-/// One part of a job.
+/// One part of a job. A key it does not know is refused (a part another program
+/// edited, or a newer tapsim's, is not merged as if it were this one's).
 #[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Part {
     /// Always [`FORMAT`].
     pub format: String,
