@@ -148,7 +148,7 @@ fn sweep_points(
     mut keep: impl FnMut(usize, &SweepPoint) -> bool,
 ) -> Result<Vec<SweepPoint>> {
     if let Some(request) = thermal {
-        request.check()?;
+        request.check(setup.cantilever.quality)?;
     }
     let p = Prepared::new(setup, numerics)?;
     let mut phase = p.simulation().free_steady_start();
@@ -332,7 +332,7 @@ pub fn map_cells(
     thermal: Option<&AverageRequest>,
 ) -> Result<Vec<MapCell>> {
     if let Some(request) = thermal {
-        request.check()?;
+        request.check(setup.cantilever.quality)?;
     }
     let at_separation = |s: &TapSetup| {
         let run = crate::dynamics::observables::tap(

@@ -782,6 +782,20 @@ fn the_outside_campaigns_findings_are_refused_and_change_no_file() {
             ".png or .svg",
         ),
         (vec!["tap", "--enbw", "-1"], "give --temperature"),
+        // Work that grows without bound is refused before it starts.
+        (
+            vec![
+                "approach",
+                "--points",
+                "3",
+                "--temperature",
+                "300K",
+                "--quality",
+                "1e7",
+            ],
+            "marches",
+        ),
+        (vec!["thermal", "--duration", "1000"], "spans"),
         (vec!["tap", "--enbw", "-1", "--temperature", "300K"], "ENBW"),
     ];
     let before = snapshot(&dir);

@@ -490,10 +490,15 @@ pub fn run_captured(args: &[String]) -> std::result::Result<String, Refused> {
 }
 
 /// Run one parsed command: its files are put in place only if it succeeds (a command
-/// that fails changes no file, [`crate::report::output::stage_writes`]).
+/// that fails changes no file, [`crate::report::output::stage_writes`]) — but for
+/// `reproduce` and `figure`, which fill a directory figure by figure, list each file as
+/// it lands, and mark a directory they did not finish.
 fn dispatch(command: Command) -> crate::Result<()> {
     use crate::report::output;
     command.check_early()?;
+    if matches!(command, Command::Reproduce(_) | Command::Figure(_)) {
+        return run_command(command);
+    }
     output::stage_writes();
     match run_command(command) {
         Ok(()) => output::commit_writes(),

@@ -98,9 +98,12 @@ impl AverageRequest {
         Self { seed, ..*self }
     }
 
-    /// Refuse a temperature that is negative or not finite, or a length with fewer than
-    /// 100 periods a record or more than [`MAX_THERMAL_PERIODS`] in all.
-    pub fn check(&self) -> Result<()> {
+    /// Refuse a temperature that is negative or not finite, a length with fewer than
+    /// 100 periods a record or more than [`MAX_THERMAL_PERIODS`] in all, and an average
+    /// that would march more than [`MAX_AVERAGE_MARCHED`] drive periods with its
+    /// settling ([`settling_periods`]) on a cantilever of quality `quality` (the work
+    /// grows with Q: refused at once, not after an hour).
+    pub fn check(&self, quality: f64) -> Result<()> {
         check_temperature(self.temperature_k)?;
         let per_record = self.periods / AVERAGE_RECORDS;
         if !(100..=MAX_THERMAL_PERIODS / AVERAGE_RECORDS).contains(&per_record) {
@@ -110,8 +113,28 @@ impl AverageRequest {
                 self.periods
             )));
         }
+        let settle = settling_periods(quality);
+        let marched = (settle as f64 + per_record as f64) * AVERAGE_RECORDS as f64;
+        if marched > MAX_AVERAGE_MARCHED as f64 {
+            return Err(Error::OutOfRange(format!(
+                "a thermal average at Q = {quality} marches {marched:.3e} drive periods \
+                 ({AVERAGE_RECORDS} records, each {settle} periods of settling, ten decay \
+                 times, before its {per_record}): more than the {MAX_AVERAGE_MARCHED:.0e} \
+                 tapsim marches for one; average fewer periods, or a lower Q"
+            )));
+        }
         Ok(())
     }
+}
+
+/// The most drive periods one thermal average marches, settling included: about two
+/// minutes on two cores at 40 µs a noisy period.
+pub const MAX_AVERAGE_MARCHED: usize = 6_000_000;
+
+/// Periods a record settles for before it is averaged: ten decay times of the free
+/// amplitude, 10 Q/π.
+pub fn settling_periods(quality: f64) -> usize {
+    (10.0 * quality / std::f64::consts::PI).ceil() as usize
 }
 
 /// Whether an instrument reads state `o` only as a thermal average: it grazes a switch,
@@ -147,12 +170,12 @@ pub fn thermal_average_from(
     request: &AverageRequest,
 ) -> Result<ThermalAverage> {
     use rayon::prelude::*;
-    request.check()?;
-    let per_record = request.periods / AVERAGE_RECORDS;
     let c = p.setup.cantilever;
+    request.check(c.quality)?;
+    let per_record = request.periods / AVERAGE_RECORDS;
     let a0 = c.free_amplitude_m;
     let intensity = intensity_hat(request.temperature_k, c.stiffness_n_m, c.quality, a0);
-    let settle = (10.0 * c.quality / std::f64::consts::PI).ceil() as usize;
+    let settle = settling_periods(c.quality);
     let energy_j = c.stiffness_n_m * a0 * a0;
     let records: Vec<[f64; 4]> = (0..AVERAGE_RECORDS)
         .into_par_iter()

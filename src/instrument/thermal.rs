@@ -272,9 +272,9 @@ pub fn thermal_spectrum(
     }
     let segment = thermal_segment(quality);
     let needed = 8 * segment / SAMPLES_PER_PERIOD / 2;
-    if !(needed..=MAX_THERMAL_PERIODS).contains(&periods) {
+    if !(needed..=MAX_RECORD_PERIODS).contains(&periods) {
         return Err(Error::OutOfRange(format!(
-            "a thermal record of Q = {quality} spans {needed} to {MAX_THERMAL_PERIODS} \
+            "a thermal record of Q = {quality} spans {needed} to {MAX_RECORD_PERIODS} \
              resonance periods (at least 8 Welch segments of {} periods, half overlapping), \
              not {periods}",
             segment / SAMPLES_PER_PERIOD
@@ -321,6 +321,10 @@ pub fn thermal_spectrum(
 
 /// The most resonance periods a thermal record spans.
 pub const MAX_THERMAL_PERIODS: usize = 1_000_000_000;
+
+/// The most resonance periods a free cantilever's thermal record spans: about two
+/// minutes of computing (the default 8 000 Q at Q = 400, 3.2e6 periods, takes 4 s).
+pub const MAX_RECORD_PERIODS: usize = 100_000_000;
 
 /// The free oscillator's transition matrix over Δ ([`FreeFlight::transition`]).
 fn free_transition(quality: f64, step: f64) -> Matrix2<f64> {

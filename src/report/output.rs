@@ -281,13 +281,24 @@ pub fn write_with(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Resul
 
 /// Write `bytes` to `path` as [`write_bytes`] does, never announced: a file the user
 /// did not ask for (the on-disk cache).
+/// Never staged either: the cache is read back within the run that fills it.
 pub fn write_unannounced(path: &Path, bytes: &[u8]) -> Result<()> {
-    put(path, |tmp| fs::write(tmp, bytes).map_err(|e| io(tmp, e))).map(|_| ())
+    put_now(
+        path,
+        |tmp| fs::write(tmp, bytes).map_err(|e| io(tmp, e)),
+        false,
+    )
+    .map(|_| ())
 }
 
 /// [`write_with`] without the announcement: whether the file is in place now (false:
 /// staged until the command succeeds).
 fn put(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<bool> {
+    put_now(path, write, true)
+}
+
+/// [`put`], staged only if `stage` (and staging is on).
+fn put_now(path: &Path, write: impl FnOnce(&Path) -> Result<()>, stage: bool) -> Result<bool> {
     let target = target(path)?;
     let (beside, at) = match &target {
         Target::Replace(t) => (true, t),
@@ -295,7 +306,7 @@ fn put(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<bool> {
     };
     let tmp = Partial::new(at, beside);
     write(&tmp.path).map_err(|e| about(path, &tmp.path, e))?;
-    if let Some(list) = staged().as_mut() {
+    if let Some(list) = staged().as_mut().filter(|_| stage) {
         // Kept (and still registered for an interrupt) until the command ends.
         list.push(Staged {
             tmp: tmp.path.clone(),
