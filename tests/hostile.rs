@@ -796,6 +796,7 @@ fn the_outside_campaigns_findings_are_refused_and_change_no_file() {
             "marches",
         ),
         (vec!["thermal", "--duration", "1000"], "spans"),
+        (vec!["branches", "--overlay", "2000"], "give --plot"),
         (vec!["tap", "--enbw", "-1", "--temperature", "300K"], "ENBW"),
     ];
     let before = snapshot(&dir);

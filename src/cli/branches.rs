@@ -1,7 +1,7 @@
 //! `tapsim branches`: the period-1 orbit family through the rest separation.
 
 use crate::config::{TapInputs, length};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::report::{branches as report, records};
 use crate::sweep::{self, BranchPointKind};
 use clap::Args;
@@ -40,13 +40,20 @@ pub struct BranchesArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = length)]
     max_step: Option<f64>,
     /// Also run an approach–retract ramp of this many points over the same range and
-    /// draw it on the plot.
+    /// draw it on the plot (with --plot only).
     #[arg(long)]
     overlay: Option<usize>,
 }
 
 /// Run the subcommand.
 pub fn run(args: BranchesArgs) -> Result<()> {
+    // The overlay is drawn, never printed: without a plot it would be computed for
+    // nothing.
+    if args.overlay.is_some() && args.out.plot.is_none() {
+        return Err(Error::NotApplicable(
+            "--overlay draws an approach–retract ramp on the plot: give --plot too".into(),
+        ));
+    }
     let start = super::SweepStart::new("branches", args.inputs, &args.range)?;
     let (setup, (from, to)) = (&start.setup, start.range);
     let a0 = setup.cantilever.free_amplitude_m;
