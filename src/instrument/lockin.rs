@@ -277,8 +277,8 @@ impl StepObserver for LockIn {
     }
 }
 
-/// Several lock-ins watching one integration (one per eigenmode, each reading its
-/// mode's deflection at its own reference: [`LockIn::reading`]).
+/// Several lock-ins watching one integration (one per eigenmode, each reading the
+/// deflection, the sum of the modes, at its mode's drive frequency: [`LockIn::summing`]).
 pub struct LockIns<'a>(pub &'a mut [LockIn]);
 
 impl StepObserver for LockIns<'_> {
