@@ -4,6 +4,7 @@
 //! (integrals over the period carried by the integrator).
 
 mod common;
+use common::column;
 use tapsim::dynamics::observables::TapObservables;
 use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};
 use tapsim::instrument::lockin::{LockIn, step_response};
@@ -508,16 +509,6 @@ fn a_fast_scan_shows_the_feedback_artefacts() {
     assert!(peak > settled + 0.1e-9, "overshoot {:e} m", peak - settled);
     let high = retrace.iter().copied().fold(f64::MIN, f64::max);
     assert!(high > 0.85, "highest amplitude on the retrace {high}");
-}
-
-/// A column of numbers of a command's JSON (an object of arrays).
-fn column(v: &serde_json::Value, key: &str) -> Vec<f64> {
-    v[key]
-        .as_array()
-        .unwrap_or_else(|| panic!("no column {key}"))
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
 }
 
 /// A sample whose first region is raised: the loop engages there and the line starts

@@ -4,6 +4,7 @@
 //! repeat each period.
 
 mod common;
+use common::column;
 
 use tapsim::config::TapInputs;
 use tapsim::dynamics::setup::{Numerics, Prepared};
@@ -14,16 +15,6 @@ use tapsim::instrument::repeats::{DEFAULT_TOLERANCE, Repeats};
 use tapsim::instrument::scan::{Pixel, Region, row};
 use tapsim::instrument::thermal::ThermalForce;
 use tapsim::sample::{BLEND, Sample};
-
-/// A column of a scan's JSON.
-fn column(v: &serde_json::Value, key: &str) -> Vec<f64> {
-    v[key]
-        .as_array()
-        .unwrap_or_else(|| panic!("no column {key}"))
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
-}
 
 /// `scan` with `args`, and with `--exact`: every pixel's topography within 1 pm and
 /// phase within 1e-3°. Returns both documents.

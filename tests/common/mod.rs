@@ -85,6 +85,16 @@ pub fn json(args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("exactly one JSON object on stdout")
 }
 
+/// A column of numbers of a command's JSON (an object of arrays).
+pub fn column(v: &serde_json::Value, key: &str) -> Vec<f64> {
+    v[key]
+        .as_array()
+        .unwrap_or_else(|| panic!("no column {key}"))
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
 /// The number under `key`.
 pub fn num(v: &serde_json::Value, key: &str) -> f64 {
     v[key]
