@@ -130,8 +130,12 @@ def test_ctrl_c_stops_a_long_map():
     import signal
     import time
 
+    # (The child turns Ctrl-C into KeyboardInterrupt itself: a job started in the
+    # background by a non-interactive shell, as a CI runner may start it, inherits
+    # SIGINT ignored, and Python then leaves it ignored.)
     script = (
-        "import sys, tapsim\n"
+        "import signal, sys, tapsim\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "print('started', flush=True)\n"
         "try:\n"
         "    tapsim.map(steps=100)\n"
