@@ -797,6 +797,18 @@ fn the_outside_campaigns_findings_are_refused_and_change_no_file() {
         ),
         (vec!["thermal", "--duration", "1000"], "spans"),
         (vec!["branches", "--overlay", "2000"], "give --plot"),
+        (
+            vec![
+                "scan",
+                "--temperature",
+                "300K",
+                "--lines",
+                "64",
+                "--line-rate",
+                "1",
+            ],
+            "every drive period is marched",
+        ),
         (vec!["tap", "--enbw", "-1", "--temperature", "300K"], "ENBW"),
     ];
     let before = snapshot(&dir);

@@ -144,6 +144,10 @@ struct Row {
 /// The most drive periods one scan marches (every line, both directions).
 const MAX_PERIODS: f64 = 2e8;
 
+/// The most drive periods a scan marches under the thermal force (none skipped): some 20
+/// minutes on one core, ten on two.
+const MAX_NOISY_PERIODS: f64 = 3e7;
+
 /// The loop's engagement over the first region, in drive periods.
 const ENGAGE_PERIODS: usize = 10_000;
 
@@ -234,6 +238,16 @@ pub fn run(args: ScanArgs) -> Result<()> {
             } else {
                 format!("{:e}", args.line_rate)
             }
+        )));
+    }
+    // Under the thermal force no period repeats another: every one is marched, at some
+    // 42 µs each (`cargo bench --bench dynamics -- noise/`).
+    if args.temperature.is_some_and(|t| t > 0.0) && total > MAX_NOISY_PERIODS {
+        return Err(Error::OutOfRange(format!(
+            "under the thermal force every drive period is marched: {total:.3e} in all, \
+             about {:.0} min on one core at 42 µs a period; at most {MAX_NOISY_PERIODS:e} \
+             (fewer lines or pixels, or a faster line rate)",
+            total * 42e-6 / 60.0
         )));
     }
     let per_pixel = per_pixel as usize;
