@@ -19,7 +19,8 @@ use super::model::{
     relax_internal, reset_phi, section_dim, set_internal,
 };
 use super::numeric::{
-    self, Crossing, Events, StepEnd, StepObserver, Tolerances, hermite, internal_at,
+    self, Crossing, Events, StepEnd, StepObserver, Tolerances, hermite, hermite_turn_fraction,
+    internal_at,
 };
 use crate::error::Result;
 use crate::law::{Branch, Exits, ForceLaw, Internal, MAX_INTERNAL};
@@ -263,28 +264,7 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
 /// positive) or its maximum.
 fn hermite_turn<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, rising: bool) -> f64 {
     let h = b.tau - a.tau;
-    let (p0, p1, m0, m1) = (a.y[X], b.y[X], h * a.y[V], h * b.y[V]);
-    // The cubic is p0 + m0 t + c2 t² + c3 t³; its derivative 3c3 t² + 2c2 t + m0.
-    let c3 = 2.0 * p0 + m0 - 2.0 * p1 + m1;
-    let c2 = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1;
-    let (qa, qb, qc) = (3.0 * c3, 2.0 * c2, m0);
-    let t = if qa.abs() <= 1e-14 * (qb.abs() + qc.abs()) {
-        -qc / qb
-    } else {
-        let disc = (qb * qb - 4.0 * qa * qc).max(0.0).sqrt();
-        let (r1, r2) = ((-qb - disc) / (2.0 * qa), (-qb + disc) / (2.0 * qa));
-        // The root where the derivative rises (falls) through zero.
-        if (2.0 * qa * r1 + qb > 0.0) == rising {
-            r1
-        } else {
-            r2
-        }
-    };
-    if t.is_finite() {
-        t.clamp(0.0, 1.0)
-    } else {
-        0.5
-    }
+    hermite_turn_fraction((a.y[X], h * a.y[V]), (b.y[X], h * b.y[V]), rising)
 }
 
 /// A law, an oscillator, its coupling to the contact and the integrator settings.

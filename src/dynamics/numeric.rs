@@ -130,6 +130,38 @@ where
         + (t3 - t2) * h * b.dy[i]
 }
 
+/// Where in a step (the fraction t in [0, 1]) the cubic Hermite p through the values
+/// and scaled slopes (p₀, h·p₀′) and (p₁, h·p₁′) turns: the root of its derivative (a
+/// quadratic in t) where the derivative rises (`rising`: a minimum) or falls through zero;
+/// ½ where there is none.
+pub(crate) fn hermite_turn_fraction(
+    (p0, m0): (f64, f64),
+    (p1, m1): (f64, f64),
+    rising: bool,
+) -> f64 {
+    // The cubic is p0 + m0 t + c2 t² + c3 t³; its derivative 3c3 t² + 2c2 t + m0.
+    let c3 = 2.0 * p0 + m0 - 2.0 * p1 + m1;
+    let c2 = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1;
+    let (qa, qb, qc) = (3.0 * c3, 2.0 * c2, m0);
+    let t = if qa.abs() <= 1e-14 * (qb.abs() + qc.abs()) {
+        -qc / qb
+    } else {
+        let disc = (qb * qb - 4.0 * qa * qc).max(0.0).sqrt();
+        let (r1, r2) = ((-qb - disc) / (2.0 * qa), (-qb + disc) / (2.0 * qa));
+        // The root where the derivative rises (falls) through zero.
+        if (2.0 * qa * r1 + qb > 0.0) == rising {
+            r1
+        } else {
+            r2
+        }
+    };
+    if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.5
+    }
+}
+
 /// The law's internal state on the step [a, b] at τ, by cubic Hermite interpolation
 /// (zeros where the layout carries none).
 pub fn internal_at<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, tau: f64) -> Internal {

@@ -15,7 +15,7 @@ use super::set::{Modal, ModeModel};
 use crate::dynamics::budget;
 use crate::dynamics::dopri5::{self, Settings, StepError, System};
 use crate::dynamics::model::{Coupling, State};
-use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver, Tolerances};
+use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver, Tolerances, hermite_turn_fraction};
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
 use crate::law::AnyLaw;
@@ -313,37 +313,20 @@ impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
     }
 }
 
-/// The lowest tip deflection Σqᵢ over a step: its ends, or a turning point inside it
-/// where the Hermite cubic's derivative (a quadratic in the step fraction) vanishes.
+/// The lowest tip deflection Σqᵢ over a step: its ends, or the turning point inside it
+/// where the Hermite cubic of Σqᵢ has its minimum.
 fn lowest_tip<const M: usize, const S: usize>(a: &StepEnd<S>, b: &StepEnd<S>) -> f64 {
     let h = b.tau - a.tau;
     let sum = |e: &StepEnd<S>, part: fn(usize) -> usize| (0..M).map(|i| e.y[part(i)]).sum::<f64>();
     let (x0, x1) = (sum(a, q), sum(b, q));
     let (d0, d1) = (h * sum(a, v), h * sum(b, v));
-    let mut low = x0.min(x1);
+    let ends = x0.min(x1);
     if d0 < 0.0 && d1 > 0.0 {
-        // p′(t) = αt² + βt + γ for the cubic Hermite p through (x0, d0), (x1, d1).
-        let (al, be, ga) = (
-            6.0 * (x0 - x1) + 3.0 * (d0 + d1),
-            6.0 * (x1 - x0) - 4.0 * d0 - 2.0 * d1,
-            d0,
-        );
-        let roots = if al.abs() < 1e-300 {
-            [-ga / be, f64::NAN]
-        } else {
-            let disc = (be * be - 4.0 * al * ga).max(0.0).sqrt();
-            [(-be - disc) / (2.0 * al), (-be + disc) / (2.0 * al)]
-        };
-        for t in roots.into_iter().filter(|t| (0.0..=1.0).contains(t)) {
-            let (t2, t3) = (t * t, t * t * t);
-            let p = (2.0 * t3 - 3.0 * t2 + 1.0) * x0
-                + (t3 - 2.0 * t2 + t) * d0
-                + (-2.0 * t3 + 3.0 * t2) * x1
-                + (t3 - t2) * d1;
-            low = low.min(p);
-        }
+        let t = hermite_turn_fraction((x0, d0), (x1, d1), true);
+        ends.min(tip_at::<M, S>(a, b, a.tau + t * h))
+    } else {
+        ends
     }
-    low
 }
 
 /// Steps of one segment at most (a stalled integration ends with an error).
