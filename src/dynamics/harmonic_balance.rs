@@ -20,7 +20,7 @@
 use super::march::{Phase, Simulation};
 use super::model::Drive;
 use crate::law::{Branch, ContactState, ForceLaw, Internal};
-use crate::numeric::GAUSS_LEGENDRE_8;
+use crate::numeric::{GAUSS_LEGENDRE_8, bracketed_root};
 use std::f64::consts::PI;
 
 /// Gauss–Legendre panels along a stretch of the cosine on one branch.
@@ -29,8 +29,6 @@ const PANELS: usize = 8;
 const GRID: usize = 96;
 /// How far above the free amplitude roots are looked for.
 const REACH: f64 = 1.25;
-/// Bisections of each bracketing pair of amplitudes.
-const BISECTIONS: usize = 30;
 /// Golden-section steps into a dip of the residual between grid points.
 const GOLDEN_STEPS: usize = 40;
 /// A bracket whose residual stays above this fraction of f₀ holds a jump of the
@@ -102,16 +100,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
         }
         brackets.sort_by(|x, y| x.0.total_cmp(&y.0));
         let mut out = Vec::new();
-        for (mut x0, mut x1) in brackets {
-            for _ in 0..BISECTIONS {
-                let mid = 0.5 * (x0 + x1);
-                if residual(mid).0 < 0.0 {
-                    x0 = mid;
-                } else {
-                    x1 = mid;
-                }
-            }
-            let a = 0.5 * (x0 + x1);
+        for (lo, hi) in brackets {
+            // (A bracket that does not converge holds no root worth starting from.)
+            let Ok(a) = bracketed_root("a harmonic-balance root", |a| residual(a).0, lo, hi, 1e-12)
+            else {
+                continue;
+            };
             let (res, m, h) = residual(a);
             if res.abs() <= ROOT_RESIDUAL * f0 {
                 out.push(self.estimate(a, m, h, f0, (lr, li)));
