@@ -10,7 +10,7 @@
 
 use super::lockin::LockIn;
 use super::probe::{OneMode, Probe};
-use super::repeats::{Repeats, STATE_LEN};
+use super::repeats::Repeats;
 use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
 use crate::dynamics::setup::Prepared;
@@ -142,7 +142,6 @@ pub fn hold_probe<P: Probe>(
     let settle = probe.settling_periods();
     probe.march(material, z, settle)?;
     repeats.restart();
-    let mut state = [0.0; STATE_LEN];
     let mut out: Vec<LoopSample> = Vec::with_capacity(periods);
     while out.len() < periods {
         let (amplitude_ratio, phase_deg) = probe.march(material, z, 1)?[0];
@@ -154,12 +153,7 @@ pub fn hold_probe<P: Probe>(
             error,
         });
         z += dz * a0;
-        let known = probe.loop_state(&mut state).map(|n| {
-            state[n] = z / a0;
-            state[n + 1] = error;
-            &state
-        });
-        if repeats.settled(known, cycle) && out.len() >= cycle {
+        if probe.repeats_itself(repeats, [z / a0, error]) && out.len() >= cycle {
             // The whole cycles left repeat the last.
             let last = out.len() - cycle;
             let left = (periods - out.len()) / cycle * cycle;

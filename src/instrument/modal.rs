@@ -12,7 +12,6 @@
 
 use super::lockin::{LockIn, LockIns};
 use super::probe::{Probe, Readings, settling_periods};
-use super::repeats::LoopState;
 use crate::dynamics::model::State;
 use crate::dynamics::modes::MAX_MODES;
 use crate::dynamics::modes::orbit::free_section;
@@ -141,20 +140,16 @@ impl Probe for ModalProbe<'_> {
         Ok(out)
     }
 
-    fn loop_state(&self, out: &mut LoopState) -> Option<usize> {
+    fn loop_state(&self) -> Option<impl Iterator<Item = f64> + '_> {
         // Without a common period the motion never repeats.
         self.materials[0].1.periods?;
         let modes = self.lockins.len();
-        let parts = self.section[..2 * modes]
-            .iter()
-            .copied()
-            .chain(self.lockins.iter().flat_map(LockIn::state));
-        let mut n = 0;
-        for (o, v) in out.iter_mut().zip(parts) {
-            *o = v;
-            n += 1;
-        }
-        Some(n)
+        Some(
+            self.section[..2 * modes]
+                .iter()
+                .copied()
+                .chain(self.lockins.iter().flat_map(LockIn::state)),
+        )
     }
 
     fn cycle(&self) -> usize {

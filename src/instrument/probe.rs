@@ -5,7 +5,7 @@
 //! or several eigenmodes ([`super::modal::ModalProbe`]).
 
 use super::lockin::LockIn;
-use super::repeats::LoopState;
+use super::repeats::{LoopState, Repeats, STATE_LEN};
 use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
 use crate::dynamics::modes::MAX_MODES;
@@ -31,17 +31,29 @@ pub trait Probe {
     /// March `periods` drive periods of the first mode over material `material` at rest
     /// separation `separation_m`; the lock-ins' readings after the last.
     fn march(&mut self, material: usize, separation_m: f64, periods: usize) -> Result<Readings>;
-    /// Write its state after the last march into the first entries of `out` (the rest
-    /// left alone), in units of A₀, and say how many; none (the default) where periods
-    /// must all be marched (a random force, a state that repeats only after several
-    /// periods). What [`super::repeats::Repeats`] watches.
-    fn loop_state(&self, _out: &mut LoopState) -> Option<usize> {
-        None
+    /// Its state after the last march, in units of A₀; none (the default) where periods
+    /// must all be marched (a random force, drives with no common period). What
+    /// [`Repeats`] watches.
+    fn loop_state(&self) -> Option<impl Iterator<Item = f64> + '_> {
+        None::<std::iter::Empty<f64>>
     }
     /// Drive periods after which its motion can repeat: 1, or the common period of
     /// several modes' drives.
     fn cycle(&self) -> usize {
         1
+    }
+    /// Show `repeats` the loop's state after a marched period: this probe's
+    /// ([`Probe::loop_state`]), then `rest` (the piezo over A₀ and the controller's last
+    /// error); whether the loop now repeats itself ([`Repeats::settled`]).
+    fn repeats_itself(&self, repeats: &mut Repeats, rest: [f64; 2]) -> bool {
+        let state = self.loop_state().map(|parts| {
+            let mut state: LoopState = [0.0; STATE_LEN];
+            for (o, v) in state.iter_mut().zip(parts.chain(rest)) {
+                *o = v;
+            }
+            state
+        });
+        repeats.settled(state.as_ref(), self.cycle())
     }
 }
 
@@ -90,20 +102,16 @@ impl Probe for OneMode<'_> {
         Ok(out)
     }
 
-    fn loop_state(&self, out: &mut LoopState) -> Option<usize> {
+    fn loop_state(&self) -> Option<impl Iterator<Item = f64> + '_> {
         if self.force.intensity_hat() > 0.0 {
             return None;
         }
         let p = &*self.phase;
-        let parts = [p.x, p.v]
-            .into_iter()
-            .chain(p.internal.iter().copied())
-            .chain(self.lockin.state());
-        let mut n = 0;
-        for (o, v) in out.iter_mut().zip(parts) {
-            *o = v;
-            n += 1;
-        }
-        Some(n)
+        Some(
+            [p.x, p.v]
+                .into_iter()
+                .chain(p.internal.iter().copied())
+                .chain(self.lockin.state()),
+        )
     }
 }

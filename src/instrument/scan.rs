@@ -12,7 +12,7 @@
 use super::feedback::PiController;
 use super::lockin::LockIn;
 use super::probe::{OneMode, Probe, Readings};
-use super::repeats::{Repeats, STATE_LEN};
+use super::repeats::Repeats;
 use super::thermal::ThermalForce;
 use crate::dynamics::march::Phase;
 use crate::dynamics::modes::MAX_MODES;
@@ -147,7 +147,6 @@ pub fn line_probe<P: Probe>(
     let mut recent: Vec<(Readings, f64)> = Vec::with_capacity(cycle);
     let (mut repeat_until, mut replayed) = (0, 0);
     repeats.restart();
-    let mut state = [0.0; STATE_LEN];
     let mut sum = [0.0; 4];
     let mut higher = [(0.0, 0.0); MAX_MODES];
     for g in 0..total {
@@ -173,12 +172,7 @@ pub fn line_probe<P: Probe>(
                 recent.remove(0);
             }
             recent.push((read, error));
-            let known = probe.loop_state(&mut state).map(|n| {
-                state[n] = z / a0;
-                state[n + 1] = error;
-                &state
-            });
-            if repeats.settled(known, cycle) && recent.len() == cycle {
+            if probe.repeats_itself(repeats, [z / a0, error]) && recent.len() == cycle {
                 // Whole cycles up to the next region (or the line's end) repeat this one.
                 let end = if under + 1 < regions.len() {
                     first_past(region.until_m)
