@@ -842,3 +842,53 @@ fn the_outside_campaigns_findings_are_refused_and_change_no_file() {
     assert!(r.stderr.contains("unknown field `extra`"), "{}", r.stderr);
     assert!(!dir.join("m.csv").exists());
 }
+
+/// Long work says how far it is where stderr is not a terminal (a batch job's log): a
+/// line at a tenth of the way past two seconds with the time left, and one at the end;
+/// quick work and `--quiet` write nothing (issue 45, item 7).
+#[test]
+fn long_work_writes_progress_lines_to_a_log_and_quiet_silences_them() {
+    let dir = scratch("hostile-progress");
+    let long = [
+        "approach",
+        "--points",
+        "800",
+        "--from",
+        "24nm",
+        "--to",
+        "8nm",
+        "--no-retract",
+    ];
+    let r = common::run_limited(&long, &dir, Duration::from_secs(120));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    // Some 4 s here; a machine fast enough to finish within the quiet two seconds
+    // rightly writes nothing.
+    if r.elapsed > Duration::from_secs(3) {
+        let lines: Vec<&str> = r.stderr.lines().collect();
+        assert!(
+            lines.iter().any(|l| l.starts_with("approach: ")
+                && l.contains(" %) in ")
+                && l.ends_with("s left")),
+            "no progress line in {:.1} s: {}",
+            r.elapsed.as_secs_f64(),
+            r.stderr
+        );
+        assert!(
+            lines
+                .iter()
+                .any(|l| l.starts_with("approach: 800/800 done in ")),
+            "{}",
+            r.stderr
+        );
+    }
+    // The same work with --quiet: not a line.
+    let mut quiet = long.to_vec();
+    quiet.push("--quiet");
+    let r = common::run_limited(&quiet, &dir, Duration::from_secs(120));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(r.stderr.is_empty(), "{}", r.stderr);
+    // Quick work: not a line either.
+    let r = run(&["approach", "--points", "5"], &dir);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(r.stderr.is_empty(), "{}", r.stderr);
+}

@@ -126,7 +126,7 @@ pub fn run(mut args: ApproachArgs) -> Result<()> {
     let (points, not_held) = match args.sweep {
         Sweep::Separation => {
             let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
-            let bar = args.out.progress_bar(ramp.len());
+            let bar = args.out.progress("approach", ramp.len());
             let points =
                 sweep::approach_curve_at(setup, numerics, &ramp, thermal.as_ref(), |done, _| {
                     bar.set_position(done as u64)
@@ -160,7 +160,7 @@ pub fn run(mut args: ApproachArgs) -> Result<()> {
                 )));
             }
             let ramp = sweep::ramp(from, to, args.points, !args.no_retract)?;
-            let bar = args.out.progress_bar(ramp.len());
+            let bar = args.out.progress("approach", ramp.len());
             let swept = setpoint::sweep_setpoints(setup, numerics, &ramp, |done, _| {
                 bar.set_position(done as u64)
             })?;

@@ -371,7 +371,7 @@ pub fn run(args: BatchArgs) -> Result<()> {
         .resolve("batch", args.out.csv.is_some() || args.out.json)?;
     let items = shard.unwrap_or(Shard::WHOLE).items(cases.len());
     let pool = sweep::thread_pool(args.threads)?;
-    let bar = args.out.progress_bar(items.len());
+    let bar = args.out.progress("batch", items.len());
     // Each case's records kept as JSON text: a tenth of the memory of parsed objects.
     let records: Vec<Vec<Box<RawValue>>> = pool.install(|| {
         items

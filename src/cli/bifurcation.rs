@@ -39,7 +39,7 @@ pub fn run(args: BifurcationArgs) -> Result<()> {
     let (setup, numerics, (from, to)) = (&start.setup, &start.sweep_numerics, start.range);
     let ramp = sweep::ramp(from, to, args.points, false)?;
     let separations: Vec<f64> = ramp.iter().map(|r| r.0).collect();
-    let bar = args.out.progress_bar(separations.len());
+    let bar = args.out.progress("bifurcation", separations.len());
     let samples = sweep::bifurcation(setup, numerics, &separations, args.samples, |done, _| {
         bar.set_position(done as u64)
     })?;

@@ -66,7 +66,7 @@ pub fn run(args: BranchesArgs) -> Result<()> {
     let ramp = match args.overlay {
         Some(points) => {
             let ramp = sweep::ramp(from.max(to), from.min(to), points, true)?;
-            let bar = args.out.progress_bar(ramp.len());
+            let bar = args.out.progress("branches", ramp.len());
             let curve = sweep::approach_curve(setup, &start.sweep_numerics, &ramp, |done, _| {
                 bar.set_position(done as u64)
             })?;

@@ -200,21 +200,24 @@ impl From<FitParameter> for Parameter {
 }
 
 /// Progress on stderr: a spinner with the stage, curves, best χ² and time left on a
-/// terminal; one line per stage otherwise; nothing with --quiet.
+/// terminal; otherwise a line where the stage changes and every half minute within one;
+/// nothing with --quiet.
 struct Reporter {
     bar: indicatif::ProgressBar,
     lines: bool,
-    last: Mutex<Option<Stage>>,
+    last: Mutex<Option<(Stage, std::time::Instant)>>,
     what: String,
 }
 
 impl Reporter {
     fn new(what: &str, quiet: bool) -> Self {
-        use std::io::IsTerminal;
-        let terminal = std::io::stderr().is_terminal();
+        let shown = super::progress::shown(quiet);
         Self {
-            bar: super::tap::spinner(what, quiet),
-            lines: !quiet && !terminal,
+            bar: match shown {
+                Some(true) => super::progress::spinner(what),
+                _ => indicatif::ProgressBar::hidden(),
+            },
+            lines: shown == Some(false),
             last: Mutex::new(None),
             what: what.to_string(),
         }
@@ -244,8 +247,12 @@ impl Reporter {
                 other => other,
             };
             let mut last = self.last.lock().expect("progress lock");
-            if *last != Some(key) {
-                *last = Some(key);
+            let due = match *last {
+                Some((stage, at)) => stage != key || at.elapsed().as_secs() >= 30,
+                None => true,
+            };
+            if due {
+                *last = Some((key, std::time::Instant::now()));
                 eprintln!("{message}");
             }
         }

@@ -176,7 +176,7 @@ pub fn run(args: MapArgs) -> Result<()> {
         }
         _ => None,
     };
-    let bar = args.out.progress_bar(cells.len());
+    let bar = args.out.progress("map", cells.len());
     let computed = match setpoint {
         None => sweep::map_cells(
             &setup,

@@ -47,6 +47,7 @@ mod lj;
 mod map;
 mod merge;
 mod modal;
+mod progress;
 mod reconstruct;
 mod reproduce;
 mod scan;
@@ -308,19 +309,9 @@ impl SweepOutput {
         check_targets([self.csv.as_deref(), self.plot.as_deref()])
     }
 
-    /// A progress bar over `len` items on stderr, hidden with --quiet or when stderr is
-    /// not a terminal.
-    pub fn progress_bar(&self, len: usize) -> indicatif::ProgressBar {
-        use std::io::IsTerminal;
-        if self.quiet || !std::io::stderr().is_terminal() {
-            return indicatif::ProgressBar::hidden();
-        }
-        let bar = indicatif::ProgressBar::new(len as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len}, {eta} left")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar
+    /// Progress of `what` over `len` items on stderr ([`progress::Progress`]).
+    pub(crate) fn progress(&self, what: &str, len: usize) -> progress::Progress {
+        progress::Progress::counted(what, len, self.quiet)
     }
 
     /// Write `records` as CSV to --csv and the charts `charts` draws to --plot, where

@@ -33,8 +33,8 @@ pub(super) fn tap(
     let Some((ratio, branch)) = setpoint else {
         let (p, modal) = prepare(setup, set, numerics)?;
         if modal.periods.is_none() {
-            let busy = super::tap::spinner(
-                "averaging the modes over windows of thousands of drive periods",
+            let busy = super::progress::Busy::new(
+                "tap: averaging the modes over windows of thousands of drive periods",
                 quiet,
             );
             let state = modal_windowed(&p, &modal, numerics);
@@ -120,7 +120,7 @@ pub(super) fn approach(
     out: &super::SweepOutput,
 ) -> Result<()> {
     let (p, modal) = prepare(&start.setup, set, &start.sweep_numerics)?;
-    let bar = out.progress_bar(ramp.len());
+    let bar = out.progress("approach", ramp.len());
     let separations: Vec<f64> = ramp.iter().map(|r| r.0).collect();
     let points = bimodal::approach(&p, &modal, &start.sweep_numerics, &separations, || {
         bar.inc(1)
@@ -179,7 +179,7 @@ pub(super) fn contrast(
     setpoints: &[f64],
     out: &super::SweepOutput,
 ) -> Result<()> {
-    let bar = out.progress_bar(laws.len() * materials.len());
+    let bar = out.progress("contrast", laws.len() * materials.len());
     let rows = bimodal::contrast(materials, set, laws, setpoints, || bar.inc(1));
     bar.finish_and_clear();
     let rows = rows?;
@@ -204,7 +204,7 @@ pub(super) fn map(
     setpoint: Option<(f64, PhaseBranch)>,
     out: &super::SweepOutput,
 ) -> Result<()> {
-    let bar = out.progress_bar(works.len() * moduli.len());
+    let bar = out.progress("map", works.len() * moduli.len());
     let cells = bimodal::map_cells(
         setup,
         set,

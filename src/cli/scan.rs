@@ -268,7 +268,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
     let controller = PiController::new(args.setpoint, args.proportional_gain, args.integral_gain)?;
     let bar = args
         .out
-        .progress_bar(mine.len() * (args.pixels * directions + 1));
+        .progress("scan", mine.len() * (args.pixels * directions + 1));
     let shape = (sample.length_m, args.pixels, per_pixel);
     let scanned = {
         use rayon::prelude::*;

@@ -1,5 +1,6 @@
 //! `tapsim tap`: one tapping-mode simulation to its steady state.
 
+use super::progress::Busy;
 use crate::coexist::{Search, coexisting};
 use crate::config::{BranchChoice, TapInputs, length, number};
 use crate::dynamics::observables::{Observe, Starts, tap};
@@ -207,7 +208,10 @@ pub fn run(args: TapArgs) -> Result<()> {
     }
     // Another stable period-1 state at this z_c (a bistable setpoint: the free
     // oscillation settles on one, an approach or a retract may sit on the other).
-    let searching = spinner("looking for other stable states at this z_c", args.quiet);
+    let searching = Busy::new(
+        "tap: looking for other stable states at this z_c",
+        args.quiet,
+    );
     let search = if args.all_states {
         Search::Thorough
     } else {
@@ -224,7 +228,7 @@ pub fn run(args: TapArgs) -> Result<()> {
     // switch, what an instrument reads is the average over the thermal motion.
     let average = match args.noise.temperature {
         Some(temperature_k) if reads_as_average(&run.observables) => {
-            let busy = spinner("averaging the state over a thermal record", args.quiet);
+            let busy = Busy::new("tap: averaging the state over a thermal record", args.quiet);
             let request = AverageRequest {
                 temperature_k,
                 periods: args.thermal_periods,
@@ -330,8 +334,8 @@ fn at_setpoint(
         .setpoint_ratio(setup.cantilever.free_amplitude_m)
         .expect("called with a setpoint");
     let branch = inputs.branch.unwrap_or(BranchChoice::All).only();
-    let spinner = spinner(
-        "following the period-1 families to the setpoint",
+    let spinner = Busy::new(
+        "tap: following the period-1 families to the setpoint",
         args.quiet,
     );
     let states = states_at_setpoint(&setup, &numerics, ratio, branch);
@@ -393,17 +397,4 @@ fn at_setpoint(
         }
     }
     Ok(())
-}
-
-/// A spinner saying `what` on stderr while it runs, ticking every half second (hidden
-/// where stderr is not a terminal).
-pub(super) fn spinner(what: &str, quiet: bool) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    if quiet || !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new_spinner();
-    bar.set_message(what.to_string());
-    bar.enable_steady_tick(std::time::Duration::from_millis(500));
-    bar
 }

@@ -111,7 +111,7 @@ pub fn run(args: ThermalArgs) -> Result<()> {
         )));
     }
     let periods = periods_f.round() as usize;
-    let bar = args.out.progress_bar(periods);
+    let bar = args.out.progress("thermal", periods);
     let spectrum = thermal_spectrum((k, f0, q), t, (periods, args.steps), args.seed, |done| {
         bar.set_position(done as u64)
     })?;

@@ -41,7 +41,8 @@ pub struct Progress {
     /// Seconds since the fit began.
     pub elapsed_s: f64,
     /// A rough estimate of the seconds left (the curves still expected at the mean
-    /// time a curve has taken so far), where one can be made.
+    /// time a curve has taken in this stage — the design's screened curves are far
+    /// cheaper than the local runs' whole ones), where one can be made.
     pub remaining_s: Option<f64>,
 }
 
@@ -61,6 +62,8 @@ struct State {
     /// Curves expected in this stage in all, and simulated when it began.
     expected_stage: usize,
     stage_began_at: usize,
+    /// Seconds from the start of the fit to the start of this stage.
+    stage_began_s: f64,
 }
 
 impl<'a> Tracker<'a> {
@@ -74,6 +77,7 @@ impl<'a> Tracker<'a> {
                 expected_after: 0,
                 expected_stage: 0,
                 stage_began_at: 0,
+                stage_began_s: 0.0,
             }),
             report,
             began: Instant::now(),
@@ -88,6 +92,7 @@ impl<'a> Tracker<'a> {
             s.expected_stage = curves;
             s.expected_after = after;
             s.stage_began_at = s.curves;
+            s.stage_began_s = self.began.elapsed().as_secs_f64();
             self.progress(&s)
         };
         (self.report)(&progress);
@@ -127,12 +132,17 @@ impl<'a> Tracker<'a> {
         let elapsed = self.began.elapsed().as_secs_f64();
         let in_stage = s.curves - s.stage_began_at;
         let left = s.expected_stage.saturating_sub(in_stage) + s.expected_after;
+        let per_curve_s = if in_stage > 0 {
+            Some((elapsed - s.stage_began_s) / in_stage as f64)
+        } else {
+            (s.curves > 0).then(|| elapsed / s.curves as f64)
+        };
         Progress {
             stage: s.stage,
             curves: s.curves,
             best_chi_square: s.best,
             elapsed_s: elapsed,
-            remaining_s: (s.curves > 0).then(|| elapsed / s.curves as f64 * left as f64),
+            remaining_s: per_curve_s.map(|t| t * left as f64),
         }
     }
 }
