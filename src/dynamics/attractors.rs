@@ -7,7 +7,7 @@
 //! it, with how many starts reached each.
 
 use super::march::{Phase, Simulation};
-use super::observables::TapObservables;
+use super::observed::TapObservables;
 use super::setup::{Numerics, Prepared, TapSetup};
 use crate::error::Result;
 use crate::law::AnyLaw;

@@ -17,7 +17,7 @@
 //! marching reaches.
 
 use super::march::{Phase, Simulation};
-use super::steady::SteadyState;
+use super::motion::SteadyState;
 use crate::law::{Branch, ForceLaw};
 use nalgebra::{DMatrix, DVector};
 

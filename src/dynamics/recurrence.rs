@@ -2,7 +2,7 @@
 //! repeats: the periods worth looking for an orbit of.
 
 use super::march::MAX_SECTION;
-use super::steady::{MAX_PERIOD, SHORT_PERIOD};
+use super::motion::{MAX_PERIOD, SHORT_PERIOD};
 use crate::law::Branch;
 use nalgebra::DVector;
 

@@ -6,31 +6,11 @@
 use super::capture::Candidate;
 use super::march::{CycleIntegrals, MAX_SECTION, Phase, Simulation};
 use super::model::{chain, phi_start};
-use super::steady::{Motion, SteadyOptions, SteadyState};
-use super::window::StdErr;
+pub use super::motion::Multipliers;
+use super::motion::{Motion, StdErr, SteadyOptions, SteadyState};
 use crate::error::{Error, Result};
 use crate::law::ForceLaw;
 use nalgebra::{Complex, DMatrix, DVector};
-
-/// Floquet multipliers of a periodic orbit: the eigenvalues of its monodromy matrix, one
-/// per dimension of the section state (two for a law without internal state).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Multipliers {
-    values: [Complex<f64>; MAX_SECTION],
-    len: usize,
-}
-
-impl Multipliers {
-    /// The multipliers.
-    pub fn as_slice(&self) -> &[Complex<f64>] {
-        &self.values[..self.len]
-    }
-
-    /// Iterate over them.
-    pub fn iter(&self) -> std::slice::Iter<'_, Complex<f64>> {
-        self.as_slice().iter()
-    }
-}
 
 /// The n-period map evaluated at a state.
 pub(crate) struct MapValue {

@@ -9,78 +9,21 @@
 //! ([`super::window`]).
 
 use super::budget;
-use super::march::{CycleIntegrals, Phase, Simulation};
+use super::march::{Phase, Simulation};
+pub(crate) use super::motion::MIN_CYCLES;
+pub use super::motion::{
+    Grazing, MARCHING_TOLERANCE, MAX_PERIOD, Motion, SHORT_PERIOD, SteadyOptions, SteadyState,
+};
 use super::numeric;
 use super::recurrence::Recurrence;
-use super::shooting::Multipliers;
-use super::window::{StdErr, Window};
+use super::window::Window;
 use crate::error::Result;
 use crate::law::ForceLaw;
 
-/// The longest period looked for; motion that repeats after no n ≤ this is `irregular`.
-/// Periods up to [`SHORT_PERIOD`] are looked for wherever the motion nearly repeats;
-/// longer ones (mode locks near grazing, such as 13 touches in 27 periods) where the
-/// section state has returned within `LOCK_GAP` (1e-5) three periods running.
-pub const MAX_PERIOD: usize = 1000;
-
-/// The longest period looked for from loose near-returns, and by time-marching alone
-/// (without shooting).
-pub const SHORT_PERIOD: usize = 8;
-
-/// How the steady motion repeats.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Motion {
-    /// The state at the drive phase returns after `period` drive periods (and after no
-    /// fewer).
-    Periodic {
-        /// n.
-        period: usize,
-        /// Eigenvalues of the orbit's monodromy matrix (the derivative of the n-period
-        /// map).
-        multipliers: Multipliers,
-    },
-    /// Quasi-periodic, chaotic or intermittent motion, or a period above [`MAX_PERIOD`].
-    Irregular,
-}
-
-impl Motion {
-    /// "period-n" or "irregular".
-    pub fn regime(&self) -> String {
-        match self {
-            Motion::Periodic { period, .. } => format!("period-{period}"),
-            Motion::Irregular => "irregular".into(),
-        }
-    }
-
-    /// n for a periodic orbit.
-    pub fn period(&self) -> Option<usize> {
-        match self {
-            Motion::Periodic { period, .. } => Some(*period),
-            Motion::Irregular => None,
-        }
-    }
-
-    /// Whether a periodic orbit is stable (every multiplier inside the unit circle).
-    pub fn stable(&self) -> Option<bool> {
-        match self {
-            Motion::Periodic { multipliers, .. } => {
-                Some(multipliers.iter().all(|m| m.norm() < 1.0))
-            }
-            Motion::Irregular => None,
-        }
-    }
-}
-
-/// The fewest periods a steady-state search may be given: enough to classify the motion
-/// and average irregular motion over a window of its own.
-pub(crate) const MIN_CYCLES: usize = 32;
 /// Periods integrated before the first look for orbits of higher period.
 const FIRST_STRETCH: usize = 32;
 /// Periods the search for an orbit may integrate at most (with shooting).
 const SEARCH_PERIODS: usize = 1000;
-/// Marched periods are integrated at this fraction of the averages' tolerance (the
-/// default of [`SteadyOptions::marching_fraction`]).
-pub const MARCHING_TOLERANCE: f64 = 1e-5;
 
 impl<L: ForceLaw> Simulation<'_, L> {
     /// The steady state reached from `phase` (which is left on it): the attractor the
@@ -223,56 +166,4 @@ impl<L: ForceLaw> Simulation<'_, L> {
     pub(super) fn marching(&self, opts: &SteadyOptions) -> Self {
         self.loosened(opts.marching_fraction * opts.average_tolerance)
     }
-}
-
-/// Settings of the steady-state search.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SteadyOptions {
-    /// Periodic orbits: the largest |Pⁿ(z) − z| accepted (units of L); Newton aims 100×
-    /// lower. Time-marching: how close to the orbit the state must be (judged from its
-    /// return distances).
-    pub tolerance: f64,
-    /// Irregular motion: the standard error of the averages (A relative, φ in rad, E_ts
-    /// relative to E_drive) to reach.
-    pub average_tolerance: f64,
-    /// At most this many periods.
-    pub max_cycles: usize,
-    /// Look for periodic orbits by Newton's method on the period map.
-    pub shooting: bool,
-    /// At most this many integrator steps ([`budget`]).
-    pub max_steps: u64,
-    /// Periods marched for averages and for the choice of candidate periods are
-    /// integrated at this fraction of `average_tolerance` ([`MARCHING_TOLERANCE`]
-    /// unless tightened to re-decide a grazing state).
-    pub marching_fraction: f64,
-    /// A grazing margin below this (units of L) counts as grazing ([`super::grazing`]),
-    /// as does one below the state's resolution ([`Simulation::resolution`]): the
-    /// thermal rms deflection at 300 K over A₀ for a prepared experiment.
-    pub grazing_threshold: f64,
-}
-
-/// Whether a steady state grazes a switch ([`Simulation::grazing`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Grazing {
-    /// A turning point lies within the threshold of some switch level.
-    pub any: bool,
-    /// … of a level where the force jumps: the period map is discontinuous within that
-    /// distance, and an orbit's stability rests on the grazing contact.
-    pub jump: bool,
-}
-
-/// The outcome of [`Simulation::steady_state`].
-#[derive(Debug, Clone, Copy)]
-pub struct SteadyState {
-    /// The integrals over what is reported: one pass of the periodic orbit (n periods),
-    /// or the averaging window of irregular motion.
-    pub window: CycleIntegrals,
-    /// Periods integrated in all.
-    pub cycles: usize,
-    /// Whether the reported values meet their tolerance.
-    pub converged: bool,
-    /// How the motion repeats.
-    pub motion: Motion,
-    /// Standard errors of the window averages.
-    pub std_err: StdErr,
 }

@@ -3,22 +3,12 @@
 
 use super::capture::Candidate;
 use super::march::{CycleIntegrals, Phase, Simulation};
+pub use super::motion::StdErr;
+use super::motion::{Motion, SteadyOptions, SteadyState};
 use super::numeric;
 use super::recurrence::Recurrence;
-use super::steady::{Motion, SteadyOptions, SteadyState};
 use crate::error::Result;
 use crate::law::ForceLaw;
-
-/// Standard errors of window averages (batch means); zero for a periodic orbit.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct StdErr {
-    /// Of the amplitude (units of L).
-    pub amplitude: f64,
-    /// Of the phase (rad).
-    pub phase: f64,
-    /// Of E_ts per drive period (units of kL²).
-    pub e_ts: f64,
-}
 
 /// The averaging window of irregular motion: whole batches and the one being filled.
 pub(super) struct Window {

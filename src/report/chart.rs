@@ -3,7 +3,6 @@
 
 use crate::error::{Error, Result};
 use serde::Serialize;
-use std::path::Path;
 
 /// Linear or logarithmic axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -233,16 +232,5 @@ impl Chart {
             path: format!("{}.csv", self.name).into(),
             reason: e.to_string(),
         })
-    }
-
-    /// Write `<dir>/<name>.csv`, `.png` and `.svg`; returns the paths written.
-    pub fn write_all(&self, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
-        let csv_path = dir.join(format!("{}.csv", self.name));
-        super::output::write_bytes(&csv_path, &self.to_csv()?)?;
-        let png = dir.join(format!("{}.png", self.name));
-        let svg = dir.join(format!("{}.svg", self.name));
-        super::plot::render_png(self, &png)?;
-        super::plot::render_svg(self, &svg)?;
-        Ok(vec![csv_path, png, svg])
     }
 }
