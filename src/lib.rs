@@ -2,61 +2,65 @@
 //!
 //! The physics follows Ciavarella, Greenwood & Barber, "Effect of Tabor parameter on
 //! hysteresis losses during adhesive contact"; equation numbers in the documentation
-//! are that paper's. Data flows one way: [`params`] → [`contact`] (force laws) →
-//! [`law`] → [`dynamics`] / [`quasistatic`] → [`instrument`] → [`sweep`] / [`setpoint`] →
-//! [`identification`] →
-//! [`figures`] → [`report`].
+//! are that paper's.
+//!
+//! # The plan of the house
+//!
+//! The folders are the layers, and data flows one way, up:
+//!
+//! | layer | folder | what lives there |
+//! |---|---|---|
+//! | 0 | [`error`], [`numeric`], [`interrupt`] | errors, root finders and quadrature, the stop flag |
+//! | 1 | [`physics`] | parameters, contact mechanics, force laws, quasi-static cycles: the paper |
+//! | 2 | [`dynamics`] | the cantilever: march, periodic orbits, attractors, modes |
+//! | 3 | [`instrument`] | lock-in, feedback, noise, scans, the instrument's modes |
+//! | 4 | [`analysis`] | setpoints, sweeps, contrast, identification, reconstruction, fit |
+//! | 5 | `app` (feature `app`) | command line, configuration, reports and plots, figures, caches |
+//!
+//! A module imports only from its own layer or below, and no two modules import each
+//! other, directly or round a circle (`tests/architecture.rs` checks both). Layers 0–4
+//! are the physics library: no file system, no environment, no terminal; progress and
+//! interruption are passed down as values. Without the `app` feature
+//! (`--no-default-features`) the crate is that library alone, without the application's
+//! dependencies. Where a new piece goes: a force law is a file in [`physics::law`]; an
+//! instrument mode a file in [`instrument`]; a way of using the simulations a file in
+//! [`analysis`]; a command a file in `app/cli/`.
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-// The physics library: no file system, no environment, no command line.
-pub mod bimodal;
-pub mod coexist;
-pub mod contact;
-pub mod contrast;
-pub mod dynamics;
+// Layer 0: the foundation.
 pub mod error;
-pub mod fit;
-pub mod identification;
-pub mod instrument;
 pub mod interrupt;
-pub mod law;
 pub mod numeric;
-pub mod params;
-pub mod quasistatic;
-pub mod reconstruct;
-pub mod setpoint;
-pub mod summary;
-pub mod sweep;
 
-// The application on top (feature `app`, on by default).
-#[cfg(feature = "app")]
-pub mod cli;
-#[cfg(feature = "app")]
-pub mod config;
-#[cfg(feature = "app")]
-pub mod figures;
-#[cfg(feature = "app")]
-pub mod fnv;
-#[cfg(feature = "app")]
-pub mod lj_cache;
-#[cfg(feature = "app")]
-pub mod report;
-#[cfg(feature = "app")]
-pub mod reproduce;
-#[cfg(feature = "app")]
-pub mod sample;
-#[cfg(feature = "app")]
-pub mod units;
+// Layers 1–4: the physics library.
+pub mod analysis;
+pub mod dynamics;
+pub mod instrument;
+pub mod physics;
 
-pub use contact::lj::{LjSolution, Reach};
+// Layer 5: the application on top (feature `app`, on by default).
+#[cfg(feature = "app")]
+pub mod app;
+
+// The paths of the flat layout before the layers, kept so that code written against
+// them builds: deprecated, use the layered paths above.
+#[doc(hidden)]
+pub use analysis::{bimodal, coexist, contrast, fit, identification, reconstruct, setpoint, sweep};
+#[cfg(feature = "app")]
+#[doc(hidden)]
+pub use app::{cli, config, figures, fnv, lj_cache, report, reproduce, sample, units};
+#[doc(hidden)]
+pub use physics::{contact, law, params, quasistatic, summary};
+
 pub use dynamics::observables::{Observe, TapObservables, TapRun, tap};
 pub use dynamics::setup::{Cantilever, Numerics, TapSetup, default_setup};
 pub use error::{Error, Result};
-pub use law::{LawKind, LawSpec};
-pub use params::Contact;
-pub use summary::{HysteresisSummary, LjSummary};
+pub use physics::contact::lj::{LjSolution, Reach};
+pub use physics::law::{LawKind, LawSpec};
+pub use physics::params::Contact;
+pub use physics::summary::{HysteresisSummary, LjSummary};
 
 /// The README's Rust blocks, compiled and run as doctests so its numbers stay true.
 #[cfg(doctest)]

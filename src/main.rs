@@ -1,3 +1,3 @@
 fn main() -> std::process::ExitCode {
-    tapsim::cli::main()
+    tapsim::app::cli::main()
 }

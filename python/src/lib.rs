@@ -1,6 +1,6 @@
 //! The Python extension `tapsim._tapsim`: tapsim's commands run in this process, on the
 //! command line's own parsing, defaults, checks and code paths
-//! ([`tapsim::cli::run_captured`]), with the GIL released; each command's `--json`
+//! ([`tapsim::app::cli::run_captured`]), with the GIL released; each command's `--json`
 //! document handed to Python as dicts, with numpy arrays for its columns and grids.
 //! The package `tapsim` (python/tapsim/__init__.py) builds the arguments from keyword
 //! arguments and wraps the dicts in result objects.
@@ -14,7 +14,7 @@ use serde_json::Value;
 
 /// A refused command as the Python exception it raises: `ValueError` with the command
 /// line's message.
-fn refusal(r: tapsim::cli::Refused) -> PyErr {
+fn refusal(r: tapsim::app::cli::Refused) -> PyErr {
     PyValueError::new_err(r.message)
 }
 
@@ -156,7 +156,7 @@ fn interruptible<T: Send + 'static>(
 /// Raises ValueError with the command line's message where the command line refuses.
 #[pyfunction]
 fn run<'py>(py: Python<'py>, args: Vec<String>) -> PyResult<Bound<'py, PyAny>> {
-    let text = interruptible(py, move || tapsim::cli::run_captured(&args))?.map_err(refusal)?;
+    let text = interruptible(py, move || tapsim::app::cli::run_captured(&args))?.map_err(refusal)?;
     to_python(py, document(&text)?)
 }
 
@@ -165,10 +165,10 @@ fn run<'py>(py: Python<'py>, args: Vec<String>) -> PyResult<Bound<'py, PyAny>> {
 /// one, naming it.
 #[pyfunction]
 fn run_many<'py>(py: Python<'py>, batch: Vec<Vec<String>>) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let outcomes: Vec<Result<String, tapsim::cli::Refused>> = interruptible(py, move || {
+    let outcomes: Vec<Result<String, tapsim::app::cli::Refused>> = interruptible(py, move || {
         batch
             .par_iter()
-            .map(|args| tapsim::cli::run_captured(args))
+            .map(|args| tapsim::app::cli::run_captured(args))
             .collect()
     })?;
     outcomes

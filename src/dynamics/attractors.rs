@@ -10,7 +10,7 @@ use super::march::{Phase, Simulation};
 use super::observed::TapObservables;
 use super::setup::{Numerics, Prepared, TapSetup};
 use crate::error::Result;
-use crate::law::AnyLaw;
+use crate::physics::law::AnyLaw;
 use rayon::prelude::*;
 use serde::Serialize;
 

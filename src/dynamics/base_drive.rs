@@ -5,10 +5,10 @@
 use super::march::{Phase, Simulation};
 use super::model::{Coupling, Drive, Oscillator};
 use super::numeric::{Ignore, Tolerances};
-use crate::contact::hybrid::JumpIn;
-use crate::contact::spring;
 use crate::error::{Error, Result, positive};
-use crate::law::{AdhesiveLaw, ForceLaw};
+use crate::physics::contact::hybrid::JumpIn;
+use crate::physics::contact::spring;
+use crate::physics::law::{AdhesiveLaw, ForceLaw};
 use serde::Serialize;
 
 /// Settings of a slow base-driven cycle.

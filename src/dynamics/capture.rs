@@ -18,7 +18,7 @@
 
 use super::march::{Phase, Simulation};
 use super::motion::SteadyState;
-use crate::law::{Branch, ForceLaw};
+use crate::physics::law::{Branch, ForceLaw};
 use nalgebra::{DMatrix, DVector};
 
 /// Powers of the monodromy matrix looked at for transient growth, at most.

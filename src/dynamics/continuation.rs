@@ -19,7 +19,7 @@
 use super::march::{CycleIntegrals, Phase, Simulation};
 use super::shooting::{Multipliers, eigenvalues};
 use crate::error::{Error, Result};
-use crate::law::ForceLaw;
+use crate::physics::law::ForceLaw;
 use nalgebra::{Complex, DMatrix, DVector, Vector3};
 
 /// Settings of a continuation.

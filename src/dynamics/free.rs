@@ -279,7 +279,7 @@ impl FreeFlight {
 mod tests {
     use super::*;
     use crate::dynamics::model::{BASE, Coupling, rhs};
-    use crate::law::{Branch, NoForce};
+    use crate::physics::law::{Branch, NoForce};
 
     fn osc() -> Oscillator {
         Oscillator {

@@ -16,8 +16,8 @@
 use super::free::FreeFlight;
 use super::model::{Coupling, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver};
-use crate::law::{Branch, ForceLaw};
 use crate::numeric::GAUSS_LEGENDRE_8;
+use crate::physics::law::{Branch, ForceLaw};
 
 /// Accumulates ∫ ∂f_ts/∂x dτ and the switches' steps over everything it observes (model
 /// units: f in kL, x in L, so the average is in units of k).

@@ -13,7 +13,7 @@
 //! branch's own exits (the turning point misses them by that much) and the levels at
 //! which the other branches enter it (the turning point has cleared them by that much).
 
-use crate::law::{Branch, ForceLaw};
+use crate::physics::law::{Branch, ForceLaw};
 
 /// Every branch, in the order of its index.
 const BRANCHES: [Branch; Branch::COUNT] = [Branch::Free, Branch::Contact, Branch::Necked];
@@ -130,7 +130,7 @@ pub fn thermal_rms_m(stiffness_n_m: f64, temperature_k: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::law::{AdhesiveLaw, HertzLaw, NoForce};
+    use crate::physics::law::{AdhesiveLaw, HertzLaw, NoForce};
 
     #[test]
     fn a_cantilever_of_40_n_per_m_moves_10_pm_rms_at_room_temperature() {

@@ -19,8 +19,8 @@
 
 use super::march::{Phase, Simulation};
 use super::model::Drive;
-use crate::law::{Branch, ContactState, ForceLaw, Internal};
 use crate::numeric::{GAUSS_LEGENDRE_8, bracketed_root};
+use crate::physics::law::{Branch, ContactState, ForceLaw, Internal};
 use std::f64::consts::PI;
 
 /// Gauss–Legendre panels along a stretch of the cosine on one branch.

@@ -13,8 +13,8 @@
 use super::free::FreeFlight;
 use super::model::{Coupling, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver, internal_at};
-use crate::law::{Branch, ForceLaw};
 use crate::numeric::GAUSS_LEGENDRE_8;
+use crate::physics::law::{Branch, ForceLaw};
 use nalgebra::Complex;
 use serde::Serialize;
 

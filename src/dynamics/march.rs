@@ -23,7 +23,7 @@ use super::numeric::{
     internal_at,
 };
 use crate::error::Result;
-use crate::law::{Branch, Exits, ForceLaw, Internal, MAX_INTERNAL};
+use crate::physics::law::{Branch, Exits, ForceLaw, Internal, MAX_INTERNAL};
 use nalgebra::{DMatrix, DVector};
 
 /// The most dimensions a section state has: each mode's x and x', and the law's

@@ -1,6 +1,11 @@
-//! Tapping-mode dynamics: a point-mass cantilever against a hysteretic tip–sample force
-//! law, with located branch switches, steady-state detection and the observables of one
-//! steady cycle (docs/design.md §2).
+//! **Layer 2 — the cantilever.** Tapping-mode dynamics: a point-mass cantilever (and
+//! its higher modes, [`modes`]) against a hysteretic tip–sample force law, marched with
+//! every branch switch located ([`march`]); periodic orbits by shooting, irregular
+//! motion by windows, the attractors at a separation, continuation of orbit families,
+//! and the observables of one steady cycle (docs/design.md §2).
+//!
+//! May import: the foundation and [`crate::physics`]. Imported by the instrument,
+//! analysis and application layers.
 
 pub mod attractors;
 pub mod base_drive;

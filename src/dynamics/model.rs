@@ -8,7 +8,7 @@
 //! with f_ts = −T̂·RΔγ/(kL) and the tip–sample separation α̂ = a₀ + a₁(x + x_b(τ)),
 //! where x_b is the support displacement of a base drive (zero for a force drive).
 
-use crate::law::{Branch, ContactState, ForceLaw, Internal, MAX_INTERNAL};
+use crate::physics::law::{Branch, ContactState, ForceLaw, Internal, MAX_INTERNAL};
 use nalgebra::{DMatrix, SVector};
 use std::ops::{Index, IndexMut};
 

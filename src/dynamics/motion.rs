@@ -113,19 +113,19 @@ pub struct SteadyOptions {
     pub max_cycles: usize,
     /// Look for periodic orbits by Newton's method on the period map.
     pub shooting: bool,
-    /// At most this many integrator steps ([`budget`]).
+    /// At most this many integrator steps ([`super::budget`]).
     pub max_steps: u64,
     /// Periods marched for averages and for the choice of candidate periods are
     /// integrated at this fraction of `average_tolerance` ([`MARCHING_TOLERANCE`]
     /// unless tightened to re-decide a grazing state).
     pub marching_fraction: f64,
     /// A grazing margin below this (units of L) counts as grazing ([`super::grazing`]),
-    /// as does one below the state's resolution ([`Simulation::resolution`]): the
+    /// as does one below the state's resolution ([`super::march::Simulation::resolution`]): the
     /// thermal rms deflection at 300 K over A₀ for a prepared experiment.
     pub grazing_threshold: f64,
 }
 
-/// Whether a steady state grazes a switch ([`Simulation::grazing`]).
+/// Whether a steady state grazes a switch ([`super::march::Simulation::grazing`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Grazing {
     /// A turning point lies within the threshold of some switch level.
@@ -135,7 +135,7 @@ pub struct Grazing {
     pub jump: bool,
 }
 
-/// The outcome of [`Simulation::steady_state`].
+/// The outcome of [`super::march::Simulation::steady_state`].
 #[derive(Debug, Clone, Copy)]
 pub struct SteadyState {
     /// The integrals over what is reported: one pass of the periodic orbit (n periods),

@@ -18,8 +18,8 @@ use super::model::{
     BASE, Coupling, Oscillator, Part, State, V, X, has_tangent, internal_count, rhs, set_phasor,
 };
 use crate::error::{Error, Result};
-use crate::law::{Branch, ForceLaw, Internal};
 use crate::numeric::bracketed_root;
+use crate::physics::law::{Branch, ForceLaw, Internal};
 use std::cell::Cell;
 use std::ops::Index;
 

@@ -12,7 +12,7 @@ pub use super::observed::{
 };
 use super::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
-use crate::law::ForceLaw;
+use crate::physics::law::ForceLaw;
 use serde::Serialize;
 
 /// What a tapping run observes beyond the steady state's observables.

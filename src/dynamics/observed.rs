@@ -9,8 +9,8 @@ use super::numeric::{StepEnd, StepObserver, hermite, internal_at};
 use super::setup::Prepared;
 use super::steady::{Motion, SteadyState};
 use crate::error::{Error, Result};
-use crate::law::{Branch, ForceLaw, Internal};
-use crate::params::ELECTRONVOLT_J;
+use crate::physics::law::{Branch, ForceLaw, Internal};
+use crate::physics::params::ELECTRONVOLT_J;
 use serde::Serialize;
 use std::f64::consts::PI;
 

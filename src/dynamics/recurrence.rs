@@ -3,7 +3,7 @@
 
 use super::march::MAX_SECTION;
 use super::motion::{MAX_PERIOD, SHORT_PERIOD};
-use crate::law::Branch;
+use crate::physics::law::Branch;
 use nalgebra::DVector;
 
 /// How close (units of L) the section state must return after n > [`SHORT_PERIOD`]

@@ -8,8 +8,8 @@ use super::model::{Coupling, Drive, Oscillator};
 use super::numeric::Tolerances;
 use super::steady::{MARCHING_TOLERANCE, MIN_CYCLES, SteadyOptions};
 use crate::error::{Error, Result, finite, positive};
-use crate::law::{AnyLaw, LawKind, LawSpec};
-use crate::params::{Contact, composite_modulus};
+use crate::physics::law::{AnyLaw, LawKind, LawSpec};
+use crate::physics::params::{Contact, composite_modulus};
 use serde::{Deserialize, Serialize};
 
 /// A cantilever in SI units, driven by a force at `drive_frequency_hz` whose strength

@@ -9,7 +9,7 @@ use super::model::{chain, phi_start};
 pub use super::motion::Multipliers;
 use super::motion::{Motion, StdErr, SteadyOptions, SteadyState};
 use crate::error::{Error, Result};
-use crate::law::ForceLaw;
+use crate::physics::law::ForceLaw;
 use nalgebra::{Complex, DMatrix, DVector};
 
 /// The n-period map evaluated at a state.

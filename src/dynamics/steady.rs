@@ -18,7 +18,7 @@ use super::numeric;
 use super::recurrence::Recurrence;
 use super::window::Window;
 use crate::error::Result;
-use crate::law::ForceLaw;
+use crate::physics::law::ForceLaw;
 
 /// Periods integrated before the first look for orbits of higher period.
 const FIRST_STRETCH: usize = 32;

@@ -8,7 +8,7 @@ use super::motion::{Motion, SteadyOptions, SteadyState};
 use super::numeric;
 use super::recurrence::Recurrence;
 use crate::error::Result;
-use crate::law::ForceLaw;
+use crate::physics::law::ForceLaw;
 
 /// The averaging window of irregular motion: whole batches and the one being filled.
 pub(super) struct Window {

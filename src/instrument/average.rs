@@ -14,7 +14,7 @@ use crate::dynamics::march::{CycleIntegrals, Phase, Simulation};
 use crate::dynamics::observables::TapObservables;
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
-use crate::law::AnyLaw;
+use crate::physics::law::AnyLaw;
 
 /// What an instrument reads of a state under the thermal force, averaged over thermal
 /// records: the means and their standard errors, from the spread of independent

@@ -28,7 +28,7 @@ use crate::dynamics::free::FreeFlight;
 use crate::dynamics::model::X;
 use crate::dynamics::numeric::{StepEnd, StepObserver, hermite};
 use crate::error::{Error, Result};
-use crate::law::Branch;
+use crate::physics::law::Branch;
 
 /// The highest filter order.
 pub const MAX_ORDER: usize = 4;

@@ -1,6 +1,12 @@
-//! The instrument around the cantilever: pieces that read or drive the simulated motion
-//! as an AFM's electronics do, each a value of its own that watches the integration
-//! ([`crate::dynamics::numeric::StepObserver`]) beside the steady-state solver.
+//! **Layer 3 — the instrument around the cantilever**: pieces that read or drive the
+//! simulated motion as an AFM's electronics do (lock-in, z feedback, thermal noise,
+//! scans, several modes), each a value of its own that watches the integration
+//! ([`crate::dynamics::numeric::StepObserver`]) beside the steady-state solver. A new
+//! instrument mode is a file here and touches nothing in [`crate::physics`] or
+//! [`crate::dynamics`].
+//!
+//! May import: the foundation, [`crate::physics`], [`crate::dynamics`]. Imported by the
+//! analysis and application layers.
 
 pub mod average;
 pub mod feedback;

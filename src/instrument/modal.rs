@@ -19,7 +19,7 @@ use crate::dynamics::modes::set::Modal;
 use crate::dynamics::modes::system::{Modes, plain_len};
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
-use crate::law::Branch;
+use crate::physics::law::Branch;
 
 /// Several eigenmodes over `materials` (each prepared with its modal model; all share
 /// the cantilever and its modes), each read by its lock-in.

@@ -30,8 +30,8 @@ use super::thermal::ThermalForce;
 use crate::dynamics::march::{Phase, Simulation};
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
-use crate::law::ForceLaw;
 use crate::numeric::mean_and_variance;
+use crate::physics::law::ForceLaw;
 use nalgebra::DMatrix;
 
 /// Parts of a drive period the linear theory samples the orbit's Φ at unless told

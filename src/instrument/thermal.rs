@@ -22,7 +22,7 @@ use crate::dynamics::march::{CycleIntegrals, Phase, Simulation};
 use crate::dynamics::model::{Drive, Oscillator};
 use crate::dynamics::numeric::StepObserver;
 use crate::error::{Error, Result};
-use crate::law::ForceLaw;
+use crate::physics::law::ForceLaw;
 use nalgebra::{Matrix2, Matrix4, Vector2, Vector4};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -8,8 +8,8 @@ use super::system::{ModeIntegral, Modes, force_integral, plain_len, tangent_len}
 use crate::dynamics::budget;
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
-use crate::law::ForceLaw;
-use crate::params::ELECTRONVOLT_J;
+use crate::physics::law::ForceLaw;
+use crate::physics::params::ELECTRONVOLT_J;
 use serde::Serialize;
 
 /// One mode's share of a steady state. Energies per first-mode drive period, in J.
@@ -120,7 +120,7 @@ pub fn modal_steady(
     p: &Prepared,
     modal: &Modal,
     numerics: &Numerics,
-    start: Option<(&[f64], crate::law::Branch)>,
+    start: Option<(&[f64], crate::physics::law::Branch)>,
 ) -> Result<(ModalObservables, ModalOrbit)> {
     budget::budgeted(numerics.max_steps, || match modal.modes.len() {
         1 => solve::<1, { plain_len(1) }, { tangent_len(1) }>(p, modal, numerics, start),
@@ -136,7 +136,7 @@ fn solve<const M: usize, const P: usize, const T: usize>(
     p: &Prepared,
     modal: &Modal,
     numerics: &Numerics,
-    start: Option<(&[f64], crate::law::Branch)>,
+    start: Option<(&[f64], crate::physics::law::Branch)>,
 ) -> Result<(ModalObservables, ModalOrbit)> {
     let (q, period) = modal.common_period()?;
     let modes = Modes::<_, M>::of(p, modal);
@@ -157,7 +157,7 @@ fn solve<const M: usize, const P: usize, const T: usize>(
 pub(super) fn one_mode_start(
     p: &Prepared,
     modes: &[super::set::ModeModel],
-) -> (Vec<f64>, crate::law::Branch) {
+) -> (Vec<f64>, crate::physics::law::Branch) {
     let sim = p.simulation();
     let mut phase = sim.free_steady_start();
     let first = sim
@@ -167,7 +167,7 @@ pub(super) fn one_mode_start(
     let branch = if first.is_some() {
         phase.branch
     } else {
-        crate::law::Branch::Free
+        crate::physics::law::Branch::Free
     };
     (free_section(modes, first), branch)
 }

@@ -7,7 +7,7 @@ use super::system::{Modes, PassTally, phi, plain_len, q, tangent_len, v};
 use crate::dynamics::model::State;
 use crate::dynamics::numeric::Tolerances;
 use crate::error::{Error, Result};
-use crate::law::{Branch, ForceLaw};
+use crate::physics::law::{Branch, ForceLaw};
 use nalgebra::{DMatrix, DVector};
 
 /// A periodic orbit of the modes over one common period.

@@ -18,9 +18,9 @@ use crate::dynamics::model::{Coupling, State};
 use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver, Tolerances, hermite_turn_fraction};
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
-use crate::law::AnyLaw;
-use crate::law::{Branch, ForceLaw};
 use crate::numeric::bracketed_root;
+use crate::physics::law::AnyLaw;
+use crate::physics::law::{Branch, ForceLaw};
 
 /// Components without the tangent for `m` modes.
 pub const fn plain_len(m: usize) -> usize {

@@ -23,9 +23,9 @@ use crate::dynamics::model::State;
 use crate::dynamics::numeric::Ignore;
 use crate::dynamics::setup::{Numerics, Prepared};
 use crate::error::{Error, Result};
-use crate::law::ForceLaw;
 use crate::numeric::{mean_and_variance, wrap_angle};
-use crate::params::ELECTRONVOLT_J;
+use crate::physics::law::ForceLaw;
+use crate::physics::params::ELECTRONVOLT_J;
 use serde::Serialize;
 
 /// Windows of a round.
@@ -342,7 +342,10 @@ fn average<const M: usize, const P: usize>(
     // Each mode's integrals over its own period so far, and the first mode's contact.
     let mut period = [[0.0; 6]; M];
     let mut contact = ContactSums::empty();
-    let mut contact_start = (alpha(Modes::<crate::law::AnyLaw, M>::tip(&y)), branch);
+    let mut contact_start = (
+        alpha(Modes::<crate::physics::law::AnyLaw, M>::tip(&y)),
+        branch,
+    );
     let mut ended = [0u64; M];
     let (mut tau, mut h) = (0.0, 0.0);
     let mut length = memory;

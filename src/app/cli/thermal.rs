@@ -1,0 +1,287 @@
+//! `tapsim thermal`: the thermal spectrum of the free cantilever and its calibration.
+
+use crate::app::config::{frequency, number, stiffness, temperature, time};
+use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
+use crate::dynamics::grazing::{BOLTZMANN_J_K, ROOM_TEMPERATURE_K};
+use crate::dynamics::setup::default_setup;
+use crate::error::{Error, Result};
+use crate::instrument::spectrum::sho_psd;
+use crate::instrument::thermal::{STEPS_PER_PERIOD, ThermalSpectrum, thermal_spectrum};
+use clap::Args;
+
+/// The thermal noise of a free cantilever and the calibration it gives.
+///
+/// An AFM cantilever far from the sample and not driven still moves: the thermal force
+/// of its damping (fluctuation–dissipation: one-sided density S_F = 4k_BT·k/(ω₀Q))
+/// shakes it by √(k_BT/k) rms (10.18 pm at 40 N/m and 300 K). Its deflection spectrum is
+/// the simple harmonic oscillator's, S_z(f) = (2k_BT/(πk f₀Q))/((1 − f²/f₀²)² +
+/// f²/(f₀²Q²)), and fitting that to a measured spectrum is how a cantilever is
+/// calibrated (Hutter & Bechhoefer, RSI 64, 1868, 1993): f₀ and Q from its shape, k from
+/// its area, k = k_BT/⟨z²⟩.
+///
+/// This records that motion (the thermal force held over 64 steps a period, drawn from
+/// a seeded stream: the same record on any machine), estimates its spectrum (Welch:
+/// half-overlapping Hann segments of 16 bins a linewidth) and fits the oscillator's to
+/// it, printing the fitted f₀, Q and k beside the cantilever's own. The record is
+/// 8 000 Q resonance periods unless --duration says otherwise (10.7 s of motion at
+/// 300 kHz and Q = 400); the fit's scatter from seed to seed falls as 1/√duration.
+///
+/// JSON keys (--json): temperature_k, stiffness_n_m, resonance_hz, quality, periods,
+/// duration_s, steps_per_period, segments, rms_m, equipartition_rms_m,
+/// fit_resonance_hz, fit_quality, fit_stiffness_n_m, fit_low_frequency_m2_hz, fit_bins.
+/// --csv FILE: the spectrum (freq_hz, welch_m2_hz, sho_m2_hz, fit_m2_hz); --plot
+/// FILE.png|svg: the spectrum over 0.05–2 f₀ (log-log) and around the resonance.
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct ThermalArgs {
+    /// Temperature [K; default 300K].
+    #[arg(long, allow_hyphen_values = true, value_parser = temperature)]
+    temperature: Option<f64>,
+    /// Cantilever spring constant k [N/m; default 40].
+    #[arg(long, allow_hyphen_values = true, value_parser = stiffness)]
+    stiffness: Option<f64>,
+    /// Resonance frequency f₀ [Hz; default 300kHz].
+    #[arg(long, allow_hyphen_values = true, value_parser = frequency)]
+    resonance: Option<f64>,
+    /// Quality factor Q, 10 to 1e4 [default 400].
+    #[arg(long, allow_hyphen_values = true, value_parser = number)]
+    quality: Option<f64>,
+    /// Length of the record [s; default 8 000 Q resonance periods].
+    #[arg(long, allow_hyphen_values = true, value_parser = time)]
+    duration: Option<f64>,
+    /// Steps a period over which the thermal force is held (a multiple of 8; the
+    /// spectrum falls short of white by about (π/steps)²/3 at f₀).
+    #[arg(long, default_value_t = STEPS_PER_PERIOD)]
+    steps: usize,
+    /// Seed of the thermal force's random stream.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    #[command(flatten)]
+    pub(super) out: super::SweepOutput,
+}
+
+/// The fit beside the truth, as --json prints it.
+#[derive(serde::Serialize)]
+struct Report {
+    temperature_k: f64,
+    stiffness_n_m: f64,
+    resonance_hz: f64,
+    quality: f64,
+    periods: usize,
+    duration_s: f64,
+    steps_per_period: usize,
+    segments: usize,
+    rms_m: f64,
+    equipartition_rms_m: f64,
+    fit_resonance_hz: f64,
+    fit_quality: f64,
+    fit_stiffness_n_m: f64,
+    fit_low_frequency_m2_hz: f64,
+    fit_bins: usize,
+}
+
+/// One bin of the spectrum (--csv).
+#[derive(serde::Serialize)]
+struct Bin {
+    freq_hz: f64,
+    welch_m2_hz: f64,
+    sho_m2_hz: f64,
+    fit_m2_hz: f64,
+}
+
+/// Run the subcommand.
+pub fn run(args: ThermalArgs) -> Result<()> {
+    let c = default_setup().cantilever;
+    let k = args.stiffness.unwrap_or(c.stiffness_n_m);
+    let f0 = args.resonance.unwrap_or(c.resonance_hz);
+    let q = args.quality.unwrap_or(c.quality);
+    let t = args.temperature.unwrap_or(ROOM_TEMPERATURE_K);
+    crate::error::positive("resonance frequency", f0)?;
+    crate::error::positive("quality factor", q)?;
+    let periods_f = match args.duration {
+        Some(d) => {
+            crate::error::positive("record duration", d)?;
+            d * f0
+        }
+        None => 8000.0 * q,
+    };
+    if !periods_f.is_finite() || periods_f > 1e12 {
+        return Err(Error::OutOfRange(format!(
+            "a record of {periods_f:e} resonance periods is beyond reach"
+        )));
+    }
+    let periods = periods_f.round() as usize;
+    let bar = args.out.progress("thermal", periods);
+    let spectrum = thermal_spectrum((k, f0, q), t, (periods, args.steps), args.seed, |done| {
+        bar.set_position(done as u64)
+    })?;
+    bar.finish_and_clear();
+    let fit = spectrum.calibration;
+    let report = Report {
+        temperature_k: t,
+        stiffness_n_m: k,
+        resonance_hz: f0,
+        quality: q,
+        periods,
+        duration_s: periods as f64 / f0,
+        steps_per_period: args.steps,
+        segments: spectrum.psd.segments,
+        rms_m: spectrum.rms_m,
+        equipartition_rms_m: (BOLTZMANN_J_K * t / k).sqrt(),
+        fit_resonance_hz: fit.resonance_hz,
+        fit_quality: fit.quality,
+        fit_stiffness_n_m: fit.stiffness_n_m,
+        fit_low_frequency_m2_hz: fit.low_frequency_m2_hz,
+        fit_bins: fit.bins,
+    };
+    let bins: Vec<Bin> = spectrum
+        .psd
+        .freq_hz
+        .iter()
+        .zip(&spectrum.psd.density)
+        .map(|(&f, &p)| Bin {
+            freq_hz: f,
+            welch_m2_hz: p,
+            sho_m2_hz: sho_psd(f, f0, q, k, t),
+            fit_m2_hz: sho_psd(f, fit.resonance_hz, fit.quality, fit.stiffness_n_m, t),
+        })
+        .collect();
+    args.out
+        .write_files(&bins, || charts(&report, &bins, &spectrum))?;
+    if args.out.json {
+        outln!("{}", crate::app::report::records::document(&report)?);
+        return Ok(());
+    }
+    outln!(
+        "thermal spectrum of a free cantilever at {t} K: {periods} resonance periods \
+         ({:.3} s), {} force steps a period, {} Welch segments",
+        report.duration_s,
+        args.steps,
+        report.segments
+    );
+    outln!(
+        "{:>10} {:>14} {:>14} {:>9}",
+        "",
+        "fitted",
+        "cantilever",
+        "off"
+    );
+    let row = |name: &str, fitted: f64, true_value: f64, digits: usize| {
+        format!(
+            "{name:>10} {fitted:>14.digits$} {true_value:>14.digits$} {:>+8.3}%",
+            100.0 * (fitted / true_value - 1.0)
+        )
+    };
+    outln!("{}", row("f0 (kHz)", fit.resonance_hz * 1e-3, f0 * 1e-3, 4));
+    outln!("{}", row("Q", fit.quality, q, 2));
+    outln!("{}", row("k (N/m)", fit.stiffness_n_m, k, 4));
+    outln!(
+        "{}",
+        row(
+            "rms (pm)",
+            spectrum.rms_m * 1e12,
+            report.equipartition_rms_m * 1e12,
+            3
+        )
+    );
+    outln!(
+        "(fitted: the oscillator's spectrum fitted to the record's over {} bins; rms: the \
+         record's, beside equipartition's √(k_BT/k))",
+        fit.bins
+    );
+    Ok(())
+}
+
+/// The spectrum over 0.05–2 f₀ (log-log, averaged over logarithmic bins of 1 %; above
+/// 2f₀ the record's sampling at 8f₀ folds the tail back) and the resonance within 10
+/// linewidths (every bin), in pm²/Hz.
+fn charts(report: &Report, bins: &[Bin], spectrum: &ThermalSpectrum) -> Vec<Chart> {
+    let f0 = report.resonance_hz;
+    let title = format!(
+        "free cantilever, k = {} N/m, f₀ = {} kHz, Q = {}, T = {} K ({} segments)",
+        report.stiffness_n_m,
+        f0 * 1e-3,
+        report.quality,
+        report.temperature_k,
+        spectrum.psd.segments
+    );
+    // Logarithmic bins of 1 % for the overview.
+    let wide = |b: &Bin| b.freq_hz >= 0.05 * f0 && b.freq_hz <= 2.0 * f0;
+    let mut coarse: Vec<(f64, f64)> = Vec::new();
+    let (mut lo, mut sum_f, mut sum_p, mut n) = (0.05 * f0, 0.0, 0.0, 0);
+    const PM2: f64 = 1e24;
+    for b in bins.iter().filter(|b| wide(b)) {
+        if b.freq_hz > lo * 1.01 && n > 0 {
+            coarse.push((sum_f / n as f64 * 1e-3, PM2 * sum_p / n as f64));
+            (lo, sum_f, sum_p, n) = (b.freq_hz, 0.0, 0.0, 0);
+        }
+        sum_f += b.freq_hz;
+        sum_p += b.welch_m2_hz;
+        n += 1;
+    }
+    let model = |pick: fn(&Bin) -> f64, keep: &dyn Fn(&Bin) -> bool| -> Vec<(f64, f64)> {
+        bins.iter()
+            .filter(|b| keep(b))
+            .map(|b| (b.freq_hz * 1e-3, PM2 * pick(b)))
+            .collect()
+    };
+    let half = 10.0 * f0 / report.quality;
+    let near = move |b: &Bin| (b.freq_hz - f0).abs() <= half;
+    let fit_name = format!(
+        "SHO fit: f₀ = {:.3} kHz, Q = {:.1}, k = {:.3} N/m",
+        report.fit_resonance_hz * 1e-3,
+        report.fit_quality,
+        report.fit_stiffness_n_m
+    );
+    let series = |welch: Vec<(f64, f64)>,
+                  keep: &dyn Fn(&Bin) -> bool,
+                  (welch_name, own, fitted): (&str, &str, &str)| {
+        vec![
+            Series::new(welch_name, welch, Style::Line, 2),
+            Series::new(own, model(|b| b.sho_m2_hz, keep), Style::Line, 0),
+            Series::new(fitted, model(|b| b.fit_m2_hz, keep), Style::Dashed, 1),
+        ]
+    };
+    let overview = series(
+        coarse,
+        &wide,
+        (
+            "simulated record, Welch (1 % bins)",
+            "S_z(f), the cantilever's own (Hutter & Bechhoefer)",
+            &fit_name,
+        ),
+    );
+    let resonance = series(
+        model(|b| b.welch_m2_hz, &near),
+        &near,
+        ("record (every bin)", "cantilever's own", "SHO fit"),
+    );
+    // Room above the peak for the legend.
+    let (lo, hi) = resonance
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .fold((f64::INFINITY, 0.0_f64), |(lo, hi), y| {
+            (lo.min(y), hi.max(y))
+        });
+    vec![
+        Chart {
+            name: "thermal_spectrum".into(),
+            title: title.clone(),
+            x: Axis::log("frequency f (kHz)", "freq_khz"),
+            y: Axis::log("deflection PSD S_z (pm²/Hz)", "psd_pm2_hz"),
+            legend: Corner::LowerLeft,
+            series: overview,
+            labels: Vec::new(),
+        },
+        Chart {
+            name: "thermal_resonance".into(),
+            title: "around the resonance (10 linewidths either side)".into(),
+            x: Axis::linear("frequency f (kHz)", "freq_khz"),
+            y: Axis::log("deflection PSD S_z (pm²/Hz)", "psd_pm2_hz")
+                .with_range(0.7 * lo, 8.0 * hi),
+            legend: Corner::UpperRight,
+            series: resonance,
+            labels: Vec::new(),
+        },
+    ]
+}

@@ -1,0 +1,1186 @@
+//! Rendering a [`Chart`] with plotters, to PNG and SVG, in one house style, with an
+//! embedded font (DejaVu Sans) so no system font configuration is needed.
+
+use super::chart::{Chart, Corner, Scale, Style};
+use super::heatmap::{Cell, HeatMap, viridis};
+use super::output;
+use crate::error::{Error, Result};
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::Once;
+
+/// Size of every plot in pixels.
+pub const SIZE: (u32, u32) = (960, 720);
+
+/// Colour-blind-safe palette (Okabe–Ito).
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(0, 0, 0),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 114, 178),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(240, 228, 66),
+];
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The bytes are a valid TrueType font shipped by the `dejavu` crate.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            dejavu::sans::regular(),
+        );
+    });
+}
+
+impl Chart {
+    /// Write `<dir>/<name>.csv`, `.png` and `.svg`; returns the paths written.
+    pub fn write_all(&self, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
+        let csv_path = dir.join(format!("{}.csv", self.name));
+        output::write_bytes(&csv_path, &self.to_csv()?)?;
+        let png = dir.join(format!("{}.png", self.name));
+        let svg = dir.join(format!("{}.svg", self.name));
+        render_png(self, &png)?;
+        render_svg(self, &svg)?;
+        Ok(vec![csv_path, png, svg])
+    }
+}
+
+/// Render `chart` to a PNG file at `path` (written atomically).
+pub fn render_png(chart: &Chart, path: &Path) -> Result<()> {
+    render_stack_png(std::slice::from_ref(chart), path, Arrange::Stack)
+}
+
+/// Render `chart` to an SVG file at `path` (written atomically).
+pub fn render_svg(chart: &Chart, path: &Path) -> Result<()> {
+    render_stack_svg(std::slice::from_ref(chart), path, Arrange::Stack)
+}
+
+/// Where a panel was drawn: its plotting area (backend pixels, x and y ranges) and how
+/// much of its data its legend covers (0: none).
+#[derive(Debug, Clone, PartialEq)]
+struct Drawn {
+    area: (std::ops::Range<i32>, std::ops::Range<i32>),
+    legend_covers: usize,
+}
+
+/// One panel of a figure: a chart or a heat map.
+trait Panel {
+    /// Draw into `area`; where the plotting area went.
+    fn draw_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<Drawn, String>;
+}
+
+impl Panel for Chart {
+    fn draw_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<Drawn, String> {
+        draw(self, area)
+    }
+}
+
+impl Panel for HeatMap {
+    fn draw_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<Drawn, String> {
+        draw_heatmap(self, area)
+    }
+}
+
+/// Draw `panels` on `root`: one above the other up to three, else row by row in two
+/// columns ([`grid`]).
+fn draw_stack<DB: DrawingBackend, P: Panel>(
+    panels: &[P],
+    root: &DrawingArea<DB, Shift>,
+    arrange: Arrange,
+) -> std::result::Result<Vec<Drawn>, String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    panels
+        .iter()
+        .zip(root.split_evenly(grid(panels.len(), arrange)))
+        .map(|(panel, area)| panel.draw_panel(&area))
+        .collect()
+}
+
+/// Rows and columns of a figure of `n` charts.
+fn grid(n: usize, arrange: Arrange) -> (usize, usize) {
+    if arrange == Arrange::SideBySide {
+        (1, n.max(1))
+    } else if n <= 3 {
+        (n.max(1), 1)
+    } else {
+        (n.div_ceil(2), 2)
+    }
+}
+
+fn stack_size(n: usize, arrange: Arrange) -> (u32, u32) {
+    let (rows, columns) = grid(n, arrange);
+    if n <= 1 {
+        SIZE
+    } else if arrange == Arrange::SideBySide {
+        (SIZE.0 * columns as u32 * 3 / 4, SIZE.1 * 3 / 4)
+    } else {
+        (SIZE.0 * columns as u32, (SIZE.1 * 2 / 3) * rows as u32)
+    }
+}
+
+/// Drawn into memory and encoded there, then written like any other output: file
+/// errors are told as such, and a PNG can go to a device or a FIFO like a CSV. The
+/// pixels are the SVG's, anti-aliased ([`rasterize_smooth`]).
+fn render_stack_png<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
+    use image::ImageEncoder;
+    let (pixels, (width, height)) =
+        rasterize_smooth(panels, arrange).map_err(|reason| fail(path, reason))?;
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(&pixels, width, height, image::ColorType::Rgb8)
+        .map_err(|e| fail(path, format!("PNG encoding failed: {e}")))?;
+    output::write_bytes(path, &bytes)
+}
+
+/// RGB pixels, their width and height, and where each panel went.
+#[cfg(test)]
+type Raster = (Vec<u8>, (u32, u32), Vec<Drawn>);
+
+/// How many data points the legend of `chart`, drawn alone, covers (for the tests of
+/// the charts other modules build).
+#[cfg(test)]
+pub(crate) fn legend_covers(chart: &Chart) -> usize {
+    let (_, _, drawn) =
+        rasterize(std::slice::from_ref(chart), Arrange::Stack).expect("the chart draws");
+    drawn[0].legend_covers
+}
+
+/// `panels` drawn into RGB pixels by plotters' bitmap backend ([`draw_stack`]): no
+/// anti-aliasing, so every pixel of a series is exactly its colour (what the layout
+/// tests count).
+#[cfg(test)]
+fn rasterize<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<Raster, String> {
+    register_font();
+    let (width, height) = stack_size(panels.len(), arrange);
+    let mut pixels = vec![0u8; 3 * width as usize * height as usize];
+    let drawn = {
+        let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
+        let drawn = draw_stack(panels, &root, arrange)?;
+        root.present().map_err(|e| e.to_string())?;
+        drawn
+    };
+    Ok((pixels, (width, height), drawn))
+}
+
+/// The figure's SVG text ([`draw_stack`] into plotters' SVG backend).
+fn svg_text<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<String, String> {
+    register_font();
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, stack_size(panels.len(), arrange))
+            .into_drawing_area();
+        draw_stack(panels, &root, arrange)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(text)
+}
+
+/// `panels` as anti-aliased RGB pixels and their size: the figure's SVG drawn by resvg
+/// on white, its text in the embedded DejaVu Sans (plotters writes `sans-serif`).
+fn rasterize_smooth<P: Panel>(
+    panels: &[P],
+    arrange: Arrange,
+) -> std::result::Result<(Vec<u8>, (u32, u32)), String> {
+    use resvg::{tiny_skia, usvg};
+    // The embedded font's database, built once for every figure of the run.
+    static FONTS: std::sync::OnceLock<std::sync::Arc<usvg::fontdb::Database>> =
+        std::sync::OnceLock::new();
+    let fonts = FONTS.get_or_init(|| {
+        let mut fonts = usvg::fontdb::Database::new();
+        fonts.load_font_data(dejavu::sans::regular().to_vec());
+        fonts.set_sans_serif_family("DejaVu Sans");
+        std::sync::Arc::new(fonts)
+    });
+    let svg = svg_text(panels, arrange)?;
+    let options = usvg::Options {
+        font_family: "DejaVu Sans".into(),
+        fontdb: fonts.clone(),
+        ..Default::default()
+    };
+    let tree = usvg::Tree::from_str(&svg, &options).map_err(|e| e.to_string())?;
+    let (width, height) = stack_size(panels.len(), arrange);
+    let mut pixmap = tiny_skia::Pixmap::new(width, height).ok_or("an empty figure")?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(
+        &tree,
+        tiny_skia::Transform::identity(),
+        &mut pixmap.as_mut(),
+    );
+    // Opaque (drawn on white): the premultiplied RGBA is the RGB.
+    let rgb = pixmap
+        .data()
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    Ok((rgb, (width, height)))
+}
+
+fn render_stack_svg<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
+    let text = svg_text(panels, arrange).map_err(|reason| fail(path, reason))?;
+    output::write_bytes(path, text.as_bytes())
+}
+
+/// Render `charts` one above the other into `path`, PNG or SVG by its extension.
+pub fn render_stack(charts: &[Chart], path: &Path) -> Result<()> {
+    render(charts, path, Arrange::Stack)
+}
+
+/// Render heat maps one above the other into `path`, PNG or SVG by its extension.
+pub fn render_heatmaps(maps: &[HeatMap], path: &Path) -> Result<()> {
+    render(maps, path, Arrange::Stack)
+}
+
+/// Render heat maps side by side into `path` (an image's channels), PNG or SVG by its
+/// extension.
+pub fn render_side_by_side(maps: &[HeatMap], path: &Path) -> Result<()> {
+    render(maps, path, Arrange::SideBySide)
+}
+
+/// How the panels of a figure are laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Arrange {
+    /// One above the other up to three, else row by row in two columns.
+    Stack,
+    /// In one row.
+    SideBySide,
+}
+
+/// `panels` into `path`, PNG or SVG by its extension.
+fn render<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("png") => render_stack_png(panels, path, arrange),
+        Some("svg") => render_stack_svg(panels, path, arrange),
+        _ => Err(fail(path, "the plot file must end in .png or .svg".into())),
+    }
+}
+
+/// Ticks of a log axis over [lo, hi]: 1, 2 and 5 times each power of ten inside, or
+/// 1, 2, 3 and 5 times, or every integer multiple, the first that gives four or more.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let within = |multiples: &[f64]| -> Vec<f64> {
+        let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (first..=last)
+            .flat_map(|d| {
+                // (3/10, not 3·0.1: the tick is the decimal number.)
+                multiples.iter().map(move |m| {
+                    if d < 0 {
+                        m / 10f64.powi(-d)
+                    } else {
+                        m * 10f64.powi(d)
+                    }
+                })
+            })
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let mut ticks = Vec::new();
+    for multiples in [
+        &[1.0, 2.0, 5.0][..],
+        &[1.0, 2.0, 3.0, 5.0],
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+    ] {
+        ticks = within(multiples);
+        if ticks.len() >= 4 {
+            break;
+        }
+    }
+    ticks
+}
+
+/// One heat map: the cells on log axes (a parameter grid) or linear ones (an image), and
+/// beside them the colour bar with a key to the grey (the law does not apply) and the
+/// marked (not period-1) cells, where there is such a key ([`HeatMap::empty_label`]).
+fn draw_heatmap<DB: DrawingBackend>(
+    map: &HeatMap,
+    area: &DrawingArea<DB, Shift>,
+) -> std::result::Result<Drawn, String> {
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let (width, _) = area.dim_in_pixel();
+    let (main, side) = area.split_horizontally(width as i32 * 4 / 5);
+    let (xe, ye) = map.cell_edges();
+    if xe.len() < 2 || ye.len() < 2 {
+        return Err("a heat map needs at least one cell".into());
+    }
+    let (lo, hi) = map.value_range().unwrap_or((0.0, 1.0));
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let colour = |v: f64| {
+        let (r, g, b) = viridis((v - lo) / span);
+        RGBColor(r, g, b)
+    };
+    let grey = RGBColor(225, 225, 225);
+    let (x_range, y_range) = (xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1]);
+    let cells: (&[f64], &[f64], &dyn Fn(f64) -> RGBColor, RGBColor) = (&xe, &ye, &colour, grey);
+    let plotted = if map.log_axes {
+        let x_ticks = log_ticks(x_range.start, x_range.end);
+        let y_ticks = log_ticks(y_range.start, y_range.end);
+        draw_cells(
+            map,
+            &main,
+            (
+                x_range.log_scale().with_key_points(x_ticks),
+                y_range.log_scale().with_key_points(y_ticks),
+            ),
+            Scale::Log,
+            cells,
+        )?
+    } else {
+        draw_cells(map, &main, (x_range, y_range), Scale::Linear, cells)?
+    };
+    // The colour bar, level with the plotting area, and the key below it.
+    let top = plotted.1.start - area.get_base_pixel().1;
+    let bottom = plotted.1.end - area.get_base_pixel().1;
+    let (_, side_height) = side.dim_in_pixel();
+    let mut bar = ChartBuilder::on(&side)
+        .margin_top(top.max(0) as u32)
+        .margin_bottom((side_height as i32 - bottom).max(0) as u32)
+        .margin_right(10)
+        .y_label_area_size(90)
+        .build_cartesian_2d(0.0..1.0, lo..lo + span)
+        .map_err(|e| err(&e))?;
+    let plain = |v: &f64| tick_label(*v, Scale::Linear);
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_label_formatter(&plain)
+        .y_desc(map.value_label.as_str())
+        .axis_desc_style(("sans-serif", 20))
+        .label_style(("sans-serif", 17))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let steps = 100;
+    bar.draw_series((0..steps).map(|k| {
+        let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
+        Rectangle::new(
+            [(0.0, lo + a * span), (1.0, lo + b * span)],
+            colour(lo + 0.5 * (a + b) * span).filled(),
+        )
+    }))
+    .map_err(|e| err(&e))?;
+    if map.empty_label.is_empty() {
+        return Ok(Drawn {
+            area: plotted,
+            legend_covers: 0,
+        });
+    }
+    let key = ("sans-serif", 16).into_font().color(&BLACK);
+    let at = |dy: i32| (10, bottom + 14 + dy);
+    side.draw(&Circle::new(at(8), 6, BLACK.stroke_width(2)))
+        .map_err(|e| err(&e))?;
+    side.draw(&Text::new(
+        "not period-1",
+        (at(0).0 + 14, at(0).1),
+        key.clone(),
+    ))
+    .map_err(|e| err(&e))?;
+    side.draw(&Circle::new(at(32), 3, BLACK.filled()))
+        .map_err(|e| err(&e))?;
+    side.draw(&Text::new(
+        "grazes a switch",
+        (at(24).0 + 14, at(24).1),
+        key.clone(),
+    ))
+    .map_err(|e| err(&e))?;
+    side.draw(&Rectangle::new(
+        [at(48), (at(48).0 + 12, at(48).1 + 12)],
+        grey.filled(),
+    ))
+    .map_err(|e| err(&e))?;
+    side.draw(&Text::new(
+        map.empty_label.as_str(),
+        (at(48).0 + 18, at(48).1),
+        key,
+    ))
+    .map_err(|e| err(&e))?;
+    Ok(Drawn {
+        area: plotted,
+        legend_covers: 0,
+    })
+}
+
+/// A heat map's axes and cells on `main` (`cells`: the edges along x and y, the colour
+/// of a value, the grey of an empty cell); where the plotting area went.
+fn draw_cells<DB, X, Y>(
+    map: &HeatMap,
+    main: &DrawingArea<DB, Shift>,
+    (x, y): (X, Y),
+    scale: Scale,
+    (xe, ye, colour, grey): (&[f64], &[f64], &dyn Fn(f64) -> RGBColor, RGBColor),
+) -> std::result::Result<(std::ops::Range<i32>, std::ops::Range<i32>), String>
+where
+    DB: DrawingBackend,
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let mut ctx = ChartBuilder::on(main)
+        .caption(&map.title, ("sans-serif", 26))
+        .margin(18)
+        .x_label_area_size(60)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x, y)
+        .map_err(|e| err(&e))?;
+    let label = |v: &f64| tick_label(*v, scale);
+    ctx.configure_mesh()
+        .disable_mesh()
+        .x_label_formatter(&label)
+        .y_label_formatter(&label)
+        .x_desc(map.x_label.as_str())
+        .y_desc(map.y_label.as_str())
+        .axis_desc_style(("sans-serif", 22))
+        .label_style(("sans-serif", 17))
+        .draw()
+        .map_err(|e| err(&e))?;
+    for (j, row) in map.cells.iter().enumerate() {
+        for (i, cell) in row.iter().enumerate() {
+            let corners = [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])];
+            let fill = match *cell {
+                Cell::Value { value, .. } => colour(value),
+                Cell::NotApplicable => grey,
+            };
+            ctx.draw_series(std::iter::once(Rectangle::new(corners, fill.filled())))
+                .map_err(|e| err(&e))?;
+            let centre = (map.x[i], map.y[j]);
+            if let Cell::Value {
+                period_one: false, ..
+            } = cell
+            {
+                ctx.draw_series([
+                    Circle::new(centre, 6, WHITE.filled()),
+                    Circle::new(centre, 6, BLACK.stroke_width(2)),
+                ])
+                .map_err(|e| err(&e))?;
+            }
+            if let Cell::Value { grazing: true, .. } = cell {
+                ctx.draw_series([Circle::new(centre, 3, BLACK.filled())])
+                    .map_err(|e| err(&e))?;
+            }
+        }
+    }
+    Ok(ctx.plotting_area().get_pixel_range())
+}
+
+fn fail(path: &Path, reason: String) -> Error {
+    Error::Output {
+        path: path.to_path_buf(),
+        reason,
+    }
+}
+
+/// Data range of one coordinate over all series, padded; positive-only for log axes.
+fn data_range(chart: &Chart, pick: impl Fn(&(f64, f64)) -> f64, scale: Scale) -> (f64, f64) {
+    let values = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(&pick))
+        .filter(|v| v.is_finite() && (scale == Scale::Linear || *v > 0.0));
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    if !lo.is_finite() {
+        return if scale == Scale::Log {
+            (0.1, 10.0)
+        } else {
+            (0.0, 1.0)
+        };
+    }
+    match scale {
+        Scale::Linear => {
+            // A spread below 1e-6 of the values is below what the numbers resolve (a
+            // quantity constant along the curve, up to round-off): not zoomed into.
+            let floor = 1e-6 * lo.abs().max(hi.abs());
+            if hi - lo > floor {
+                let pad = 0.05 * (hi - lo);
+                (lo - pad, hi + pad)
+            } else {
+                let mid = 0.5 * (lo + hi);
+                let half = if mid == 0.0 { 0.5 } else { 0.05 * mid.abs() };
+                (mid - half, mid + half)
+            }
+        }
+        Scale::Log => {
+            let pad = if hi > lo { (hi / lo).powf(0.05) } else { 2.0 };
+            (lo / pad, hi * pad)
+        }
+    }
+}
+
+fn draw<DB: DrawingBackend>(
+    chart: &Chart,
+    root: &DrawingArea<DB, Shift>,
+) -> std::result::Result<Drawn, String> {
+    let xr = chart
+        .x
+        .range
+        .unwrap_or_else(|| data_range(chart, |p| p.0, chart.x.scale));
+    let yr = chart
+        .y
+        .range
+        .unwrap_or_else(|| data_range(chart, |p| p.1, chart.y.scale));
+    match (chart.x.scale, chart.y.scale) {
+        (Scale::Linear, Scale::Linear) => draw_in(chart, root, xr.0..xr.1, yr.0..yr.1),
+        (Scale::Log, Scale::Linear) => draw_in(chart, root, (xr.0..xr.1).log_scale(), yr.0..yr.1),
+        (Scale::Linear, Scale::Log) => draw_in(chart, root, xr.0..xr.1, (yr.0..yr.1).log_scale()),
+        (Scale::Log, Scale::Log) => draw_in(
+            chart,
+            root,
+            (xr.0..xr.1).log_scale(),
+            (yr.0..yr.1).log_scale(),
+        ),
+    }
+}
+
+fn draw_in<DB, X, Y>(
+    chart: &Chart,
+    root: &DrawingArea<DB, Shift>,
+    xr: X,
+    yr: Y,
+) -> std::result::Result<Drawn, String>
+where
+    DB: DrawingBackend,
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let mut ctx = ChartBuilder::on(root)
+        .caption(&chart.title, ("sans-serif", 26))
+        .margin(18)
+        .margin_right(40)
+        .x_label_area_size(60)
+        .y_label_area_size(80)
+        .build_cartesian_2d(xr, yr)
+        .map_err(|e| err(&e))?;
+    let fx = |v: &f64| tick_label(*v, chart.x.scale);
+    let fy = |v: &f64| tick_label(*v, chart.y.scale);
+    ctx.configure_mesh()
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
+        .x_desc(chart.x.label.as_str())
+        .y_desc(chart.y.label.as_str())
+        .axis_desc_style(("sans-serif", 22))
+        .label_style(("sans-serif", 17))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(210, 210, 210))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let (x_lo, x_hi) = (ctx.x_range().start, ctx.x_range().end);
+    let (y_lo, y_hi) = (ctx.y_range().start, ctx.y_range().end);
+    let clip = Clip::new(
+        (x_lo, x_hi, chart.x.scale == Scale::Log),
+        (y_lo, y_hi, chart.y.scale == Scale::Log),
+    );
+    for series in &chart.series {
+        let color = PALETTE[series.color % PALETTE.len()];
+        let style = color.stroke_width(2);
+        // A marker style: each point inside the axes drawn by `$at`, the legend entry
+        // (for a named series) by `$legend`.
+        macro_rules! marks {
+            ($at:expr, $legend:expr) => {{
+                let inside = series.points.iter().copied().filter(|&p| clip.contains(p));
+                let anno = ctx.draw_series(inside.map($at)).map_err(|e| err(&e))?;
+                if !series.name.is_empty() {
+                    anno.label(series.name.as_str()).legend($legend);
+                }
+            }};
+        }
+        match series.style {
+            Style::Markers => marks!(|p| Circle::new(p, 5, style), move |(x, y)| Circle::new(
+                (x + 10, y),
+                5,
+                style
+            )),
+            Style::Squares => marks!(
+                move |p| EmptyElement::at(p) + Rectangle::new([(-7, -7), (7, 7)], style),
+                move |(x, y)| Rectangle::new([(x + 3, y - 7), (x + 17, y + 7)], style)
+            ),
+            Style::Crosses => marks!(|p| Cross::new(p, 5, style), move |(x, y)| Cross::new(
+                (x + 10, y),
+                5,
+                style
+            )),
+            Style::Dots => {
+                let filled = color.filled();
+                marks!(|p| Circle::new(p, 2, filled), move |(x, y)| Circle::new(
+                    (x + 10, y),
+                    4,
+                    filled
+                ))
+            }
+            Style::Triangles => {
+                let filled = color.filled();
+                marks!(|p| TriangleMarker::new(p, 7, filled), move |(x, y)| {
+                    TriangleMarker::new((x + 10, y), 7, filled)
+                })
+            }
+            Style::Line | Style::Dashed | Style::Dotted => {
+                let (dash, gap) = match series.style {
+                    Style::Dashed => (12, 8),
+                    _ => (3, 5),
+                };
+                // A named series with no points is a legend entry alone (a curve whose
+                // every point is drawn as a marker).
+                let mut runs = clip.runs(&series.points);
+                if series.points.is_empty() && !series.name.is_empty() {
+                    runs.push(Vec::new());
+                }
+                for (i, run) in runs.into_iter().enumerate() {
+                    let anno = if series.style == Style::Line {
+                        ctx.draw_series(LineSeries::new(run, style))
+                    } else {
+                        ctx.draw_series(DashedLineSeries::new(run, dash, gap, style))
+                    }
+                    .map_err(|e| err(&e))?;
+                    if i == 0 && !series.name.is_empty() {
+                        let solid = series.style == Style::Line;
+                        anno.label(series.name.as_str()).legend(move |(x, y)| {
+                            let (d, g) = if solid { (24, 0) } else { (dash, gap) };
+                            plotters::element::DashedPathElement::new(
+                                vec![(x, y), (x + 24, y)],
+                                d,
+                                g,
+                                style,
+                            )
+                        });
+                    }
+                }
+            }
+        }
+    }
+    for label in &chart.labels {
+        ctx.draw_series(std::iter::once(Text::new(
+            label.text.clone(),
+            (label.x, label.y),
+            ("sans-serif", 22).into_font().color(&BLACK),
+        )))
+        .map_err(|e| err(&e))?;
+    }
+    let mut legend_covers = 0;
+    if chart.legend != Corner::Hidden {
+        let legend = place_legend(&ctx, chart, &clip)?;
+        ctx.configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .label_font(("sans-serif", LEGEND_FONT))
+            .position(SeriesLabelPosition::Coordinate(legend.0, legend.1))
+            .draw()
+            .map_err(|e| err(&e))?;
+        legend_covers = legend.2;
+    }
+    let area = ctx.plotting_area().get_pixel_range();
+    Ok(Drawn {
+        area,
+        legend_covers,
+    })
+}
+
+/// A tick label: decades of a log axis as 0.1, 1, 10, then 10², 10³, … (10⁻², …);
+/// anything else with up to six decimals, trailing zeros dropped ("140", "0.25"), or
+/// far from 1 as a mantissa and exponent ("2.5e-18").
+fn tick_label(v: f64, scale: Scale) -> String {
+    if scale == Scale::Log && v > 0.0 {
+        let k = v.log10().round();
+        if (v.log10() - k).abs() < 1e-9 && !(-1.0..=1.0).contains(&k) {
+            const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+            let exponent: String = (k.abs() as i64)
+                .to_string()
+                .chars()
+                .map(|c| DIGITS[c.to_digit(10).unwrap_or(0) as usize])
+                .collect();
+            return format!("10{}{exponent}", if k < 0.0 { "⁻" } else { "" });
+        }
+    }
+    if v != 0.0 && !(1e-3..1e7).contains(&v.abs()) {
+        // Far from 1: a mantissa with its exponent ("2.5e-18").
+        let text = format!("{v:.4e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        return format!("{mantissa}e{exponent}");
+    }
+    let text = format!("{v:.6}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.into()
+    }
+}
+
+/// Font size of legend entries.
+const LEGEND_FONT: u32 = 17;
+
+/// Where the legend goes, in the plotting area's pixels, and how many markers and line
+/// segments of the data its box covers: of the positions along the plot's edges (the
+/// chart's preferred corner first, then the other corners, then the middles of the
+/// edges), the first that covers nothing, else the one that covers least. The box is
+/// measured as plotters will draw it (the same text layout, a 30-pixel key, 10-pixel
+/// margins).
+fn place_legend<DB, X, Y>(
+    ctx: &ChartContext<DB, Cartesian2d<X, Y>>,
+    chart: &Chart,
+    clip: &Clip,
+) -> std::result::Result<(i32, i32, usize), String>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let style: TextStyle = ("sans-serif", LEGEND_FONT).into_font().into();
+    let mut text = MultiLineText::<_, &str>::new((0, 0), &style);
+    // Labelled as drawn: a line only if some of it is inside the box.
+    for series in chart.series.iter().filter(|s| !s.name.is_empty()) {
+        if series.style.is_marker()
+            || series.points.is_empty()
+            || !clip.runs(&series.points).is_empty()
+        {
+            text.push_line(series.name.as_str());
+        }
+    }
+    let (w, h) = text.estimate_dimension().map_err(|e| e.to_string())?;
+    let (w, h) = (w + 30 + 20, h + 20);
+    let area = ctx.plotting_area();
+    let (aw, ah) = area.dim_in_pixel();
+    let (aw, ah) = (aw as i32, ah as i32);
+    let base = area.get_base_pixel();
+    let local = |p: (f64, f64)| {
+        let (x, y) = ctx.backend_coord(&p);
+        ((x - base.0) as f64, (y - base.1) as f64)
+    };
+    let markers: Vec<(f64, f64)> = chart
+        .series
+        .iter()
+        .filter(|s| s.style.is_marker())
+        .flat_map(|s| s.points.iter().copied().filter(|&p| clip.contains(p)))
+        .map(local)
+        .collect();
+    let segments: Vec<((f64, f64), (f64, f64))> = chart
+        .series
+        .iter()
+        .filter(|s| !s.style.is_marker())
+        .flat_map(|s| clip.runs(&s.points))
+        .flat_map(|run| {
+            let px: Vec<_> = run.into_iter().map(local).collect();
+            px.windows(2).map(|w| (w[0], w[1])).collect::<Vec<_>>()
+        })
+        .collect();
+    let covers = |(x, y): (i32, i32)| {
+        // The box grown by a marker's radius and a line's half width.
+        let (x0, x1, y0, y1) = (x as f64, (x + w) as f64, y as f64, (y + h) as f64);
+        let m = markers
+            .iter()
+            .filter(|p| p.0 >= x0 - 7.0 && p.0 <= x1 + 7.0 && p.1 >= y0 - 7.0 && p.1 <= y1 + 7.0)
+            .count();
+        let l = segments
+            .iter()
+            .filter(|(a, b)| {
+                liang_barsky(*a, *b, (x0 - 2.0, x1 + 2.0), (y0 - 2.0, y1 + 2.0)).is_some()
+            })
+            .count();
+        m + l
+    };
+    let (left, right, mid_x) = (5, aw - w - 5, (aw - w) / 2);
+    let (top, bottom, mid_y) = (5, ah - h - 5, (ah - h) / 2);
+    let corners = [
+        (Corner::UpperRight, (right, top)),
+        (Corner::UpperLeft, (left, top)),
+        (Corner::LowerRight, (right, bottom)),
+        (Corner::LowerLeft, (left, bottom)),
+    ];
+    let preferred = corners.iter().filter(|c| c.0 == chart.legend);
+    let others = corners.iter().filter(|c| c.0 != chart.legend);
+    let candidates = preferred.chain(others).map(|c| c.1).chain([
+        (right, mid_y),
+        (left, mid_y),
+        (mid_x, top),
+        (mid_x, bottom),
+    ]);
+    let mut best = (right, top, usize::MAX);
+    for at in candidates {
+        let n = covers(at);
+        if n < best.2 {
+            best = (at.0, at.1, n);
+        }
+        if n == 0 {
+            break;
+        }
+    }
+    Ok(best)
+}
+
+/// Clipping of polylines to the plotted box (plotters would clamp out-of-range points
+/// onto the border, bending straight lines). Works in the axes' own coordinates:
+/// log10 of the value on a log axis, so straight lines stay straight.
+struct Clip {
+    x: (f64, f64, bool),
+    y: (f64, f64, bool),
+}
+
+impl Clip {
+    fn new(x: (f64, f64, bool), y: (f64, f64, bool)) -> Self {
+        Self { x, y }
+    }
+
+    fn data_to_axes(&self, (x, y): (f64, f64)) -> (f64, f64) {
+        let t = |v: f64, log: bool| if log { v.log10() } else { v };
+        (t(x, self.x.2), t(y, self.y.2))
+    }
+
+    fn axes_to_data(&self, (u, v): (f64, f64)) -> (f64, f64) {
+        let t = |w: f64, log: bool| if log { 10f64.powf(w) } else { w };
+        (t(u, self.x.2), t(v, self.y.2))
+    }
+
+    fn contains(&self, p: (f64, f64)) -> bool {
+        let ok = |v: f64, (lo, hi, log): (f64, f64, bool)| {
+            v.is_finite() && v >= lo && v <= hi && (!log || v > 0.0)
+        };
+        ok(p.0, self.x) && ok(p.1, self.y)
+    }
+
+    /// The parts of the polyline inside the box, each a run of connected points.
+    fn runs(&self, points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+        let (x0, y0) = self.data_to_axes((self.x.0, self.y.0));
+        let (x1, y1) = self.data_to_axes((self.x.1, self.y.1));
+        let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+        let mut current: Vec<(f64, f64)> = Vec::new();
+        for w in points.windows(2) {
+            let (a, b) = (self.data_to_axes(w[0]), self.data_to_axes(w[1]));
+            let clipped = if [a.0, a.1, b.0, b.1].iter().all(|v| v.is_finite()) {
+                liang_barsky(a, b, (x0, x1), (y0, y1))
+            } else {
+                None
+            };
+            match clipped {
+                Some((p, q)) => {
+                    let (p, q) = (self.axes_to_data(p), self.axes_to_data(q));
+                    if current.last() != Some(&p) {
+                        if !current.is_empty() {
+                            runs.push(std::mem::take(&mut current));
+                        }
+                        current.push(p);
+                    }
+                    current.push(q);
+                }
+                None => {
+                    if !current.is_empty() {
+                        runs.push(std::mem::take(&mut current));
+                    }
+                }
+            }
+        }
+        if !current.is_empty() {
+            runs.push(current);
+        }
+        runs
+    }
+}
+
+/// The part of segment a→b inside the box, by the Liang–Barsky algorithm.
+fn liang_barsky(
+    a: (f64, f64),
+    b: (f64, f64),
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Option<((f64, f64), (f64, f64))> {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [
+        (-dx, a.0 - x0),
+        (dx, x1 - a.0),
+        (-dy, a.1 - y0),
+        (dy, y1 - a.1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let r = q / p;
+            if p < 0.0 {
+                t0 = t0.max(r);
+            } else {
+                t1 = t1.min(r);
+            }
+        }
+    }
+    (t0 <= t1).then(|| {
+        let at = |t: f64| (a.0 + t * dx, a.1 + t * dy);
+        (at(t0), at(t1))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clipping_keeps_log_lines_straight() {
+        let clip = Clip::new((1.0, 100.0, true), (1.0, 100.0, true));
+        // y = 1000/x from x = 1 to 1e4 crosses the box from (10, 100) to (100, 10).
+        let runs = clip.runs(&[(1.0, 1000.0), (1e4, 0.1)]);
+        assert_eq!(runs.len(), 1);
+        let (p, q) = (runs[0][0], runs[0][1]);
+        assert!((p.0 - 10.0).abs() < 1e-9 && (p.1 - 100.0).abs() < 1e-9);
+        assert!((q.0 - 100.0).abs() < 1e-9 && (q.1 - 10.0).abs() < 1e-9);
+    }
+
+    use crate::app::report::chart::{Axis, Series};
+
+    fn chart(x: Axis, y: Axis, series: Vec<Series>, legend: Corner) -> Chart {
+        Chart {
+            name: "test".into(),
+            title: "test".into(),
+            x,
+            y,
+            series,
+            labels: Vec::new(),
+            legend,
+        }
+    }
+
+    /// Pixels of exactly `color` outside the drawn charts' plotting areas (grown by a
+    /// pixel for a line's half width).
+    fn strays(charts: &[Chart], color: RGBColor) -> usize {
+        let (pixels, (width, _), drawn) = rasterize(charts, Arrange::Stack).unwrap();
+        pixels
+            .chunks(3)
+            .enumerate()
+            .filter(|(_, p)| (p[0], p[1], p[2]) == (color.0, color.1, color.2))
+            .filter(|&(i, _)| {
+                let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
+                !drawn.iter().any(|d| {
+                    (d.area.0.start - 1..d.area.0.end + 1).contains(&x)
+                        && (d.area.1.start - 1..d.area.1.end + 1).contains(&y)
+                })
+            })
+            .count()
+    }
+
+    #[test]
+    fn no_drawn_pixel_of_a_series_leaves_its_plot_area() {
+        // Thick lines that run far outside fixed ranges, solid and dashed, on linear and
+        // log axes, one chart and a stack (plotters' bitmap backend draws wide strokes
+        // as polygons it does not clip).
+        let wild = vec![(-5.0, 3.0), (0.5, 0.5), (5.0, -3.0), (0.2, 9.0), (0.9, 0.1)];
+        let color = PALETTE[7];
+        let lines = |style| Series::new("wild", wild.clone(), style, 7);
+        let linear = chart(
+            Axis::linear("x", "x").with_range(0.0, 1.0),
+            Axis::linear("y", "y").with_range(0.0, 1.0),
+            vec![lines(Style::Line), lines(Style::Dashed)],
+            Corner::UpperRight,
+        );
+        let positive: Vec<(f64, f64)> = wild
+            .iter()
+            .map(|p| (p.0.abs() + 1e-3, p.1.abs() + 1e-3))
+            .collect();
+        let log = chart(
+            Axis::log("x", "x").with_range(0.1, 1.0),
+            Axis::log("y", "y").with_range(0.1, 1.0),
+            vec![Series::new("wild", positive, Style::Dotted, 7)],
+            Corner::LowerLeft,
+        );
+        assert!(strays(std::slice::from_ref(&linear), color) == 0);
+        assert!(strays(&[linear.clone(), log.clone(), linear], color) == 0);
+        // (Not vacuous: the series is drawn, in that colour.)
+        let (pixels, _, _) = rasterize(&[log], Arrange::Stack).unwrap();
+        assert!(
+            pixels
+                .chunks(3)
+                .any(|p| (p[0], p[1], p[2]) == (color.0, color.1, color.2))
+        );
+    }
+
+    #[test]
+    fn the_legend_goes_where_it_covers_no_data() {
+        // A line through the preferred (upper right) corner and markers in the upper left.
+        let diagonal: Vec<(f64, f64)> = (0..=50)
+            .map(|i| (i as f64 / 50.0, i as f64 / 50.0))
+            .collect();
+        let upper_left: Vec<(f64, f64)> = (0..10)
+            .map(|i| (0.02 * i as f64, 0.98 - 0.02 * i as f64))
+            .collect();
+        let busy = chart(
+            Axis::linear("x", "x").with_range(0.0, 1.0),
+            Axis::linear("y", "y").with_range(0.0, 1.0),
+            vec![
+                Series::new("diagonal", diagonal, Style::Line, 1),
+                Series::new("corner", upper_left, Style::Markers, 2),
+            ],
+            Corner::UpperRight,
+        );
+        let (_, _, drawn) = rasterize(&[busy], Arrange::Stack).unwrap();
+        assert_eq!(drawn[0].legend_covers, 0);
+    }
+
+    #[test]
+    fn tick_labels_read_as_people_write_them() {
+        let log = |v| tick_label(v, Scale::Log);
+        let lin = |v| tick_label(v, Scale::Linear);
+        assert_eq!(
+            [
+                log(0.01),
+                log(0.1),
+                log(1.0),
+                log(10.0),
+                log(100.0),
+                log(1e3),
+                log(2e3)
+            ],
+            ["10⁻²", "0.1", "1", "10", "10²", "10³", "2000"]
+        );
+        assert_eq!(
+            [
+                lin(140.0),
+                lin(0.25),
+                lin(0.1 + 0.2),
+                lin(-0.0),
+                lin(-2.5),
+                lin(2.5e-18)
+            ],
+            ["140", "0.25", "0.3", "0", "-2.5", "2.5e-18"]
+        );
+    }
+
+    #[test]
+    fn a_heat_map_colours_cells_greys_the_inapplicable_and_marks_the_irregular() {
+        let map = HeatMap {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            value_label: "v".into(),
+            empty_label: "law n/a".into(),
+            x: vec![1.0, 10.0],
+            y: vec![1.0, 10.0],
+            log_axes: true,
+            cells: vec![
+                vec![
+                    Cell::Value {
+                        value: 0.0,
+                        period_one: true,
+                        grazing: false,
+                    },
+                    Cell::Value {
+                        value: 1.0,
+                        period_one: false,
+                        grazing: false,
+                    },
+                ],
+                vec![
+                    Cell::NotApplicable,
+                    Cell::Value {
+                        value: 0.5,
+                        period_one: true,
+                        grazing: false,
+                    },
+                ],
+            ],
+        };
+        let (pixels, _, _) = rasterize(&[map], Arrange::Stack).unwrap();
+        let count = |c: (u8, u8, u8)| pixels.chunks(3).filter(|p| (p[0], p[1], p[2]) == c).count();
+        // A quarter of a ~600 x 500 plot each, and the ends of the colour bar.
+        assert!(count(viridis(0.0)) > 20_000, "{}", count(viridis(0.0)));
+        assert!(count(viridis(1.0)) > 20_000);
+        assert!(count(viridis(0.5)) > 20_000);
+        assert!(count((225, 225, 225)) > 20_000);
+        // The marked cell has a white disc in it.
+        assert!(count((255, 255, 255)) > 0);
+        assert_eq!(log_ticks(0.017, 0.23), [0.02, 0.05, 0.1, 0.2]);
+        assert_eq!(log_ticks(0.26, 3.5), [0.3, 0.5, 1.0, 2.0, 3.0]);
+    }
+
+    #[test]
+    fn clipping_splits_runs_that_leave_the_box() {
+        let clip = Clip::new((0.0, 1.0, false), (0.0, 1.0, false));
+        let runs = clip.runs(&[(0.1, 0.5), (0.5, 2.0), (0.9, 0.5), (0.95, 0.5)]);
+        assert_eq!(runs.len(), 2);
+    }
+
+    /// The PNG's pixels are the bitmap backend's geometry, anti-aliased and with its
+    /// text. Plotters' bitmap backend blends the edges of a wide line but draws a
+    /// marker's ring mostly pixel by pixel, in its colour or not at all; in the PNG the
+    /// rings' edges are blended into the white (three times the pixels only partly of the
+    /// colour), every
+    /// pixel of the colour lies within two pixels of where the bitmap backend drew it, and
+    /// the title is drawn (the embedded font was found: without it resvg would draw no
+    /// text at all).
+    #[test]
+    fn png_markers_are_anti_aliased_where_the_bitmap_draws_them() {
+        let points: Vec<(f64, f64)> = (1..20)
+            .map(|i| (i as f64 / 20.0, 0.3 * i as f64 / 20.0 + 0.1))
+            .collect();
+        let c = chart(
+            Axis::linear("x", "x").with_range(0.0, 1.0),
+            Axis::linear("y", "y").with_range(0.0, 1.0),
+            vec![Series::new("rings", points, Style::Markers, 2)],
+            Corner::UpperRight,
+        );
+        let color = PALETTE[2];
+        // The share t of the marker's colour over white in a pixel (None: another
+        // colour, to within 3 levels).
+        let coverage = |p: &[u8]| {
+            let t = (255.0 - p[0] as f64) / (255.0 - color.0 as f64);
+            let on_white = [color.0, color.1, color.2].iter().zip(p).all(|(&c, &v)| {
+                let expect = t * c as f64 + (1.0 - t) * 255.0;
+                (expect - v as f64).abs() <= 3.0
+            });
+            (t > 0.05 && on_white).then_some(t.min(1.0))
+        };
+        let (bitmap, (width, height), _) =
+            rasterize(std::slice::from_ref(&c), Arrange::Stack).unwrap();
+        let (smooth, size) = rasterize_smooth(std::slice::from_ref(&c), Arrange::Stack).unwrap();
+        assert_eq!(size, (width, height));
+        let partial = |px: &[u8]| {
+            px.chunks(3)
+                .filter(|p| coverage(p).is_some_and(|t| (0.15..0.85).contains(&t)))
+                .count()
+        };
+        let (soft, hard) = (partial(&smooth), partial(&bitmap));
+        // (668 against 212 when written.)
+        assert!(soft > 2 * hard, "partly covered: {soft} PNG, {hard} bitmap");
+        let pixel = |x: usize, y: usize| &smooth[3 * (y * width as usize + x)..][..3];
+        let title_ink = (0..40)
+            .flat_map(|y| (300..660).map(move |x| (x, y)))
+            .filter(|&(x, y)| pixel(x, y).iter().all(|&v| v < 80))
+            .count();
+        assert!(title_ink > 20, "no title: {title_ink} dark pixels");
+        let line: Vec<(i64, i64)> = bitmap
+            .chunks(3)
+            .enumerate()
+            .filter(|(_, p)| coverage(p).is_some())
+            .map(|(i, _)| ((i as u32 % width) as i64, (i as u32 / width) as i64))
+            .collect();
+        for (i, p) in smooth.chunks(3).enumerate() {
+            if coverage(p).is_some_and(|t| t > 0.3) {
+                let (x, y) = ((i as u32 % width) as i64, (i as u32 / width) as i64);
+                assert!(
+                    line.iter()
+                        .any(|&(u, v)| (u - x).abs() <= 2 && (v - y).abs() <= 2),
+                    "a pixel of a ring at ({x}, {y}) far from the bitmap's"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,624 @@
+//! Tip–sample force laws for the dynamics, behind one trait.
+//!
+//! Every law works in the contact's dimensionless variables: separation α̂ = α/(με) and
+//! force T̂ = T/(RΔγ) (tensile positive), so inner loops never touch SI units. A law has
+//! two branches — out of contact ([`Branch::Free`]) and in contact ([`Branch::Contact`]) —
+//! and switches from Free to Contact when α̂ falls to [`ForceLaw::jump_in_alpha_hat`], and
+//! back when α̂ rises to [`ForceLaw::jump_out_alpha_hat`]. Conservative laws switch both
+//! ways at the same separation; hysteretic laws enclose [`ForceLaw::loop_area_hat`].
+
+/// The methods of a wrapper around a contact law (`elastic_law()`) that leaves the
+/// law's elastic part as it is: force, slope and work function per branch, the
+/// capillary share, the switches and the loop. A wrapper that adds a rate-dependent
+/// force (a viscous or relaxing sample) writes only what it adds.
+macro_rules! elastic_part_from_inside {
+    () => {
+        #[inline]
+        fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.elastic_law().t_hat(alpha_hat, branch)
+        }
+        #[inline]
+        fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.elastic_law().slope_hat(alpha_hat, branch)
+        }
+        fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.elastic_law().work_hat(alpha_hat, branch)
+        }
+        fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.elastic_law().capillary_work_hat(alpha_hat, branch)
+        }
+        fn jump_in_alpha_hat(&self) -> f64 {
+            self.elastic_law().jump_in_alpha_hat()
+        }
+        fn jump_out_alpha_hat(&self) -> f64 {
+            self.elastic_law().jump_out_alpha_hat()
+        }
+        fn exits(&self, branch: Branch) -> $crate::physics::law::Exits {
+            self.elastic_law().exits(branch)
+        }
+        /// The added force acts only in contact.
+        fn free_branch_is_force_free(&self) -> bool {
+            self.elastic_law().free_branch_is_force_free()
+        }
+        /// The elastic law's own loop (what the added force loses depends on the motion).
+        fn loop_area_hat(&self) -> f64 {
+            self.elastic_law().loop_area_hat()
+        }
+    };
+}
+
+mod adhesive;
+mod capillary;
+mod conservative;
+mod fold_branch;
+mod registry;
+mod sls;
+mod table;
+mod viscous;
+
+pub use adhesive::AdhesiveLaw;
+pub use capillary::{Capillary, Neck};
+pub use conservative::{DmtLaw, HertzLaw, NoForce};
+pub use fold_branch::{FarField, FoldBranch, Side};
+pub use registry::{
+    CONTACT_ANGLE, HAMAKER, LAW_PARAMS, LAWS, LawInfo, LawParam, LawSpec, RELAXATION_TIME,
+    RUPTURE_DISTANCE, SURFACE_TENSION, UNRELAXED_MODULUS, VISCOSITY,
+};
+pub use sls::StandardLinearSolid;
+pub use table::UniformTable;
+pub use viscous::KelvinVoigt;
+
+use crate::error::{Error, Result};
+use crate::physics::contact::hybrid::JumpIn;
+use crate::physics::contact::lj::Reach;
+use crate::physics::params::Contact;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// The state of the contact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Branch {
+    /// Out of contact (approach branch).
+    Free,
+    /// In contact.
+    Contact,
+    /// Out of contact with a capillary neck still attached: a neck on a hysteretic
+    /// contact law outlives the contact (no other law enters it).
+    Necked,
+}
+
+impl Branch {
+    /// How many there are (the integrator keeps a first step per branch).
+    pub const COUNT: usize = 3;
+}
+
+/// Where a branch ends and which branch follows: α̂ falling to `below.0` enters
+/// `below.1`, α̂ rising to `above.0` enters `above.1` (none: the branch runs on that way).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exits {
+    /// The level α̂ falls to and the branch entered there.
+    pub below: Option<(f64, Branch)>,
+    /// The level α̂ rises to and the branch entered there.
+    pub above: Option<(f64, Branch)>,
+}
+
+/// Most internal state variables a law may declare ([`ForceLaw::internal_states`]).
+pub const MAX_INTERNAL: usize = 1;
+
+/// A law's internal state variables ([`ForceLaw::internal_states`] of them are used,
+/// the rest are zero).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Internal(pub [f64; MAX_INTERNAL]);
+
+impl std::ops::Deref for Internal {
+    type Target = [f64; MAX_INTERNAL];
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for Internal {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.0
+    }
+}
+
+/// What a law sees of the contact at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactState {
+    /// Separation α̂.
+    pub alpha_hat: f64,
+    /// Its rate dα̂/dτ (τ = ω₀t).
+    pub rate_hat: f64,
+    /// The branch.
+    pub branch: Branch,
+    /// The law's internal state variables, as the integrator carries them (the first
+    /// [`ForceLaw::internal_states`] are the law's; the rest are zero).
+    pub internal: Internal,
+}
+
+/// The derivatives of a law's internal dynamics and of its force with respect to its
+/// internal state, for the variational equations ([`ForceLaw::internal_slopes_hat`]).
+/// Entry k belongs to internal variable k; entries past the law's count are zero.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct InternalSlopes {
+    /// ∂(ds_k/dτ)/∂α̂.
+    pub rate_d_alpha: [f64; MAX_INTERNAL],
+    /// ∂(ds_k/dτ)/∂(dα̂/dτ).
+    pub rate_d_rate: [f64; MAX_INTERNAL],
+    /// ∂(ds_k/dτ)/∂s_j, row k.
+    pub rate_d_internal: [[f64; MAX_INTERNAL]; MAX_INTERNAL],
+    /// ∂T̂_d/∂s_k.
+    pub force_d_internal: [f64; MAX_INTERNAL],
+}
+
+/// A two-branch tip–sample force law in dimensionless variables.
+///
+/// The force is T̂(α̂, branch) + T̂_d(state): an elastic (possibly hysteretic) part with a
+/// work function per branch, and a rate-dependent part, zero unless the law says
+/// otherwise, whose work the integrator carries as an integral (a viscous sample has no
+/// work function). The rate-dependent part may depend on internal state variables the
+/// law declares (a relaxing sample's memory, [`ForceLaw::internal_states`]): the
+/// integrator carries them with the motion, through free flight and contact alike, and
+/// the period map and its derivative include them.
+pub trait ForceLaw: Send + Sync {
+    /// Force T̂ (tensile positive) at separation α̂ on `branch`. Finite for every finite
+    /// α̂, including past a branch's own end (integrator trial stages overshoot).
+    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64;
+    /// Slope dT̂/dα̂ on `branch`, for the variational equations of the one-period map.
+    /// Finite everywhere (where T̂ has a square-root fold, capped very near it).
+    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64;
+    /// Work function of a branch: an antiderivative Φ with dΦ/dα̂ = T̂(α̂, branch), so the
+    /// work done along a branch between two separations is a difference of Φ (each branch
+    /// is conservative; the loss comes from switching).
+    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64;
+    /// Separation at which the Free branch gives way to Contact on the way down.
+    fn jump_in_alpha_hat(&self) -> f64;
+    /// Separation at which the Contact branch gives way to Free on the way up.
+    fn jump_out_alpha_hat(&self) -> f64;
+    /// Where `branch` ends and which branch follows. By default the two-branch law of
+    /// [`ForceLaw::jump_in_alpha_hat`] and [`ForceLaw::jump_out_alpha_hat`]: Free ends
+    /// falling to the jump-in separation (into Contact), Contact rising to the jump-out
+    /// one (into Free); a law that never enters [`Branch::Necked`] gives it Free's.
+    fn exits(&self, branch: Branch) -> Exits {
+        match branch {
+            Branch::Free | Branch::Necked => Exits {
+                below: Some((self.jump_in_alpha_hat(), Branch::Contact)),
+                above: None,
+            },
+            Branch::Contact => Exits {
+                below: None,
+                above: Some((self.jump_out_alpha_hat(), Branch::Free)),
+            },
+        }
+    }
+    /// Whether T̂ is identically zero on the Free branch above the jump-in separation
+    /// (motion there is then a linear oscillator with a closed-form solution).
+    fn free_branch_is_force_free(&self) -> bool;
+    /// Area of the force loop, ∮ T̂ dα̂ over one full traversal (Ŵ; 0 if conservative).
+    fn loop_area_hat(&self) -> f64;
+    /// The part of [`ForceLaw::work_hat`] that a capillary neck contributes (0 by
+    /// default), so its loss is told apart from the contact law's own hysteresis.
+    fn capillary_work_hat(&self, _alpha_hat: f64, _branch: Branch) -> f64 {
+        0.0
+    }
+    /// Whether the force has a rate-dependent part (if not, the integrator never asks
+    /// for it).
+    fn is_rate_dependent(&self) -> bool {
+        false
+    }
+    /// The rate-dependent part T̂_d of the force at `state` (0 by default). Zero at
+    /// zero rate, and continuous across the branch switches.
+    fn dissipative_t_hat(&self, _state: &ContactState) -> f64 {
+        0.0
+    }
+    /// ∂T̂_d/∂α̂ and ∂T̂_d/∂(dα̂/dτ) at `state`, for the variational equations (finite
+    /// everywhere).
+    fn dissipative_slopes_hat(&self, _state: &ContactState) -> (f64, f64) {
+        (0.0, 0.0)
+    }
+    /// How many internal state variables the law declares (0 by default, at most
+    /// [`MAX_INTERNAL`]). A law that declares any is rate-dependent
+    /// ([`ForceLaw::is_rate_dependent`]), its internal force being part of T̂_d.
+    fn internal_states(&self) -> usize {
+        0
+    }
+    /// The rates ds_k/dτ of the internal state variables at `state` (zero by default).
+    fn internal_rates_hat(&self, _state: &ContactState) -> [f64; MAX_INTERNAL] {
+        [0.0; MAX_INTERNAL]
+    }
+    /// The rates λ_k at which the internal variables relax on the free branch of a law
+    /// whose free branch is force-free ([`ForceLaw::free_branch_is_force_free`]),
+    /// ds_k/dτ = −λ_k s_k there, so that free flight stays in closed form; `None` (the
+    /// default) if they do not relax so simply, and free flight is then integrated.
+    fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
+        None
+    }
+    /// The derivatives of the internal rates, and of T̂_d with respect to the internal
+    /// state, at `state` (zero by default), for the variational equations.
+    fn internal_slopes_hat(&self, _state: &ContactState) -> InternalSlopes {
+        InternalSlopes::default()
+    }
+    /// The whole force T̂ + T̂_d at `state`.
+    #[inline]
+    fn force_hat(&self, state: &ContactState) -> f64 {
+        let elastic = self.t_hat(state.alpha_hat, state.branch);
+        if self.is_rate_dependent() {
+            elastic + self.dissipative_t_hat(state)
+        } else {
+            elastic
+        }
+    }
+}
+
+/// The laws on offer (their names and help text are in the registry, [`LAWS`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LawKind {
+    /// The paper's hybrid law, eqs. (17), (5), (8), (18).
+    #[default]
+    Hybrid,
+    /// The hybrid law with Greenwood's semi-rigid attraction, eqs. (12), (14), (15).
+    HybridAttractive,
+    /// Classic JKR.
+    Jkr,
+    /// DMT as VEDA and dForce define it.
+    Dmt,
+    /// Hertz.
+    Hertz,
+    /// The Lennard-Jones law (10), tabulated from the full numerical solution.
+    Lj,
+    /// No tip–sample force.
+    None,
+}
+
+impl LawKind {
+    /// Every law, in the order of the help (the registry's).
+    pub const ALL: [LawKind; LAWS.len()] = {
+        let mut all = [LawKind::Hybrid; LAWS.len()];
+        let mut i = 0;
+        while i < LAWS.len() {
+            all[i] = LAWS[i].kind;
+            i += 1;
+        }
+        all
+    };
+
+    /// What the registry says of this law.
+    pub fn info(self) -> &'static LawInfo {
+        LAWS.iter()
+            .find(|l| l.kind == self)
+            .expect("every law is registered")
+    }
+
+    /// The law a user names (as `--law` takes it), if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        LAWS.iter()
+            .find(|l| l.name.eq_ignore_ascii_case(name.trim()))
+            .map(|l| l.kind)
+    }
+
+    /// The names of every law as a user types them.
+    pub fn names() -> Vec<String> {
+        LAWS.iter().map(|l| l.name.to_string()).collect()
+    }
+}
+
+impl fmt::Display for LawKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.info().name)
+    }
+}
+
+/// One of the laws, chosen at run time.
+#[derive(Debug, Clone)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "built once per simulation and read on every right-hand-side evaluation: \
+              a box would add a pointer chase to the hot path for no saving"
+)]
+pub enum AnyLaw {
+    /// hybrid, hybrid-attractive or jkr.
+    Adhesive(AdhesiveLaw),
+    /// dmt.
+    Dmt(DmtLaw),
+    /// hertz.
+    Hertz(HertzLaw),
+    /// none.
+    None(NoForce),
+    /// Any of the above on a rate-dependent sample (Kelvin–Voigt or standard linear
+    /// solid).
+    Viscous(Box<Rheology>),
+    /// Any of the above with a capillary neck.
+    Capillary(Necked),
+}
+
+/// A law with a capillary neck, behind a call: its methods inlined into the hot dispatch
+/// of [`AnyLaw`] pushed the other laws' calls out of line (a whole Hertz run took 2.5 %
+/// more instructions under callgrind, a viscous one 9 %); behind the call a neck pays
+/// one call per evaluation and the rest 1–3 % (the extra variant and channel).
+#[derive(Debug, Clone)]
+pub struct Necked(Box<Capillary<AnyLaw>>);
+
+impl ForceLaw for Necked {
+    #[inline(never)]
+    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.0.t_hat(alpha_hat, branch)
+    }
+    #[inline(never)]
+    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.0.slope_hat(alpha_hat, branch)
+    }
+    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.0.work_hat(alpha_hat, branch)
+    }
+    fn jump_in_alpha_hat(&self) -> f64 {
+        self.0.jump_in_alpha_hat()
+    }
+    fn jump_out_alpha_hat(&self) -> f64 {
+        self.0.jump_out_alpha_hat()
+    }
+    fn exits(&self, branch: Branch) -> Exits {
+        self.0.exits(branch)
+    }
+    fn free_branch_is_force_free(&self) -> bool {
+        self.0.free_branch_is_force_free()
+    }
+    fn loop_area_hat(&self) -> f64 {
+        self.0.loop_area_hat()
+    }
+    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.0.capillary_work_hat(alpha_hat, branch)
+    }
+    fn is_rate_dependent(&self) -> bool {
+        self.0.is_rate_dependent()
+    }
+    #[inline(never)]
+    fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
+        self.0.dissipative_t_hat(state)
+    }
+    #[inline(never)]
+    fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
+        self.0.dissipative_slopes_hat(state)
+    }
+}
+
+/// A law on a sample with a rate-dependent response. One variant of [`AnyLaw`] holds
+/// both models: each variant of the law dispatch is code inlined into the integrator's
+/// right-hand side, and a variant of its own for the relaxing sample cost every other
+/// law 1–4 % more instructions per run (callgrind).
+#[derive(Debug, Clone)]
+pub enum Rheology {
+    /// A Kelvin–Voigt viscous sample.
+    KelvinVoigt(KelvinVoigt<AnyLaw>),
+    /// A standard-linear-solid sample (Hertz or DMT only).
+    Relaxing(StandardLinearSolid<AnyLaw>),
+}
+
+/// Forward a method to the law inside [`Rheology`].
+macro_rules! rheology {
+    ($self:ident, $l:ident => $e:expr) => {
+        match $self {
+            Rheology::KelvinVoigt($l) => $e,
+            Rheology::Relaxing($l) => $e,
+        }
+    };
+}
+
+impl Rheology {
+    /// The contact law under the sample, whichever model the sample follows: one
+    /// forwarding call for the elastic part, not one per model.
+    #[inline]
+    fn elastic_law(&self) -> &AnyLaw {
+        rheology!(self, l => l.elastic_law())
+    }
+}
+
+impl ForceLaw for Rheology {
+    elastic_part_from_inside!();
+    fn is_rate_dependent(&self) -> bool {
+        true
+    }
+    fn internal_states(&self) -> usize {
+        rheology!(self, l => l.internal_states())
+    }
+    #[inline]
+    fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
+        rheology!(self, l => l.dissipative_t_hat(state))
+    }
+    fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
+        rheology!(self, l => l.dissipative_slopes_hat(state))
+    }
+    fn internal_rates_hat(&self, state: &ContactState) -> [f64; MAX_INTERNAL] {
+        rheology!(self, l => l.internal_rates_hat(state))
+    }
+    fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
+        rheology!(self, l => l.free_relaxation_rates())
+    }
+    fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
+        rheology!(self, l => l.internal_slopes_hat(state))
+    }
+}
+
+impl AnyLaw {
+    /// Build the law `spec` asks for on `contact`, for a cantilever resonating at
+    /// `resonance_hz` (the time scale of a rate-dependent force). Refuses, naming a law
+    /// that applies, where the law does not apply, and names a parameter the law does
+    /// not take.
+    pub fn new(spec: &LawSpec, contact: &Contact, resonance_hz: f64) -> Result<Self> {
+        spec.check()?;
+        let kind = spec.kind;
+        let mu = contact.tabor_mu();
+        let refuse = |why: String| {
+            Error::NotApplicable(format!(
+                "the {kind} law does not apply at Tabor parameter mu = {mu:.4}: {why}; \
+                 use the DMT law (small mu) or JKR"
+            ))
+        };
+        let elastic = match kind {
+            LawKind::Hybrid => AnyLaw::Adhesive(
+                AdhesiveLaw::hybrid(mu, JumpIn::Fit).map_err(|e| refuse(e.to_string()))?,
+            ),
+            LawKind::HybridAttractive => AnyLaw::Adhesive(
+                AdhesiveLaw::hybrid_attractive(mu).map_err(|e| refuse(e.to_string()))?,
+            ),
+            LawKind::Jkr => AnyLaw::Adhesive(AdhesiveLaw::jkr()),
+            LawKind::Dmt => AnyLaw::Dmt(DmtLaw::new(contact, spec.hamaker_j)?),
+            LawKind::Hertz => AnyLaw::Hertz(HertzLaw),
+            LawKind::Lj => AnyLaw::Adhesive(
+                AdhesiveLaw::lennard_jones(
+                    &crate::physics::contact::lj::obtain(mu, Reach::Springs).map_err(
+                        |e| match e {
+                            // No loop: no hysteretic law to tabulate (a cell a map skips).
+                            Error::NoHysteresis(why) => Error::NotApplicable(why),
+                            other => other,
+                        },
+                    )?,
+                )
+                .map_err(|e| refuse(e.to_string()))?,
+            ),
+            LawKind::None => AnyLaw::None(NoForce),
+        };
+        let elastic = match spec.neck() {
+            Some(neck) => {
+                // The gap at contact: DMT's d = α + ε, the other laws' d = α.
+                let contact_gap_m = if kind == LawKind::Dmt {
+                    contact.range_m
+                } else {
+                    0.0
+                };
+                let capillary = Capillary::new(elastic, &neck, contact, contact_gap_m)?;
+                // A relaxing sample's Maxwell force acts in contact only, so the neck
+                // takes a state of its own beyond it.
+                AnyLaw::Capillary(Necked(Box::new(if spec.relaxing().is_some() {
+                    capillary.outliving_contact()
+                } else {
+                    capillary
+                })))
+            }
+            None => elastic,
+        };
+        if let Some((unrelaxed_pa, relaxation_s)) = spec.relaxing() {
+            return Ok(AnyLaw::Viscous(Box::new(Rheology::Relaxing(
+                StandardLinearSolid::new(
+                    elastic,
+                    unrelaxed_pa,
+                    relaxation_s,
+                    contact,
+                    resonance_hz,
+                )?,
+            ))));
+        }
+        Ok(match spec.viscosity_pa_s {
+            Some(eta) => AnyLaw::Viscous(Box::new(Rheology::KelvinVoigt(KelvinVoigt::new(
+                elastic,
+                eta,
+                contact,
+                resonance_hz,
+            )?))),
+            None => elastic,
+        })
+    }
+}
+
+/// Forward a method to the law inside [`AnyLaw`].
+macro_rules! dispatch {
+    ($self:ident, $l:ident => $e:expr) => {
+        match $self {
+            AnyLaw::Adhesive($l) => $e,
+            AnyLaw::Dmt($l) => $e,
+            AnyLaw::Hertz($l) => $e,
+            AnyLaw::None($l) => $e,
+            AnyLaw::Capillary($l) => $e,
+            AnyLaw::Viscous($l) => $e,
+        }
+    };
+}
+
+impl ForceLaw for AnyLaw {
+    #[inline]
+    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        dispatch!(self, l => l.t_hat(alpha_hat, branch))
+    }
+    #[inline]
+    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        dispatch!(self, l => l.slope_hat(alpha_hat, branch))
+    }
+    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        dispatch!(self, l => l.work_hat(alpha_hat, branch))
+    }
+    fn jump_in_alpha_hat(&self) -> f64 {
+        dispatch!(self, l => l.jump_in_alpha_hat())
+    }
+    fn jump_out_alpha_hat(&self) -> f64 {
+        dispatch!(self, l => l.jump_out_alpha_hat())
+    }
+    fn exits(&self, branch: Branch) -> Exits {
+        dispatch!(self, l => l.exits(branch))
+    }
+    fn free_branch_is_force_free(&self) -> bool {
+        dispatch!(self, l => l.free_branch_is_force_free())
+    }
+    fn loop_area_hat(&self) -> f64 {
+        dispatch!(self, l => l.loop_area_hat())
+    }
+    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        dispatch!(self, l => l.capillary_work_hat(alpha_hat, branch))
+    }
+    #[inline]
+    fn is_rate_dependent(&self) -> bool {
+        matches!(self, AnyLaw::Viscous(_))
+    }
+    fn internal_states(&self) -> usize {
+        match self {
+            AnyLaw::Viscous(l) => l.internal_states(),
+            _ => 0,
+        }
+    }
+    fn internal_rates_hat(&self, state: &ContactState) -> [f64; MAX_INTERNAL] {
+        match self {
+            AnyLaw::Viscous(l) => l.internal_rates_hat(state),
+            _ => [0.0; MAX_INTERNAL],
+        }
+    }
+    fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
+        match self {
+            AnyLaw::Viscous(l) => l.internal_slopes_hat(state),
+            _ => InternalSlopes::default(),
+        }
+    }
+    fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
+        match self {
+            AnyLaw::Viscous(l) => l.free_relaxation_rates(),
+            _ => None,
+        }
+    }
+    #[inline]
+    fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
+        dispatch!(self, l => l.dissipative_t_hat(state))
+    }
+    fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
+        dispatch!(self, l => l.dissipative_slopes_hat(state))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_law_is_registered_once_under_a_name_that_parses_back() {
+        for kind in LawKind::ALL {
+            assert_eq!(
+                LAWS.iter().filter(|l| l.kind == kind).count(),
+                1,
+                "{kind:?}"
+            );
+            assert_eq!(LawKind::from_name(&kind.to_string()), Some(kind));
+        }
+        assert_eq!(LAWS.len(), LawKind::ALL.len());
+        assert_eq!(LawKind::from_name(" JKR "), Some(LawKind::Jkr));
+        assert_eq!(LawKind::from_name("jkr2"), None);
+    }
+}
