@@ -156,7 +156,8 @@ fn interruptible<T: Send + 'static>(
 /// Raises ValueError with the command line's message where the command line refuses.
 #[pyfunction]
 fn run<'py>(py: Python<'py>, args: Vec<String>) -> PyResult<Bound<'py, PyAny>> {
-    let text = interruptible(py, move || tapsim::app::cli::run_captured(&args))?.map_err(refusal)?;
+    let text =
+        interruptible(py, move || tapsim::app::cli::run_captured(&args))?.map_err(refusal)?;
     to_python(py, document(&text)?)
 }
 
