@@ -543,3 +543,35 @@ fn library_modules_touch_no_file_no_environment_and_name_no_flag() {
         }
     }
 }
+
+/// Within a layer, the order its folders' docs state: the parameters (which take the
+/// adhesive length scale from contact mechanics) and the closed forms of contact
+/// mechanics under the force laws, the laws under the quasi-static cycles, the reports
+/// under the command line.
+#[test]
+fn within_a_layer_the_stated_order_holds() {
+    let below = [
+        ("physics::params", "physics::law"),
+        ("physics::contact", "physics::law"),
+        ("physics::contact", "physics::quasistatic"),
+        ("physics::law", "physics::quasistatic"),
+        ("physics::law", "physics::summary"),
+        ("app::report", "app::cli"),
+    ];
+    let edges = graph(&src());
+    let mut broken = Vec::new();
+    for (from, to) in edges
+        .iter()
+        .flat_map(|(f, t)| t.iter().map(move |t| (f, t)))
+    {
+        let (from, to) = (name(from), name(to));
+        for (lower, upper) in below {
+            let within =
+                |m: &str, folder: &str| m == folder || m.starts_with(&format!("{folder}::"));
+            if within(&from, lower) && within(&to, upper) {
+                broken.push(format!("{from} → {to} ({lower} is below {upper})"));
+            }
+        }
+    }
+    assert!(broken.is_empty(), "{}", broken.join("\n"));
+}

@@ -13,6 +13,9 @@
 //! the fit (local Levenberg–Marquardt runs from the best starts), [`identifiability`]
 //! what its Jacobian says, [`diagnose`] whether the fit describes the data, [`select`]
 //! which law the data support (AIC, BIC) and [`progress`] what a running fit reports.
+//!
+//! May import: every library layer below and the rest of [`crate::analysis`]; no I/O
+//! (progress is reported to a callback).
 
 pub mod diagnose;
 mod features;

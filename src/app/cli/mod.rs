@@ -1,5 +1,8 @@
 //! The `tapsim` command line: parse, call the library, print. Each subcommand lives in
 //! its own module.
+//!
+//! May import: everything. One file a command (its flags, checks and run); what it
+//! prints or writes comes from its presenter in [`crate::app::report`].
 
 /// Refuse a plot file that is neither .png nor .svg, before any work is done.
 pub fn check_plot_path(path: Option<&std::path::Path>) -> crate::Result<()> {

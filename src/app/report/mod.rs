@@ -1,5 +1,8 @@
 //! Everything that leaves tapsim: charts (PNG, SVG), CSV tables, JSON objects and the
 //! human-readable summaries. Files are written whole or not at all.
+//!
+//! May import: the library and the rest of [`crate::app`] but [`crate::app::cli`];
+//! computes no physics.
 
 pub mod bifurcation;
 pub mod branches;

@@ -5,6 +5,8 @@
 //! ([`observables`]), or, for drives with no common period, averages over a window
 //! ([`window`]). A value beside the one-mode steady-state solver, not a branch in
 //! it: one mode is tapsim's point-mass model, untouched.
+//!
+//! May import: the foundation, [`crate::physics`] and the rest of [`crate::dynamics`].
 
 pub mod observables;
 pub mod orbit;

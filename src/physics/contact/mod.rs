@@ -6,6 +6,9 @@
 //! - [`spring`]: a support of finite stiffness, eqs. (22)–(27);
 //! - [`length_scale`]: the adhesive length scale, eqs. (19)–(21);
 //! - [`lj`]: the full Lennard-Jones numerical solution (§3.1).
+//!
+//! May import: the foundation and [`crate::physics::params`]. Pure: the Lennard-Jones
+//! cache on disk is the application's, handed in as a source.
 
 pub mod hybrid;
 pub mod jkr;

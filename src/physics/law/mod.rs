@@ -6,6 +6,10 @@
 //! and switches from Free to Contact when α̂ falls to [`ForceLaw::jump_in_alpha_hat`], and
 //! back when α̂ rises to [`ForceLaw::jump_out_alpha_hat`]. Conservative laws switch both
 //! ways at the same separation; hysteretic laws enclose [`ForceLaw::loop_area_hat`].
+//!
+//! May import: the foundation, [`crate::physics::params`] and
+//! [`crate::physics::contact`]. A new law: a file here, its entry in the registry
+//! (`registry.rs`), its `LawKind` variant and its construction in `AnyLaw::new`.
 
 /// The methods of a wrapper around a contact law (`elastic_law()`) that leaves the
 /// law's elastic part as it is: force, slope and work function per branch, the
