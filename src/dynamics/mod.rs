@@ -25,6 +25,7 @@ pub mod motion;
 pub mod numeric;
 pub mod observables;
 pub mod observed;
+pub mod observer;
 mod recurrence;
 pub mod setup;
 pub mod shooting;
