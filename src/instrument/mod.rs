@@ -13,6 +13,7 @@ pub mod feedback;
 pub mod lockin;
 pub mod modal;
 pub mod noise;
+pub mod peakforce;
 pub mod probe;
 pub mod repeats;
 pub mod scan;

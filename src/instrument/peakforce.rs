@@ -1,0 +1,580 @@
+//! Off-resonance tapping (Bruker's PeakForce Tapping, Asylum's Fast Force Mapping, JPK's
+//! QI): the support of the cantilever is moved sinusoidally far below resonance, so
+//! that every modulation cycle is a fast force–distance curve — the paper's cycle with
+//! the cantilever as its compliant support (§4, eqs. (22)–(27)) — and the instrument
+//! reads per cycle the peak force, the adhesion, the energy dissipated, the deformation
+//! and a DMT modulus fitted to the retract curve (the "QNM" channels).
+//!
+//! The support moves as x_b = A_m cos 2πf_m t (at its farthest from the sample at t = 0;
+//! the first half of a cycle approaches, the second retracts), the tip–sample
+//! separation is z_c + x_b + z (z the deflection, measured from the support), and the
+//! point-mass cantilever obeys the tapping model's equation of motion with the drive
+//! force replaced by the support's motion. The support's acceleration does not enter
+//! (the deflection it adds, (f_m/f₀)²·A_m — 7 pm at 2 kHz, 300 kHz, 150 nm — is the
+//! baseline instruments subtract). A value beside the tapping solver, not a branch
+//! in it: the same marcher, the same located switches, the same steady-state search on
+//! the period map of the modulation.
+
+use crate::dynamics::budget::budgeted;
+use crate::dynamics::march::{Phase, Simulation};
+use crate::dynamics::model::Drive;
+use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver, hermite, internal_at};
+use crate::dynamics::setup::{Cantilever, Numerics, Prepared, TapSetup};
+use crate::error::{Error, Result};
+use crate::physics::law::{AnyLaw, Branch, ForceLaw, MAX_INTERNAL};
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// The support's modulation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Modulation {
+    /// f_m, Hz (PeakForce Tapping: 0.1–8 kHz; default 2 kHz).
+    pub frequency_hz: f64,
+    /// A_m, m (default 150 nm).
+    pub amplitude_m: f64,
+}
+
+impl Default for Modulation {
+    fn default() -> Self {
+        Self {
+            frequency_hz: 2e3,
+            amplitude_m: 150e-9,
+        }
+    }
+}
+
+/// The highest modulation frequency, as a fraction of the cantilever's resonance: above
+/// it a cycle is no longer a force curve (the lever cannot follow the support).
+pub const MAX_FREQUENCY_RATIO: f64 = 0.2;
+
+impl Modulation {
+    /// Refuse a modulation that is not off-resonance tapping on `cantilever`.
+    pub fn check(&self, cantilever: &Cantilever) -> Result<()> {
+        let f0 = cantilever.resonance_hz;
+        if !(self.frequency_hz > 0.0 && self.frequency_hz.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "modulation frequency",
+                value: self.frequency_hz,
+                reason: "must be positive (PeakForce Tapping runs at 0.1–8 kHz)",
+            });
+        }
+        if self.frequency_hz > MAX_FREQUENCY_RATIO * f0 {
+            return Err(Error::NotApplicable(format!(
+                "a modulation at {:.4} kHz is not off-resonance on a cantilever resonating \
+                 at {:.4} kHz: off-resonance tapping needs f_m well below f₀ (at most \
+                 {MAX_FREQUENCY_RATIO}·f₀ = {:.4} kHz; instruments use 0.1–8 kHz on levers of \
+                 50–500 kHz)",
+                self.frequency_hz * 1e-3,
+                f0 * 1e-3,
+                MAX_FREQUENCY_RATIO * f0 * 1e-3
+            )));
+        }
+        if !(self.amplitude_m > 0.0 && self.amplitude_m <= 10e-6) {
+            return Err(Error::InvalidParameter {
+                name: "modulation amplitude",
+                value: self.amplitude_m,
+                reason: "must be above 0 and at most 10 µm (instruments use 10–300 nm)",
+            });
+        }
+        // Resolve the lever's own motion: the cycle is at most 10⁵ of its periods.
+        if f0 / self.frequency_hz > 1e5 {
+            return Err(Error::NotApplicable(format!(
+                "a modulation at {} Hz lasts {:.0} periods of the {:.4} kHz cantilever; at \
+                 most 100000 are integrated per cycle: raise the modulation frequency",
+                self.frequency_hz,
+                f0 / self.frequency_hz,
+                f0 * 1e-3
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One point of a recorded cycle (SI).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ForcePoint {
+    /// Time from the start of the cycle (the support at its farthest), s.
+    pub t_s: f64,
+    /// The support's position: the separation of the undeflected tip, z_c + x_b, m.
+    pub piezo_m: f64,
+    /// The deflection z, m (toward the sample negative).
+    pub deflection_m: f64,
+    /// The tip–sample separation α, m (negative: indentation).
+    pub separation_m: f64,
+    /// The tip–sample force, N (repulsive positive).
+    pub force_n: f64,
+    /// Whether the support moves toward the sample (the approach half of the cycle).
+    pub approach: bool,
+    /// Whether the tip is on the law's contact branch.
+    pub contact: bool,
+}
+
+/// The QNM channels of one cycle, as the instrument computes them from its force curve.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Channels {
+    /// The largest force of the cycle, N.
+    pub peak_force_n: f64,
+    /// The adhesion: minus the least force on retract, N.
+    pub adhesion_n: f64,
+    /// The energy dissipated: the area between the approach and retract force–
+    /// separation curves, −∮F dα, J.
+    pub dissipation_j: f64,
+    /// The deformation: from where the approach force last crosses zero before the peak
+    /// to the separation at the peak, m.
+    pub deformation_m: f64,
+    /// The DMT modulus E* fitted to the retract curve between the two force fractions
+    /// ([`Analysis`]), Pa; None where fewer than 3 points lie in the window.
+    pub dmt_modulus_pa: Option<f64>,
+    /// The separation of the fit's zero (where F = −adhesion on the DMT curve), m.
+    pub dmt_contact_m: Option<f64>,
+    /// Points in the fit's window.
+    pub dmt_points: usize,
+}
+
+/// How the channels are computed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Analysis {
+    /// The DMT fit's window on the retract curve, as fractions of the span from the
+    /// adhesion to the peak force (commercial QNM analysis: 30 % and 90 %).
+    pub fit_window: (f64, f64),
+}
+
+impl Default for Analysis {
+    fn default() -> Self {
+        Self {
+            fit_window: (0.3, 0.9),
+        }
+    }
+}
+
+impl Analysis {
+    /// Refuse a window that is not two fractions in order.
+    pub fn check(&self) -> Result<()> {
+        let (lo, hi) = self.fit_window;
+        if !((0.0..1.0).contains(&lo) && lo < hi && hi <= 1.0) {
+            return Err(Error::NotApplicable(format!(
+                "the DMT fit window {lo}–{hi} must be two fractions 0 ≤ lo < hi ≤ 1 of the \
+                 span from the adhesion to the peak force (instruments use 0.3 and 0.9)"
+            )));
+        }
+        Ok(())
+    }
+
+    /// The channels of one cycle's force curve `curve` (in time order) for a tip of
+    /// radius `radius_m`. The DMT fit: on the retract from the peak to the least force,
+    /// F − F_min = (4/3)E*√R (d₀ − d)^{3/2} (Derjaguin, Muller & Toporov 1975), linear in
+    /// d once both sides are raised to 2/3, so E* and d₀ come from a straight-line fit.
+    pub fn channels(&self, curve: &[ForcePoint], radius_m: f64) -> Channels {
+        let peak_at = curve
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.force_n.total_cmp(&b.1.force_n))
+            .map_or(0, |(i, _)| i);
+        let peak = curve.get(peak_at).map_or(0.0, |p| p.force_n);
+        let min_at = (peak_at..curve.len())
+            .min_by(|&a, &b| curve[a].force_n.total_cmp(&curve[b].force_n))
+            .unwrap_or(peak_at);
+        let least = curve.get(min_at).map_or(0.0, |p| p.force_n);
+        let dissipation = -curve
+            .windows(2)
+            .map(|w| 0.5 * (w[0].force_n + w[1].force_n) * (w[1].separation_m - w[0].separation_m))
+            .sum::<f64>();
+        // The approach's last crossing of zero force before the peak.
+        let zero = (1..=peak_at)
+            .rev()
+            .find(|&i| curve[i - 1].force_n <= 0.0 && curve[i].force_n > 0.0)
+            .map(|i| {
+                let (a, b) = (&curve[i - 1], &curve[i]);
+                let t = -a.force_n / (b.force_n - a.force_n);
+                a.separation_m + t * (b.separation_m - a.separation_m)
+            });
+        let deformation = zero.map_or(0.0, |z| z - curve[peak_at].separation_m);
+        // The DMT fit on the retract between the window's forces.
+        let span = peak - least;
+        let (lo, hi) = (
+            least + self.fit_window.0 * span,
+            least + self.fit_window.1 * span,
+        );
+        let window: Vec<(f64, f64)> = curve[peak_at..=min_at.max(peak_at)]
+            .iter()
+            .filter(|p| p.force_n >= lo && p.force_n <= hi && p.contact)
+            .map(|p| (p.separation_m, (p.force_n - least).powf(2.0 / 3.0)))
+            .collect();
+        let fit = (window.len() >= 3 && span > 0.0)
+            .then(|| line(&window))
+            .flatten()
+            .filter(|&(slope, _)| slope < 0.0);
+        Channels {
+            peak_force_n: peak,
+            adhesion_n: -least.min(0.0) + 0.0,
+            dissipation_j: dissipation,
+            deformation_m: deformation,
+            dmt_modulus_pa: fit.map(|(slope, _)| 0.75 * (-slope).powf(1.5) / radius_m.sqrt()),
+            dmt_contact_m: fit.map(|(slope, intercept)| -intercept / slope),
+            dmt_points: window.len(),
+        }
+    }
+}
+
+/// The least-squares line y = s·x + c through `points`: (s, c), None if the x coincide.
+fn line(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let n = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), &(x, y)| (a + x / n, b + y / n));
+    let (sxx, sxy) = points.iter().fold((0.0, 0.0), |(a, b), &(x, y)| {
+        (a + (x - mx) * (x - mx), b + (x - mx) * (y - my))
+    });
+    (sxx > 0.0).then(|| {
+        let s = sxy / sxx;
+        (s, my - s * mx)
+    })
+}
+
+/// A cycle of off-resonance tapping at a rest separation, once the motion has settled.
+#[derive(Debug, Clone, Serialize)]
+pub struct PeakForceCycle {
+    /// z_c: the separation of the undeflected tip with the support at the modulation's
+    /// centre, m.
+    pub separation_m: f64,
+    /// How the settled motion repeats ("period-1": every cycle alike; "period-n": n
+    /// cycles before it repeats, each listed; "irregular").
+    pub regime: String,
+    /// Modulation cycles marched before the motion repeated itself (to [`SETTLED`] of the
+    /// free amplitude), or before giving up on it.
+    pub settled_after: usize,
+    /// The channels of each cycle of the settled motion (one for period-1, n for
+    /// period-n, the last 8 for irregular motion).
+    pub cycles: Vec<Channels>,
+    /// The energy the tip–sample force took from the cantilever per cycle, −∮F dα over
+    /// the exact path (switches located), J; the channels' dissipation is the same
+    /// integral over the recorded curve.
+    pub contact_loss_j: f64,
+    /// The energy damping took per cycle (the ringing after pull-off among it), J.
+    pub damping_loss_j: f64,
+    /// The work the moving support did on the cantilever per cycle, J.
+    pub drive_work_j: f64,
+    /// |drive work − contact loss − damping loss − change of the lever's energy| per
+    /// cycle, over the drive work or, where more, the work the contact stores and gives
+    /// back in a cycle (half of ∮|F dα|).
+    pub energy_balance_rel: f64,
+    /// The recorded force curve of the settled motion (its cycles in turn).
+    pub curve: Vec<ForcePoint>,
+}
+
+/// The most cycles of irregular motion whose channels are listed.
+const IRREGULAR_CYCLES: usize = 8;
+
+/// The motion has settled once the state at the start of a cycle is within this of its
+/// repeating motion (units of the free amplitude; 2 fm on the built-in lever).
+pub const SETTLED: f64 = 1e-7;
+
+/// Modulation cycles marched at most before the motion is called irregular.
+pub const MAX_SETTLE_CYCLES: usize = 400;
+
+/// Cycles in a row whose return gap must be below [`SETTLED`]/100.
+const QUIET_CYCLES: usize = 8;
+
+/// The longest repeat looked for, in modulation cycles.
+pub const LONGEST_REPEAT: usize = 8;
+
+/// March `sim` from rest until its state at the start of a cycle (deflection, velocity,
+/// a law's internal state) repeats itself after n ≤ [`LONGEST_REPEAT`] cycles: the
+/// state there, n (None: irregular after [`MAX_SETTLE_CYCLES`]) and the cycles
+/// marched. Repeating means a return gap |s_k − s_{k−n}| below [`SETTLED`]/100 for
+/// [`QUIET_CYCLES`] cycles running: for motion contracting onto its cycle by any factor
+/// up to 0.99 a cycle the state is then within [`SETTLED`] of it (gap·ρ/(1 − ρ)). The
+/// integrator's own noise is some 1e-13 of the free amplitude. Newton's method on the
+/// period map is not used: after each pull-off the lever rings and meets the next
+/// jump-in with what is left, and turning points of the separation near the jump-in
+/// level shrink the region where its answer may be trusted to nothing.
+fn settle(sim: &Simulation<'_, AnyLaw>, max_steps: u64) -> Result<(Phase, Option<usize>, usize)> {
+    let mut phase = Phase::at_rest();
+    let mut history: Vec<[f64; 2 + MAX_INTERNAL]> = Vec::with_capacity(MAX_SETTLE_CYCLES);
+    // Per repeat n: cycles running with the gap quiet, and with it no longer shrinking.
+    let mut quiet = [0usize; LONGEST_REPEAT];
+    let mut stalled = [0usize; LONGEST_REPEAT];
+    let mut last_gap = [f64::INFINITY; LONGEST_REPEAT];
+    for marched in 1..=MAX_SETTLE_CYCLES {
+        sim.rewind(&mut phase);
+        budgeted(max_steps, || sim.cycle(&mut phase, &mut Ignore))?;
+        let mut state = [0.0; 2 + MAX_INTERNAL];
+        state[0] = phase.x;
+        state[1] = phase.v;
+        state[2..].copy_from_slice(&phase.internal.0);
+        history.push(state);
+        for n in 1..=LONGEST_REPEAT {
+            let Some(before) = history.len().checked_sub(n + 1).map(|k| history[k]) else {
+                continue;
+            };
+            let gap = state
+                .iter()
+                .zip(&before)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            quiet[n - 1] = if gap <= 1e-2 * SETTLED {
+                quiet[n - 1] + 1
+            } else {
+                0
+            };
+            stalled[n - 1] = if gap >= 0.99 * last_gap[n - 1] {
+                stalled[n - 1] + 1
+            } else {
+                0
+            };
+            last_gap[n - 1] = gap;
+        }
+        // The least quiet repeat, once every shorter one that divides it has stopped
+        // shrinking (an orbit approached with a negative multiplier returns closer after
+        // two cycles than after one while it converges).
+        if let Some(n) = (1..=LONGEST_REPEAT).find(|&n| quiet[n - 1] >= QUIET_CYCLES)
+            && (1..n)
+                .filter(|d| n % d == 0)
+                .all(|d| stalled[d - 1] >= QUIET_CYCLES)
+        {
+            return Ok((phase, Some(n), marched));
+        }
+    }
+    Ok((phase, None, MAX_SETTLE_CYCLES))
+}
+
+/// Points recorded per integrator step (its end and points on its Hermite interpolant):
+/// the area between approach and retract is then within 1e-4 of the exact loss.
+const POINTS_PER_STEP: usize = 4;
+
+/// Records the force curve: points on each accepted step (the integrator's steps
+/// resolve the contact finely and the free ringing at the lever's own period).
+struct CurveRecorder<'a> {
+    law: &'a AnyLaw,
+    sim: &'a Simulation<'a, AnyLaw>,
+    /// (τ, x, α̂, f_ts, branch).
+    samples: Vec<(f64, f64, f64, f64, Branch)>,
+}
+
+impl StepObserver for CurveRecorder<'_> {
+    fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch) {
+        let first = usize::from(!self.samples.is_empty());
+        for i in first..=POINTS_PER_STEP {
+            let tau = from.tau + (to.tau - from.tau) * i as f64 / POINTS_PER_STEP as f64;
+            self.push(from, to, tau, branch);
+        }
+    }
+}
+
+impl CurveRecorder<'_> {
+    fn push<const N: usize>(&mut self, a: &StepEnd<N>, b: &StepEnd<N>, tau: f64, branch: Branch) {
+        use crate::dynamics::model::{V, X};
+        let (x, v) = (hermite(a, b, X, tau), hermite(a, b, V, tau));
+        let state = self.sim.cpl.contact_state(
+            (x, v),
+            self.sim.osc.base_at(tau),
+            branch,
+            internal_at(a, b, tau),
+        );
+        let f = -self.sim.cpl.f_scale * self.law.force_hat(&state) + 0.0;
+        self.samples.push((tau, x, state.alpha_hat, f, branch));
+    }
+}
+
+/// The simulation of `setup`'s cantilever and law driven through its support by
+/// `modulation`, at rest separation `separation_m`: the length unit L is the free
+/// amplitude as in tapping, the time unit 1/ω₀, and every step resolves the lever's own
+/// period (at least the numerics' steps per period of it).
+fn simulation<'a>(
+    p: &'a Prepared,
+    modulation: &Modulation,
+    separation_m: f64,
+    steps_per_period: f64,
+) -> Result<Simulation<'a, AnyLaw>> {
+    let cant = &p.setup.cantilever;
+    modulation.check(cant)?;
+    let scale_m = cant.free_amplitude_m;
+    if !(separation_m.is_finite() && separation_m.abs() <= 10.0 * modulation.amplitude_m + 1e-6) {
+        return Err(Error::InvalidParameter {
+            name: "rest separation",
+            value: separation_m,
+            reason: "must lie within ten modulation amplitudes of the sample",
+        });
+    }
+    let mut sim = p.simulation();
+    sim.osc.drive = Drive::Base {
+        amplitude: modulation.amplitude_m / scale_m,
+    };
+    sim.osc.omega = modulation.frequency_hz / cant.resonance_hz;
+    sim.cpl.a0 = separation_m / p.setup.contact.separation_scale_m();
+    sim.tol.h_max = 2.0 * PI / steps_per_period;
+    Ok(sim)
+}
+
+/// A settled cycle of off-resonance tapping on `setup` (its cantilever, contact and
+/// law; the tapping drive unused) at rest separation `separation_m`, channels computed
+/// by `analysis`.
+pub fn cycle(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    modulation: &Modulation,
+    analysis: &Analysis,
+    separation_m: f64,
+) -> Result<PeakForceCycle> {
+    analysis.check()?;
+    let p = Prepared::new(setup, numerics)?;
+    let sim = simulation(&p, modulation, separation_m, numerics.min_steps_per_period)?;
+    let (mut phase, period, marched) = settle(&sim, p.steady.max_steps)?;
+    let cycles = period.unwrap_or(IRREGULAR_CYCLES);
+    let mut recorder = CurveRecorder {
+        law: &p.law,
+        sim: &sim,
+        samples: Vec::new(),
+    };
+    let mut sums = (0.0, 0.0, 0.0, 0.0);
+    let mut starts = Vec::with_capacity(cycles + 1);
+    for _ in 0..cycles {
+        sim.rewind(&mut phase);
+        starts.push(recorder.samples.len());
+        let c = budgeted(p.steady.max_steps, || sim.cycle(&mut phase, &mut recorder))?;
+        sums = (
+            sums.0 + c.e_ts,
+            sums.1 + c.e_damp,
+            sums.2 + c.e_drive,
+            sums.3 + c.delta_mechanical,
+        );
+    }
+    starts.push(recorder.samples.len());
+    let cant = &p.setup.cantilever;
+    let (k, l) = (cant.stiffness_n_m, cant.free_amplitude_m);
+    let w0 = 2.0 * PI * cant.resonance_hz;
+    let scale = p.setup.contact.separation_scale_m();
+    let energy = k * l * l;
+    let n = cycles as f64;
+    let curve: Vec<ForcePoint> = recorder
+        .samples
+        .iter()
+        .map(|&(tau, x, alpha, f, branch)| {
+            let (x_b, v_b) = sim.osc.base_at(tau);
+            ForcePoint {
+                t_s: (tau % sim.osc.period()) / w0,
+                piezo_m: separation_m + x_b * l,
+                deflection_m: x * l,
+                separation_m: alpha * scale,
+                force_n: f * k * l,
+                approach: v_b < 0.0,
+                contact: branch != Branch::Free,
+            }
+        })
+        .collect();
+    let channels = starts
+        .windows(2)
+        .map(|w| analysis.channels(&curve[w[0]..w[1]], p.setup.contact.radius_m))
+        .collect();
+    let drive = sums.2;
+    // The energy the books are kept on: the drive's work, or the work the contact
+    // stores and gives back each cycle where that is more (a conservative contact,
+    // whose drive work is the slow motion's damping alone).
+    let exchanged = 0.5
+        * curve
+            .windows(2)
+            .map(|w| {
+                (0.5 * (w[0].force_n + w[1].force_n) * (w[1].separation_m - w[0].separation_m))
+                    .abs()
+            })
+            .sum::<f64>()
+        / n;
+    let books = (drive / n * energy)
+        .abs()
+        .max(exchanged)
+        .max(f64::MIN_POSITIVE);
+    Ok(PeakForceCycle {
+        separation_m,
+        regime: period.map_or("irregular".into(), |n| format!("period-{n}")),
+        settled_after: marched,
+        cycles: channels,
+        contact_loss_j: sums.0 / n * energy,
+        damping_loss_j: sums.1 / n * energy,
+        drive_work_j: drive / n * energy,
+        energy_balance_rel: ((drive - sums.0 - sums.1 - sums.3) * energy / books).abs(),
+        curve,
+    })
+}
+
+/// The least peak-force setpoint, N: below it the peak is lost in the free ringing.
+pub const MIN_SETPOINT_N: f64 = 1e-12;
+
+/// The settled cycle whose peak force is `setpoint_n` (N): the rest separation solved
+/// for directly (the peak force falls as the support is withdrawn; bracketed from where
+/// the support's lowest point just reaches the sample, then regula falsi to 1e-4 nm),
+/// what a peak-force feedback settles on.
+pub fn at_setpoint(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    modulation: &Modulation,
+    analysis: &Analysis,
+    setpoint_n: f64,
+) -> Result<PeakForceCycle> {
+    if !(MIN_SETPOINT_N..=1e-5).contains(&setpoint_n) {
+        return Err(Error::InvalidParameter {
+            name: "peak-force setpoint",
+            value: setpoint_n,
+            reason: "must be 1 pN to 10 µN (instruments use 0.1–100 nN)",
+        });
+    }
+    modulation.check(&setup.cantilever)?;
+    let peak = |z: f64| -> Result<f64> {
+        let c = cycle(setup, numerics, modulation, analysis, z)?;
+        Ok(c.cycles
+            .iter()
+            .map(|ch| ch.peak_force_n)
+            .fold(f64::NEG_INFINITY, f64::max))
+    };
+    // Withdrawn until the peak is below the setpoint, pushed in until it is above.
+    let top = modulation.amplitude_m + 2.0 * setup.contact.range_m;
+    let mut hi = top;
+    let mut f_hi = peak(hi)?;
+    let mut depth = 1e-9;
+    while f_hi >= setpoint_n {
+        hi += depth;
+        depth *= 2.0;
+        if depth > modulation.amplitude_m {
+            return Err(Error::NotApplicable(
+                "the peak force stays above the setpoint however far the support is withdrawn"
+                    .into(),
+            ));
+        }
+        f_hi = peak(hi)?;
+    }
+    let mut lo = top - 1e-9;
+    let mut depth = 1e-9;
+    let mut f_lo = peak(lo)?;
+    while f_lo < setpoint_n {
+        depth *= 2.0;
+        if depth > modulation.amplitude_m {
+            return Err(Error::NotApplicable(format!(
+                "a peak force of {:.4} nN is not reached with the support pushed {:.4} nm \
+                 into the sample (the most this modulation allows; peak {:.4} nN there): \
+                 lower the setpoint or raise the modulation amplitude",
+                setpoint_n * 1e9,
+                depth * 0.5e9,
+                f_lo * 1e9
+            )));
+        }
+        lo = top - depth;
+        f_lo = peak(lo)?;
+    }
+    let mut failure = None;
+    let z = crate::numeric::bracketed_root(
+        "peak force at the setpoint",
+        |z| match peak(z) {
+            Ok(f) => f - setpoint_n,
+            Err(e) => {
+                failure.get_or_insert(e);
+                f64::NAN
+            }
+        },
+        lo,
+        hi,
+        1e-13,
+    )?;
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    cycle(setup, numerics, modulation, analysis, z)
+}

@@ -1,0 +1,204 @@
+//! Off-resonance tapping (PeakForce-type): the QNM channels checked against what they
+//! must be — a conservative contact loses nothing and its DMT fit returns the modulus it
+//! was given; the area between approach and retract is the exact contact loss; the
+//! energy books close; the ringing after pull-off decays as the free lever's
+//! e^{−ω₀t/2Q}; adhesive laws bias the modulus and JKR overstates the dissipation
+//! against the hybrid law (the paper's point, as a QNM user meets it); bad input is
+//! refused (issue 47).
+
+use tapsim::instrument::peakforce::{Analysis, Modulation, at_setpoint, cycle};
+use tapsim::{LawKind, Numerics, TapSetup, default_setup};
+
+fn setup(law: LawKind) -> TapSetup {
+    TapSetup {
+        law: law.into(),
+        ..default_setup()
+    }
+}
+
+fn at(law: LawKind, separation_m: f64) -> tapsim::instrument::peakforce::PeakForceCycle {
+    cycle(
+        &setup(law),
+        &Numerics::default(),
+        &Modulation::default(),
+        &Analysis::default(),
+        separation_m,
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_conservative_contact_loses_nothing_and_its_dmt_fit_returns_its_modulus() {
+    let e_star = default_setup().contact.modulus_pa;
+    // Hertz, and DMT pushed in far enough that its peak is repulsive.
+    for (law, z) in [(LawKind::Hertz, 148.6e-9), (LawKind::Dmt, 147.0e-9)] {
+        let c = at(law, z);
+        assert_eq!(c.regime, "period-1", "{law}");
+        let ch = c.cycles[0];
+        assert!(ch.peak_force_n > 1e-9, "{law}: {ch:?}");
+        // The work of the peak force over the deformation, against which the loss is
+        // nothing.
+        let work = ch.peak_force_n * ch.deformation_m;
+        assert!(
+            c.contact_loss_j.abs() < 1e-9 * work,
+            "{law}: {}",
+            c.contact_loss_j
+        );
+        assert!(ch.dissipation_j.abs() < 1e-4 * work, "{law}: {ch:?}");
+        let e = ch.dmt_modulus_pa.expect("a fit");
+        assert!((e / e_star - 1.0).abs() < 0.005, "{law}: {e} vs {e_star}");
+        assert!(ch.dmt_points > 50, "{law}: {ch:?}");
+        assert!(
+            c.energy_balance_rel < 1e-6,
+            "{law}: {}",
+            c.energy_balance_rel
+        );
+    }
+}
+
+#[test]
+fn adhesive_laws_bias_the_modulus_and_jkr_overstates_the_dissipation() {
+    let e_star = default_setup().contact.modulus_pa;
+    let z = 148.0e-9;
+    let hybrid = at(LawKind::Hybrid, z);
+    let jkr = at(LawKind::Jkr, z);
+    for c in [&hybrid, &jkr] {
+        assert_eq!(c.regime, "period-1");
+        let ch = c.cycles[0];
+        // The area between the recorded approach and retract is the exact loss.
+        assert!(
+            (ch.dissipation_j / c.contact_loss_j - 1.0).abs() < 1e-3,
+            "{} vs {}",
+            ch.dissipation_j,
+            c.contact_loss_j
+        );
+        // Adhesion: the JKR pull-off force (3/2)πRΔγ on this contact.
+        let s = default_setup().contact;
+        let jkr_pull_off = 1.5 * std::f64::consts::PI * s.radius_m * s.work_of_adhesion_j_m2;
+        assert!((ch.adhesion_n / jkr_pull_off - 1.0).abs() < 1e-3, "{ch:?}");
+        // The DMT fit of an adhesive contact reads a modulus off by percents.
+        let e = ch.dmt_modulus_pa.unwrap();
+        assert!((e / e_star - 1.0).abs() > 0.02, "{e} vs {e_star}");
+        assert!(c.energy_balance_rel < 1e-6, "{}", c.energy_balance_rel);
+    }
+    // The hybrid contact loses its loop Ŵ_hybrid(μ)·μεRΔγ, JKR its own larger one.
+    let ratio = jkr.contact_loss_j / hybrid.contact_loss_j;
+    assert!(ratio > 2.0, "JKR/hybrid dissipation {ratio}");
+    let o = tapsim::tap(
+        &setup(LawKind::Hybrid),
+        &Numerics::default(),
+        Default::default(),
+    )
+    .unwrap()
+    .observables;
+    assert!(
+        (hybrid.contact_loss_j / o.loop_area_j - 1.0).abs() < 1e-6,
+        "{} vs the hybrid loop {}",
+        hybrid.contact_loss_j,
+        o.loop_area_j
+    );
+}
+
+#[test]
+fn the_ringing_after_pull_off_decays_as_the_free_lever() {
+    let c = at(LawKind::Hybrid, 148.0e-9);
+    let cant = default_setup().cantilever;
+    // After the last point in contact the hybrid law is force-free: the lever rings.
+    let last_contact = c.curve.iter().rposition(|p| p.contact).unwrap();
+    let free = &c.curve[last_contact + 1..];
+    let peaks: Vec<(f64, f64)> = free
+        .windows(3)
+        .filter(|w| w[1].deflection_m > w[0].deflection_m && w[1].deflection_m >= w[2].deflection_m)
+        .map(|w| (w[1].t_s, w[1].deflection_m.abs()))
+        .collect();
+    assert!(peaks.len() > 50, "{} peaks", peaks.len());
+    // Least-squares slope of ln(peak) against time.
+    let n = peaks.len() as f64;
+    let (mt, ml) = peaks
+        .iter()
+        .fold((0.0, 0.0), |(a, b), &(t, d)| (a + t / n, b + d.ln() / n));
+    let (stt, stl) = peaks.iter().fold((0.0, 0.0), |(a, b), &(t, d)| {
+        (a + (t - mt).powi(2), b + (t - mt) * (d.ln() - ml))
+    });
+    let rate = -stl / stt;
+    let expected = 2.0 * std::f64::consts::PI * cant.resonance_hz / (2.0 * cant.quality);
+    assert!(
+        (rate / expected - 1.0).abs() < 0.02,
+        "decay {rate} /s against ω₀/2Q = {expected} /s"
+    );
+}
+
+#[test]
+fn the_setpoint_is_held_by_the_separation_solved_for() {
+    let s = setup(LawKind::Hybrid);
+    let c = at_setpoint(
+        &s,
+        &Numerics::default(),
+        &Modulation::default(),
+        &Analysis::default(),
+        5e-9,
+    )
+    .unwrap();
+    let peak = c.cycles[0].peak_force_n;
+    assert!((peak / 5e-9 - 1.0).abs() < 0.01, "{peak}");
+    // Withdrawn by 0.05 nm the peak falls, pushed in it rises: the setpoint is bracketed.
+    let up = at(LawKind::Hybrid, c.separation_m + 0.05e-9).cycles[0].peak_force_n;
+    let down = at(LawKind::Hybrid, c.separation_m - 0.05e-9).cycles[0].peak_force_n;
+    assert!(up < 5e-9 && down > 5e-9, "{up} {down}");
+}
+
+#[test]
+fn modulations_that_are_not_off_resonance_tapping_are_refused() {
+    let s = setup(LawKind::Hybrid);
+    let n = Numerics::default();
+    let a = Analysis::default();
+    for (m, says) in [
+        (
+            Modulation {
+                frequency_hz: 300e3,
+                ..Default::default()
+            },
+            "well below f₀",
+        ),
+        (
+            Modulation {
+                frequency_hz: -1.0,
+                ..Default::default()
+            },
+            "positive",
+        ),
+        (
+            Modulation {
+                amplitude_m: 0.0,
+                ..Default::default()
+            },
+            "modulation amplitude",
+        ),
+        (
+            Modulation {
+                frequency_hz: 1.0,
+                ..Default::default()
+            },
+            "raise the modulation frequency",
+        ),
+    ] {
+        let e = cycle(&s, &n, &m, &a, 148e-9).unwrap_err().to_string();
+        assert!(e.contains(says), "{m:?}: {e}");
+    }
+    // A setpoint the modulation cannot reach.
+    let small = Modulation {
+        amplitude_m: 20e-9,
+        ..Default::default()
+    };
+    let e = at_setpoint(&s, &n, &small, &a, 5e-6)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("lower the setpoint"), "{e}");
+    let e = Analysis {
+        fit_window: (0.9, 0.3),
+    }
+    .check()
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("0.3 and 0.9"), "{e}");
+}
