@@ -202,3 +202,52 @@ fn modulations_that_are_not_off_resonance_tapping_are_refused() {
     .to_string();
     assert!(e.contains("0.3 and 0.9"), "{e}");
 }
+
+#[test]
+fn the_command_prints_the_channels_and_refuses_what_is_not_off_resonance() {
+    let dir = std::env::temp_dir().join(format!("tapsim-peakforce-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bin = env!("CARGO_BIN_EXE_tapsim");
+    let run = |args: &[&str]| {
+        std::process::Command::new(bin)
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap()
+    };
+    let out = run(&[
+        "peakforce",
+        "--separation",
+        "148.6nm",
+        "--law",
+        "hertz",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["regime"], "period-1");
+    let e = v["cycles"][0]["dmt_modulus_pa"].as_f64().unwrap();
+    let given = v["modulus_given_pa"].as_f64().unwrap();
+    assert!((e / given - 1.0).abs() < 0.005, "{e} vs {given}");
+    assert_eq!(v["contact_loss_j"].as_f64(), Some(0.0));
+    // A modulation at resonance, and a plot that cannot be drawn: refused, nothing written.
+    let out = run(&[
+        "peakforce",
+        "--modulation-frequency",
+        "300kHz",
+        "--csv",
+        "c.csv",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not off-resonance"));
+    let out = run(&["peakforce", "--csv", "c.csv", "--plot", "c.jpg"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!dir.join("c.csv").exists());
+    let out = run(&["peakforce", "--peak-force", "-1nN"]);
+    assert_ne!(out.status.code(), Some(0));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -50,6 +50,8 @@ unit_parser!(/// A time (s).
     time, "time", Dimension::Time);
 unit_parser!(/// A temperature (K).
     temperature, "temperature", Dimension::Temperature);
+unit_parser!(/// A force (N).
+    force, "force", Dimension::Force);
 unit_parser!(/// A plain number.
     number, "value", Dimension::Dimensionless);
 

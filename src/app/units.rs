@@ -25,6 +25,8 @@ pub enum Dimension {
     Time,
     /// Kelvins.
     Temperature,
+    /// Newtons.
+    Force,
     /// A plain number.
     Dimensionless,
 }
@@ -41,6 +43,7 @@ impl Dimension {
             Dimension::Viscosity => &[("Pa·s", 1.0), ("Pa*s", 1.0), ("Pa s", 1.0), ("Pas", 1.0)],
             Dimension::Time => &[("s", 1.0)],
             Dimension::Temperature => &[("K", 1.0)],
+            Dimension::Force => &[("N", 1.0)],
             Dimension::Dimensionless => &[],
         }
     }

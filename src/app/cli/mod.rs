@@ -50,6 +50,7 @@ mod lj;
 mod map;
 mod merge;
 mod modal;
+mod peakforce;
 mod progress;
 mod reconstruct;
 mod reproduce;
@@ -87,6 +88,7 @@ enum Command {
     Map(map::MapArgs),
     Scan(scan::ScanArgs),
     Thermal(thermal::ThermalArgs),
+    Peakforce(peakforce::PeakForceArgs),
     Batch(batch::BatchArgs),
     Merge(merge::MergeArgs),
     Hysteresis(hysteresis::HysteresisArgs),
@@ -110,6 +112,7 @@ impl Command {
             Command::Map(a) => a.out.quiet,
             Command::Scan(a) => a.out.quiet,
             Command::Thermal(a) => a.out.quiet,
+            Command::Peakforce(a) => a.out.quiet,
             Command::Batch(a) => a.out.quiet,
             Command::Merge(a) => a.output.quiet,
             Command::Hysteresis(a) => a.quiet,
@@ -142,6 +145,7 @@ impl Command {
             }
             Command::Scan(a) => a.out.check(),
             Command::Thermal(a) => a.out.check(),
+            Command::Peakforce(a) => a.check(),
             Command::Batch(a) => a.out.check(),
             Command::Merge(a) => a.output.check(),
             Command::Fit(_)
@@ -516,6 +520,7 @@ fn run_command(command: Command) -> crate::Result<()> {
         Command::Map(args) => map::run(args),
         Command::Scan(args) => scan::run(args),
         Command::Thermal(args) => thermal::run(args),
+        Command::Peakforce(args) => peakforce::run(args),
         Command::Batch(args) => batch::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),

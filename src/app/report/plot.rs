@@ -573,8 +573,20 @@ where
         .y_label_area_size(80)
         .build_cartesian_2d(xr, yr)
         .map_err(|e| err(&e))?;
-    let fx = |v: &f64| tick_label(*v, chart.x.scale);
-    let fy = |v: &f64| tick_label(*v, chart.y.scale);
+    // A tick at zero reached by adding steps reads as round-off (-5.551e-17): zero.
+    let snap = |v: f64, (lo, hi): (f64, f64), scale: Scale| {
+        if scale == Scale::Linear && v.abs() < 1e-9 * (hi - lo).abs() {
+            0.0
+        } else {
+            v
+        }
+    };
+    let (x_span, y_span) = (
+        (ctx.x_range().start, ctx.x_range().end),
+        (ctx.y_range().start, ctx.y_range().end),
+    );
+    let fx = |v: &f64| tick_label(snap(*v, x_span, chart.x.scale), chart.x.scale);
+    let fy = |v: &f64| tick_label(snap(*v, y_span, chart.y.scale), chart.y.scale);
     ctx.configure_mesh()
         .x_label_formatter(&fx)
         .y_label_formatter(&fy)
