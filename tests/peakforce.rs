@@ -249,5 +249,108 @@ fn the_command_prints_the_channels_and_refuses_what_is_not_off_resonance() {
     assert!(!dir.join("c.csv").exists());
     let out = run(&["peakforce", "--peak-force", "-1nN"]);
     assert_ne!(out.status.code(), Some(0));
+    // The setpoint reached by the feedback, cycle by cycle.
+    let out = run(&["peakforce", "--feedback", "--peak-force", "3nN", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["feedback_cycles"].as_u64().unwrap() > 8);
+    let peak = v["cycles"][0]["peak_force_n"].as_f64().unwrap();
+    assert!((peak / 3e-9 - 1.0).abs() < 0.01, "{peak}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_feedback_settles_where_the_direct_solve_puts_the_setpoint() {
+    use tapsim::instrument::peakforce::{PeakForceFeedback, feedback};
+    let s = setup(LawKind::Hybrid);
+    let (n, m) = (Numerics::default(), Modulation::default());
+    let direct = at_setpoint(&s, &n, &m, &Analysis::default(), 5e-9).unwrap();
+    // From rest with the support's lowest point 2 nm above the sample.
+    let run = feedback(
+        &s,
+        &n,
+        &m,
+        &PeakForceFeedback {
+            setpoint_n: 5e-9,
+            gain: 0.5,
+        },
+        m.amplitude_m + 2e-9,
+    )
+    .unwrap();
+    assert!(run.settled, "{} cycles", run.cycles.len());
+    let last = run.cycles.last().unwrap();
+    assert!((last.peak_force_n / 5e-9 - 1.0).abs() < 0.01, "{last:?}");
+    assert!(
+        (last.separation_m - direct.separation_m).abs() < 0.01e-9,
+        "feedback {} nm, direct {} nm",
+        last.separation_m * 1e9,
+        direct.separation_m * 1e9
+    );
+    println!(
+        "settled after {} cycles at {} nm (direct {} nm)",
+        run.cycles.len(),
+        last.separation_m * 1e9,
+        direct.separation_m * 1e9
+    );
+}
+
+/// Hostile values for each of the command's own flags: refused with a message (or run,
+/// where the value is sound) within seconds, never a panic, nothing written on refusal
+/// (issue 45, item 7: the hostile tests rerun over the new command).
+#[test]
+fn hostile_values_of_the_commands_flags_end_cleanly() {
+    let dir = std::env::temp_dir().join(format!("tapsim-peakforce-hostile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bin = env!("CARGO_BIN_EXE_tapsim");
+    let flags = [
+        "--modulation-frequency",
+        "--modulation-amplitude",
+        "--peak-force",
+        "--fit-from",
+        "--fit-to",
+        "--gain",
+    ];
+    for flag in flags {
+        for value in ["NaN", "inf", "-1", "0", "1e308", "4e-320", "x", "1e9"] {
+            let mut args = vec![
+                "peakforce".to_string(),
+                format!("{flag}={value}"),
+                "--csv".into(),
+                "out.csv".into(),
+                "--quiet".into(),
+            ];
+            if flag == "--gain" {
+                args.push("--feedback".into());
+            }
+            let started = std::time::Instant::now();
+            let out = std::process::Command::new(bin)
+                .args(&args)
+                .current_dir(&dir)
+                .output()
+                .unwrap();
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                started.elapsed() < std::time::Duration::from_secs(20),
+                "{args:?} took {:?}",
+                started.elapsed()
+            );
+            assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+            match out.status.code() {
+                Some(0) => {
+                    assert!(dir.join("out.csv").exists(), "{args:?}");
+                    let _ = std::fs::remove_file(dir.join("out.csv"));
+                }
+                Some(1 | 2) => {
+                    assert!(!stderr.trim().is_empty(), "{args:?}: no message");
+                    assert!(!dir.join("out.csv").exists(), "{args:?} wrote on refusal");
+                }
+                other => panic!("{args:?}: exit {other:?}: {stderr}"),
+            }
+        }
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

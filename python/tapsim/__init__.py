@@ -42,6 +42,7 @@ __all__ = [
     "map",
     "scan",
     "thermal",
+    "peakforce",
     "hysteresis",
     "lj",
     "fit",
@@ -290,6 +291,15 @@ def scan(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
 def thermal(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
     """The free cantilever's thermal noise and its spectrum fit (``tapsim thermal``)."""
     return _run("thermal", setup, kwargs)
+
+
+def peakforce(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
+    """Off-resonance tapping, PeakForce-type (``tapsim peakforce``): one settled cycle
+    at a peak-force setpoint (``peak_force="5nN"``, the default) or a separation, and
+    its QNM channels per cycle (``cycles``: peak force, adhesion, dissipation,
+    deformation, DMT modulus); ``curve=True`` adds the recorded force curve as numpy
+    arrays (``curve["force_n"]`` against ``curve["separation_m"]`` or ``curve["t_s"]``)."""
+    return _run("peakforce", setup, kwargs)
 
 
 def hysteresis(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:

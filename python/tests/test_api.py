@@ -115,6 +115,20 @@ def test_hysteresis_gives_the_papers_closed_forms():
     assert tapsim.hysteresis(mu=10).w_hat_jkr == h.w_hat_jkr
 
 
+def test_peakforce_returns_the_channels_and_the_curve_as_arrays():
+    # A Hertz contact: no loss, and the DMT fit of the retract returns the modulus given.
+    r = tapsim.peakforce(law="hertz", separation="148.6nm", curve=True)
+    assert r.regime == "period-1"
+    ch = r.cycles[0]
+    assert ch["dmt_modulus_pa"] == pytest.approx(r.modulus_given_pa, rel=5e-3)
+    assert r.contact_loss_j == 0.0
+    force, separation = r.curve["force_n"], r.curve["separation_m"]
+    assert isinstance(force, np.ndarray) and force.shape == separation.shape
+    assert force.max() == pytest.approx(ch["peak_force_n"], rel=1e-12)
+    with pytest.raises(ValueError, match="not off-resonance"):
+        tapsim.peakforce(modulation_frequency="300kHz")
+
+
 def test_results_show_their_keys():
     r = tapsim.tap()
     assert "phase_deg" in dir(r) and "phase_deg" in r

@@ -587,3 +587,102 @@ pub fn at_setpoint(
     }
     cycle(setup, numerics, modulation, analysis, z)
 }
+
+/// The peak-force feedback of an instrument: after each modulation cycle the rest
+/// separation moves by `gain`·(F_peak − F_set)/k (k the lever's stiffness: the change of
+/// deflection that would make up the error on a stiff sample), an integral controller
+/// acting once a cycle as the instrument's does.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PeakForceFeedback {
+    /// F_set, N.
+    pub setpoint_n: f64,
+    /// The controller's gain per cycle (0 < g ≤ 1; default 0.5).
+    pub gain: f64,
+}
+
+/// One cycle of a feedback run.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FeedbackCycle {
+    /// The rest separation during the cycle, m.
+    pub separation_m: f64,
+    /// The cycle's peak force, N.
+    pub peak_force_n: f64,
+}
+
+/// A feedback run: every cycle, and whether the loop settled.
+#[derive(Debug, Clone, Serialize)]
+pub struct FeedbackRun {
+    /// Each modulation cycle in turn.
+    pub cycles: Vec<FeedbackCycle>,
+    /// Whether the peak force held the setpoint within 1e-3 and the separation moved by
+    /// less than 1e-4 nm a cycle for the last [`QUIET_CYCLES`] cycles.
+    pub settled: bool,
+}
+
+/// The most cycles a feedback run marches.
+pub const MAX_FEEDBACK_CYCLES: usize = 2000;
+
+/// Run the peak-force feedback on `setup` from rest at `start_m` (the support's lowest
+/// point just above the sample, say) until it settles or [`MAX_FEEDBACK_CYCLES`] pass.
+pub fn feedback(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    modulation: &Modulation,
+    loop_: &PeakForceFeedback,
+    start_m: f64,
+) -> Result<FeedbackRun> {
+    if !(MIN_SETPOINT_N..=1e-5).contains(&loop_.setpoint_n) {
+        return Err(Error::InvalidParameter {
+            name: "peak-force setpoint",
+            value: loop_.setpoint_n,
+            reason: "must be 1 pN to 10 µN (instruments use 0.1–100 nN)",
+        });
+    }
+    if !(loop_.gain > 0.0 && loop_.gain <= 1.0) {
+        return Err(Error::InvalidParameter {
+            name: "feedback gain",
+            value: loop_.gain,
+            reason: "must be above 0 and at most 1 (per cycle)",
+        });
+    }
+    let p = Prepared::new(setup, numerics)?;
+    let mut sim = simulation(&p, modulation, start_m, numerics.min_steps_per_period)?;
+    let cant = &p.setup.cantilever;
+    let (k, l) = (cant.stiffness_n_m, cant.free_amplitude_m);
+    let scale = p.setup.contact.separation_scale_m();
+    let mut z = start_m;
+    let mut phase = Phase::at_rest();
+    let mut cycles = Vec::new();
+    let mut quiet = 0;
+    let limit = 10.0 * modulation.amplitude_m + 1e-6;
+    budgeted(p.steady.max_steps.saturating_mul(4), || {
+        for _ in 0..MAX_FEEDBACK_CYCLES {
+            sim.cpl.a0 = z / scale;
+            sim.rewind(&mut phase);
+            let c = sim.cycle(&mut phase, &mut Ignore)?;
+            let peak = c.max_force * k * l;
+            cycles.push(FeedbackCycle {
+                separation_m: z,
+                peak_force_n: peak,
+            });
+            let step = loop_.gain * (peak - loop_.setpoint_n) / k;
+            let held = (peak / loop_.setpoint_n - 1.0).abs() < 1e-3 && step.abs() < 1e-13;
+            quiet = if held { quiet + 1 } else { 0 };
+            if quiet >= QUIET_CYCLES {
+                return Ok(true);
+            }
+            z += step;
+            if z.abs() > limit {
+                return Err(Error::NotApplicable(format!(
+                    "the feedback withdrew the support beyond {:.4} nm without the peak \
+                     force reaching the setpoint {:.4} nN: lower the setpoint or raise the \
+                     modulation amplitude",
+                    limit * 1e9,
+                    loop_.setpoint_n * 1e9
+                )));
+            }
+        }
+        Ok(false)
+    })
+    .map(|settled| FeedbackRun { cycles, settled })
+}

@@ -5,7 +5,8 @@ use crate::app::config::{TapInputs, force, frequency, length, number};
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::error::{Error, Result};
 use crate::instrument::peakforce::{
-    Analysis, Channels, ForcePoint, Modulation, PeakForceCycle, at_setpoint, cycle,
+    Analysis, Channels, ForcePoint, Modulation, PeakForceCycle, PeakForceFeedback, at_setpoint,
+    cycle, feedback,
 };
 use clap::Args;
 
@@ -41,13 +42,15 @@ use clap::Args;
 /// Examples:
 ///   tapsim peakforce                               # hybrid law, 5 nN on the built-in lever
 ///   tapsim peakforce --law jkr --peak-force 2nN
+///   tapsim peakforce --feedback                    # the setpoint reached cycle by cycle
 ///   tapsim peakforce --separation 148nm --csv curve.csv --plot curve.png
 ///
 /// JSON keys (--json): law, modulation_frequency_hz, modulation_amplitude_m,
 /// peak_force_setpoint_n (null with --separation), separation_m, regime, settled_after,
 /// cycles (each: peak_force_n, adhesion_n, dissipation_j, deformation_m, dmt_modulus_pa,
-/// dmt_contact_m, dmt_points), contact_loss_j, damping_loss_j, drive_work_j,
-/// energy_balance_rel, modulus_given_pa. --csv FILE: the recorded curve (t_s, piezo_m,
+/// dmt_contact_m, dmt_points), feedback_cycles (with --feedback), contact_loss_j, damping_loss_j, drive_work_j,
+/// energy_balance_rel, modulus_given_pa, and with --curve the recorded curve as columns
+/// (curve: t_s, piezo_m, deflection_m, separation_m, force_n, approach, contact). --csv FILE: the recorded curve (t_s, piezo_m,
 /// deflection_m, separation_m, force_n, approach, contact); --plot FILE.png|svg: force
 /// against time (the ringing after pull-off shown) and against separation.
 #[derive(Debug, Args)]
@@ -72,6 +75,18 @@ pub struct PeakForceArgs {
     /// Upper end of the DMT fit's window [default 0.9].
     #[arg(long, allow_hyphen_values = true, value_parser = number)]
     fit_to: Option<f64>,
+    /// Reach the setpoint as the instrument does: the peak-force feedback, cycle by
+    /// cycle from the support's lowest point 2 nm above the sample, instead of solving
+    /// for the separation; prints how many cycles it took.
+    #[arg(long, conflicts_with = "separation")]
+    feedback: bool,
+    /// With --json: the recorded force curve too, as columns (`curve`: t_s, piezo_m,
+    /// deflection_m, separation_m, force_n, approach, contact).
+    #[arg(long, requires = "json")]
+    curve: bool,
+    /// The feedback's gain per cycle (0 < g ≤ 1) [default 0.5].
+    #[arg(long, allow_hyphen_values = true, value_parser = number, requires = "feedback")]
+    gain: Option<f64>,
     #[command(flatten)]
     pub(super) out: super::SweepOutput,
 }
@@ -90,11 +105,41 @@ struct Report {
     regime: String,
     settled_after: usize,
     cycles: Vec<Channels>,
+    feedback_cycles: Option<usize>,
     contact_loss_j: f64,
     damping_loss_j: f64,
     drive_work_j: f64,
     energy_balance_rel: f64,
     modulus_given_pa: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    curve: Option<Columns>,
+}
+
+/// The recorded curve as columns (--json --curve).
+#[derive(serde::Serialize)]
+struct Columns {
+    t_s: Vec<f64>,
+    piezo_m: Vec<f64>,
+    deflection_m: Vec<f64>,
+    separation_m: Vec<f64>,
+    force_n: Vec<f64>,
+    approach: Vec<bool>,
+    contact: Vec<bool>,
+}
+
+impl Columns {
+    fn of(curve: &[ForcePoint]) -> Self {
+        let col = |f: fn(&ForcePoint) -> f64| curve.iter().map(f).collect();
+        Self {
+            t_s: col(|p| p.t_s),
+            piezo_m: col(|p| p.piezo_m),
+            deflection_m: col(|p| p.deflection_m),
+            separation_m: col(|p| p.separation_m),
+            force_n: col(|p| p.force_n),
+            approach: curve.iter().map(|p| p.approach).collect(),
+            contact: curve.iter().map(|p| p.contact).collect(),
+        }
+    }
 }
 
 /// Run the subcommand.
@@ -127,7 +172,29 @@ pub fn run(args: PeakForceArgs) -> Result<()> {
         },
         args.out.quiet,
     );
+    let mut feedback_cycles = None;
     let result = match setpoint {
+        Some(f) if args.feedback => {
+            let loop_ = PeakForceFeedback {
+                setpoint_n: f,
+                gain: args.gain.unwrap_or(0.5),
+            };
+            let start = modulation.amplitude_m + 2e-9;
+            feedback(&setup, &numerics, &modulation, &loop_, start).and_then(|run| {
+                match run.cycles.last().copied() {
+                    Some(last) if run.settled => {
+                        feedback_cycles = Some(run.cycles.len());
+                        cycle(&setup, &numerics, &modulation, &analysis, last.separation_m)
+                    }
+                    _ => Err(Error::NotApplicable(format!(
+                        "the peak-force feedback did not settle in {} cycles (gain {}): \
+                         lower the gain, or solve for the separation (leave out --feedback)",
+                        run.cycles.len(),
+                        loop_.gain
+                    ))),
+                }
+            })
+        }
         Some(f) => at_setpoint(&setup, &numerics, &modulation, &analysis, f),
         None => cycle(
             &setup,
@@ -148,11 +215,13 @@ pub fn run(args: PeakForceArgs) -> Result<()> {
         regime: c.regime.clone(),
         settled_after: c.settled_after,
         cycles: c.cycles.clone(),
+        feedback_cycles,
         contact_loss_j: c.contact_loss_j,
         damping_loss_j: c.damping_loss_j,
         drive_work_j: c.drive_work_j,
         energy_balance_rel: c.energy_balance_rel,
         modulus_given_pa: setup.contact.modulus_pa,
+        curve: args.curve.then(|| Columns::of(&c.curve)),
     };
     args.out.write_files(&c.curve, || charts(&report, &c))?;
     if args.out.json {
@@ -170,9 +239,13 @@ pub fn run(args: PeakForceArgs) -> Result<()> {
         trimmed(cant.resonance_hz * 1e-3),
         trimmed(cant.quality)
     );
-    let at = match setpoint {
-        Some(f) => format!(" (where the peak force is the setpoint {:.4} nN)", f * 1e9),
-        None => String::new(),
+    let at = match (setpoint, feedback_cycles) {
+        (Some(f), Some(n)) => format!(
+            " (where the peak-force feedback settled on the setpoint {:.4} nN after {n} cycles)",
+            f * 1e9
+        ),
+        (Some(f), None) => format!(" (where the peak force is the setpoint {:.4} nN)", f * 1e9),
+        (None, _) => String::new(),
     };
     outln!(
         "rest separation z_c = {:.4} nm{at}; motion {} after {} cycles marched",
