@@ -615,7 +615,7 @@ pub struct FeedbackRun {
     /// Each modulation cycle in turn.
     pub cycles: Vec<FeedbackCycle>,
     /// Whether the peak force held the setpoint within 1e-3 and the separation moved by
-    /// less than 1e-4 nm a cycle for the last [`QUIET_CYCLES`] cycles.
+    /// less than 1e-4 nm a cycle for the last 8 cycles.
     pub settled: bool,
 }
 
