@@ -101,31 +101,61 @@ fn adhesive_laws_bias_the_modulus_and_jkr_overstates_the_dissipation() {
 
 #[test]
 fn the_ringing_after_pull_off_decays_as_the_free_lever() {
-    let c = at(LawKind::Hybrid, 148.0e-9);
-    let cant = default_setup().cantilever;
-    // After the last point in contact the hybrid law is force-free: the lever rings.
-    let last_contact = c.curve.iter().rposition(|p| p.contact).unwrap();
-    let free = &c.curve[last_contact + 1..];
-    let peaks: Vec<(f64, f64)> = free
-        .windows(3)
-        .filter(|w| w[1].deflection_m > w[0].deflection_m && w[1].deflection_m >= w[2].deflection_m)
-        .map(|w| (w[1].t_s, w[1].deflection_m.abs()))
-        .collect();
-    assert!(peaks.len() > 50, "{} peaks", peaks.len());
-    // Least-squares slope of ln(peak) against time.
-    let n = peaks.len() as f64;
-    let (mt, ml) = peaks
-        .iter()
-        .fold((0.0, 0.0), |(a, b), &(t, d)| (a + t / n, b + d.ln() / n));
-    let (stt, stl) = peaks.iter().fold((0.0, 0.0), |(a, b), &(t, d)| {
-        (a + (t - mt).powi(2), b + (t - mt) * (d.ln() - ml))
-    });
-    let rate = -stl / stt;
-    let expected = 2.0 * std::f64::consts::PI * cant.resonance_hz / (2.0 * cant.quality);
-    assert!(
-        (rate / expected - 1.0).abs() < 0.02,
-        "decay {rate} /s against ω₀/2Q = {expected} /s"
-    );
+    // The built-in 300 kHz, 40 N/m lever and a soft 70 kHz, 0.4 N/m one, both Q = 400.
+    let soft = {
+        let mut s = setup(LawKind::Hybrid);
+        s.cantilever.resonance_hz = 70e3;
+        s.cantilever.drive_frequency_hz = 70e3;
+        s.cantilever.stiffness_n_m = 0.4;
+        s
+    };
+    for s in [setup(LawKind::Hybrid), soft] {
+        let c = cycle(
+            &s,
+            &Numerics::default(),
+            &Modulation::default(),
+            &Analysis::default(),
+            148.0e-9,
+        )
+        .unwrap();
+        let cant = s.cantilever;
+        // (The soft lever's motion at this separation is reported irregular: no repeat
+        // of up to 8 cycles within 400. The books and the ringing hold for any motion.)
+        if cant.stiffness_n_m > 1.0 {
+            assert_eq!(c.regime, "period-1", "{cant:?}");
+        }
+        assert!(c.contact_loss_j > 0.0, "{cant:?}: no contact");
+        assert!(
+            c.energy_balance_rel < 1e-6,
+            "{cant:?}: {}",
+            c.energy_balance_rel
+        );
+        // After the last point in contact the hybrid law is force-free: the lever rings.
+        let last_contact = c.curve.iter().rposition(|p| p.contact).unwrap();
+        let free = &c.curve[last_contact + 1..];
+        let peaks: Vec<(f64, f64)> = free
+            .windows(3)
+            .filter(|w| {
+                w[1].deflection_m > w[0].deflection_m && w[1].deflection_m >= w[2].deflection_m
+            })
+            .map(|w| (w[1].t_s, w[1].deflection_m.abs()))
+            .collect();
+        assert!(peaks.len() > 10, "{cant:?}: {} peaks", peaks.len());
+        // Least-squares slope of ln(peak) against time.
+        let n = peaks.len() as f64;
+        let (mt, ml) = peaks
+            .iter()
+            .fold((0.0, 0.0), |(a, b), &(t, d)| (a + t / n, b + d.ln() / n));
+        let (stt, stl) = peaks.iter().fold((0.0, 0.0), |(a, b), &(t, d)| {
+            (a + (t - mt).powi(2), b + (t - mt) * (d.ln() - ml))
+        });
+        let rate = -stl / stt;
+        let expected = 2.0 * std::f64::consts::PI * cant.resonance_hz / (2.0 * cant.quality);
+        assert!(
+            (rate / expected - 1.0).abs() < 0.02,
+            "{cant:?}: decay {rate} /s against ω₀/2Q = {expected} /s"
+        );
+    }
 }
 
 #[test]
@@ -390,8 +420,10 @@ fn slow_modulation_converges_to_the_finite_stiffness_loss_26() {
                     frequency_hz: ratio * s.cantilever.resonance_hz,
                     amplitude_m: 0.5 * (top - bottom),
                 };
-                let mut n = Numerics::default();
-                n.max_steps = 50_000_000;
+                let n = Numerics {
+                    max_steps: 50_000_000,
+                    ..Default::default()
+                };
                 let c = cycle(&s, &n, &m, &Analysis::default(), 0.5 * (top + bottom)).unwrap();
                 assert_eq!(c.regime, "period-1");
                 // The contact itself loses the rigid hybrid loop.
