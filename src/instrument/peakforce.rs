@@ -508,6 +508,19 @@ pub fn cycle(
 /// The least peak-force setpoint, N: below it the peak is lost in the free ringing.
 pub const MIN_SETPOINT_N: f64 = 1e-12;
 
+/// Refuse a peak-force setpoint no instrument holds.
+fn check_setpoint(setpoint_n: f64) -> Result<()> {
+    if (MIN_SETPOINT_N..=1e-5).contains(&setpoint_n) {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter {
+            name: "peak-force setpoint",
+            value: setpoint_n,
+            reason: "must be 1 pN to 10 µN (instruments use 0.1–100 nN)",
+        })
+    }
+}
+
 /// The settled cycle whose peak force is `setpoint_n` (N): the rest separation solved
 /// for directly (the peak force falls as the support is withdrawn; bracketed from where
 /// the support's lowest point just reaches the sample, then regula falsi to 1e-4 nm),
@@ -519,13 +532,7 @@ pub fn at_setpoint(
     analysis: &Analysis,
     setpoint_n: f64,
 ) -> Result<PeakForceCycle> {
-    if !(MIN_SETPOINT_N..=1e-5).contains(&setpoint_n) {
-        return Err(Error::InvalidParameter {
-            name: "peak-force setpoint",
-            value: setpoint_n,
-            reason: "must be 1 pN to 10 µN (instruments use 0.1–100 nN)",
-        });
-    }
+    check_setpoint(setpoint_n)?;
     modulation.check(&setup.cantilever)?;
     let peak = |z: f64| -> Result<f64> {
         let c = cycle(setup, numerics, modulation, analysis, z)?;
@@ -631,13 +638,7 @@ pub fn feedback(
     loop_: &PeakForceFeedback,
     start_m: f64,
 ) -> Result<FeedbackRun> {
-    if !(MIN_SETPOINT_N..=1e-5).contains(&loop_.setpoint_n) {
-        return Err(Error::InvalidParameter {
-            name: "peak-force setpoint",
-            value: loop_.setpoint_n,
-            reason: "must be 1 pN to 10 µN (instruments use 0.1–100 nN)",
-        });
-    }
+    check_setpoint(loop_.setpoint_n)?;
     if !(loop_.gain > 0.0 && loop_.gain <= 1.0) {
         return Err(Error::InvalidParameter {
             name: "feedback gain",
