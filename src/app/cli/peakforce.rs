@@ -47,12 +47,13 @@ use clap::Args;
 ///
 /// JSON keys (--json): law, modulation_frequency_hz, modulation_amplitude_m,
 /// peak_force_setpoint_n (null with --separation), separation_m, regime, settled_after,
-/// cycles (each: peak_force_n, adhesion_n, dissipation_j, deformation_m, dmt_modulus_pa,
-/// dmt_contact_m, dmt_points), feedback_cycles (with --feedback), contact_loss_j, damping_loss_j, drive_work_j,
-/// energy_balance_rel, modulus_given_pa, and with --curve the recorded curve as columns
-/// (curve: t_s, piezo_m, deflection_m, separation_m, force_n, approach, contact). --csv FILE: the recorded curve (t_s, piezo_m,
-/// deflection_m, separation_m, force_n, approach, contact); --plot FILE.png|svg: force
-/// against time (the ringing after pull-off shown) and against separation.
+/// cycles (each: peak_force_n, adhesion_n, dissipation_j, deformation_m,
+/// dmt_modulus_pa, dmt_contact_m, dmt_points), feedback_cycles (with --feedback),
+/// contact_loss_j, damping_loss_j, drive_work_j, energy_balance_rel, modulus_given_pa,
+/// and with --curve the recorded curve as columns (curve: t_s, piezo_m, deflection_m,
+/// separation_m, force_n, approach, contact). --csv FILE: the recorded curve, the same
+/// columns; --plot FILE.png|svg: force and deflection against time (the ringing after
+/// pull-off shown) and force against separation, approach and retract.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct PeakForceArgs {
