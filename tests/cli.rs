@@ -1732,6 +1732,7 @@ fn every_command_takes_quiet_and_names_the_files_it_writes() {
         "map",
         "scan",
         "thermal",
+        "peakforce",
         "batch",
         "merge",
         "hysteresis",
