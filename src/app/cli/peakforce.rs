@@ -33,6 +33,12 @@ use clap::Args;
 ///                  between 30 % and 90 % of the span from adhesion to peak (--fit-from,
 ///                  --fit-to), as commercial QNM analysis does.
 ///
+/// Sync distance and baseline: an instrument must find where in its sampled deflection
+/// each cycle's peak lies (the "sync distance", a delay of its electronics) and subtract
+/// a baseline; here every point's time and separation are known exactly and the
+/// support's acceleration is not in the model (its baseline, (f_m/f₀)²·A_m, is 7 pm
+/// on the defaults), so neither applies.
+///
 /// On a conservative law (hertz, dmt) the dissipation is nothing and the DMT modulus
 /// is the E* given; on the adhesive laws the modulus comes out biased, and JKR loses
 /// several times the hybrid law's energy per cycle: the paper's conclusion as a QNM
