@@ -138,7 +138,18 @@ fn the_ringing_after_pull_off_decays_as_the_free_lever() {
             .filter(|w| {
                 w[1].deflection_m > w[0].deflection_m && w[1].deflection_m >= w[2].deflection_m
             })
-            .map(|w| (w[1].t_s, w[1].deflection_m.abs()))
+            // Each maximum refined by the parabola through it and its neighbours (the
+            // free flight is sampled evenly, 32 points a period).
+            .map(|w| {
+                let (y0, y1, y2) = (w[0].deflection_m, w[1].deflection_m, w[2].deflection_m);
+                let curvature = y2 - 2.0 * y1 + y0;
+                let top = if curvature < 0.0 {
+                    y1 - (y2 - y0).powi(2) / (8.0 * curvature)
+                } else {
+                    y1
+                };
+                (w[1].t_s, top.abs())
+            })
             .collect();
         assert!(peaks.len() > 10, "{cant:?}: {} peaks", peaks.len());
         // Least-squares slope of ln(peak) against time.

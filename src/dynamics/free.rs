@@ -1,7 +1,9 @@
 //! Closed-form motion of the force-driven, underdamped oscillator while the tip feels no
 //! force: x'' + 2γx' + x = f₀ cos Ωτ + b, b a constant force (the thermal force over
 //! one of its steps; usually 0). Exact, so free flight costs no integration steps, and
-//! so are the carried integrals.
+//! so are the carried integrals. Under a base drive (the support moving as B cos Ωτ, no
+//! drive force: f₀ = 0) the deflection rings freely and the separation follows
+//! x + B cos Ωτ, whose fall to the jump-in ends the flight (`FreeFlight::separation`).
 
 use super::model::{Carried, Drive, Oscillator, State, V, X, has_tangent, phi_column, section_dim};
 use crate::numeric::newton_bracketed;
@@ -35,6 +37,11 @@ pub struct FreeFlight {
     omega_d: f64,
     omega: f64,
     f0: f64,
+    /// The support's amplitude B under a base drive (0 under a force drive).
+    base: f64,
+    /// Whether this is the separation x + B cos Ωτ of a base-driven flight, not the
+    /// deflection.
+    shifted: bool,
 }
 
 /// (e^z − 1)/z, accurate also for small |z|.
@@ -48,11 +55,12 @@ fn exprel(z: Complex<f64>) -> Complex<f64> {
 }
 
 impl FreeFlight {
-    /// The free motion through (`tau0`, `x0`, `v0`); `None` unless the drive is a force
-    /// and the oscillator underdamped.
+    /// The free motion through (`tau0`, `x0`, `v0`); `None` unless the oscillator is
+    /// underdamped.
     pub fn new(osc: &Oscillator, tau0: f64, x0: f64, v0: f64) -> Option<Self> {
-        let Drive::Force { amplitude: f0 } = osc.drive else {
-            return None;
+        let (f0, base) = match osc.drive {
+            Drive::Force { amplitude } => (amplitude, 0.0),
+            Drive::Base { amplitude } => (0.0, amplitude),
         };
         if !osc.underdamped() {
             return None;
@@ -78,7 +86,24 @@ impl FreeFlight {
             omega_d,
             omega: w,
             f0,
+            base,
+            shifted: false,
         })
+    }
+
+    /// The separation coordinate x + x_b of this flight (x itself under a force drive):
+    /// the same form with the support's B cos Ωτ added to the particular part, for the
+    /// fall to a switch level and the turning points the grazing margins measure.
+    pub(crate) fn separation(&self) -> Self {
+        if self.base == 0.0 {
+            return *self;
+        }
+        Self {
+            a: self.a + self.base,
+            base: 0.0,
+            shifted: true,
+            ..*self
+        }
     }
 
     /// The steady free response (a, b) for a force drive: x = a cos Ωτ + b sin Ωτ.
@@ -131,13 +156,28 @@ impl FreeFlight {
         })
     }
 
-    /// Velocity and acceleration at τ (the acceleration from the equation of motion).
+    /// Velocity and acceleration at τ: from the equation of motion for the deflection;
+    /// for a separation under a base drive ([`FreeFlight::separation`]), the particular
+    /// part's −Ω²(a cos Ωτ + b sin Ωτ) and the transient's, which obeys the free
+    /// equation (h'' = −2γh' − h).
     #[inline]
     fn velocity_and_acceleration(&self, tau: f64) -> (f64, f64) {
         let (x, v) = self.at(tau);
+        if !self.shifted {
+            return (
+                v,
+                self.f0 * (self.omega * tau).cos() + self.bias - 2.0 * self.gamma * v - x,
+            );
+        }
+        let (s, c) = (self.omega * tau).sin_cos();
+        let particular = self.a * c + self.b * s;
+        let (x_h, v_h) = (
+            x - particular - self.bias,
+            v - self.omega * (-self.a * s + self.b * c),
+        );
         (
             v,
-            self.f0 * (self.omega * tau).cos() + self.bias - 2.0 * self.gamma * v - x,
+            -self.omega * self.omega * particular - 2.0 * self.gamma * v_h - x_h,
         )
     }
 
@@ -293,6 +333,52 @@ mod tests {
     /// With and without a constant force (the thermal force's step).
     fn oscs() -> [Oscillator; 2] {
         [osc(), Oscillator { bias: 0.3, ..osc() }]
+    }
+
+    #[test]
+    fn under_a_base_drive_the_separation_adds_the_support() {
+        let base = Oscillator {
+            gamma: 1.0 / 800.0,
+            omega: 2.0 / 300.0,
+            drive: Drive::Base { amplitude: 7.5 },
+            bias: 0.0,
+        };
+        let flight = FreeFlight::new(&base, 3.0, 0.01, -0.02).unwrap();
+        let separation = flight.separation();
+        for tau in [3.0, 4.7, 30.0, 500.0] {
+            let (x, v) = flight.at(tau);
+            let (x_b, v_b) = base.base_at(tau);
+            let (y, w) = separation.at(tau);
+            assert!((y - (x + x_b)).abs() < 1e-12 && (w - (v + v_b)).abs() < 1e-12);
+            // The deflection rings freely: x'' = −2γx' − x.
+            let h = 1e-5;
+            let acc = (flight.at(tau + h).1 - flight.at(tau - h).1) / (2.0 * h);
+            assert!((acc + 2.0 * base.gamma * v + x).abs() < 1e-8, "{acc}");
+            // The separation's acceleration, as Newton on its turning points uses it.
+            let (w2, a2) = separation.velocity_and_acceleration(tau);
+            let fd = (separation.at(tau + h).1 - separation.at(tau - h).1) / (2.0 * h);
+            assert!(
+                (w2 - w).abs() < 1e-12 && (a2 - fd).abs() < 1e-8,
+                "{a2} vs {fd}"
+            );
+        }
+        // A fall of the separation to a level below the deflection's reach is found
+        // where the support brings it there.
+        let level = -7.0;
+        let fall = separation.first_fall_to(
+            level,
+            3.0,
+            3.0 + base.period(),
+            2.0 * std::f64::consts::PI / 8.0,
+        );
+        let hit = fall.hit.expect("the support carries the tip down");
+        assert!((separation.at(hit).0 - level).abs() < 1e-10);
+        assert!(
+            flight
+                .first_fall_to(level, 3.0, 3.0 + base.period(), 1.0)
+                .hit
+                .is_none()
+        );
     }
 
     #[test]

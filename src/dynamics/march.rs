@@ -14,9 +14,9 @@ use super::budget;
 use super::free::FreeFlight;
 use super::grazing::{Margins, SwitchLevels};
 use super::model::{
-    BASE, Carried, Coupling, MEMORY, MEMORY_TANGENT, MODES, Oscillator, RATE, RATE_TANGENT, State,
-    TANGENT, V, X, dissipative_work_index, has_tangent, internal, internal_count, phi, phi_column,
-    relax_internal, reset_phi, section_dim, set_internal,
+    BASE, Carried, Coupling, Drive, MEMORY, MEMORY_TANGENT, MODES, Oscillator, RATE, RATE_TANGENT,
+    State, TANGENT, V, X, dissipative_work_index, has_tangent, internal, internal_count, phi,
+    phi_column, relax_internal, reset_phi, section_dim, set_internal,
 };
 use super::numeric::{
     self, Crossing, Events, StepEnd, StepObserver, Tolerances, hermite, hermite_turn_fraction,
@@ -569,7 +569,16 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 .flatten();
             if let Some(flight) = flight {
                 let level = self.cpl.x_at(jump_in);
-                let fall = flight.first_fall_to(level, tau, tau_end, period / 8.0);
+                // The separation's motion (under a base drive the support moves too),
+                // sampled an eighth of a drive period apart — of the lever's own under
+                // a slow base drive, where the drive period is many of its periods.
+                let max_dt = match self.osc.drive {
+                    Drive::Force { .. } => period / 8.0,
+                    Drive::Base { .. } => period.min(2.0 * std::f64::consts::PI) / 8.0,
+                };
+                let fall = flight
+                    .separation()
+                    .first_fall_to(level, tau, tau_end, max_dt);
                 let (hit, min_x) = (fall.hit, fall.min_x);
                 let stop = hit.unwrap_or(tau_end);
                 for turn in [fall.lowest_turn, fall.highest_turn] {

@@ -16,6 +16,7 @@
 //! the period map of the modulation.
 
 use crate::dynamics::budget::budgeted;
+use crate::dynamics::free::FreeFlight;
 use crate::dynamics::march::{Phase, Simulation};
 use crate::dynamics::model::Drive;
 use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver, hermite, internal_at};
@@ -343,7 +344,7 @@ fn settle(sim: &Simulation<'_, AnyLaw>) -> Result<(Phase, Option<usize>, usize)>
 const POINTS_PER_STEP: usize = 4;
 
 /// Records the force curve: points on each accepted step (the integrator's steps
-/// resolve the contact finely and the free ringing at the lever's own period).
+/// resolve the contact finely) and the closed-form free flight sampled evenly.
 struct CurveRecorder<'a> {
     law: &'a AnyLaw,
     sim: &'a Simulation<'a, AnyLaw>,
@@ -353,15 +354,53 @@ struct CurveRecorder<'a> {
 
 impl StepObserver for CurveRecorder<'_> {
     fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch) {
-        let first = usize::from(!self.samples.is_empty());
+        let first = self.first(branch);
         for i in first..=POINTS_PER_STEP {
             let tau = from.tau + (to.tau - from.tau) * i as f64 / POINTS_PER_STEP as f64;
             self.push(from, to, tau, branch);
         }
     }
+
+    fn free_flight(&mut self, flight: &FreeFlight, from: f64, to: f64) {
+        self.record_flight(flight, from, to);
+    }
 }
 
+/// Points recorded per period of the lever in closed-form free flight.
+const FREE_POINTS_PER_PERIOD: f64 = 32.0;
+
 impl CurveRecorder<'_> {
+    /// The first of a step's points to record: its start too where the curve begins or
+    /// the branch has just switched (the force jumps there at one separation), else the
+    /// start is the last step's end, already recorded.
+    fn first(&self, branch: Branch) -> usize {
+        match self.samples.last() {
+            Some(last) if last.4 == branch => 1,
+            _ => 0,
+        }
+    }
+
+    /// The free flight from `from` to `to`, sampled evenly (the lever's ringing).
+    fn record_flight(&mut self, flight: &FreeFlight, from: f64, to: f64) {
+        let n = ((to - from) / (2.0 * PI) * FREE_POINTS_PER_PERIOD)
+            .ceil()
+            .max(1.0) as usize;
+        let first = self.first(Branch::Free);
+        for i in first..=n {
+            let tau = from + (to - from) * i as f64 / n as f64;
+            let (x, v) = flight.at(tau);
+            let state = self.sim.cpl.contact_state(
+                (x, v),
+                self.sim.osc.base_at(tau),
+                Branch::Free,
+                Default::default(),
+            );
+            let f = -self.sim.cpl.f_scale * self.law.force_hat(&state) + 0.0;
+            self.samples
+                .push((tau, x, state.alpha_hat, f, Branch::Free));
+        }
+    }
+
     fn push<const N: usize>(&mut self, a: &StepEnd<N>, b: &StepEnd<N>, tau: f64, branch: Branch) {
         use crate::dynamics::model::{V, X};
         let (x, v) = (hermite(a, b, X, tau), hermite(a, b, V, tau));
