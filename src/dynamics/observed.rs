@@ -292,15 +292,47 @@ pub struct TrajectorySample {
 
 /// Records the trajectory (dimensionless samples, converted by [`Recorder::to_si`]):
 /// step ends plus points on each step's Hermite interpolant, and closed-form free flight
-/// sampled evenly.
+/// sampled evenly, as densely as its [`Sampling`] says.
 pub(crate) struct Recorder<'a, L: ForceLaw> {
     /// (τ, x, x', α̂, f_ts, branch).
     pub samples: Vec<(f64, f64, f64, f64, f64, Branch)>,
-    /// Whether samples were dropped at [`MAX_TRAJECTORY_SAMPLES`].
+    /// Whether samples were dropped at the sampling's `max_samples`.
     pub overflowed: bool,
     law: &'a L,
     cpl: Coupling,
     osc: Oscillator,
+    sampling: Sampling,
+}
+
+/// How densely a [`Recorder`] samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Sampling {
+    /// Points on each integrator step (its end and points on its interpolant).
+    pub points_per_step: usize,
+    /// Free flight: this many samples per `free_period` of τ.
+    pub free_samples: f64,
+    /// The span of τ `free_samples` fall on.
+    pub free_period: f64,
+    /// Whether a step or a flight that begins on another branch than the last sample's
+    /// records its start too (the force jumps there at one separation: a force curve
+    /// integrated over the separation needs both sides); else a step's start is taken
+    /// as the last sample and a flight's start is recorded again.
+    pub switch_starts: bool,
+    /// The most samples kept (a record that would need more is marked overflowed).
+    pub max_samples: usize,
+}
+
+impl Sampling {
+    /// A tapping trajectory: six points a step, 400 samples a drive period in free flight.
+    pub fn trajectory(osc: &Oscillator) -> Self {
+        Self {
+            points_per_step: 6,
+            free_samples: 400.0,
+            free_period: osc.period(),
+            switch_starts: false,
+            max_samples: MAX_TRAJECTORY_SAMPLES,
+        }
+    }
 }
 
 /// Most cycles a run records.
@@ -310,15 +342,12 @@ pub const MAX_RECORD_CYCLES: usize = 1000;
 /// or plot, so some 40 MB).
 pub const MAX_TRAJECTORY_SAMPLES: usize = 200_000;
 
-/// Interpolated points per integrator step, and samples per period in free flight.
-const POINTS_PER_STEP: usize = 6;
-const FREE_SAMPLES_PER_PERIOD: f64 = 400.0;
-
 impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
     fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch) {
-        let start = if self.samples.is_empty() { 0 } else { 1 };
-        for i in start..=POINTS_PER_STEP {
-            let tau = from.tau + (to.tau - from.tau) * i as f64 / POINTS_PER_STEP as f64;
+        let start = self.first(branch, 1);
+        let points = self.sampling.points_per_step;
+        for i in start..=points {
+            let tau = from.tau + (to.tau - from.tau) * i as f64 / points as f64;
             let x = hermite(from, to, X, tau);
             let v = hermite(from, to, V, tau);
             self.push(tau, (x, v), internal_at(from, to, tau), branch);
@@ -326,10 +355,11 @@ impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
     }
 
     fn free_flight(&mut self, flight: &FreeFlight, from: f64, to: f64) {
-        let n = ((to - from) / self.osc.period() * FREE_SAMPLES_PER_PERIOD)
+        let s = self.sampling;
+        let n = ((to - from) / s.free_period * s.free_samples)
             .ceil()
             .max(1.0) as usize;
-        for i in 0..=n {
+        for i in self.first(Branch::Free, 0)..=n {
             let tau = from + (to - from) * i as f64 / n as f64;
             // (Closed-form free flight is only taken for laws without internal state.)
             self.push(tau, flight.at(tau), Internal::default(), Branch::Free);
@@ -338,19 +368,38 @@ impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
 }
 
 impl<'a, L: ForceLaw> Recorder<'a, L> {
-    /// An empty recorder for the law and model of a simulation.
+    /// An empty recorder for the law and model of a simulation, sampling a tapping
+    /// trajectory ([`Sampling::trajectory`]).
     pub fn new(law: &'a L, cpl: Coupling, osc: Oscillator) -> Self {
+        Self::sampling(law, cpl, osc, Sampling::trajectory(&osc))
+    }
+
+    /// An empty recorder sampling as `sampling` says.
+    pub fn sampling(law: &'a L, cpl: Coupling, osc: Oscillator, sampling: Sampling) -> Self {
         Self {
             samples: Vec::new(),
             overflowed: false,
             law,
             cpl,
             osc,
+            sampling,
+        }
+    }
+
+    /// The first point of a step or flight on `branch` to record: its start where the
+    /// record begins, or (with `switch_starts`) where the branch has just switched;
+    /// else `otherwise`.
+    fn first(&self, branch: Branch, otherwise: usize) -> usize {
+        match self.samples.last() {
+            None => 0,
+            Some(last) if self.sampling.switch_starts && last.5 != branch => 0,
+            Some(_) if self.sampling.switch_starts => 1,
+            Some(_) => otherwise,
         }
     }
 
     fn push(&mut self, tau: f64, (x, v): (f64, f64), internal: Internal, branch: Branch) {
-        if self.samples.len() >= MAX_TRAJECTORY_SAMPLES {
+        if self.samples.len() >= self.sampling.max_samples {
             self.overflowed = true;
             return;
         }

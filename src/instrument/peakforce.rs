@@ -16,13 +16,13 @@
 //! the period map of the modulation.
 
 use crate::dynamics::budget::budgeted;
-use crate::dynamics::free::FreeFlight;
 use crate::dynamics::march::{Phase, Simulation};
 use crate::dynamics::model::Drive;
-use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver, hermite, internal_at};
+use crate::dynamics::numeric::Ignore;
+use crate::dynamics::observed::{Recorder, Sampling};
 use crate::dynamics::setup::{Cantilever, Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
-use crate::physics::law::{AnyLaw, Branch, ForceLaw, MAX_INTERNAL};
+use crate::physics::law::{AnyLaw, Branch, MAX_INTERNAL};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -176,10 +176,7 @@ impl Analysis {
             .min_by(|&a, &b| curve[a].force_n.total_cmp(&curve[b].force_n))
             .unwrap_or(peak_at);
         let least = curve.get(min_at).map_or(0.0, |p| p.force_n);
-        let dissipation = -curve
-            .windows(2)
-            .map(|w| 0.5 * (w[0].force_n + w[1].force_n) * (w[1].separation_m - w[0].separation_m))
-            .sum::<f64>();
+        let dissipation = -curve.windows(2).map(work_on_tip).sum::<f64>();
         // The approach's last crossing of zero force before the peak.
         let zero = (1..=peak_at)
             .rev()
@@ -215,6 +212,12 @@ impl Analysis {
             dmt_points: window.len(),
         }
     }
+}
+
+/// The work the tip–sample force does on the tip between two recorded points,
+/// ∫F dα by the trapezoid rule.
+fn work_on_tip(pair: &[ForcePoint]) -> f64 {
+    0.5 * (pair[0].force_n + pair[1].force_n) * (pair[1].separation_m - pair[0].separation_m)
 }
 
 /// The least-squares line y = s·x + c through `points`: (s, c), None if the x coincide.
@@ -339,81 +342,22 @@ fn settle(sim: &Simulation<'_, AnyLaw>) -> Result<(Phase, Option<usize>, usize)>
     Ok((phase, None, MAX_SETTLE_CYCLES))
 }
 
-/// Points recorded per integrator step (its end and points on its Hermite interpolant):
-/// the area between approach and retract is then within 1e-4 of the exact loss.
-const POINTS_PER_STEP: usize = 4;
+/// How the force curve is recorded: four points on each integrator step (the steps
+/// resolve the contact finely; the area between approach and retract is then within
+/// 1e-4 of the exact loss), the closed-form free flight 32 times a period of the lever,
+/// and a step's start where the branch switched (the force jumps there at one
+/// separation); at most [`MAX_CURVE_SAMPLES`].
+const CURVE: Sampling = Sampling {
+    points_per_step: 4,
+    free_samples: 32.0,
+    free_period: 2.0 * PI,
+    switch_starts: true,
+    max_samples: MAX_CURVE_SAMPLES,
+};
 
-/// Records the force curve: points on each accepted step (the integrator's steps
-/// resolve the contact finely) and the closed-form free flight sampled evenly.
-struct CurveRecorder<'a> {
-    law: &'a AnyLaw,
-    sim: &'a Simulation<'a, AnyLaw>,
-    /// (τ, x, α̂, f_ts, branch).
-    samples: Vec<(f64, f64, f64, f64, Branch)>,
-}
-
-impl StepObserver for CurveRecorder<'_> {
-    fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch) {
-        let first = self.first(branch);
-        for i in first..=POINTS_PER_STEP {
-            let tau = from.tau + (to.tau - from.tau) * i as f64 / POINTS_PER_STEP as f64;
-            self.push(from, to, tau, branch);
-        }
-    }
-
-    fn free_flight(&mut self, flight: &FreeFlight, from: f64, to: f64) {
-        self.record_flight(flight, from, to);
-    }
-}
-
-/// Points recorded per period of the lever in closed-form free flight.
-const FREE_POINTS_PER_PERIOD: f64 = 32.0;
-
-impl CurveRecorder<'_> {
-    /// The first of a step's points to record: its start too where the curve begins or
-    /// the branch has just switched (the force jumps there at one separation), else the
-    /// start is the last step's end, already recorded.
-    fn first(&self, branch: Branch) -> usize {
-        match self.samples.last() {
-            Some(last) if last.4 == branch => 1,
-            _ => 0,
-        }
-    }
-
-    /// The free flight from `from` to `to`, sampled evenly (the lever's ringing).
-    fn record_flight(&mut self, flight: &FreeFlight, from: f64, to: f64) {
-        let n = ((to - from) / (2.0 * PI) * FREE_POINTS_PER_PERIOD)
-            .ceil()
-            .max(1.0) as usize;
-        let first = self.first(Branch::Free);
-        for i in first..=n {
-            let tau = from + (to - from) * i as f64 / n as f64;
-            let (x, v) = flight.at(tau);
-            let state = self.sim.cpl.contact_state(
-                (x, v),
-                self.sim.osc.base_at(tau),
-                Branch::Free,
-                Default::default(),
-            );
-            let f = -self.sim.cpl.f_scale * self.law.force_hat(&state) + 0.0;
-            self.samples
-                .push((tau, x, state.alpha_hat, f, Branch::Free));
-        }
-    }
-
-    fn push<const N: usize>(&mut self, a: &StepEnd<N>, b: &StepEnd<N>, tau: f64, branch: Branch) {
-        use crate::dynamics::model::{V, X};
-        let (x, v) = (hermite(a, b, X, tau), hermite(a, b, V, tau));
-        let state = self.sim.cpl.contact_state(
-            (x, v),
-            self.sim.osc.base_at(tau),
-            branch,
-            internal_at(a, b, tau),
-        );
-        let f = -self.sim.cpl.f_scale * self.law.force_hat(&state) + 0.0;
-        self.samples.push((tau, x, state.alpha_hat, f, branch));
-    }
-}
+/// The most points of a recorded force curve (some 100 bytes each with the curve in
+/// SI beside its samples: 100 MB): a slow modulation's cycles of 10⁴ lever periods fit.
+pub const MAX_CURVE_SAMPLES: usize = 1_000_000;
 
 /// The simulation of `setup`'s cantilever and law driven through its support by
 /// `modulation`, at rest separation `separation_m`: the length unit L is the free
@@ -462,17 +406,19 @@ pub fn cycle(
     let (period, marched, samples, starts, sums) = budgeted(p.steady.max_steps, || {
         let (mut phase, period, marched) = settle(&sim)?;
         let cycles = period.unwrap_or(IRREGULAR_CYCLES);
-        let mut recorder = CurveRecorder {
-            law: &p.law,
-            sim: &sim,
-            samples: Vec::new(),
-        };
+        let mut recorder = Recorder::sampling(&p.law, sim.cpl, sim.osc, CURVE);
         let mut sums = (0.0, 0.0, 0.0, 0.0);
         let mut starts = Vec::with_capacity(cycles + 1);
         for _ in 0..cycles {
             sim.rewind(&mut phase);
             starts.push(recorder.samples.len());
             let c = sim.cycle(&mut phase, &mut recorder)?;
+            if recorder.overflowed {
+                return Err(Error::NotApplicable(format!(
+                    "the settled motion's force curve needs more than {MAX_CURVE_SAMPLES} \
+                     samples, the most tapsim records: raise the modulation frequency"
+                )));
+            }
             sums = (
                 sums.0 + c.e_ts,
                 sums.1 + c.e_damp,
@@ -492,7 +438,7 @@ pub fn cycle(
     let n = cycles as f64;
     let curve: Vec<ForcePoint> = samples
         .iter()
-        .map(|&(tau, x, alpha, f, branch)| {
+        .map(|&(tau, x, _, alpha, f, branch)| {
             let (x_b, v_b) = sim.osc.base_at(tau);
             ForcePoint {
                 t_s: (tau % sim.osc.period()) / w0,
@@ -513,15 +459,7 @@ pub fn cycle(
     // The energy the books are kept on: the drive's work, or the work the contact
     // stores and gives back each cycle where that is more (a conservative contact,
     // whose drive work is the slow motion's damping alone).
-    let exchanged = 0.5
-        * curve
-            .windows(2)
-            .map(|w| {
-                (0.5 * (w[0].force_n + w[1].force_n) * (w[1].separation_m - w[0].separation_m))
-                    .abs()
-            })
-            .sum::<f64>()
-        / n;
+    let exchanged = 0.5 * curve.windows(2).map(|w| work_on_tip(w).abs()).sum::<f64>() / n;
     let books = (drive / n * energy)
         .abs()
         .max(exchanged)
@@ -547,8 +485,8 @@ pub fn cycle(
 /// The least peak-force setpoint, N: below it the peak is lost in the free ringing.
 pub const MIN_SETPOINT_N: f64 = 1e-12;
 
-/// Refuse a peak-force setpoint no instrument holds.
-fn check_setpoint(setpoint_n: f64) -> Result<()> {
+/// Refuse a peak-force setpoint no instrument holds (N).
+pub fn check_setpoint(setpoint_n: f64) -> Result<()> {
     if (MIN_SETPOINT_N..=1e-5).contains(&setpoint_n) {
         Ok(())
     } else {
