@@ -6,6 +6,9 @@
 //! against the hybrid law (the paper's point, as a QNM user meets it); bad input is
 //! refused (issue 47).
 
+mod common;
+use common::{run_limited, scratch};
+use std::time::Duration;
 use tapsim::instrument::peakforce::{Analysis, Modulation, at_setpoint, cycle};
 use tapsim::{LawKind, Numerics, TapSetup, default_setup};
 
@@ -246,16 +249,8 @@ fn modulations_that_are_not_off_resonance_tapping_are_refused() {
 
 #[test]
 fn the_command_prints_the_channels_and_refuses_what_is_not_off_resonance() {
-    let dir = std::env::temp_dir().join(format!("tapsim-peakforce-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let bin = env!("CARGO_BIN_EXE_tapsim");
-    let run = |args: &[&str]| {
-        std::process::Command::new(bin)
-            .args(args)
-            .current_dir(&dir)
-            .output()
-            .unwrap()
-    };
+    let dir = scratch("command");
+    let run = |args: &[&str]| run_limited(args, &dir, Duration::from_secs(120));
     let out = run(&[
         "peakforce",
         "--separation",
@@ -264,12 +259,8 @@ fn the_command_prints_the_channels_and_refuses_what_is_not_off_resonance() {
         "hertz",
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     assert_eq!(v["regime"], "period-1");
     let e = v["cycles"][0]["dmt_modulus_pa"].as_f64().unwrap();
     let given = v["modulus_given_pa"].as_f64().unwrap();
@@ -283,21 +274,17 @@ fn the_command_prints_the_channels_and_refuses_what_is_not_off_resonance() {
         "--csv",
         "c.csv",
     ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("not off-resonance"));
+    assert_eq!(out.code, Some(1));
+    assert!(out.stderr.contains("not off-resonance"));
     let out = run(&["peakforce", "--csv", "c.csv", "--plot", "c.jpg"]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.code, Some(1));
     assert!(!dir.join("c.csv").exists());
     let out = run(&["peakforce", "--peak-force", "-1nN"]);
-    assert_ne!(out.status.code(), Some(0));
+    assert_ne!(out.code, Some(0));
     // The setpoint reached by the feedback, cycle by cycle.
     let out = run(&["peakforce", "--feedback", "--peak-force", "3nN", "--json"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     assert!(v["feedback_cycles"].as_u64().unwrap() > 8);
     let peak = v["cycles"][0]["peak_force_n"].as_f64().unwrap();
     assert!((peak / 3e-9 - 1.0).abs() < 0.01, "{peak}");
@@ -344,9 +331,7 @@ fn the_feedback_settles_where_the_direct_solve_puts_the_setpoint() {
 /// (issue 45, item 7: the hostile tests rerun over the new command).
 #[test]
 fn hostile_values_of_the_commands_flags_end_cleanly() {
-    let dir = std::env::temp_dir().join(format!("tapsim-peakforce-hostile-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let bin = env!("CARGO_BIN_EXE_tapsim");
+    let dir = scratch("hostile");
     let flags = [
         "--modulation-frequency",
         "--modulation-amplitude",
@@ -367,20 +352,15 @@ fn hostile_values_of_the_commands_flags_end_cleanly() {
             if flag == "--gain" {
                 args.push("--feedback".into());
             }
-            let started = std::time::Instant::now();
-            let out = std::process::Command::new(bin)
-                .args(&args)
-                .current_dir(&dir)
-                .output()
-                .unwrap();
-            let stderr = String::from_utf8_lossy(&out.stderr);
+            let out = run_limited(&args, &dir, Duration::from_secs(20));
+            let stderr = &out.stderr;
             assert!(
-                started.elapsed() < std::time::Duration::from_secs(20),
+                out.elapsed < Duration::from_secs(20),
                 "{args:?} took {:?}",
-                started.elapsed()
+                out.elapsed
             );
             assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
-            match out.status.code() {
+            match out.code {
                 Some(0) => {
                     assert!(dir.join("out.csv").exists(), "{args:?}");
                     let _ = std::fs::remove_file(dir.join("out.csv"));

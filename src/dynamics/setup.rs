@@ -174,7 +174,7 @@ impl Numerics {
 }
 
 /// `value` to four significant digits, without trailing zeros: 0.5, 1e-13, 3.333e-6.
-fn significant(value: f64) -> String {
+pub(crate) fn significant(value: f64) -> String {
     let magnitude = value.abs();
     if magnitude == 0.0 {
         "0".into()

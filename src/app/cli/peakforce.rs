@@ -3,10 +3,11 @@
 use super::progress::Busy;
 use crate::app::config::{TapInputs, force, frequency, length, number};
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
+use crate::dynamics::setup::significant;
 use crate::error::{Error, Result};
 use crate::instrument::peakforce::{
     Analysis, Channels, ForcePoint, Modulation, PeakForceCycle, PeakForceFeedback, at_setpoint,
-    cycle, feedback,
+    check_setpoint, cycle, feedback,
 };
 use clap::Args;
 
@@ -240,11 +241,11 @@ pub fn run(args: PeakForceArgs) -> Result<()> {
         "off-resonance tapping, {} law: the support moved by {} nm at {} kHz on a {} N/m \
          lever resonating at {} kHz (Q {})",
         report.law,
-        trimmed(modulation.amplitude_m * 1e9),
-        trimmed(modulation.frequency_hz * 1e-3),
-        trimmed(cant.stiffness_n_m),
-        trimmed(cant.resonance_hz * 1e-3),
-        trimmed(cant.quality)
+        significant(modulation.amplitude_m * 1e9),
+        significant(modulation.frequency_hz * 1e-3),
+        significant(cant.stiffness_n_m),
+        significant(cant.resonance_hz * 1e-3),
+        significant(cant.quality)
     );
     let at = match (setpoint, feedback_cycles) {
         (Some(f), Some(n)) => format!(
@@ -310,20 +311,6 @@ pub fn run(args: PeakForceArgs) -> Result<()> {
         100.0 * analysis.fit_window.1
     );
     Ok(())
-}
-
-/// `x` to 6 significant digits, without trailing zeros.
-fn trimmed(x: f64) -> String {
-    let s = format!(
-        "{:.*}",
-        (5 - x.abs().log10().floor().max(-6.0) as i32).clamp(0, 12) as usize,
-        x
-    );
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
 }
 
 /// Force against time over the recorded cycles (the ringing after pull-off in the
@@ -400,14 +387,8 @@ fn charts(report: &Report, c: &PeakForceCycle) -> Vec<Chart> {
 impl PeakForceArgs {
     /// Refuse before any work what can be known bad from the flags alone.
     pub(super) fn check(&self) -> Result<()> {
-        if let Some(f) = self.peak_force
-            && (f.is_nan() || f <= 0.0)
-        {
-            return Err(Error::InvalidParameter {
-                name: "peak-force setpoint",
-                value: f,
-                reason: "must be positive (instruments use 0.1–100 nN)",
-            });
+        if let Some(f) = self.peak_force {
+            check_setpoint(f)?;
         }
         self.out.check()
     }

@@ -15,8 +15,9 @@ const QUIET_FOR: Duration = Duration::from_secs(2);
 /// How often a job of unknown length says it is still working, in log lines.
 const BUSY_EVERY: Duration = Duration::from_secs(30);
 
-/// How progress is shown: `None` with --quiet, else a bar or log lines.
-fn terminal(quiet: bool) -> Option<bool> {
+/// Whether progress goes to a terminal (`Some(true)`: a bar or spinner), to log lines
+/// (`Some(false)`), or nowhere (--quiet, `None`).
+pub(crate) fn shown(quiet: bool) -> Option<bool> {
     (!quiet).then(|| std::io::stderr().is_terminal())
 }
 
@@ -41,7 +42,7 @@ impl Progress {
     /// Progress of `what` (e.g. "map") over `len` items.
     pub(crate) fn counted(what: &str, len: usize, quiet: bool) -> Self {
         let len = len as u64;
-        match terminal(quiet) {
+        match shown(quiet) {
             Some(true) => {
                 let bar = indicatif::ProgressBar::new(len);
                 bar.set_style(
@@ -138,12 +139,6 @@ pub(crate) fn spinner(what: &str) -> indicatif::ProgressBar {
     bar
 }
 
-/// Whether progress goes to a terminal (`Some(true)`), to log lines (`Some(false)`), or
-/// nowhere (--quiet).
-pub(crate) fn shown(quiet: bool) -> Option<bool> {
-    terminal(quiet)
-}
-
 /// Progress of a job of unknown length: a spinner saying what runs on a terminal; in log
 /// lines, that it still runs, first after [`QUIET_FOR`] and then every [`BUSY_EVERY`].
 pub(crate) struct Busy {
@@ -154,7 +149,7 @@ pub(crate) struct Busy {
 impl Busy {
     /// `what` runs (e.g. "tap: averaging the state over a thermal record").
     pub(crate) fn new(what: &str, quiet: bool) -> Self {
-        match terminal(quiet) {
+        match shown(quiet) {
             Some(true) => Self {
                 bar: spinner(what),
                 stop: None,
