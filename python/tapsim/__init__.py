@@ -43,6 +43,7 @@ __all__ = [
     "scan",
     "thermal",
     "peakforce",
+    "force_curve",
     "hysteresis",
     "lj",
     "fit",
@@ -166,7 +167,8 @@ def _column(values: List[Any]) -> Any:
 
 
 def _flag(key: str) -> str:
-    return "--" + key.replace("_", "-")
+    # A trailing underscore lets a flag that is a Python keyword through (``from_``).
+    return "--" + key.rstrip("_").replace("_", "-")
 
 
 def _text(value: Any) -> str:
@@ -300,6 +302,17 @@ def peakforce(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
     deformation, DMT modulus); ``curve=True`` adds the recorded force curve as numpy
     arrays (``curve["force_n"]`` against ``curve["separation_m"]`` or ``curve["t_s"]``)."""
     return _run("peakforce", setup, kwargs)
+
+
+def force_curve(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
+    """A force-distance curve (``tapsim force-curve``): the support ramped from
+    ``from_="20nm"`` toward the sample at ``velocity="1um/s"``, turned at the trigger
+    (``trigger="5nN"``) or at ``to``, held for ``dwell`` and withdrawn; the snap-in and
+    pull-off (``snap_in``, ``pull_off``: piezo position, tip separation, force), the QNM
+    channels of the curve (``channels``), the energy books, and with ``curve=True`` the
+    curve as numpy arrays (``curve["force_n"]`` against ``curve["piezo_m"]``,
+    ``curve["separation_m"]`` or ``curve["t_s"]``; at most ``points`` of them)."""
+    return _run("force-curve", setup, kwargs)
 
 
 def hysteresis(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:

@@ -129,6 +129,25 @@ def test_peakforce_returns_the_channels_and_the_curve_as_arrays():
         tapsim.peakforce(modulation_frequency="300kHz")
 
 
+def test_force_curve_returns_its_jumps_and_the_curve_as_arrays():
+    # The hybrid law snaps in at a positive separation and pulls off at JKR's adhesion
+    # (3/2)piR dgamma; the books close; the curve comes as arrays of at most `points`.
+    r = tapsim.force_curve(curve=True, points=400)
+    assert r.triggered and r.snap_in["separation_m"] > 0.5e-9
+    radius, dgamma = 20e-9, 0.1
+    assert r.channels["adhesion_n"] == pytest.approx(1.5 * math.pi * radius * dgamma, rel=1e-6)
+    assert r.energy_balance_rel < 1e-6
+    force, piezo = r.curve["force_n"], r.curve["piezo_m"]
+    assert isinstance(force, np.ndarray) and force.shape == piezo.shape
+    assert 400 <= len(force) <= 430
+    assert force.max() == pytest.approx(r.channels["peak_force_n"], rel=1e-12)
+    # A conservative law loses nothing in the contact; a keyword flag takes a `_`.
+    hertz = tapsim.force_curve(law="hertz", from_="10nm")
+    assert hertz.contact_loss_j == 0.0 and hertz.start_m == 10e-9
+    with pytest.raises(ValueError, match="too fast for a force curve"):
+        tapsim.force_curve(velocity="1m/s")
+
+
 def test_results_show_their_keys():
     r = tapsim.tap()
     assert "phase_deg" in dir(r) and "phase_deg" in r

@@ -52,6 +52,8 @@ unit_parser!(/// A temperature (K).
     temperature, "temperature", Dimension::Temperature);
 unit_parser!(/// A force (N).
     force, "force", Dimension::Force);
+unit_parser!(/// A velocity (m/s).
+    velocity, "velocity", Dimension::Velocity);
 unit_parser!(/// A plain number.
     number, "value", Dimension::Dimensionless);
 

@@ -27,6 +27,8 @@ pub enum Dimension {
     Temperature,
     /// Newtons.
     Force,
+    /// Metres per second.
+    Velocity,
     /// A plain number.
     Dimensionless,
 }
@@ -44,6 +46,7 @@ impl Dimension {
             Dimension::Time => &[("s", 1.0)],
             Dimension::Temperature => &[("K", 1.0)],
             Dimension::Force => &[("N", 1.0)],
+            Dimension::Velocity => &[("m/s", 1.0)],
             Dimension::Dimensionless => &[],
         }
     }

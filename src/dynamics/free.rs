@@ -3,7 +3,8 @@
 //! one of its steps; usually 0). Exact, so free flight costs no integration steps, and
 //! so are the carried integrals. Under a base drive (the support moving as B cos Ωτ, no
 //! drive force: f₀ = 0) the deflection rings freely and the separation follows
-//! x + B cos Ωτ, whose fall to the jump-in ends the flight (`FreeFlight::separation`).
+//! x + B cos Ωτ, whose fall to the jump-in ends the flight (`FreeFlight::separation`);
+//! on a ramp's leg (the support moving at a constant speed u) it is x + p + uτ.
 
 use super::model::{Carried, Drive, Oscillator, State, V, X, has_tangent, phi_column, section_dim};
 use crate::numeric::newton_bracketed;
@@ -39,6 +40,9 @@ pub struct FreeFlight {
     f0: f64,
     /// The support's amplitude B under a base drive (0 under a force drive).
     base: f64,
+    /// The support's (p, u) on a ramp's leg, x_b = p + uτ ((0, 0) otherwise); part of
+    /// the particular solution only in the separation ([`FreeFlight::separation`]).
+    line: (f64, f64),
     /// Whether this is the separation x + B cos Ωτ of a base-driven flight, not the
     /// deflection.
     shifted: bool,
@@ -58,9 +62,10 @@ impl FreeFlight {
     /// The free motion through (`tau0`, `x0`, `v0`); `None` unless the oscillator is
     /// underdamped.
     pub fn new(osc: &Oscillator, tau0: f64, x0: f64, v0: f64) -> Option<Self> {
-        let (f0, base) = match osc.drive {
-            Drive::Force { amplitude } => (amplitude, 0.0),
-            Drive::Base { amplitude } => (0.0, amplitude),
+        let (f0, base, ramp) = match osc.drive {
+            Drive::Force { amplitude } => (amplitude, 0.0, (0.0, 0.0)),
+            Drive::Base { amplitude } => (0.0, amplitude, (0.0, 0.0)),
+            Drive::Ramp { position, speed } => (0.0, 0.0, (position, speed)),
         };
         if !osc.underdamped() {
             return None;
@@ -87,15 +92,17 @@ impl FreeFlight {
             omega: w,
             f0,
             base,
+            line: ramp,
             shifted: false,
         })
     }
 
     /// The separation coordinate x + x_b of this flight (x itself under a force drive):
-    /// the same form with the support's B cos Ωτ added to the particular part, for the
-    /// fall to a switch level and the turning points the grazing margins measure.
+    /// the same form with the support's B cos Ωτ (or a ramp's p + uτ) added to the
+    /// particular part, for the fall to a switch level and the turning points the
+    /// grazing margins measure.
     pub(crate) fn separation(&self) -> Self {
-        if self.base == 0.0 {
+        if self.base == 0.0 && self.line == (0.0, 0.0) {
             return *self;
         }
         Self {
@@ -103,6 +110,16 @@ impl FreeFlight {
             base: 0.0,
             shifted: true,
             ..*self
+        }
+    }
+
+    /// The ramp's share of the particular part at τ, (p + uτ, u), in the separation.
+    #[inline]
+    fn line_at(&self, tau: f64) -> (f64, f64) {
+        if self.shifted {
+            (self.line.0 + self.line.1 * tau, self.line.1)
+        } else {
+            (0.0, 0.0)
         }
     }
 
@@ -116,19 +133,21 @@ impl FreeFlight {
     pub fn at(&self, tau: f64) -> (f64, f64) {
         let t = tau - self.tau0;
         self.combine(
+            tau,
             (self.omega * tau).sin_cos(),
             (self.omega_d * t).sin_cos(),
             (-self.gamma * t).exp(),
         )
     }
 
-    /// (x, x') from the drive phasor (sin Ωτ, cos Ωτ), the transient's phasor
+    /// (x, x') at τ from the drive phasor (sin Ωτ, cos Ωτ), the transient's phasor
     /// (sin ω_d s, cos ω_d s) and its decay e^{−γs}.
     #[inline]
-    fn combine(&self, (s, c): (f64, f64), (sd, cd): (f64, f64), e: f64) -> (f64, f64) {
+    fn combine(&self, tau: f64, (s, c): (f64, f64), (sd, cd): (f64, f64), e: f64) -> (f64, f64) {
+        let (p, u) = self.line_at(tau);
         let (x_p, v_p) = (
-            self.a * c + self.b * s + self.bias,
-            self.omega * (-self.a * s + self.b * c),
+            self.a * c + self.b * s + self.bias + p,
+            self.omega * (-self.a * s + self.b * c) + u,
         );
         let x_h = e * (self.c1 * cd + self.c2 * sd);
         let v_h = e
@@ -147,8 +166,10 @@ impl FreeFlight {
         let (rs, rc) = (self.omega * h).sin_cos();
         let (rsd, rcd) = (self.omega_d * h).sin_cos();
         let decay = (-self.gamma * h).exp();
+        let mut k = 0.0;
         std::iter::from_fn(move || {
-            let sample = self.combine((s, c), (sd, cd), e);
+            let sample = self.combine(tau_a + k * h, (s, c), (sd, cd), e);
+            k += 1.0;
             (s, c) = (s * rc + c * rs, c * rc - s * rs);
             (sd, cd) = (sd * rcd + cd * rsd, cd * rcd - sd * rsd);
             e *= decay;
@@ -157,7 +178,7 @@ impl FreeFlight {
     }
 
     /// Velocity and acceleration at τ: from the equation of motion for the deflection;
-    /// for a separation under a base drive ([`FreeFlight::separation`]), the particular
+    /// for a separation under a base drive or a ramp ([`FreeFlight::separation`]), the particular
     /// part's −Ω²(a cos Ωτ + b sin Ωτ) and the transient's, which obeys the free
     /// equation (h'' = −2γh' − h).
     #[inline]
@@ -171,9 +192,10 @@ impl FreeFlight {
         }
         let (s, c) = (self.omega * tau).sin_cos();
         let particular = self.a * c + self.b * s;
+        let (p, u) = self.line_at(tau);
         let (x_h, v_h) = (
-            x - particular - self.bias,
-            v - self.omega * (-self.a * s + self.b * c),
+            x - particular - self.bias - p,
+            v - self.omega * (-self.a * s + self.b * c) - u,
         );
         (
             v,
@@ -336,14 +358,26 @@ mod tests {
     }
 
     #[test]
-    fn under_a_base_drive_the_separation_adds_the_support() {
-        let base = Oscillator {
-            gamma: 1.0 / 800.0,
-            omega: 2.0 / 300.0,
-            drive: Drive::Base { amplitude: 7.5 },
-            bias: 0.0,
-        };
-        let flight = FreeFlight::new(&base, 3.0, 0.01, -0.02).unwrap();
+    fn under_a_base_drive_or_a_ramp_the_separation_adds_the_support() {
+        for drive in [
+            Drive::Base { amplitude: 7.5 },
+            Drive::Ramp {
+                position: 7.5,
+                speed: -0.02,
+            },
+        ] {
+            let base = Oscillator {
+                gamma: 1.0 / 800.0,
+                omega: 2.0 / 300.0,
+                drive,
+                bias: 0.0,
+            };
+            under_a_moving_support(&base);
+        }
+    }
+
+    fn under_a_moving_support(base: &Oscillator) {
+        let flight = FreeFlight::new(base, 3.0, 0.01, -0.02).unwrap();
         let separation = flight.separation();
         for tau in [3.0, 4.7, 30.0, 500.0] {
             let (x, v) = flight.at(tau);

@@ -574,7 +574,9 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 // a slow base drive, where the drive period is many of its periods.
                 let max_dt = match self.osc.drive {
                     Drive::Force { .. } => period / 8.0,
-                    Drive::Base { .. } => period.min(2.0 * std::f64::consts::PI) / 8.0,
+                    Drive::Base { .. } | Drive::Ramp { .. } => {
+                        period.min(2.0 * std::f64::consts::PI) / 8.0
+                    }
                 };
                 let fall = flight
                     .separation()
@@ -676,8 +678,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
             e_drive: self.osc.drive_work(
                 start,
                 (tau, y[X], y[V]),
-                y[Carried::CosProjection],
-                y[Carried::SinProjection],
+                (y[Carried::CosProjection], y[Carried::SinProjection]),
+                y[Carried::Force],
             ),
             delta_mechanical: mechanical(&y) - e0,
             sc: y[Carried::CosProjection],

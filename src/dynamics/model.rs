@@ -292,6 +292,15 @@ pub enum Drive {
         /// Amplitude b in units of L.
         amplitude: f64,
     },
+    /// The support moves at a constant speed, x_b = p + uτ: one leg of a force–distance
+    /// ramp (a triangular ramp is a sequence of them, its dwell a leg with u = 0; the
+    /// Fourier phasor still turns at Ω, which only sets the span a call may cover).
+    Ramp {
+        /// p: x_b at τ = 0, in units of L.
+        position: f64,
+        /// u = dx_b/dτ, in units of L per 1/ω₀ (toward the sample negative).
+        speed: f64,
+    },
 }
 
 /// The oscillator: damping, drive frequency and drive.
@@ -325,23 +334,35 @@ impl Oscillator {
     pub fn base_at(&self, tau: f64) -> (f64, f64) {
         match self.drive {
             Drive::Force { .. } => (0.0, 0.0),
-            Drive::Base { .. } => self.base_from((self.omega * tau).sin_cos()),
+            Drive::Base { .. } => self.base_from(tau, (self.omega * tau).sin_cos()),
+            Drive::Ramp { position, speed } => (position + speed * tau, speed),
+        }
+    }
+
+    /// The support's acceleration x_b'' at τ (zero on a ramp's leg).
+    #[inline]
+    pub(crate) fn base_acceleration(&self, tau: f64) -> f64 {
+        match self.drive {
+            Drive::Base { .. } => -self.omega * self.omega * self.base_at(tau).0,
+            Drive::Force { .. } | Drive::Ramp { .. } => 0.0,
         }
     }
 
     /// Work done by the drive between `start` and `end` (each (τ, x, x')), from the
-    /// Fourier projections `sc` = ∫ x cos Ωτ dτ and `ss` = ∫ x sin Ωτ dτ over the span.
+    /// Fourier projections `sc` = ∫ x cos Ωτ dτ and `ss` = ∫ x sin Ωτ dτ over the span
+    /// and the force's integral `force` = ∫ f_ts dτ.
     ///
     /// Force drive, by parts: ∫ f₀ cos Ωτ x' dτ = f₀([x cos Ωτ] + Ω·ss), exact for any
     /// path. Base drive: the work −∫ f_ts x_b' dτ = bΩ ∫ f_ts sin Ωτ dτ, with f_ts =
     /// x'' + 2γx' + x from the equation of motion and the same integration by parts:
     /// ∫ f_ts sin Ωτ dτ = [x' sin Ωτ] − Ω[x cos Ωτ] + 2γ[x sin Ωτ] + (1 − Ω²)·ss − 2γΩ·sc.
+    /// A ramp's leg: −u ∫ f_ts dτ.
     pub fn drive_work(
         &self,
         start: (f64, f64, f64),
         end: (f64, f64, f64),
-        sc: f64,
-        ss: f64,
+        (sc, ss): (f64, f64),
+        force: f64,
     ) -> f64 {
         let w = self.omega;
         let span = |g: &dyn Fn(f64, f64, f64) -> f64| {
@@ -357,24 +378,28 @@ impl Oscillator {
                     - 2.0 * self.gamma * w * sc;
                 amplitude * w * force_sin
             }
+            Drive::Ramp { speed, .. } => -speed * force,
         }
     }
 
-    /// Support displacement and velocity (x_b, x_b') from the phasor (sin Ωτ, cos Ωτ).
+    /// Support displacement and velocity (x_b, x_b') at τ, whose drive phasor is
+    /// (sin Ωτ, cos Ωτ): no trigonometry.
     #[inline]
-    pub(crate) fn base_from(&self, (s, c): (f64, f64)) -> (f64, f64) {
+    pub(crate) fn base_from(&self, tau: f64, (s, c): (f64, f64)) -> (f64, f64) {
         match self.drive {
             Drive::Force { .. } => (0.0, 0.0),
             Drive::Base { amplitude } => (amplitude * c, -amplitude * self.omega * s),
+            Drive::Ramp { position, speed } => (position + speed * tau, speed),
         }
     }
 
-    /// Drive force f_drive and support displacement x_b from cos Ωτ.
+    /// Drive force f_drive and support displacement x_b at τ, whose cos Ωτ is `c`.
     #[inline]
-    pub(crate) fn drive_from(&self, c: f64) -> (f64, f64) {
+    pub(crate) fn drive_from(&self, tau: f64, c: f64) -> (f64, f64) {
         match self.drive {
             Drive::Force { amplitude } => (amplitude * c, 0.0),
             Drive::Base { amplitude } => (0.0, amplitude * c),
+            Drive::Ramp { position, speed } => (0.0, position + speed * tau),
         }
     }
 }
@@ -439,17 +464,16 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
     y: &State<N>,
     dy: &mut State<N>,
 ) {
-    let _ = tau;
     let (x, v) = (y[X], y[V]);
     let (s, c) = (y[Part::DriveSin], y[Part::DriveCos]);
-    let (drive, x_b) = osc.drive_from(c);
+    let (drive, x_b) = osc.drive_from(tau, c);
     let alpha = cpl.alpha_hat(x, x_b);
     let elastic = law.t_hat(alpha, branch);
     let mut state = None;
     let dissipative = if law.is_rate_dependent() {
         let at = ContactState {
             alpha_hat: alpha,
-            rate_hat: cpl.a1 * (v + osc.base_from((s, c)).1),
+            rate_hat: cpl.a1 * (v + osc.base_from(tau, (s, c)).1),
             branch,
             internal: internal(y),
         };
@@ -549,6 +573,10 @@ mod tests {
         for drive in [
             Drive::Force { amplitude: 0.7 },
             Drive::Base { amplitude: 0.4 },
+            Drive::Ramp {
+                position: 0.4,
+                speed: -0.03,
+            },
         ] {
             let osc = Oscillator {
                 gamma: 0.05,
@@ -557,6 +585,7 @@ mod tests {
                 bias: 0.0,
             };
             let w = osc.omega;
+            let f_ts = |t: f64| a(t) + 2.0 * osc.gamma * v(t) + x(t);
             let sc = simpson(|t| x(t) * (w * t).cos(), t0, t1, n);
             let ss = simpson(|t| x(t) * (w * t).sin(), t0, t1, n);
             let direct = match drive {
@@ -565,11 +594,12 @@ mod tests {
                 }
                 Drive::Base { amplitude } => {
                     // −∫ f_ts x_b' dτ with x_b = b cos Ωτ.
-                    let f_ts = |t: f64| a(t) + 2.0 * osc.gamma * v(t) + x(t);
                     simpson(|t| f_ts(t) * amplitude * w * (w * t).sin(), t0, t1, n)
                 }
+                Drive::Ramp { speed, .. } => -simpson(|t| f_ts(t) * speed, t0, t1, n),
             };
-            let work = osc.drive_work((t0, x(t0), v(t0)), (t1, x(t1), v(t1)), sc, ss);
+            let force = simpson(f_ts, t0, t1, n);
+            let work = osc.drive_work((t0, x(t0), v(t0)), (t1, x(t1), v(t1)), (sc, ss), force);
             assert!(
                 (work - direct).abs() < 1e-12,
                 "{drive:?}: {work} vs {direct}"

@@ -155,9 +155,8 @@ impl<L: ForceLaw, O: StepObserver, const N: usize> Segment<'_, L, O, N> {
             return false;
         }
         let time = gap / rate;
-        let (x_b, _) = self.osc.base_at(end.tau);
         let accel =
-            sigma(crossing) * self.cpl.a1 * (end.dy[V] - self.osc.omega * self.osc.omega * x_b);
+            sigma(crossing) * self.cpl.a1 * (end.dy[V] + self.osc.base_acceleration(end.tau));
         time <= 1.5 * h
             && (-accel).max(0.0) * time <= 0.5 * rate
             && end.tau + 2.0 * time < self.tau_end
@@ -264,7 +263,9 @@ impl<L: ForceLaw, const N: usize> Approach<'_, L, N> {
     fn tau_form(&self, w: f64, y: &State<N>) -> (f64, State<N>) {
         let u = self.u0 - w;
         let alpha = self.level - self.sigma * u * u;
-        let (x_b, _) = self.osc.base_from((y[Part::DriveSin], y[Part::DriveCos]));
+        let (x_b, _) = self
+            .osc
+            .base_from(y[X], (y[Part::DriveSin], y[Part::DriveCos]));
         let mut z = *y;
         z[X] = self.cpl.x_at(alpha) - x_b;
         (y[X], z)
@@ -276,7 +277,9 @@ impl<L: ForceLaw, const N: usize> System<N> for Approach<'_, L, N> {
     fn system(&self, w: f64, y: &State<N>, dy: &mut State<N>) {
         let (tau, z) = self.tau_form(w, y);
         rhs(self.law, self.osc, self.cpl, self.branch, tau, &z, dy);
-        let (_, v_b) = self.osc.base_from((z[Part::DriveSin], z[Part::DriveCos]));
+        let (_, v_b) = self
+            .osc
+            .base_from(tau, (z[Part::DriveSin], z[Part::DriveCos]));
         let mut rate = self.sigma * self.cpl.a1 * (z[V] + v_b);
         if rate.is_nan() || rate < self.min_rate {
             self.landing.failed.set(true);

@@ -2,19 +2,22 @@
 //! simulated motion as an AFM's electronics do (lock-in, z feedback, thermal noise,
 //! scans, several modes), each a value of its own that watches the integration
 //! ([`crate::dynamics::numeric::StepObserver`]) beside the steady-state solver. A new
-//! instrument mode is a file here and touches nothing in [`crate::physics`] or
-//! [`crate::dynamics`].
+//! instrument mode is a file here and touches nothing in [`crate::physics`], and in
+//! [`crate::dynamics`] at most a new way of moving the lever
+//! ([`crate::dynamics::model::Drive`]: the force-curve ramp is one).
 //!
 //! May import: the foundation, [`crate::physics`], [`crate::dynamics`]. Imported by the
 //! analysis and application layers.
 
 pub mod average;
 pub mod feedback;
+pub mod force_curve;
 pub mod lockin;
 pub mod modal;
 pub mod noise;
 pub mod peakforce;
 pub mod probe;
+pub mod qnm;
 pub mod repeats;
 pub mod scan;
 pub mod spectrum;

@@ -45,6 +45,7 @@ mod contrast;
 mod curve_data;
 mod figure;
 mod fit;
+mod force_curve;
 mod hysteresis;
 mod lj;
 mod map;
@@ -89,6 +90,7 @@ enum Command {
     Scan(scan::ScanArgs),
     Thermal(thermal::ThermalArgs),
     Peakforce(peakforce::PeakForceArgs),
+    ForceCurve(force_curve::ForceCurveArgs),
     Batch(batch::BatchArgs),
     Merge(merge::MergeArgs),
     Hysteresis(hysteresis::HysteresisArgs),
@@ -113,6 +115,7 @@ impl Command {
             Command::Scan(a) => a.out.quiet,
             Command::Thermal(a) => a.out.quiet,
             Command::Peakforce(a) => a.out.quiet,
+            Command::ForceCurve(a) => a.out.quiet,
             Command::Batch(a) => a.out.quiet,
             Command::Merge(a) => a.output.quiet,
             Command::Hysteresis(a) => a.quiet,
@@ -146,6 +149,7 @@ impl Command {
             Command::Scan(a) => a.out.check(),
             Command::Thermal(a) => a.out.check(),
             Command::Peakforce(a) => a.check(),
+            Command::ForceCurve(a) => a.check(),
             Command::Batch(a) => a.out.check(),
             Command::Merge(a) => a.output.check(),
             Command::Fit(_)
@@ -521,6 +525,7 @@ fn run_command(command: Command) -> crate::Result<()> {
         Command::Scan(args) => scan::run(args),
         Command::Thermal(args) => thermal::run(args),
         Command::Peakforce(args) => peakforce::run(args),
+        Command::ForceCurve(args) => force_curve::run(args),
         Command::Batch(args) => batch::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Hysteresis(args) => hysteresis::run(args),

@@ -76,13 +76,8 @@ pub struct PeakForceArgs {
     /// Modulation amplitude A_m [m; default 150nm].
     #[arg(long, allow_hyphen_values = true, value_parser = length)]
     modulation_amplitude: Option<f64>,
-    /// Lower end of the DMT fit's window on the retract, as a fraction of the span from
-    /// adhesion to peak [default 0.3].
-    #[arg(long, allow_hyphen_values = true, value_parser = number)]
-    fit_from: Option<f64>,
-    /// Upper end of the DMT fit's window [default 0.9].
-    #[arg(long, allow_hyphen_values = true, value_parser = number)]
-    fit_to: Option<f64>,
+    #[command(flatten)]
+    window: FitWindowArgs,
     /// Reach the setpoint as the instrument does: the peak-force feedback, cycle by
     /// cycle from the support's lowest point 2 nm above the sample, instead of solving
     /// for the separation; prints how many cycles it took.
@@ -99,8 +94,35 @@ pub struct PeakForceArgs {
     pub(super) out: super::SweepOutput,
 }
 
+/// The DMT fit's window on the retract (the QNM analysis), as flags.
+#[derive(Debug, Args)]
+pub(super) struct FitWindowArgs {
+    /// Lower end of the DMT fit's window on the retract, as a fraction of the span from
+    /// adhesion to peak [default 0.3].
+    #[arg(long, allow_hyphen_values = true, value_parser = number)]
+    fit_from: Option<f64>,
+    /// Upper end of the DMT fit's window [default 0.9].
+    #[arg(long, allow_hyphen_values = true, value_parser = number)]
+    fit_to: Option<f64>,
+}
+
+impl FitWindowArgs {
+    /// The analysis these flags ask for, checked.
+    pub(super) fn analysis(&self) -> Result<Analysis> {
+        let window = Analysis::default().fit_window;
+        let analysis = Analysis {
+            fit_window: (
+                self.fit_from.unwrap_or(window.0),
+                self.fit_to.unwrap_or(window.1),
+            ),
+        };
+        analysis.check()?;
+        Ok(analysis)
+    }
+}
+
 /// The default peak-force setpoint, N.
-const DEFAULT_PEAK_FORCE_N: f64 = 5e-9;
+pub(super) const DEFAULT_PEAK_FORCE_N: f64 = 5e-9;
 
 /// What --json prints.
 #[derive(serde::Serialize)]
@@ -123,9 +145,9 @@ struct Report {
     curve: Option<Columns>,
 }
 
-/// The recorded curve as columns (--json --curve).
+/// A recorded force curve as columns (--json --curve).
 #[derive(serde::Serialize)]
-struct Columns {
+pub(super) struct Columns {
     t_s: Vec<f64>,
     piezo_m: Vec<f64>,
     deflection_m: Vec<f64>,
@@ -136,7 +158,7 @@ struct Columns {
 }
 
 impl Columns {
-    fn of(curve: &[ForcePoint]) -> Self {
+    pub(super) fn of(curve: &[ForcePoint]) -> Self {
         let col = |f: fn(&ForcePoint) -> f64| curve.iter().map(f).collect();
         Self {
             t_s: col(|p| p.t_s),
@@ -161,14 +183,7 @@ pub fn run(args: PeakForceArgs) -> Result<()> {
         amplitude_m: args.modulation_amplitude.unwrap_or(defaults.amplitude_m),
     };
     modulation.check(&setup.cantilever)?;
-    let window = Analysis::default().fit_window;
-    let analysis = Analysis {
-        fit_window: (
-            args.fit_from.unwrap_or(window.0),
-            args.fit_to.unwrap_or(window.1),
-        ),
-    };
-    analysis.check()?;
+    let analysis = args.window.analysis()?;
     let setpoint = match inputs.separation {
         Some(_) => None,
         None => Some(args.peak_force.unwrap_or(DEFAULT_PEAK_FORCE_N)),
