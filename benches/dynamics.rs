@@ -595,7 +595,52 @@ fn peakforce(c: &mut Criterion) {
     group.finish();
 }
 
+/// A 128 × 128 QNM image (issue 47: under 2 min on two threads): `tapsim scan --mode
+/// peakforce` on the built-in blend at 1 line/s (16 modulation cycles a pixel, trace and
+/// retrace, each line engaged on its own), the repeats of a settled loop taken, and
+/// with --exact every cycle marched (trace only: 262 144 cycles).
+fn qnm_image(c: &mut Criterion) {
+    use std::process::{Command, Stdio};
+    let image = [
+        "scan",
+        "--mode",
+        "peakforce",
+        "--lines",
+        "128",
+        "--pixels",
+        "128",
+        "--line-rate",
+        "1",
+        "--threads",
+        "2",
+        "--quiet",
+    ];
+    let mut group = c.benchmark_group("qnm_image");
+    group.sample_size(10);
+    for (name, extra) in [
+        ("128 x 128, trace and retrace", &[][..]),
+        (
+            "128 x 128, trace, every cycle (--exact)",
+            &["--exact", "--no-retrace"][..],
+        ),
+    ] {
+        let run = || {
+            let status = Command::new(env!("CARGO_BIN_EXE_tapsim"))
+                .args(image)
+                .args(extra)
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status()
+                .expect("tapsim runs");
+            assert!(status.success());
+        };
+        group.bench_function(name, |b| b.iter(run));
+    }
+    group.finish();
+}
+
 criterion_group!(
-    benches, bench, settle, map, setpoint, march, scan_line, noise, modes, fit, process, peakforce
+    benches, bench, settle, map, setpoint, march, scan_line, noise, modes, fit, process, peakforce,
+    qnm_image
 );
 criterion_main!(benches);

@@ -459,3 +459,189 @@ fn slow_modulation_converges_to_the_finite_stiffness_loss_26() {
         }
     }
 }
+
+/// A line scanned with the peak-force loop over two materials at two heights: every
+/// settled pixel shows what the direct solve of its material at the setpoint gives (the
+/// rest separation within 0.01 nm above its surface, the channels of that cycle), and
+/// taking the repeating loop's cycles as repeats (its state returning within 1e-9 A₀)
+/// moves the topography by less than 1e-14 m and the channels by less than 1e-6 against
+/// marching every one.
+#[test]
+fn a_scanned_line_shows_each_materials_settled_cycle() {
+    use tapsim::instrument::peakforce::PeakForceFeedback;
+    use tapsim::instrument::peakforce_scan::Scanner;
+    use tapsim::instrument::scan::Region;
+    let a = setup(LawKind::Hybrid);
+    let mut b = a.clone();
+    b.contact.modulus_pa = 1.2e9;
+    b.contact.work_of_adhesion_j_m2 = 0.06;
+    let n = Numerics::default();
+    let (m, an) = (Modulation::default(), Analysis::default());
+    let materials = [
+        tapsim::dynamics::setup::Prepared::new(&a, &n).unwrap(),
+        tapsim::dynamics::setup::Prepared::new(&b, &n).unwrap(),
+    ];
+    let regions = [
+        Region {
+            until_m: 500e-9,
+            material: 0,
+            height_m: 0.0,
+        },
+        Region {
+            until_m: 1e-6,
+            material: 1,
+            height_m: 5e-9,
+        },
+    ];
+    let loop_ = PeakForceFeedback {
+        setpoint_n: 5e-9,
+        gain: 0.5,
+    };
+    let scan = |exact: bool| {
+        let mut s = Scanner::new(&materials, &m, an, loop_, &n).unwrap();
+        if exact {
+            s = s.exact();
+        }
+        s.engage(0, 0.0, m.amplitude_m).unwrap();
+        let engaged = s.marched;
+        let pixels = s.line(&regions, (1e-6, 16, 16), |_| {}).unwrap();
+        (pixels, s.marched - engaged)
+    };
+    let (fast, marched_fast) = scan(false);
+    let (exact, marched_exact) = scan(true);
+    // (The loop takes some 80 cycles to settle after the 5 nm step.)
+    assert!(
+        marched_fast * 2 < marched_exact,
+        "{marched_fast} vs {marched_exact}"
+    );
+    for (f, e) in fast.iter().zip(&exact) {
+        assert!(
+            (f.topography_m - e.topography_m).abs() < 1e-14,
+            "{f:?} vs {e:?}"
+        );
+        assert!((f.adhesion_n / e.adhesion_n - 1.0).abs() < 1e-6);
+        assert!((f.dissipation_j / e.dissipation_j - 1.0).abs() < 1e-6);
+    }
+    // (The loop's gain is set against the lever's stiffness; on these materials the
+    // contact is far softer than the 40 N/m lever, so after the step it settles over
+    // some 60 cycles.)
+    for (material, s, pixels, h) in [(0, &a, &fast[2..8], 0.0), (1, &b, &fast[12..16], 5e-9)] {
+        let direct = at_setpoint(s, &n, &m, &an, 5e-9).unwrap();
+        let ch = direct.cycles[0];
+        for p in pixels {
+            assert!(
+                (p.topography_m - h - direct.separation_m).abs() < 0.01e-9,
+                "material {material}: {} vs {}",
+                p.topography_m - h,
+                direct.separation_m
+            );
+            assert!((p.peak_force_n / 5e-9 - 1.0).abs() < 1e-2);
+            assert!((p.adhesion_n / ch.adhesion_n - 1.0).abs() < 1e-3);
+            assert!((p.dissipation_j / ch.dissipation_j - 1.0).abs() < 1e-3);
+        }
+    }
+}
+
+/// `map --mode peakforce` solves each cell as `tapsim peakforce` does; `scan --mode
+/// peakforce` shows each material of the built-in blend at its settled cycle; the
+/// tapping flags are refused in this mode and this mode's flags without it.
+#[test]
+fn map_and_scan_in_peakforce_mode_show_the_qnm_channels() {
+    let dir = scratch("qnm_modes");
+    let run = |args: &[&str]| run_limited(args, &dir, Duration::from_secs(120));
+    let out = run(&[
+        "map",
+        "--mode",
+        "peakforce",
+        "--steps",
+        "2",
+        "--adhesion-from",
+        "0.05",
+        "--adhesion-to",
+        "0.1",
+        "--modulus-from",
+        "0.5GPa",
+        "--modulus-to",
+        "1GPa",
+        "--json",
+    ]);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let col = |k: &str, i: usize| v[k][i].as_f64().unwrap();
+    // The first cell (Δγ 0.05, E* 0.5 GPa), solved directly.
+    let mut s = setup(LawKind::Hybrid);
+    s.contact.work_of_adhesion_j_m2 = 0.05;
+    s.contact.modulus_pa = 0.5e9;
+    let direct = at_setpoint(
+        &s,
+        &Numerics::default(),
+        &Modulation::default(),
+        &Analysis::default(),
+        5e-9,
+    )
+    .unwrap();
+    assert_eq!(col("separation_m", 0), direct.separation_m);
+    assert_eq!(col("adhesion_n", 0), direct.cycles[0].adhesion_n);
+    assert_eq!(col("dissipation_j", 0), direct.cycles[0].dissipation_j);
+    // The last (Δγ 0.1, E* 1 GPa) moves irregularly near the setpoint, and its peak
+    // force jumps across it: no separation holds it, and the cell says so.
+    assert!(v["separation_m"][3].is_null());
+    let note = v["note"][3].as_str().unwrap();
+    assert!(note.contains("jumps across the setpoint"), "{note}");
+    // A line over the blend: material A's settled pixels hold A's cycle.
+    let out = run(&[
+        "scan",
+        "--mode",
+        "peakforce",
+        "--pixels",
+        "8",
+        "--json",
+        "--plot",
+        "line.png",
+    ]);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let rows: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let a = at_setpoint(
+        &setup(LawKind::Hybrid),
+        &tapsim::Numerics {
+            rtol: tapsim::instrument::MARCH_RTOL,
+            atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
+            ..Numerics::default()
+        },
+        &Modulation::default(),
+        &Analysis::default(),
+        5e-9,
+    )
+    .unwrap();
+    // (The third pixel of eight: the loop has settled on A, the first half.)
+    let pixel = |k: &str| rows[k][2].as_f64().unwrap();
+    assert_eq!(rows["direction"][2], "trace");
+    assert!((pixel("topography_m") - a.separation_m).abs() < 0.01e-9);
+    assert!((pixel("adhesion_n") / a.cycles[0].adhesion_n - 1.0).abs() < 1e-3);
+    assert!(dir.join("line.png").exists());
+    // What this mode does not take, and its flags without it.
+    for (args, says) in [
+        (
+            vec!["map", "--mode", "peakforce", "--setpoint", "0.8"],
+            "--setpoint is tapping's",
+        ),
+        (
+            vec!["scan", "--mode", "peakforce", "--temperature", "300K"],
+            "--temperature is tapping's",
+        ),
+        (vec!["scan", "--peak-force", "3nN"], "add --mode peakforce"),
+        (
+            vec!["map", "--modulation-frequency", "1kHz"],
+            "add --mode peakforce",
+        ),
+        (
+            vec!["scan", "--mode", "peakforce", "--peak-force-gain", "2"],
+            "peak-force gain",
+        ),
+    ] {
+        let out = run(&args);
+        assert_eq!(out.code, Some(1), "{args:?}: {}", out.stderr);
+        assert!(out.stderr.contains(says), "{args:?}: {}", out.stderr);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

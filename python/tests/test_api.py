@@ -148,6 +148,15 @@ def test_force_curve_returns_its_jumps_and_the_curve_as_arrays():
         tapsim.force_curve(velocity="1m/s")
 
 
+def test_scan_in_peakforce_mode_returns_the_qnm_channels_per_pixel():
+    r = tapsim.scan(mode="peakforce", pixels=4, no_retrace=True)
+    assert r.adhesion_n.shape == (4,) and r.topography_m.shape == (4,)
+    # The blend's two materials: the first half adheres more (0.1 against 0.08 J/m^2).
+    assert r.adhesion_n[0] > r.adhesion_n[3]
+    with pytest.raises(ValueError, match="add --mode peakforce"):
+        tapsim.scan(peak_force="3nN")
+
+
 def test_results_show_their_keys():
     r = tapsim.tap()
     assert "phase_deg" in dir(r) and "phase_deg" in r

@@ -12,6 +12,7 @@ pub mod coexist;
 pub mod contrast;
 pub mod fit;
 pub mod identification;
+pub mod qnm_map;
 pub mod reconstruct;
 pub mod setpoint;
 pub mod sweep;

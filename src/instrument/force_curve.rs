@@ -338,7 +338,11 @@ pub fn force_curve(
                     force_n: zero_below(on.force_n, peak),
                 }
             });
-        if approach { found.next() } else { found.next_back() }
+        if approach {
+            found.next()
+        } else {
+            found.next_back()
+        }
     };
     let energy = k * l * l;
     let final_energy = 0.5 * (phase.x * phase.x + phase.v * phase.v) * energy;

@@ -16,6 +16,7 @@ pub mod lockin;
 pub mod modal;
 pub mod noise;
 pub mod peakforce;
+pub mod peakforce_scan;
 pub mod probe;
 pub mod qnm;
 pub mod repeats;

@@ -201,11 +201,39 @@ fn settle(sim: &Simulation<'_, AnyLaw>) -> Result<(Phase, Option<usize>, usize)>
     Ok((phase, None, MAX_SETTLE_CYCLES))
 }
 
+/// A recorder's samples of `sim` (at rest separation `separation_m`) in SI.
+pub(crate) fn force_points(
+    p: &Prepared,
+    sim: &Simulation<'_, AnyLaw>,
+    separation_m: f64,
+    samples: &[(f64, f64, f64, f64, f64, Branch)],
+) -> Vec<ForcePoint> {
+    let cant = &p.setup.cantilever;
+    let (k, l) = (cant.stiffness_n_m, cant.free_amplitude_m);
+    let w0 = 2.0 * PI * cant.resonance_hz;
+    let scale = p.setup.contact.separation_scale_m();
+    samples
+        .iter()
+        .map(|&(tau, x, _, alpha, f, branch)| {
+            let (x_b, v_b) = sim.osc.base_at(tau);
+            ForcePoint {
+                t_s: (tau % sim.osc.period()) / w0,
+                piezo_m: separation_m + x_b * l,
+                deflection_m: x * l,
+                separation_m: alpha * scale,
+                force_n: f * k * l,
+                approach: v_b < 0.0,
+                contact: branch != Branch::Free,
+            }
+        })
+        .collect()
+}
+
 /// The simulation of `setup`'s cantilever and law driven through its support by
 /// `modulation`, at rest separation `separation_m`: the length unit L is the free
 /// amplitude as in tapping, the time unit 1/ω₀, and every step resolves the lever's own
 /// period (at least the numerics' steps per period of it).
-fn simulation<'a>(
+pub(crate) fn simulation<'a>(
     p: &'a Prepared,
     modulation: &Modulation,
     separation_m: f64,
@@ -274,25 +302,9 @@ pub fn cycle(
     let cycles = period.unwrap_or(IRREGULAR_CYCLES);
     let cant = &p.setup.cantilever;
     let (k, l) = (cant.stiffness_n_m, cant.free_amplitude_m);
-    let w0 = 2.0 * PI * cant.resonance_hz;
-    let scale = p.setup.contact.separation_scale_m();
     let energy = k * l * l;
     let n = cycles as f64;
-    let curve: Vec<ForcePoint> = samples
-        .iter()
-        .map(|&(tau, x, _, alpha, f, branch)| {
-            let (x_b, v_b) = sim.osc.base_at(tau);
-            ForcePoint {
-                t_s: (tau % sim.osc.period()) / w0,
-                piezo_m: separation_m + x_b * l,
-                deflection_m: x * l,
-                separation_m: alpha * scale,
-                force_n: f * k * l,
-                approach: v_b < 0.0,
-                contact: branch != Branch::Free,
-            }
-        })
-        .collect();
+    let curve = force_points(&p, &sim, separation_m, &samples);
     let channels = starts
         .windows(2)
         .map(|w| analysis.channels(&curve[w[0]..w[1]], p.setup.contact.radius_m))
@@ -411,7 +423,25 @@ pub fn at_setpoint(
     if let Some(e) = failure {
         return Err(e);
     }
-    cycle(setup, numerics, modulation, analysis, z)
+    let found = cycle(setup, numerics, modulation, analysis, z)?;
+    // Where the motion changes across the bracket (a period doubling, say) the peak
+    // force may jump over the setpoint: then no separation holds it.
+    let held = found
+        .cycles
+        .iter()
+        .map(|ch| ch.peak_force_n)
+        .fold(f64::NEG_INFINITY, f64::max);
+    if (held / setpoint_n - 1.0).abs() > 1e-3 {
+        return Err(Error::NotApplicable(format!(
+            "the peak force jumps across the setpoint {:.4} nN at z_c = {:.4} nm (to {:.4} nN \
+             in {} motion): no rest separation holds it; try another setpoint",
+            setpoint_n * 1e9,
+            z * 1e9,
+            held * 1e9,
+            found.regime
+        )));
+    }
+    Ok(found)
 }
 
 /// The peak-force feedback of an instrument: after each modulation cycle the rest

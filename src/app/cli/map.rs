@@ -24,6 +24,13 @@ use clap::Args;
 /// separation_m, amplitude1_ratio, phase1_deg, amplitude2_ratio, phase2_deg, e_ts_j,
 /// stable, note), JSON as columns, heat maps of φ₂, φ₁, A₂/A₀₂ and E_ts. Not sharded.
 ///
+/// With --mode peakforce: every cell off-resonance tapping at the peak-force setpoint
+/// (--peak-force, 5 nN; the rest separation solved for, as `tapsim peakforce` does), one
+/// row per cell (work_of_adhesion_j_m2, modulus_pa, tabor_mu, separation_m, regime,
+/// peak_force_n, adhesion_n, dissipation_j, deformation_m, dmt_modulus_pa, note), heat
+/// maps of adhesion, dissipation, DMT modulus and deformation: the QNM images a blend of
+/// these materials would give. Not sharded.
+///
 /// Output: CSV (--csv, one row per cell; without --csv, --json or --plot it goes to
 /// stdout) with work_of_adhesion_j_m2, modulus_pa, tabor_mu and the tap observables
 /// per cell (empty where the law does not apply, with a note). JSON (--json): law, the
@@ -91,6 +98,8 @@ pub struct MapArgs {
     split: super::shard::ShardArgs,
     #[command(flatten)]
     modes: crate::app::config::ModeInputs,
+    #[command(flatten)]
+    qnm: super::qnm::QnmArgs,
 }
 
 /// Run the subcommand.
@@ -111,6 +120,23 @@ pub fn run(args: MapArgs) -> Result<()> {
         args.steps,
     )?;
     let moduli = sweep::log_grid("modulus", args.modulus_from, args.modulus_to, args.steps)?;
+    if let Some(q) = args.qnm.resolve()? {
+        super::qnm::refuse_in_peakforce(&[
+            ("--setpoint", args.setpoint.is_some()),
+            ("--amplitude-setpoint", args.amplitude_setpoint.is_some()),
+            ("--branch", args.branch.is_some()),
+            ("--temperature", args.noise.temperature.is_some()),
+            ("--modes", args.modes.modes.is_some()),
+            ("--shard", args.split.resolve("map", false)?.is_some()),
+        ])?;
+        return super::qnm::map(
+            &q,
+            (&setup, &numerics),
+            (&works, &moduli),
+            args.threads,
+            &args.out,
+        );
+    }
     if let Some(set) = args.modes.mode_set(&inputs.mode_file, &setup.cantilever)? {
         use super::modal::refuse;
         refuse(args.noise.temperature.is_some(), "--temperature")?;

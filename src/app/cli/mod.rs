@@ -53,6 +53,7 @@ mod merge;
 mod modal;
 mod peakforce;
 mod progress;
+mod qnm;
 mod reconstruct;
 mod reproduce;
 mod scan;

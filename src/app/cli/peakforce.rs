@@ -70,12 +70,8 @@ pub struct PeakForceArgs {
     /// separation is solved for where each cycle's peak force is this.
     #[arg(long, allow_hyphen_values = true, value_parser = force, conflicts_with = "separation")]
     peak_force: Option<f64>,
-    /// Modulation frequency f_m [Hz; default 2kHz; well below the lever's resonance].
-    #[arg(long, allow_hyphen_values = true, value_parser = frequency)]
-    modulation_frequency: Option<f64>,
-    /// Modulation amplitude A_m [m; default 150nm].
-    #[arg(long, allow_hyphen_values = true, value_parser = length)]
-    modulation_amplitude: Option<f64>,
+    #[command(flatten)]
+    modulation: ModulationArgs,
     #[command(flatten)]
     window: FitWindowArgs,
     /// Reach the setpoint as the instrument does: the peak-force feedback, cycle by
@@ -94,16 +90,38 @@ pub struct PeakForceArgs {
     pub(super) out: super::SweepOutput,
 }
 
+/// The support's modulation, as flags.
+#[derive(Debug, Args)]
+pub(super) struct ModulationArgs {
+    /// Modulation frequency f_m [Hz; default 2kHz; well below the lever's resonance].
+    #[arg(long, allow_hyphen_values = true, value_parser = frequency)]
+    pub(super) modulation_frequency: Option<f64>,
+    /// Modulation amplitude A_m [m; default 150nm].
+    #[arg(long, allow_hyphen_values = true, value_parser = length)]
+    pub(super) modulation_amplitude: Option<f64>,
+}
+
+impl ModulationArgs {
+    /// The modulation these flags ask for (not yet checked against a lever).
+    pub(super) fn modulation(&self) -> Modulation {
+        let d = Modulation::default();
+        Modulation {
+            frequency_hz: self.modulation_frequency.unwrap_or(d.frequency_hz),
+            amplitude_m: self.modulation_amplitude.unwrap_or(d.amplitude_m),
+        }
+    }
+}
+
 /// The DMT fit's window on the retract (the QNM analysis), as flags.
 #[derive(Debug, Args)]
 pub(super) struct FitWindowArgs {
     /// Lower end of the DMT fit's window on the retract, as a fraction of the span from
     /// adhesion to peak [default 0.3].
     #[arg(long, allow_hyphen_values = true, value_parser = number)]
-    fit_from: Option<f64>,
+    pub(super) fit_from: Option<f64>,
     /// Upper end of the DMT fit's window [default 0.9].
     #[arg(long, allow_hyphen_values = true, value_parser = number)]
-    fit_to: Option<f64>,
+    pub(super) fit_to: Option<f64>,
 }
 
 impl FitWindowArgs {
@@ -177,11 +195,7 @@ pub fn run(args: PeakForceArgs) -> Result<()> {
     let inputs = args.inputs.clone().with_config()?;
     inputs.no_setpoint("peakforce")?;
     let (setup, numerics) = inputs.resolve()?;
-    let defaults = Modulation::default();
-    let modulation = Modulation {
-        frequency_hz: args.modulation_frequency.unwrap_or(defaults.frequency_hz),
-        amplitude_m: args.modulation_amplitude.unwrap_or(defaults.amplitude_m),
-    };
+    let modulation = args.modulation.modulation();
     modulation.check(&setup.cantilever)?;
     let analysis = args.window.analysis()?;
     let setpoint = match inputs.separation {

@@ -79,6 +79,14 @@ impl HeatMap {
                 e.push(values[0] - 0.5 * (values[1] - values[0]));
                 e.extend(values.windows(2).map(|w| 0.5 * (w[0] + w[1])));
                 e.push(values[n - 1] + 0.5 * (values[n - 1] - values[n - 2]));
+                // An edge at zero computed from the values (pixels from 0) is zero, not
+                // the round-off an axis would label.
+                let span = (e[n] - e[0]).abs();
+                for v in &mut e {
+                    if v.abs() < 1e-9 * span {
+                        *v = 0.0;
+                    }
+                }
                 e
             }
         }
@@ -148,6 +156,9 @@ mod tests {
 
     #[test]
     fn edges_enclose_each_log_spaced_value() {
+        // Pixel centres of an image from 0: its first edge is 0 exactly.
+        let y: Vec<f64> = (0..48).map(|j| 1000.0 * (j as f64 + 0.5) / 48.0).collect();
+        assert_eq!(HeatMap::linear_edges(&y)[0], 0.0);
         let e = HeatMap::edges(&[1.0, 10.0, 100.0]);
         assert_eq!(e.len(), 4);
         let expect = [

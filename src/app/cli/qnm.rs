@@ -1,0 +1,436 @@
+//! `tapsim map --mode peakforce` and `tapsim scan --mode peakforce`: off-resonance
+//! tapping over a grid of materials and over a sample, the QNM channels as heat maps.
+
+use super::peakforce::{DEFAULT_PEAK_FORCE_N, FitWindowArgs, ModulationArgs};
+use crate::analysis::qnm_map::{QnmCell, map_cells};
+use crate::app::config::{force, number};
+use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
+use crate::app::report::heatmap::{Cell, HeatMap};
+use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
+use crate::error::{Error, Result};
+use crate::instrument::peakforce::{Modulation, PeakForceFeedback, check_setpoint};
+use crate::instrument::peakforce_scan::{QnmPixel, Scanner};
+use crate::instrument::qnm::Analysis;
+use crate::instrument::scan::{Region, mirrored};
+use crate::physics::params::ELECTRONVOLT_J;
+use clap::Args;
+
+/// How the sample is imaged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Mode {
+    /// Tapping (amplitude modulation): the lock-in's amplitude held at a setpoint.
+    #[default]
+    Tapping,
+    /// Off-resonance tapping (PeakForce-type): the peak force of each modulation cycle
+    /// held at a setpoint, the QNM channels read from each pixel's force curve.
+    Peakforce,
+}
+
+/// The imaging mode and, for off-resonance tapping, its flags.
+#[derive(Debug, Args)]
+#[command(next_help_heading = "Off-resonance tapping (--mode peakforce)")]
+pub(super) struct QnmArgs {
+    /// The imaging mode: tapping (the amplitude held at a setpoint; the default) or
+    /// peakforce (off-resonance tapping: the peak force held at --peak-force; the maps
+    /// are the QNM channels — adhesion, dissipation, DMT modulus, deformation).
+    #[arg(long, value_enum, ignore_case = true, default_value_t = Mode::Tapping)]
+    pub(super) mode: Mode,
+    /// The peak-force setpoint [N; default 5nN].
+    #[arg(long, allow_hyphen_values = true, value_parser = force)]
+    peak_force: Option<f64>,
+    #[command(flatten)]
+    modulation: ModulationArgs,
+    #[command(flatten)]
+    window: FitWindowArgs,
+    /// The peak-force feedback's gain per cycle (0 < g ≤ 1) [default 0.5] (scan).
+    #[arg(long, allow_hyphen_values = true, value_parser = number)]
+    peak_force_gain: Option<f64>,
+}
+
+/// What a run in peakforce mode needs, checked.
+pub(super) struct Qnm {
+    pub(super) setpoint_n: f64,
+    pub(super) modulation: Modulation,
+    pub(super) analysis: Analysis,
+    pub(super) gain: f64,
+}
+
+impl QnmArgs {
+    /// Off-resonance tapping's settings, if the mode is peakforce; else a refusal of
+    /// its flags.
+    pub(super) fn resolve(&self) -> Result<Option<Qnm>> {
+        if self.mode == Mode::Tapping {
+            let given = [
+                ("--peak-force", self.peak_force.is_some()),
+                (
+                    "--modulation-frequency",
+                    self.modulation.modulation_frequency.is_some(),
+                ),
+                (
+                    "--modulation-amplitude",
+                    self.modulation.modulation_amplitude.is_some(),
+                ),
+                ("--fit-from", self.window.fit_from.is_some()),
+                ("--fit-to", self.window.fit_to.is_some()),
+                ("--peak-force-gain", self.peak_force_gain.is_some()),
+            ];
+            if let Some((flag, _)) = given.iter().find(|g| g.1) {
+                return Err(Error::NotApplicable(format!(
+                    "{flag} sets off-resonance tapping: add --mode peakforce"
+                )));
+            }
+            return Ok(None);
+        }
+        let setpoint_n = self.peak_force.unwrap_or(DEFAULT_PEAK_FORCE_N);
+        check_setpoint(setpoint_n)?;
+        let gain = self.peak_force_gain.unwrap_or(0.5);
+        if !(gain > 0.0 && gain <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "peak-force gain",
+                value: gain,
+                reason: "must be above 0 and at most 1 (per cycle)",
+            });
+        }
+        Ok(Some(Qnm {
+            setpoint_n,
+            modulation: self.modulation.modulation(),
+            analysis: self.window.analysis()?,
+            gain,
+        }))
+    }
+}
+
+/// Refuse, in peakforce mode, a flag of the tapping loop that was given.
+pub(super) fn refuse_in_peakforce(given: &[(&str, bool)]) -> Result<()> {
+    match given.iter().find(|g| g.1) {
+        Some((flag, _)) => Err(Error::NotApplicable(format!(
+            "{flag} is tapping's (the amplitude loop); --mode peakforce holds the peak force \
+             (--peak-force)"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// A QNM map over (Δγ, E*) at the peak-force setpoint: every cell solved, then the CSV,
+/// JSON and heat maps of adhesion, dissipation, DMT modulus and deformation.
+pub(super) fn map(
+    q: &Qnm,
+    (setup, numerics): (&TapSetup, &Numerics),
+    (works, moduli): (&[f64], &[f64]),
+    threads: usize,
+    out: &super::SweepOutput,
+) -> Result<()> {
+    q.modulation.check(&setup.cantilever)?;
+    let bar = out.progress("map", works.len() * moduli.len());
+    let cells = map_cells(
+        setup,
+        numerics,
+        (works, moduli),
+        threads,
+        || bar.inc(1),
+        &q.modulation,
+        &q.analysis,
+        q.setpoint_n,
+    );
+    bar.finish_and_clear();
+    let cells = cells?;
+    let title = format!("{} law, peak force {} nN", setup.law, q.setpoint_n * 1e9);
+    out.emit(
+        ("map", &[]),
+        &cells,
+        || crate::app::report::records::columns_json(&cells),
+        Some(&|path| {
+            crate::app::report::plot::render_heatmaps(
+                &map_heat_maps(&title, works, moduli, &cells),
+                path,
+            )
+        }),
+    )?;
+    let empty = cells.iter().filter(|c| c.note.is_some()).count();
+    if empty > 0 && !out.quiet {
+        eprintln!(
+            "note: {empty} of {} cells hold no peak force at the setpoint (column note; grey \
+             on the heat maps)",
+            cells.len()
+        );
+    }
+    Ok(())
+}
+
+/// The QNM channels over the grid.
+fn map_heat_maps(title: &str, works: &[f64], moduli: &[f64], cells: &[QnmCell]) -> Vec<HeatMap> {
+    let panel = |what: &str, label: &str, value: &dyn Fn(&QnmCell) -> Option<f64>| HeatMap {
+        title: format!("{what} ({title})"),
+        x_label: "work of adhesion Δγ (J/m²)".into(),
+        y_label: "composite modulus E* (GPa)".into(),
+        value_label: label.into(),
+        empty_label: "not held or n/a".into(),
+        x: works.to_vec(),
+        y: moduli.iter().map(|e| e * 1e-9).collect(),
+        log_axes: true,
+        cells: cells
+            .chunks(works.len())
+            .map(|row| {
+                row.iter()
+                    .map(|c| match value(c) {
+                        Some(value) => Cell::Value {
+                            value,
+                            period_one: c.regime.as_deref() == Some("period-1"),
+                            grazing: false,
+                        },
+                        None => Cell::NotApplicable,
+                    })
+                    .collect()
+            })
+            .collect(),
+    };
+    vec![
+        panel("adhesion", "adhesion (nN)", &|c| {
+            c.adhesion_n.map(|f| f * 1e9)
+        }),
+        panel("dissipation", "dissipation per cycle (eV)", &|c| {
+            c.dissipation_j.map(|e| e / ELECTRONVOLT_J)
+        }),
+        panel("DMT modulus", "DMT modulus fitted (GPa)", &|c| {
+            c.dmt_modulus_pa.map(|e| e * 1e-9)
+        }),
+        panel("deformation", "deformation (nm)", &|c| {
+            c.deformation_m.map(|d| d * 1e9)
+        }),
+    ]
+}
+
+/// A pixel of a QNM scan with its direction and line.
+#[derive(serde::Serialize)]
+struct Row {
+    direction: &'static str,
+    line: usize,
+    y_m: f64,
+    #[serde(flatten)]
+    pixel: QnmPixel,
+}
+
+/// The most modulation cycles one QNM scan marches (every line, both directions), before
+/// repeats are taken: some 15 minutes on one core at 0.44 ms a cycle if none repeat.
+const MAX_CYCLES: f64 = 2e6;
+
+/// A QNM line scan or image of `lines` (y and regions each) over `prepared` materials:
+/// each line engaged over its first region, then traced (and retraced).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn scan(
+    q: &Qnm,
+    prepared: &[Prepared],
+    numerics: &Numerics,
+    lines: &[(f64, Vec<Region>)],
+    (length_m, pixels, line_rate): (f64, usize, f64),
+    (threads, retrace, exact): (usize, bool, bool),
+    out: &super::SweepOutput,
+) -> Result<()> {
+    let cantilever = &prepared[0].setup.cantilever;
+    q.modulation.check(cantilever)?;
+    let per_pixel = (q.modulation.frequency_hz / (pixels as f64 * line_rate)).round();
+    let directions = if retrace { 2 } else { 1 };
+    let total = per_pixel * (pixels * lines.len() * directions) as f64;
+    if !(per_pixel >= 1.0 && total <= MAX_CYCLES) {
+        return Err(Error::OutOfRange(format!(
+            "{} lines of {pixels} pixels at {line_rate} lines/s is {per_pixel:e} modulation \
+             cycles a pixel at {} kHz, {total:.3e} in all: from 1 a pixel to {MAX_CYCLES:e} \
+             in all (a faster line rate, fewer pixels or lines)",
+            lines.len(),
+            q.modulation.frequency_hz * 1e-3
+        )));
+    }
+    let per_pixel = per_pixel as usize;
+    let loop_ = PeakForceFeedback {
+        setpoint_n: q.setpoint_n,
+        gain: q.gain,
+    };
+    let bar = out.progress("scan", lines.len() * (pixels * directions + 1));
+    let scanned: Vec<Vec<Row>> = {
+        use rayon::prelude::*;
+        crate::analysis::sweep::thread_pool(threads)?.install(|| {
+            lines
+                .par_iter()
+                .enumerate()
+                .map(|(j, (y_m, regions))| {
+                    crate::interrupt::check()?;
+                    let mut s = Scanner::new(prepared, &q.modulation, q.analysis, loop_, numerics)?;
+                    if exact {
+                        s = s.exact();
+                    }
+                    let first = regions[0];
+                    s.engage(first.material, first.height_m, q.modulation.amplitude_m)?;
+                    bar.inc(1);
+                    let shape = (length_m, pixels, per_pixel);
+                    let tag = |direction: &'static str, pixels: Vec<QnmPixel>| {
+                        pixels.into_iter().map(move |pixel| Row {
+                            direction,
+                            line: j,
+                            y_m: *y_m,
+                            pixel,
+                        })
+                    };
+                    let trace = s.line(regions, shape, |_| bar.inc(1))?;
+                    let mut rows: Vec<Row> = tag("trace", trace).collect();
+                    if retrace {
+                        let back = mirrored(regions, length_m);
+                        let mut pixels = s.line(&back, shape, |_| bar.inc(1))?;
+                        for p in &mut pixels {
+                            p.x_m = length_m - p.x_m;
+                        }
+                        rows.extend(tag("retrace", pixels));
+                    }
+                    Ok(rows)
+                })
+                .collect::<Result<Vec<_>>>()
+        })?
+    };
+    bar.finish_and_clear();
+    let rows: Vec<Row> = scanned.into_iter().flatten().collect();
+    let image = lines.len() > 1;
+    let caption = format!(
+        "off-resonance tapping at {} nN ({} kHz, {} nm)",
+        q.setpoint_n * 1e9,
+        q.modulation.frequency_hz * 1e-3,
+        q.modulation.amplitude_m * 1e9
+    );
+    out.write_files_drawn(&rows, |path| {
+        if image {
+            let short = format!("peak force {} nN", q.setpoint_n * 1e9);
+            crate::app::report::plot::render_side_by_side(
+                &images(&rows, lines.len(), pixels, &short),
+                path,
+            )
+        } else {
+            crate::app::report::plot::render_stack(&profiles(&rows, &caption), path)
+        }
+    })?;
+    if out.json {
+        return out.print_json(&rows);
+    }
+    outln!(
+        "{} in off-resonance tapping at a peak force of {} nN: {pixels} pixels a line, \
+         {per_pixel} modulation cycles each (the channels from each pixel's last)",
+        if image {
+            format!("image of {} lines", lines.len())
+        } else {
+            "line scan".into()
+        },
+        q.setpoint_n * 1e9
+    );
+    outln!(
+        "{:>10} {:>10} {:>8} {:>12} {:>10} {:>10} {:>12} {:>10} {:>10}",
+        "y (nm)",
+        "x (nm)",
+        "dir",
+        "height (nm)",
+        "peak (nN)",
+        "adh. (nN)",
+        "dissip. (eV)",
+        "deform (nm)",
+        "E* (GPa)"
+    );
+    for r in &rows {
+        let p = &r.pixel;
+        outln!(
+            "{:>10.2} {:>10.2} {:>8} {:>12.4} {:>10.4} {:>10.4} {:>12.4} {:>10.4} {:>10}",
+            r.y_m * 1e9,
+            p.x_m * 1e9,
+            r.direction,
+            p.topography_m * 1e9,
+            p.peak_force_n * 1e9,
+            p.adhesion_n * 1e9,
+            p.dissipation_j / ELECTRONVOLT_J,
+            p.deformation_m * 1e9,
+            p.dmt_modulus_pa
+                .map_or("no fit".into(), |e| format!("{:.4}", e * 1e-9))
+        );
+    }
+    Ok(())
+}
+
+/// What a QNM plot shows of a pixel.
+type Pick = fn(&QnmPixel) -> Option<f64>;
+
+/// The channels plotted: name, label, value.
+const CHANNELS: [(&str, &str, Pick); 4] = [
+    ("topography", "z piezo height (nm)", |p| {
+        Some(p.topography_m * 1e9)
+    }),
+    ("adhesion", "adhesion (nN)", |p| Some(p.adhesion_n * 1e9)),
+    ("dissipation", "dissipation per cycle (eV)", |p| {
+        Some(p.dissipation_j / ELECTRONVOLT_J)
+    }),
+    ("DMT modulus", "DMT modulus fitted (GPa)", |p| {
+        p.dmt_modulus_pa.map(|e| e * 1e-9)
+    }),
+];
+
+/// One line's channels along x, trace and retrace.
+fn profiles(rows: &[Row], caption: &str) -> Vec<Chart> {
+    CHANNELS
+        .iter()
+        .map(|&(name, label, pick)| {
+            let series: Vec<Series> = [("trace", Style::Line, 1), ("retrace", Style::Dashed, 2)]
+                .into_iter()
+                .filter_map(|(dir, style, color)| {
+                    let points: Vec<(f64, f64)> = rows
+                        .iter()
+                        .filter(|r| r.direction == dir)
+                        .filter_map(|r| Some((r.pixel.x_m * 1e9, pick(&r.pixel)?)))
+                        .collect();
+                    (!points.is_empty()).then(|| Series::new(dir, points, style, color))
+                })
+                .collect();
+            Chart {
+                name: name.replace(' ', "_"),
+                title: format!("{name}, {caption}"),
+                x: Axis::linear("position along the line x (nm)", "x_nm"),
+                y: Axis::linear(label, name),
+                legend: Corner::quietest(&series),
+                series,
+                labels: vec![],
+            }
+        })
+        .collect()
+}
+
+/// Heat maps of the trace's channels over the image.
+fn images(rows: &[Row], lines: usize, pixels: usize, caption: &str) -> Vec<HeatMap> {
+    let trace: Vec<&Row> = rows.iter().filter(|r| r.direction == "trace").collect();
+    let x: Vec<f64> = trace
+        .iter()
+        .take(pixels)
+        .map(|r| r.pixel.x_m * 1e9)
+        .collect();
+    let y: Vec<f64> = trace.iter().step_by(pixels).map(|r| r.y_m * 1e9).collect();
+    CHANNELS
+        .iter()
+        .map(|&(name, label, pick)| HeatMap {
+            title: format!("{name}, {caption} (trace)"),
+            x_label: "x along the line (nm)".into(),
+            y_label: "y across the lines (nm)".into(),
+            value_label: label.into(),
+            x: x.clone(),
+            y: y.clone(),
+            cells: trace
+                .chunks(pixels)
+                .take(lines)
+                .map(|line| {
+                    line.iter()
+                        .map(|r| match pick(&r.pixel) {
+                            Some(value) => Cell::Value {
+                                value,
+                                period_one: true,
+                                grazing: false,
+                            },
+                            None => Cell::NotApplicable,
+                        })
+                        .collect()
+                })
+                .collect(),
+            empty_label: "no DMT fit".into(),
+            log_axes: false,
+        })
+        .collect()
+}
