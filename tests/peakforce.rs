@@ -566,6 +566,7 @@ fn map_and_scan_in_peakforce_mode_show_the_qnm_channels() {
         "--json",
     ]);
     assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let map_json = out.stdout.clone();
     let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
     let col = |k: &str, i: usize| v[k][i].as_f64().unwrap();
     // The first cell (Δγ 0.05, E* 0.5 GPa), solved directly.
@@ -588,16 +589,18 @@ fn map_and_scan_in_peakforce_mode_show_the_qnm_channels() {
     assert!(v["separation_m"][3].is_null());
     let note = v["note"][3].as_str().unwrap();
     assert!(note.contains("jumps across the setpoint"), "{note}");
-    // A line over the blend: material A's settled pixels hold A's cycle.
+    // An image of the blend: material A's settled pixels hold A's cycle.
     let out = run(&[
         "scan",
         "--mode",
         "peakforce",
+        "--lines",
+        "2",
         "--pixels",
         "8",
         "--json",
         "--plot",
-        "line.png",
+        "image.png",
     ]);
     assert_eq!(out.code, Some(0), "{}", out.stderr);
     let rows: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
@@ -618,7 +621,57 @@ fn map_and_scan_in_peakforce_mode_show_the_qnm_channels() {
     assert_eq!(rows["direction"][2], "trace");
     assert!((pixel("topography_m") - a.separation_m).abs() < 0.01e-9);
     assert!((pixel("adhesion_n") / a.cycles[0].adhesion_n - 1.0).abs() < 1e-3);
-    assert!(dir.join("line.png").exists());
+    assert!(dir.join("image.png").exists());
+    // Sharded and merged: byte for byte the JSON the whole runs above printed.
+    let grid = [
+        "map",
+        "--mode",
+        "peakforce",
+        "--steps",
+        "2",
+        "--adhesion-from",
+        "0.05",
+        "--adhesion-to",
+        "0.1",
+        "--modulus-from",
+        "0.5GPa",
+        "--modulus-to",
+        "1GPa",
+        "--quiet",
+    ];
+    let image = [
+        "scan",
+        "--mode",
+        "peakforce",
+        "--lines",
+        "2",
+        "--pixels",
+        "8",
+        "--quiet",
+    ];
+    for (command, name, whole) in [
+        (&grid[..], "map", &map_json),
+        (&image[..], "scan", &out.stdout),
+    ] {
+        let mut parts = vec!["merge".to_string()];
+        for i in 0..2 {
+            let (shard, part) = (format!("{i}/2"), format!("{name}_part{i}.json"));
+            let mut args = command.to_vec();
+            args.extend(["--shard", &shard, "--part", &part]);
+            let out = run(&args);
+            assert_eq!(out.code, Some(0), "{}", out.stderr);
+            parts.push(part);
+        }
+        let merged = format!("{name}_merged.json");
+        parts.extend(["--out".into(), merged.clone(), "--quiet".into()]);
+        let out = run(&parts.iter().map(String::as_str).collect::<Vec<_>>());
+        assert_eq!(out.code, Some(0), "{}", out.stderr);
+        assert_eq!(
+            &std::fs::read_to_string(dir.join(&merged)).unwrap(),
+            whole,
+            "{name}"
+        );
+    }
     // What this mode does not take, and its flags without it.
     for (args, says) in [
         (

@@ -6,10 +6,10 @@ use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
 use crate::instrument::peakforce::{Modulation, at_setpoint};
 use crate::instrument::qnm::Analysis;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// One cell of a QNM map (None where the cell has no answer: `note` says why).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct QnmCell {
     /// Δγ, J/m².
     pub work_of_adhesion_j_m2: f64,
@@ -36,14 +36,16 @@ pub struct QnmCell {
     pub note: Option<String>,
 }
 
-/// The QNM channels of every cell of the (Δγ, E*) grid at the peak-force setpoint
-/// `setpoint_n` (cells in parallel on `threads`, 0: every core). A cell the setpoint
-/// cannot be reached at, or whose law does not apply, is listed with why.
+/// The QNM channels of the cells `cells` (indices into the (Δγ, E*) grid, Δγ fastest)
+/// at the peak-force setpoint `setpoint_n` (in parallel on `threads`, 0: every core). A
+/// cell the setpoint cannot be reached at, or whose law does not apply, is listed with
+/// why.
 #[allow(clippy::too_many_arguments)]
 pub fn map_cells(
     setup: &TapSetup,
     numerics: &Numerics,
     (works_j_m2, moduli_pa): (&[f64], &[f64]),
+    cells: &[usize],
     threads: usize,
     progress: impl Fn() + Sync,
     modulation: &Modulation,
@@ -52,11 +54,10 @@ pub fn map_cells(
 ) -> Result<Vec<QnmCell>> {
     modulation.check(&setup.cantilever)?;
     analysis.check()?;
-    let every: Vec<usize> = (0..works_j_m2.len() * moduli_pa.len()).collect();
     crate::analysis::sweep::over_grid(
         setup,
         (works_j_m2, moduli_pa),
-        &every,
+        cells,
         threads,
         progress,
         |s, (w, e)| {

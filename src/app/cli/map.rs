@@ -29,7 +29,7 @@ use clap::Args;
 /// row per cell (work_of_adhesion_j_m2, modulus_pa, tabor_mu, separation_m, regime,
 /// peak_force_n, adhesion_n, dissipation_j, deformation_m, dmt_modulus_pa, note), heat
 /// maps of adhesion, dissipation, DMT modulus and deformation: the QNM images a blend of
-/// these materials would give. Not sharded.
+/// these materials would give. Sharded and merged as the tapping map is.
 ///
 /// Output: CSV (--csv, one row per cell; without --csv, --json or --plot it goes to
 /// stdout) with work_of_adhesion_j_m2, modulus_pa, tabor_mu and the tap observables
@@ -127,14 +127,13 @@ pub fn run(args: MapArgs) -> Result<()> {
             ("--branch", args.branch.is_some()),
             ("--temperature", args.noise.temperature.is_some()),
             ("--modes", args.modes.modes.is_some()),
-            ("--shard", args.split.resolve("map", false)?.is_some()),
         ])?;
         return super::qnm::map(
             &q,
             (&setup, &numerics),
             (&works, &moduli),
             args.threads,
-            &args.out,
+            (&args.out, &args.split),
         );
     }
     if let Some(set) = args.modes.mode_set(&inputs.mode_file, &setup.cantilever)? {

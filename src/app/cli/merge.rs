@@ -7,9 +7,9 @@ use clap::Args;
 use std::path::PathBuf;
 
 /// Join the part files of a sharded `tapsim map`, `tapsim batch` or `tapsim scan --lines
-/// N` (--shard I/N, or a Slurm job array) into exactly the outputs the whole run writes:
-/// the CSV, the JSON and a map's or an image's heat maps are byte for byte those of one
-/// unsharded run.
+/// N` (tapping or --mode peakforce; --shard I/N, or a Slurm job array) into exactly the
+/// outputs the whole run writes: the CSV, the JSON and a map's or an image's heat maps
+/// are byte for byte those of one unsharded run.
 ///
 /// A part file is checked like any input before anything is drawn from it: written by
 /// this tapsim, its job one `map` or `batch` would run, its configuration hash recomputed
@@ -87,5 +87,28 @@ pub fn run(args: MergeArgs) -> Result<()> {
         Job::Scan { .. } => {
             super::scan::emit(&args.output, &args.out, &merged.job, &merged.records)
         }
+        Job::QnmMap {
+            law,
+            work_of_adhesion_j_m2,
+            modulus_pa,
+            peak_force_n,
+        } => super::qnm::emit_map(
+            &args.output,
+            &args.out,
+            (law, *peak_force_n),
+            (work_of_adhesion_j_m2, modulus_pa),
+            &merged.records,
+        ),
+        Job::QnmScan {
+            lines,
+            pixels,
+            peak_force_n,
+            ..
+        } => super::qnm::emit_scan(
+            &args.output,
+            &args.out,
+            (*lines, *pixels, *peak_force_n),
+            &merged.records,
+        ),
     }
 }

@@ -3,9 +3,11 @@
 
 use super::peakforce::{DEFAULT_PEAK_FORCE_N, FitWindowArgs, ModulationArgs};
 use crate::analysis::qnm_map::{QnmCell, map_cells};
+use crate::analysis::sweep::Shard;
 use crate::app::config::{force, number};
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::app::report::heatmap::{Cell, HeatMap};
+use crate::app::report::part::{self, Job};
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
 use crate::instrument::peakforce::{Modulation, PeakForceFeedback, check_setpoint};
@@ -53,6 +55,18 @@ pub(super) struct Qnm {
     pub(super) modulation: Modulation,
     pub(super) analysis: Analysis,
     pub(super) gain: f64,
+}
+
+impl Qnm {
+    /// What determines the results beyond the setup, for a part file's configuration.
+    fn settings(&self) -> serde_json::Value {
+        serde_json::json!({
+            "peak_force_n": self.setpoint_n,
+            "modulation": self.modulation,
+            "analysis": self.analysis,
+            "gain": self.gain,
+        })
+    }
 }
 
 impl QnmArgs {
@@ -111,21 +125,28 @@ pub(super) fn refuse_in_peakforce(given: &[(&str, bool)]) -> Result<()> {
     }
 }
 
-/// A QNM map over (Δγ, E*) at the peak-force setpoint: every cell solved, then the CSV,
-/// JSON and heat maps of adhesion, dissipation, DMT modulus and deformation.
+/// A QNM map over (Δγ, E*) at the peak-force setpoint: every cell (or a shard's) solved,
+/// then the CSV, JSON and heat maps of adhesion, dissipation, DMT modulus and
+/// deformation, or the shard's part file.
 pub(super) fn map(
     q: &Qnm,
     (setup, numerics): (&TapSetup, &Numerics),
     (works, moduli): (&[f64], &[f64]),
     threads: usize,
-    out: &super::SweepOutput,
+    (out, split): (&super::SweepOutput, &super::shard::ShardArgs),
 ) -> Result<()> {
     q.modulation.check(&setup.cantilever)?;
-    let bar = out.progress("map", works.len() * moduli.len());
+    let whole_outputs = out.csv.is_some() || out.plot.is_some() || out.json;
+    let shard = split.resolve("map", whole_outputs)?;
+    let mine = shard
+        .unwrap_or(Shard::WHOLE)
+        .items(works.len() * moduli.len());
+    let bar = out.progress("map", mine.len());
     let cells = map_cells(
         setup,
         numerics,
         (works, moduli),
+        &mine,
         threads,
         || bar.inc(1),
         &q.modulation,
@@ -134,11 +155,45 @@ pub(super) fn map(
     );
     bar.finish_and_clear();
     let cells = cells?;
-    let title = format!("{} law, peak force {} nN", setup.law, q.setpoint_n * 1e9);
+    let law = setup.law.to_string();
+    if let Some(shard) = shard {
+        return split.write(
+            ("map", shard, out.quiet),
+            Job::QnmMap {
+                law,
+                work_of_adhesion_j_m2: works.to_vec(),
+                modulus_pa: moduli.to_vec(),
+                peak_force_n: q.setpoint_n,
+            },
+            &part::Config::Whole(
+                serde_json::to_value((setup, numerics, works, moduli, q.settings()))
+                    .expect("a configuration serialises"),
+            ),
+            mine,
+            cells
+                .iter()
+                .map(|c| part::raw_records(std::slice::from_ref(c)))
+                .collect::<Result<_>>()?,
+        );
+    }
+    emit_map(out, &[], (&law, q.setpoint_n), (works, moduli), &cells)
+}
+
+/// Write a whole QNM map's outputs from its records (`tapsim merge` writes a sharded
+/// one's through this): the CSV, the JSON columns, the heat maps.
+pub(super) fn emit_map<T: serde::Serialize>(
+    out: &super::SweepOutput,
+    extra: &[std::path::PathBuf],
+    (law, setpoint_n): (&str, f64),
+    (works, moduli): (&[f64], &[f64]),
+    records: &[T],
+) -> Result<()> {
+    let cells: Vec<QnmCell> = typed(records)?;
+    let title = format!("{law} law, peak force {} nN", setpoint_n * 1e9);
     out.emit(
-        ("map", &[]),
-        &cells,
-        || crate::app::report::records::columns_json(&cells),
+        ("map", extra),
+        records,
+        || crate::app::report::records::columns_json(records),
         Some(&|path| {
             crate::app::report::plot::render_heatmaps(
                 &map_heat_maps(&title, works, moduli, &cells),
@@ -155,6 +210,18 @@ pub(super) fn map(
         );
     }
     Ok(())
+}
+
+/// Records (computed, or read back from part files) as the values they hold.
+fn typed<T: serde::Serialize, U: serde::de::DeserializeOwned>(records: &[T]) -> Result<Vec<U>> {
+    records
+        .iter()
+        .map(|r| {
+            serde_json::to_value(r)
+                .and_then(serde_json::from_value)
+                .map_err(|e| Error::NotApplicable(format!("a record that is not a QNM one: {e}")))
+        })
+        .collect()
 }
 
 /// The QNM channels over the grid.
@@ -201,9 +268,9 @@ fn map_heat_maps(title: &str, works: &[f64], moduli: &[f64], cells: &[QnmCell]) 
 }
 
 /// A pixel of a QNM scan with its direction and line.
-#[derive(serde::Serialize)]
+#[derive(serde::Serialize, serde::Deserialize)]
 struct Row {
-    direction: &'static str,
+    direction: String,
     line: usize,
     y_m: f64,
     #[serde(flatten)]
@@ -224,8 +291,15 @@ pub(super) fn scan(
     lines: &[(f64, Vec<Region>)],
     (length_m, pixels, line_rate): (f64, usize, f64),
     (threads, retrace, exact): (usize, bool, bool),
-    out: &super::SweepOutput,
+    (out, split, sample): (
+        &super::SweepOutput,
+        &super::shard::ShardArgs,
+        serde_json::Value,
+    ),
 ) -> Result<()> {
+    let whole_outputs = out.csv.is_some() || out.plot.is_some() || out.json;
+    let shard = split.resolve("scan", whole_outputs)?;
+    let mine = shard.unwrap_or(Shard::WHOLE).items(lines.len());
     let cantilever = &prepared[0].setup.cantilever;
     q.modulation.check(cantilever)?;
     let per_pixel = (q.modulation.frequency_hz / (pixels as f64 * line_rate)).round();
@@ -245,14 +319,13 @@ pub(super) fn scan(
         setpoint_n: q.setpoint_n,
         gain: q.gain,
     };
-    let bar = out.progress("scan", lines.len() * (pixels * directions + 1));
+    let bar = out.progress("scan", mine.len() * (pixels * directions + 1));
     let scanned: Vec<Vec<Row>> = {
         use rayon::prelude::*;
         crate::analysis::sweep::thread_pool(threads)?.install(|| {
-            lines
-                .par_iter()
-                .enumerate()
-                .map(|(j, (y_m, regions))| {
+            mine.par_iter()
+                .map(|&j| {
+                    let (y_m, regions) = &lines[j];
                     crate::interrupt::check()?;
                     let mut s = Scanner::new(prepared, &q.modulation, q.analysis, loop_, numerics)?;
                     if exact {
@@ -264,7 +337,7 @@ pub(super) fn scan(
                     let shape = (length_m, pixels, per_pixel);
                     let tag = |direction: &'static str, pixels: Vec<QnmPixel>| {
                         pixels.into_iter().map(move |pixel| Row {
-                            direction,
+                            direction: direction.into(),
                             line: j,
                             y_m: *y_m,
                             pixel,
@@ -286,25 +359,30 @@ pub(super) fn scan(
         })?
     };
     bar.finish_and_clear();
+    if let Some(shard) = shard {
+        return split.write(
+            ("scan", shard, out.quiet),
+            Job::QnmScan {
+                lines: lines.len(),
+                pixels,
+                retrace,
+                peak_force_n: q.setpoint_n,
+            },
+            &part::Config::Whole(
+                serde_json::to_value((sample, numerics, per_pixel, q.settings(), exact))
+                    .expect("a configuration serialises"),
+            ),
+            mine,
+            scanned
+                .iter()
+                .map(|rows| part::raw_records(rows))
+                .collect::<Result<_>>()?,
+        );
+    }
     let rows: Vec<Row> = scanned.into_iter().flatten().collect();
     let image = lines.len() > 1;
-    let caption = format!(
-        "off-resonance tapping at {} nN ({} kHz, {} nm)",
-        q.setpoint_n * 1e9,
-        q.modulation.frequency_hz * 1e-3,
-        q.modulation.amplitude_m * 1e9
-    );
-    out.write_files_drawn(&rows, |path| {
-        if image {
-            let short = format!("peak force {} nN", q.setpoint_n * 1e9);
-            crate::app::report::plot::render_side_by_side(
-                &images(&rows, lines.len(), pixels, &short),
-                path,
-            )
-        } else {
-            crate::app::report::plot::render_stack(&profiles(&rows, &caption), path)
-        }
-    })?;
+    let shape = (lines.len(), pixels, q.setpoint_n);
+    out.write_files_drawn(&rows, |path| draw(shape, &rows, path))?;
     if out.json {
         return out.print_json(&rows);
     }
@@ -347,6 +425,39 @@ pub(super) fn scan(
         );
     }
     Ok(())
+}
+
+/// Write a whole QNM scan's outputs from its records: `tapsim merge` writes a sharded
+/// image's through this.
+pub(super) fn emit_scan<T: serde::Serialize>(
+    out: &super::SweepOutput,
+    extra: &[std::path::PathBuf],
+    shape: (usize, usize, f64),
+    records: &[T],
+) -> Result<()> {
+    let rows: Vec<Row> = typed(records)?;
+    out.emit(
+        ("scan", extra),
+        records,
+        || crate::app::report::records::columns_json(records),
+        Some(&|path| draw(shape, &rows, path)),
+    )
+}
+
+/// The plot of a QNM scan of (lines, pixels) at the peak force setpoint: profiles of
+/// one line, heat maps of an image.
+fn draw(
+    (lines, pixels, setpoint_n): (usize, usize, f64),
+    rows: &[Row],
+    path: &std::path::Path,
+) -> Result<()> {
+    if lines > 1 {
+        let caption = format!("peak force {} nN", setpoint_n * 1e9);
+        crate::app::report::plot::render_side_by_side(&images(rows, lines, pixels, &caption), path)
+    } else {
+        let caption = format!("off-resonance tapping at {} nN", setpoint_n * 1e9);
+        crate::app::report::plot::render_stack(&profiles(rows, &caption), path)
+    }
 }
 
 /// What a QNM plot shows of a pixel.

@@ -69,7 +69,8 @@ use serde_json::value::RawValue;
 /// error_n, adhesion_n, dissipation_j, deformation_m, dmt_modulus_pa), drawn as heat
 /// maps of topography, adhesion, dissipation and modulus. Once the loop repeats itself
 /// over a region the cycles up to the next are taken as repeats (--exact marches every
-/// one; the channels agree within 1e-6, tested). Not sharded; no thermal noise.
+/// one; the channels agree within 1e-6, tested). Sharded and merged as tapping images
+/// are; no thermal noise.
 ///
 /// Output: a table, --json (a record per pixel: direction, line, y_m, x_m,
 /// topography_m, amplitude_ratio, error, phase_deg), --csv, --plot (one line: topography
@@ -235,8 +236,13 @@ pub fn run(args: ScanArgs) -> Result<()> {
         super::qnm::refuse_in_peakforce(&[
             ("--temperature", args.temperature.is_some()),
             ("--modes", set.is_some()),
-            ("--shard", shard.is_some()),
         ])?;
+        let config = serde_json::to_value((
+            &sample.materials,
+            &sample.layout,
+            (sample.length_m, sample.width_m),
+        ))
+        .expect("a sample serialises");
         return super::qnm::scan(
             &q,
             &prepared,
@@ -244,7 +250,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
             &lines,
             (sample.length_m, args.pixels, args.line_rate),
             (args.threads, !args.no_retrace, args.exact),
-            &args.out,
+            (&args.out, &args.split, config),
         );
     }
     let first = &prepared[lines[0].1[0].material];

@@ -66,6 +66,29 @@ pub enum Job {
         /// The number of cases.
         cases: usize,
     },
+    /// `tapsim map --mode peakforce`: one record per cell, each at the peak-force
+    /// setpoint.
+    QnmMap {
+        /// The law, as the map's outputs name it.
+        law: String,
+        /// The work-of-adhesion axis in J/m².
+        work_of_adhesion_j_m2: Vec<f64>,
+        /// The modulus axis in Pa.
+        modulus_pa: Vec<f64>,
+        /// The peak-force setpoint in N.
+        peak_force_n: f64,
+    },
+    /// `tapsim scan --mode peakforce --lines N`: one record per pixel, each line an item.
+    QnmScan {
+        /// Lines of the image.
+        lines: usize,
+        /// Pixels a line.
+        pixels: usize,
+        /// Whether each line is scanned back too.
+        retrace: bool,
+        /// The peak-force setpoint in N.
+        peak_force_n: f64,
+    },
     /// `tapsim scan --lines N`: one record per pixel, each line an item.
     Scan {
         /// Lines of the image.
@@ -88,8 +111,13 @@ impl Job {
                 modulus_pa,
                 ..
             } => work_of_adhesion_j_m2.len().saturating_mul(modulus_pa.len()),
+            Job::QnmMap {
+                work_of_adhesion_j_m2,
+                modulus_pa,
+                ..
+            } => work_of_adhesion_j_m2.len().saturating_mul(modulus_pa.len()),
             Job::Batch { cases } => *cases,
-            Job::Scan { lines, .. } => *lines,
+            Job::Scan { lines, .. } | Job::QnmScan { lines, .. } => *lines,
         }
     }
 
@@ -98,52 +126,41 @@ impl Job {
     /// [`log_grid`] gives for their ends and length, bit for bit); a batch holds from 1
     /// to [`MAX_CASES`] cases. `name` is the file the job was read from.
     pub fn validate(&self, name: &str) -> Result<()> {
+        let peak_force = |f: f64| {
+            crate::instrument::peakforce::check_setpoint(f).map_err(|e| {
+                Error::NotApplicable(format!(
+                    "{name}: job.peak_force_n {e}: not a part tapsim wrote"
+                ))
+            })
+        };
         let refuse = |field: &str, why: String| {
             Error::NotApplicable(format!(
                 "{name}: job.{field} {why}: not a part tapsim wrote"
             ))
         };
         match self {
+            Job::QnmMap {
+                law,
+                work_of_adhesion_j_m2,
+                modulus_pa,
+                peak_force_n,
+            } => {
+                peak_force(*peak_force_n)?;
+                Self::map_axes(name, law, work_of_adhesion_j_m2, modulus_pa)
+            }
             Job::Map {
                 law,
                 work_of_adhesion_j_m2,
                 modulus_pa,
                 setpoint,
             } => {
-                if law.is_empty() || law.len() > 64 {
-                    return Err(refuse("law", "is not a law's name".into()));
-                }
                 if setpoint.is_some_and(|s| !(s.amplitude_ratio > 0.0 && s.amplitude_ratio < 1.0)) {
                     return Err(refuse(
                         "setpoint",
                         "is not an amplitude setpoint between 0 and 1".into(),
                     ));
                 }
-                for (field, axis) in [
-                    ("work_of_adhesion_j_m2", work_of_adhesion_j_m2),
-                    ("modulus_pa", modulus_pa),
-                ] {
-                    let (Some(&lo), Some(&hi)) = (axis.first(), axis.last()) else {
-                        return Err(refuse(field, "is empty".into()));
-                    };
-                    let grid = log_grid("axis", lo, hi, axis.len()).map_err(|e| {
-                        refuse(field, format!("is not an axis tapsim map takes ({e})"))
-                    })?;
-                    if grid
-                        .iter()
-                        .zip(axis)
-                        .any(|(a, b)| a.to_bits() != b.to_bits())
-                    {
-                        return Err(refuse(
-                            field,
-                            format!(
-                                "is not the log grid of {} points from {lo:e} to {hi:e}",
-                                axis.len()
-                            ),
-                        ));
-                    }
-                }
-                Ok(())
+                Self::map_axes(name, law, work_of_adhesion_j_m2, modulus_pa)
             }
             Job::Batch { cases } => {
                 if !(1..=MAX_CASES).contains(cases) {
@@ -154,42 +171,86 @@ impl Job {
                 }
                 Ok(())
             }
+            Job::QnmScan {
+                lines,
+                pixels,
+                peak_force_n,
+                ..
+            } => {
+                peak_force(*peak_force_n)?;
+                Self::image(name, *lines, *pixels)
+            }
             Job::Scan {
                 lines,
                 pixels,
                 setpoint,
                 ..
             } => {
-                use crate::instrument::scan::{MAX_IMAGE_PIXELS, MAX_PIXELS};
-                if !(1..=MAX_PIXELS).contains(lines)
-                    || !(1..=MAX_PIXELS).contains(pixels)
-                    || lines * pixels > MAX_IMAGE_PIXELS
-                {
-                    return Err(refuse(
-                        "lines",
-                        format!(
-                            "and pixels are {lines} and {pixels}: from 1 to {MAX_PIXELS} each, \
-                             at most {MAX_IMAGE_PIXELS} in all"
-                        ),
-                    ));
-                }
                 if !(*setpoint > 0.0 && *setpoint < 1.0) {
                     return Err(refuse(
                         "setpoint",
                         "is not an amplitude setpoint between 0 and 1".into(),
                     ));
                 }
-                Ok(())
+                Self::image(name, *lines, *pixels)
             }
         }
+    }
+
+    /// Refuse a law name or map axes `tapsim map` would not write.
+    fn map_axes(name: &str, law: &str, works: &[f64], moduli: &[f64]) -> Result<()> {
+        let refuse = |field: &str, why: String| {
+            Error::NotApplicable(format!(
+                "{name}: job.{field} {why}: not a part tapsim wrote"
+            ))
+        };
+        if law.is_empty() || law.len() > 64 {
+            return Err(refuse("law", "is not a law's name".into()));
+        }
+        for (field, axis) in [("work_of_adhesion_j_m2", works), ("modulus_pa", moduli)] {
+            let (Some(&lo), Some(&hi)) = (axis.first(), axis.last()) else {
+                return Err(refuse(field, "is empty".into()));
+            };
+            let grid = log_grid("axis", lo, hi, axis.len())
+                .map_err(|e| refuse(field, format!("is not an axis tapsim map takes ({e})")))?;
+            if grid
+                .iter()
+                .zip(axis)
+                .any(|(a, b)| a.to_bits() != b.to_bits())
+            {
+                return Err(refuse(
+                    field,
+                    format!(
+                        "is not the log grid of {} points from {lo:e} to {hi:e}",
+                        axis.len()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuse an image's size `tapsim scan` would not scan.
+    fn image(name: &str, lines: usize, pixels: usize) -> Result<()> {
+        use crate::instrument::scan::{MAX_IMAGE_PIXELS, MAX_PIXELS};
+        if !(1..=MAX_PIXELS).contains(&lines)
+            || !(1..=MAX_PIXELS).contains(&pixels)
+            || lines * pixels > MAX_IMAGE_PIXELS
+        {
+            return Err(Error::NotApplicable(format!(
+                "{name}: job.lines and pixels are {lines} and {pixels}: from 1 to {MAX_PIXELS} \
+                 each, at most {MAX_IMAGE_PIXELS} in all: not a part tapsim wrote"
+            )));
+        }
+        Ok(())
     }
 
     /// What an item is called: a map's cell, a batch's case, an image's line.
     fn item_name(&self) -> &'static str {
         match self {
-            Job::Map { .. } => "cell",
+            Job::Map { .. } | Job::QnmMap { .. } => "cell",
             Job::Batch { .. } => "case",
-            Job::Scan { .. } => "line",
+            Job::Scan { .. } | Job::QnmScan { .. } => "line",
         }
     }
 
@@ -197,9 +258,12 @@ impl Job {
     /// retrace); `None` where it varies (a batch case).
     fn records_per_item(&self) -> Option<usize> {
         match self {
-            Job::Map { .. } => Some(1),
+            Job::Map { .. } | Job::QnmMap { .. } => Some(1),
             Job::Batch { .. } => None,
             Job::Scan {
+                pixels, retrace, ..
+            }
+            | Job::QnmScan {
                 pixels, retrace, ..
             } => Some(pixels * if *retrace { 2 } else { 1 }),
         }
@@ -444,6 +508,11 @@ fn check(name: &str, p: &Part) -> Result<Shard> {
             work_of_adhesion_j_m2: works,
             modulus_pa: moduli,
             ..
+        }
+        | Job::QnmMap {
+            work_of_adhesion_j_m2: works,
+            modulus_pa: moduli,
+            ..
         } => {
             for (&k, item) in p.items.iter().zip(&p.records) {
                 let record = &item[0];
@@ -492,7 +561,7 @@ fn check(name: &str, p: &Part) -> Result<Shard> {
                 }
             }
         }
-        Job::Scan { .. } => {
+        Job::Scan { .. } | Job::QnmScan { .. } => {
             for (&k, item) in p.items.iter().zip(&p.records) {
                 #[derive(Deserialize)]
                 struct On {
