@@ -1,6 +1,7 @@
 """The Python package against the command line it wraps, and against closed forms."""
 
 import math
+import os
 import subprocess
 import sys
 
@@ -155,6 +156,63 @@ def test_scan_in_peakforce_mode_returns_the_qnm_channels_per_pixel():
     assert r.adhesion_n[0] > r.adhesion_n[3]
     with pytest.raises(ValueError, match="add --mode peakforce"):
         tapsim.scan(peak_force="3nN")
+
+
+def _read_gsf(path):
+    """A Gwyddion Simple Field file, read as Gwyddion's user guide describes the format:
+    the magic line, ``name = value`` lines, one to four NULs to a multiple of 4, then
+    little-endian float32 values row by row."""
+    raw = path.read_bytes()
+    assert raw.startswith(b"Gwyddion Simple Field 1.0\n")
+    end = raw.index(b"\0")
+    header = dict(
+        (k.strip(), v.strip())
+        for k, v in (line.split("=", 1) for line in raw[:end].decode().splitlines()[1:])
+    )
+    start = (end // 4 + 1) * 4
+    assert set(raw[end:start]) == {0}
+    data = np.frombuffer(raw[start:], dtype="<f4")
+    return header, data.reshape(int(header["YRes"]), int(header["XRes"]))
+
+
+def test_a_scanned_image_opens_in_gwyddion(tmp_path):
+    import shutil
+
+    import gwyfile
+
+    gwy, gsf = tmp_path / "image.gwy", tmp_path / "image.gsf"
+    lines, pixels = 3, 5
+    r = tapsim.scan(lines=lines, pixels=pixels, gwy=str(gwy), gsf=str(gsf))
+    trace = r.direction == "trace"
+    # The image as Gwyddion holds it: the top line (largest y) first.
+    def grid(column):
+        return column[trace].reshape(lines, pixels)[::-1]
+
+    fields = gwyfile.util.get_datafields(gwyfile.load(str(gwy)))
+    for title, column, unit in [
+        ("Topography (trace)", r.topography_m, "m"),
+        ("Phase (trace)", r.phase_deg, "deg"),
+        ("Amplitude A/A0 (trace)", r.amplitude_ratio, ""),
+    ]:
+        f = fields[title]
+        assert f.data.shape == (lines, pixels)
+        assert (f.xreal, f.yreal) == (1e-6, 1e-6)
+        assert f.si_unit_xy.unitstr == "m" and f.si_unit_z.unitstr == unit
+        np.testing.assert_array_equal(f.data, grid(column))
+    assert "Topography (retrace)" in fields and "Topography levelled (trace)" in fields
+    header, data = _read_gsf(tmp_path / "image_topography_trace.gsf")
+    assert (header["XRes"], header["YRes"], header["ZUnits"]) == ("5", "3", "m")
+    np.testing.assert_array_equal(data, grid(r.topography_m).astype(np.float32))
+    # Gwyddion itself renders both (CI installs it; elsewhere the check is skipped).
+    thumbnailer = shutil.which("gwyddion-thumbnailer")
+    if thumbnailer is None:
+        if os.environ.get("TAPSIM_REQUIRE_GWYDDION"):
+            pytest.fail("gwyddion-thumbnailer is not installed")
+        pytest.skip("Gwyddion is not installed (apt-get install gwyddion)")
+    for path in (gwy, tmp_path / "image_phase_trace.gsf"):
+        png = tmp_path / (path.name + ".png")
+        subprocess.run([thumbnailer, "gnome2", "64", str(path), str(png)], check=True)
+        assert png.stat().st_size > 0
 
 
 def test_results_show_their_keys():

@@ -47,6 +47,7 @@ mod figure;
 mod fit;
 mod force_curve;
 mod hysteresis;
+mod image;
 mod lj;
 mod map;
 mod merge;
@@ -147,7 +148,10 @@ impl Command {
                 a.noise.check()?;
                 a.out.check()
             }
-            Command::Scan(a) => a.out.check(),
+            Command::Scan(a) => {
+                a.out.check()?;
+                a.images.check()
+            }
             Command::Thermal(a) => a.out.check(),
             Command::Peakforce(a) => a.check(),
             Command::ForceCurve(a) => a.check(),

@@ -296,8 +296,9 @@ pub(super) fn scan(
         &super::shard::ShardArgs,
         serde_json::Value,
     ),
+    (files, meta, size_m): (&super::image::ImageFiles, Vec<(String, String)>, (f64, f64)),
 ) -> Result<()> {
-    let whole_outputs = out.csv.is_some() || out.plot.is_some() || out.json;
+    let whole_outputs = out.csv.is_some() || out.plot.is_some() || out.json || files.any();
     let shard = split.resolve("scan", whole_outputs)?;
     let mine = shard.unwrap_or(Shard::WHOLE).items(lines.len());
     let cantilever = &prepared[0].setup.cantilever;
@@ -383,6 +384,37 @@ pub(super) fn scan(
     let image = lines.len() > 1;
     let shape = (lines.len(), pixels, q.setpoint_n);
     out.write_files_drawn(&rows, |path| draw(shape, &rows, path))?;
+    if files.any() {
+        let values: Vec<(bool, usize, f64, Vec<f64>)> = rows
+            .iter()
+            .map(|r| {
+                let p = &r.pixel;
+                let v = vec![
+                    p.topography_m,
+                    p.peak_force_n,
+                    p.error_n,
+                    p.adhesion_n,
+                    p.dissipation_j,
+                    p.deformation_m,
+                    p.dmt_modulus_pa.unwrap_or(f64::NAN),
+                ];
+                (r.direction == "trace", r.line, p.x_m, v)
+            })
+            .collect();
+        let names = [
+            ("Topography", "m"),
+            ("Peak force", "N"),
+            ("Peak force error", "N"),
+            ("Adhesion", "N"),
+            ("Dissipation", "J"),
+            ("Deformation", "m"),
+            ("DMT modulus", "Pa"),
+        ];
+        files.write(
+            &super::image::channels(&values, (lines.len(), pixels), size_m, &names),
+            &meta,
+        )?;
+    }
     if out.json {
         return out.print_json(&rows);
     }
@@ -396,6 +428,35 @@ pub(super) fn scan(
         },
         q.setpoint_n * 1e9
     );
+    if image {
+        let values: Vec<Vec<f64>> = rows
+            .iter()
+            .filter(|r| r.direction == "trace")
+            .map(|r| {
+                let p = &r.pixel;
+                vec![
+                    p.topography_m * 1e9,
+                    p.peak_force_n * 1e9,
+                    p.adhesion_n * 1e9,
+                    p.dissipation_j / ELECTRONVOLT_J,
+                    p.deformation_m * 1e9,
+                    p.dmt_modulus_pa.map_or(f64::NAN, |e| e * 1e-9),
+                ]
+            })
+            .collect();
+        return super::image::summary(
+            &[
+                "height (nm)",
+                "peak force (nN)",
+                "adhesion (nN)",
+                "dissipation (eV)",
+                "deformation (nm)",
+                "DMT modulus (GPa)",
+            ],
+            &values,
+            rows.len(),
+        );
+    }
     outln!(
         "{:>10} {:>10} {:>8} {:>12} {:>10} {:>10} {:>12} {:>10} {:>10}",
         "y (nm)",

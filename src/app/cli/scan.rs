@@ -141,6 +141,8 @@ pub struct ScanArgs {
     split: super::shard::ShardArgs,
     #[command(flatten)]
     qnm: super::qnm::QnmArgs,
+    #[command(flatten)]
+    pub(super) images: super::image::ImageFiles,
 }
 
 /// A pixel with its direction and line.
@@ -223,7 +225,8 @@ pub fn run(args: ScanArgs) -> Result<()> {
         ),
         None => None,
     };
-    let whole_outputs = args.out.csv.is_some() || args.out.plot.is_some() || args.out.json;
+    let whole_outputs =
+        args.out.csv.is_some() || args.out.plot.is_some() || args.out.json || args.images.any();
     let shard = args.split.resolve("scan", whole_outputs)?;
     let mine = shard.unwrap_or(Shard::WHOLE).items(args.lines);
     let lines: Vec<(f64, Vec<crate::instrument::scan::Region>)> = (0..args.lines)
@@ -251,6 +254,17 @@ pub fn run(args: ScanArgs) -> Result<()> {
             (sample.length_m, args.pixels, args.line_rate),
             (args.threads, !args.no_retrace, args.exact),
             (&args.out, &args.split, config),
+            (
+                &args.images,
+                super::image::meta(
+                    "off-resonance tapping (peak-force)",
+                    first_setup,
+                    &args.sample,
+                    (args.lines, args.pixels, args.line_rate),
+                    format!("peak force {} nN", q.setpoint_n * 1e9),
+                ),
+                (sample.length_m, sample.width_m),
+            ),
         );
     }
     let first = &prepared[lines[0].1[0].material];
@@ -397,6 +411,41 @@ pub fn run(args: ScanArgs) -> Result<()> {
     let rows: Vec<Row> = per_line.into_iter().flatten().collect();
     args.out
         .write_files_drawn(&rows, |path| draw(&job, &rows, path))?;
+    if args.images.any() {
+        let mut names = vec![
+            ("Topography", "m"),
+            ("Amplitude A/A0", ""),
+            ("Amplitude error", ""),
+            ("Phase", "deg"),
+        ];
+        let higher = rows.first().map_or(0, |r| r.pixel.modes.len());
+        let mode_names: Vec<String> = (2..2 + higher).map(|k| format!("Phase {k}")).collect();
+        names.extend(mode_names.iter().map(|n| (n.as_str(), "deg")));
+        let values: Vec<(bool, usize, f64, Vec<f64>)> = rows
+            .iter()
+            .map(|r| {
+                let p = &r.pixel;
+                let mut v = vec![p.topography_m, p.amplitude_ratio, p.error, p.phase_deg];
+                v.extend(p.modes.iter().map(|m| m.phase_deg));
+                (r.direction == "trace", r.line, p.x_m, v)
+            })
+            .collect();
+        args.images.write(
+            &super::image::channels(
+                &values,
+                (args.lines, args.pixels),
+                (sample.length_m, sample.width_m),
+                &names,
+            ),
+            &super::image::meta(
+                "tapping (amplitude modulation)",
+                first_setup,
+                &args.sample,
+                (args.lines, args.pixels, args.line_rate),
+                format!("A/A0 = {}", args.setpoint),
+            ),
+        )?;
+    }
     if args.out.json {
         return args.out.print_json(&rows);
     }
@@ -432,8 +481,30 @@ pub fn run(args: ScanArgs) -> Result<()> {
             format!("phi{k} (deg)")
         );
     }
-    outln!("{head}");
-    for r in &rows {
+    if args.lines > 1 {
+        let values: Vec<Vec<f64>> = rows
+            .iter()
+            .filter(|r| r.direction == "trace")
+            .map(|r| {
+                let p = &r.pixel;
+                vec![
+                    p.topography_m * 1e9,
+                    p.amplitude_ratio,
+                    p.error,
+                    p.phase_deg,
+                ]
+            })
+            .collect();
+        super::image::summary(
+            &["height (nm)", "A/A0", "amplitude error", "phase (deg)"],
+            &values,
+            rows.len(),
+        )?;
+    }
+    if args.lines == 1 {
+        outln!("{head}");
+    }
+    for r in rows.iter().filter(|_| args.lines == 1) {
         let p = &r.pixel;
         let mut line = format!(
             "{:>10.2} {:>10.2} {:>8} {:>12.4} {:>10.6} {:>10.2e} {:>10.4}",

@@ -11,6 +11,7 @@ pub mod contrast;
 pub mod display;
 pub mod fit;
 pub mod fit_text;
+pub mod gwyddion;
 pub mod heatmap;
 pub mod hysteresis;
 pub mod lj;
