@@ -201,61 +201,36 @@ fn a_thinned_curve_keeps_its_jumps_and_extremes() {
 #[test]
 #[ignore = "slow (three ramps down to 16 000 lever periods a leg at three (μ, k̂)): cargo test --release --test force_curve -- --ignored"]
 fn a_slow_ramp_converges_to_the_finite_stiffness_cycle_17_24_26() {
-    use tapsim::physics::contact::{hybrid, spring};
-    let (r, dg, eps) = (20e-9_f64, 0.1_f64, 0.3e-9_f64);
+    use tapsim::physics::contact::hybrid;
     for (mu, k_hat) in [(5.0_f64, 2.0_f64), (10.0, 0.5), (3.0, 5.0)] {
-        // The contact of Tabor parameter μ and the lever of stiffness k̂ (eq. 22).
-        let e_star = (r * dg * dg / (mu.powi(3) * eps.powi(3))).sqrt();
-        let mut s = setup(LawKind::Hybrid);
-        s.contact = tapsim::Contact::new(r, e_star, dg, eps).unwrap();
-        s.cantilever.stiffness_n_m = k_hat * r * dg / (mu * eps);
-        s.cantilever.quality = 1.0;
-        let closed = spring::hysteresis(mu, k_hat, hybrid::JumpIn::Fit).unwrap();
-        let me = mu * eps;
-        let top = (closed.support_alpha_hat_c.max(4.0) + 1.0) * me;
-        let bottom = (-1.5 * std::f64::consts::PI / k_hat - 3.0) * me;
-        let unit = me * r * dg;
+        let c = common::paper_cycle(mu, k_hat);
+        let (closed, me, unit) = (&c.closed, c.length_unit_m, c.energy_unit_j);
         let periods = [4000.0, 8000.0, 16000.0];
         let runs: Vec<(f64, f64)> = periods
             .iter()
             .map(|&n| {
                 let ramp = Ramp {
-                    start_m: top,
-                    turn_m: Some(bottom),
+                    start_m: c.top_m,
+                    turn_m: Some(c.bottom_m),
                     trigger_n: None,
-                    velocity_m_s: (top - bottom) * s.cantilever.resonance_hz / n,
+                    velocity_m_s: (c.top_m - c.bottom_m) * c.setup.cantilever.resonance_hz / n,
                     dwell_s: 0.0,
                 };
-                let c = force_curve(&s, &Numerics::default(), &ramp, &Analysis::default()).unwrap();
+                let f = force_curve(&c.setup, &Numerics::default(), &ramp, &Analysis::default())
+                    .unwrap();
                 // The contact itself loses the rigid hybrid loop; the tip snaps in where
                 // the support reaches α̂_A.
-                assert!((c.contact_loss_j / unit / hybrid::w_hat_fit(mu) - 1.0).abs() < 1e-6);
-                let snap = c.snap_in.unwrap().piezo_m / me;
+                assert!((f.contact_loss_j / unit / hybrid::w_hat_fit(mu) - 1.0).abs() < 1e-6);
+                let snap = f.snap_in.unwrap().piezo_m / me;
                 assert!((snap / closed.alpha_hat_a.unwrap() - 1.0).abs() < 1e-6);
-                assert!(c.energy_balance_rel < 1e-6);
-                (c.drive_work_j / unit, c.pull_off.unwrap().piezo_m / me)
+                assert!(f.energy_balance_rel < 1e-6);
+                (f.drive_work_j / unit, f.pull_off.unwrap().piezo_m / me)
             })
             .collect();
-        // Q = Q₀ + a v^{2/3} + b v through the three points (Cramer's rule).
-        let limit = |q: [f64; 3]| {
-            let rows: Vec<[f64; 3]> = periods
-                .iter()
-                .map(|&n| [1.0, (1.0 / n).powf(2.0 / 3.0), 1.0 / n])
-                .collect();
-            let det = |m: [[f64; 3]; 3]| {
-                m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-                    - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-                    + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-            };
-            let a = [rows[0], rows[1], rows[2]];
-            let mut a0 = a;
-            for i in 0..3 {
-                a0[i][0] = q[i];
-            }
-            det(a0) / det(a)
-        };
-        let w = limit([runs[0].0, runs[1].0, runs[2].0]);
-        let pull = limit([runs[0].1, runs[1].1, runs[2].1]);
+        // The speed in lever periods' worth: s = 1/periods.
+        let s = periods.map(|n| 1.0 / n);
+        let w = common::limit_two_thirds(s, [runs[0].0, runs[1].0, runs[2].0]);
+        let pull = common::limit_two_thirds(s, [runs[0].1, runs[1].1, runs[2].1]);
         let (rel_w, rel_pull) = (
             w / closed.w_hat - 1.0,
             pull / closed.support_alpha_hat_c - 1.0,

@@ -387,22 +387,11 @@ fn hostile_values_of_the_commands_flags_end_cleanly() {
 #[test]
 #[ignore = "slow (three modulations down to f_m = 1.25e-4 f₀ at three (μ, k̂)): cargo test --release --test peakforce -- --ignored"]
 fn slow_modulation_converges_to_the_finite_stiffness_loss_26() {
-    use tapsim::physics::contact::{hybrid, spring};
-    let (r, dg, eps) = (20e-9_f64, 0.1_f64, 0.3e-9_f64);
+    use tapsim::physics::contact::hybrid;
     for (mu, k_hat) in [(5.0_f64, 2.0_f64), (10.0, 0.5), (3.0, 5.0)] {
-        // The contact of Tabor parameter μ and the lever of stiffness k̂ (eq. 22).
-        let e_star = (r * dg * dg / (mu.powi(3) * eps.powi(3))).sqrt();
-        let mut s = setup(LawKind::Hybrid);
-        s.contact = tapsim::Contact::new(r, e_star, dg, eps).unwrap();
-        s.cantilever.stiffness_n_m = k_hat * r * dg / (mu * eps);
-        s.cantilever.quality = 1.0;
-        let closed = spring::hysteresis(mu, k_hat, hybrid::JumpIn::Fit).unwrap();
-        // The support from beyond the spring's pull-off down to a compressive force of
-        // about the pull-off force.
-        let me = mu * eps;
-        let top = (closed.support_alpha_hat_c.max(4.0) + 1.0) * me;
-        let bottom = (-1.5 * std::f64::consts::PI / k_hat - 3.0) * me;
-        let unit = me * r * dg;
+        let c = common::paper_cycle(mu, k_hat);
+        let (s, closed, unit) = (&c.setup, &c.closed, c.energy_unit_j);
+        let (top, bottom) = (c.top_m, c.bottom_m);
         let ratios = [5e-4, 2.5e-4, 1.25e-4];
         let w: Vec<f64> = ratios
             .iter()
@@ -415,7 +404,7 @@ fn slow_modulation_converges_to_the_finite_stiffness_loss_26() {
                     max_steps: 50_000_000,
                     ..Default::default()
                 };
-                let c = cycle(&s, &n, &m, &Analysis::default(), 0.5 * (top + bottom)).unwrap();
+                let c = cycle(s, &n, &m, &Analysis::default(), 0.5 * (top + bottom)).unwrap();
                 assert_eq!(c.regime, "period-1");
                 // The contact itself loses the rigid hybrid loop.
                 let rigid = hybrid::w_hat_fit(mu);
@@ -423,22 +412,8 @@ fn slow_modulation_converges_to_the_finite_stiffness_loss_26() {
                 c.drive_work_j / unit
             })
             .collect();
-        // W = W₀ + aΩ^{2/3} + bΩ through the three points (Cramer's rule).
-        let rows: Vec<[f64; 3]> = ratios
-            .iter()
-            .map(|&o| [1.0, o.powf(2.0 / 3.0), o])
-            .collect();
-        let det = |m: [[f64; 3]; 3]| {
-            m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-        };
-        let a = [rows[0], rows[1], rows[2]];
-        let mut a0 = a;
-        for i in 0..3 {
-            a0[i][0] = w[i];
-        }
-        let w0 = det(a0) / det(a);
+        // W = W₀ + aΩ^{2/3} + bΩ through the three points.
+        let w0 = common::limit_two_thirds(ratios, [w[0], w[1], w[2]]);
         let rel = w0 / closed.w_hat - 1.0;
         println!(
             "mu {mu}, k {k_hat}: W at f_m/f0 = {ratios:?}: {w:?}; limit {w0:.6} against (26) \

@@ -157,3 +157,58 @@ pub fn rows(doc: &serde_json::Value) -> Vec<serde_json::Value> {
         })
         .collect()
 }
+
+/// The paper's finite-stiffness cycle (§4) as a simulated experiment: the hybrid
+/// contact of Tabor parameter `mu` (R 20 nm, Δγ 0.1 J/m², ε 0.3 nm) on a lever of
+/// dimensionless stiffness `k_hat` (eq. 22) with Q = 1 (it rings out at once), its
+/// closed form (eq. 26), the support's travel from beyond the spring's pull-off down to
+/// a compressive force of about the pull-off force (top, bottom, m), and the unit of
+/// energy μεRΔγ (J) and of length με (m).
+pub struct PaperCycle {
+    pub setup: tapsim::TapSetup,
+    pub closed: tapsim::physics::contact::spring::SpringHysteresis,
+    pub top_m: f64,
+    pub bottom_m: f64,
+    pub energy_unit_j: f64,
+    pub length_unit_m: f64,
+}
+
+pub fn paper_cycle(mu: f64, k_hat: f64) -> PaperCycle {
+    use tapsim::physics::contact::{hybrid, spring};
+    let (r, dg, eps) = (20e-9_f64, 0.1_f64, 0.3e-9_f64);
+    let e_star = (r * dg * dg / (mu.powi(3) * eps.powi(3))).sqrt();
+    let mut setup = tapsim::TapSetup {
+        law: tapsim::LawKind::Hybrid.into(),
+        ..tapsim::default_setup()
+    };
+    setup.contact = tapsim::Contact::new(r, e_star, dg, eps).unwrap();
+    setup.cantilever.stiffness_n_m = k_hat * r * dg / (mu * eps);
+    setup.cantilever.quality = 1.0;
+    let closed = spring::hysteresis(mu, k_hat, hybrid::JumpIn::Fit).unwrap();
+    let me = mu * eps;
+    PaperCycle {
+        top_m: (closed.support_alpha_hat_c.max(4.0) + 1.0) * me,
+        bottom_m: (-1.5 * std::f64::consts::PI / k_hat - 3.0) * me,
+        closed,
+        setup,
+        energy_unit_j: me * r * dg,
+        length_unit_m: me,
+    }
+}
+
+/// The limit Q₀ of Q = Q₀ + a s^{2/3} + b s through three points (s, Q) (Cramer's
+/// rule): how a slow cycle's loss and pull-off approach the quasi-static ones (the slow
+/// passage through the fold, and the slow motion's damping).
+pub fn limit_two_thirds(s: [f64; 3], q: [f64; 3]) -> f64 {
+    let det = |m: [[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let a = s.map(|s| [1.0, s.powf(2.0 / 3.0), s]);
+    let mut a0 = a;
+    for i in 0..3 {
+        a0[i][0] = q[i];
+    }
+    det(a0) / det(a)
+}
