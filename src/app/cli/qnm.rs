@@ -578,31 +578,16 @@ fn images(rows: &[Row], lines: usize, pixels: usize, caption: &str) -> Vec<HeatM
     let y: Vec<f64> = trace.iter().step_by(pixels).map(|r| r.y_m * 1e9).collect();
     CHANNELS
         .iter()
-        .map(|&(name, label, pick)| HeatMap {
-            title: format!("{name}, {caption} (trace)"),
-            x_label: "x along the line (nm)".into(),
-            y_label: "y across the lines (nm)".into(),
-            value_label: label.into(),
-            x: x.clone(),
-            y: y.clone(),
-            cells: trace
-                .chunks(pixels)
-                .take(lines)
-                .map(|line| {
-                    line.iter()
-                        .map(|r| match pick(&r.pixel) {
-                            Some(value) => Cell::Value {
-                                value,
-                                period_one: true,
-                                grazing: false,
-                            },
-                            None => Cell::NotApplicable,
-                        })
-                        .collect()
-                })
-                .collect(),
-            empty_label: "no DMT fit".into(),
-            log_axes: false,
+        .map(|&(name, label, pick)| {
+            HeatMap::image(
+                (format!("{name}, {caption} (trace)"), label, "no DMT fit"),
+                (x.clone(), y.clone()),
+                trace
+                    .chunks(pixels)
+                    .take(lines)
+                    .map(|line| line.iter().map(|r| pick(&r.pixel)).collect())
+                    .collect(),
+            )
         })
         .collect()
 }

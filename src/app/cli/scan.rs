@@ -3,7 +3,7 @@
 use crate::analysis::sweep::Shard;
 use crate::app::config::{TapInputs, number};
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
-use crate::app::report::heatmap::{Cell, HeatMap};
+use crate::app::report::heatmap::HeatMap;
 use crate::app::report::part::{self, Job};
 use crate::app::sample::{BLEND, Sample};
 use crate::dynamics::setup::Prepared;
@@ -697,31 +697,23 @@ fn images(rows: &[Point], lines: usize, pixels: usize, setpoint: f64) -> Vec<Hea
     let trace: Vec<&Point> = rows.iter().filter(|r| r.0).collect();
     let x: Vec<f64> = trace.iter().take(pixels).map(|r| r.2 * 1e9).collect();
     let y: Vec<f64> = trace.iter().step_by(pixels).map(|r| r.1 * 1e9).collect();
-    let map = |title: &str, label: &str, pick: fn(&Point) -> f64| HeatMap {
-        title: format!(
-            "{title} at {} = {setpoint} (trace)",
-            if bimodal { "A₁/A₀₁" } else { "A/A₀" }
-        ),
-        x_label: "x along the line (nm)".into(),
-        y_label: "y across the lines (nm)".into(),
-        value_label: label.into(),
-        x: x.clone(),
-        y: y.clone(),
-        cells: trace
-            .chunks(pixels)
-            .take(lines)
-            .map(|line| {
-                line.iter()
-                    .map(|r| Cell::Value {
-                        value: pick(r),
-                        period_one: true,
-                        grazing: false,
-                    })
-                    .collect()
-            })
-            .collect(),
-        empty_label: String::new(),
-        log_axes: false,
+    let map = |title: &str, label: &str, pick: fn(&Point) -> f64| {
+        HeatMap::image(
+            (
+                format!(
+                    "{title} at {} = {setpoint} (trace)",
+                    if bimodal { "A₁/A₀₁" } else { "A/A₀" }
+                ),
+                label,
+                "",
+            ),
+            (x.clone(), y.clone()),
+            trace
+                .chunks(pixels)
+                .take(lines)
+                .map(|line| line.iter().map(|r| Some(pick(r))).collect())
+                .collect(),
+        )
     };
     let mut maps = vec![map("topography", "z piezo height (nm)", |p| p.3 * 1e9)];
     if bimodal {

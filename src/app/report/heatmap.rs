@@ -45,6 +45,40 @@ pub struct HeatMap {
 }
 
 impl HeatMap {
+    /// A scanned image's panel: `values[j][i]` at pixel i of line j (None: no value,
+    /// grey with `empty_label`), x along the line and y across the lines in nm.
+    pub fn image(
+        (title, value_label, empty_label): (String, &str, &str),
+        (x_nm, y_nm): (Vec<f64>, Vec<f64>),
+        values: Vec<Vec<Option<f64>>>,
+    ) -> Self {
+        Self {
+            title,
+            x_label: "x along the line (nm)".into(),
+            y_label: "y across the lines (nm)".into(),
+            value_label: value_label.into(),
+            x: x_nm,
+            y: y_nm,
+            cells: values
+                .into_iter()
+                .map(|line| {
+                    line.into_iter()
+                        .map(|v| match v {
+                            Some(value) => Cell::Value {
+                                value,
+                                period_one: true,
+                                grazing: false,
+                            },
+                            None => Cell::NotApplicable,
+                        })
+                        .collect()
+                })
+                .collect(),
+            empty_label: empty_label.into(),
+            log_axes: false,
+        }
+    }
+
     /// The range of the values (both ends equal if there is one value; `None` if none).
     pub fn value_range(&self) -> Option<(f64, f64)> {
         let values = self.cells.iter().flatten().filter_map(|c| match c {
