@@ -87,7 +87,7 @@ class Result:
         return key in self._data
 
     def __dir__(self) -> List[str]:
-        return sorted(set(self._data) | {"command", "keys", "to_dict"})
+        return sorted(set(self._data) | {"command", "keys", "to_dict", "to_pandas", "to_xarray"})
 
     def keys(self) -> List[str]:
         """The document's keys, in the command's order."""
@@ -96,6 +96,110 @@ class Result:
     def to_dict(self) -> Dict[str, Any]:
         """The whole document as a dict (numpy arrays for columns and grids)."""
         return dict(self._data)
+
+    def _scalars(self) -> Dict[str, Any]:
+        return {
+            k: v for k, v in self._data.items()
+            if isinstance(v, (str, int, float, bool)) and not isinstance(v, _np.ndarray)
+        }
+
+    def _table(self) -> Dict[str, Any]:
+        """One column per key, one entry per point (cell of a map, pixel of a scan,
+        setpoint of a sweep); gaps as NaN."""
+        d = self._data
+        if isinstance(d.get("grid"), dict) and "work_of_adhesion_j_m2" in d:
+            works = _np.asarray(d["work_of_adhesion_j_m2"], dtype=float)
+            moduli = _np.asarray(d["modulus_pa"], dtype=float)
+            table = {
+                "work_of_adhesion_j_m2": _np.tile(works, len(moduli)),
+                "modulus_pa": _np.repeat(moduli, len(works)),
+            }
+            shape = (len(moduli), len(works))
+            for k, v in d["grid"].items():
+                a = _grid(v, shape)
+                if a is None:
+                    try:
+                        a = _np.asarray(v)
+                    except ValueError:
+                        continue
+                    if a.shape != shape:
+                        continue
+                if k not in table:
+                    table[k] = a.reshape(-1)
+            return table
+        columns = {
+            k: v for k, v in d.items()
+            if isinstance(v, _np.ndarray) and v.ndim == 1 and v.size > 0
+        }
+        if not columns:
+            raise ValueError(f"tapsim {self.command} has no columns to tabulate (its keys: {', '.join(d)})")
+        lengths = [len(v) for v in columns.values()]
+        n = max(set(lengths), key=lengths.count)
+        table = {
+            k: (_np.ma.filled(v.astype(float), _np.nan) if _np.ma.isMaskedArray(v) else v)
+            for k, v in columns.items() if len(v) == n
+        }
+        modes = d.get("modes")
+        if isinstance(modes, Result):
+            for k, v in modes._data.items():
+                a = _np.asarray(v)
+                if a.ndim == 2 and a.shape[0] == n:
+                    for i in range(a.shape[1]):
+                        table[f"modes_{i + 1}_{k}"] = a[:, i]
+        return table
+
+    def to_pandas(self) -> Any:
+        """The result as a pandas DataFrame: one row per point (a sweep's setpoint, a
+        map's cell, a scan's pixel), the JSON's keys as columns with the units in their
+        names, gaps as NaN; the scalar keys (law, ...) in ``df.attrs``. Needs pandas."""
+        import pandas as pd
+
+        df = pd.DataFrame(self._table())
+        df.attrs.update(self._scalars())
+        df.attrs["command"] = self.command
+        return df
+
+    def to_xarray(self) -> Any:
+        """The result as an xarray Dataset with labelled axes in SI: a map over
+        (modulus_pa, work_of_adhesion_j_m2); a scanned image over (direction, y_m, x_m),
+        x ascending in both directions; anything else over its points. The scalar keys
+        as attributes. Needs xarray."""
+        import xarray as xr
+
+        d = self._data
+        attrs = dict(self._scalars(), command=self.command)
+        if isinstance(d.get("grid"), dict) and "work_of_adhesion_j_m2" in d:
+            coords = {
+                "modulus_pa": _np.asarray(d["modulus_pa"], dtype=float),
+                "work_of_adhesion_j_m2": _np.asarray(d["work_of_adhesion_j_m2"], dtype=float),
+            }
+            shape = (len(coords["modulus_pa"]), len(coords["work_of_adhesion_j_m2"]))
+            data = {}
+            for k, v in d["grid"].items():
+                a = _grid(v, shape)
+                if a is not None and k not in coords:
+                    data[k] = (("modulus_pa", "work_of_adhesion_j_m2"), a)
+            return xr.Dataset(data, coords=coords, attrs=attrs)
+        table = self._table()
+        if {"direction", "line", "x_m", "y_m"} <= set(table):
+            directions = [x for x in ("trace", "retrace") if _np.any(table["direction"] == x)]
+            lines = int(_np.max(table["line"])) + 1
+            ys = _np.array([table["y_m"][table["line"] == j][0] for j in range(lines)])
+            xs = _np.sort(_np.unique(table["x_m"][table["direction"] == directions[0]]))
+            data = {}
+            for k, v in table.items():
+                if k in ("direction", "line", "x_m", "y_m") or not _is_numeric(v):
+                    continue
+                grid = _np.full((len(directions), lines, len(xs)), _np.nan)
+                for a, direction in enumerate(directions):
+                    for j in range(lines):
+                        mine = (table["direction"] == direction) & (table["line"] == j)
+                        order = _np.argsort(table["x_m"][mine])
+                        grid[a, j, :] = _np.asarray(v, dtype=float)[mine][order]
+                data[k] = (("direction", "y_m", "x_m"), grid)
+            coords = {"direction": directions, "y_m": ys, "x_m": xs}
+            return xr.Dataset(data, coords=coords, attrs=attrs)
+        return xr.Dataset({k: ("point", v) for k, v in table.items()}, attrs=attrs)
 
     def __repr__(self) -> str:
         scalar = [
@@ -133,6 +237,30 @@ def _arrays(value: Any) -> Any:
     if rows:
         data, mask = data.reshape(len(value), -1), mask.reshape(len(value), -1)
     return _np.ma.masked_array(data, mask=mask)
+
+
+def _grid(value: Any, shape: Any) -> Optional[Any]:
+    """A map grid's entry as a float array of `shape` (gaps NaN), or None where it is
+    not one number per cell (names, flags, lists per cell)."""
+    if _np.ma.isMaskedArray(value):
+        value = _np.ma.filled(value.astype(float), _np.nan)
+    try:
+        a = _np.asarray(value)
+    except ValueError:
+        return None
+    if a.shape != tuple(shape):
+        return None
+    if a.dtype.kind in "fiu":
+        return a.astype(float)
+    if a.dtype == object and all(
+        x is None or (isinstance(x, (int, float)) and not isinstance(x, bool)) for x in a.ravel()
+    ):
+        return _np.array([_np.nan if x is None else x for x in a.ravel()], dtype=float).reshape(shape)
+    return None
+
+
+def _is_numeric(value: Any) -> bool:
+    return _np.asarray(value).dtype.kind in "fiub" and _np.asarray(value).dtype.kind != "b"
 
 
 def _modes(value: Any) -> Any:
@@ -327,27 +455,137 @@ def lj(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
     return _run("lj", setup, kwargs)
 
 
-def fit(data: Any, setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
-    """A measured approach curve (a CSV path: position, amplitude and/or phase columns
-    with units in the header, as ``tapsim fit`` reads it) fitted by the simulator
-    (``tapsim fit``): ``parameters`` (value, std_err, interval_68, interval_95,
-    identifiable), ``identifiability`` (singular_values, condition_number, correlations,
-    notes), chi_square, ``converged``, ``diagnosis`` (describes_data, reasons,
-    worst_points), the ``minima`` found, the fitted curve; ``profile=True`` adds
-    ``profiles``. ``law=["hybrid", "jkr"]`` fits each law: ``laws`` (one report per
-    law) and ``comparison`` (ranking by AIC and BIC, ``verdict`` in words)."""
-    args = _argv("fit", _options(setup, kwargs))
-    return Result("fit", _tapsim.run([args[0], _os.fspath(data)] + args[1:]))
+# Data columns as the CSV reader names them (units in the name), and the short
+# keywords in SI: z and amplitude in m, phase in degrees.
+_DATA_COLUMNS = {
+    f"{p}_{u}" for p in ("z", "z_c", "separation", "position") for u in ("m", "nm")
+} | {
+    "amplitude_m", "amplitude_nm", "amplitude_ratio", "amplitude_v",
+    "amplitude1_m", "amplitude1_nm", "amplitude1_ratio", "amplitude1_v",
+    "phase_deg", "phase1_deg", "amplitude2_m", "amplitude2_nm", "amplitude2_ratio",
+    "phase2_deg", "setpoint_ratio", "deflection_m", "deflection_nm", "mean_force_n",
+}
+_DATA_ALIASES = {
+    "z": "z_m", "amplitude": "amplitude_m", "phase": "phase_deg",
+    "amplitude2": "amplitude2_m", "phase2": "phase2_deg", "deflection": "deflection_m",
+}
+# Columns of labels (a DataFrame's or a dict's; as keywords they would be flags).
+_LABEL_COLUMNS = {"direction", "segment"}
+_POSITIONS = sorted(c for c in _DATA_COLUMNS if c.split("_")[0] in ("z", "separation", "position"))
 
 
-def reconstruct(data: Any, setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
-    """The force and the loss an AM curve implies (``tapsim reconstruct``; a CSV path
-    with position, amplitude and phase columns, units in the header, as ``tapsim
-    approach --csv`` writes it): columns closest_m, force_n, e_ts_j, in_phase_force_n,
-    frequency_shift (with ``with_law=True`` also law_approach_force_n and
-    law_retract_force_n), and notes."""
-    args = _argv("reconstruct", _options(setup, kwargs))
-    return Result("reconstruct", _tapsim.run([args[0], _os.fspath(data)] + args[1:]))
+def _data_columns(data: Any, kwargs: Dict[str, Any]) -> Optional[Dict[str, Any]]:
+    """The curve's columns given as arrays -- a pandas DataFrame or a dict as ``data``,
+    or keywords -- by their CSV names; None where ``data`` is a path."""
+    is_path = isinstance(data, (str, bytes, _os.PathLike))
+    columns: Dict[str, Any] = {}
+    if data is not None and not is_path:
+        if hasattr(data, "columns") and hasattr(data, "__getitem__"):
+            items = [(str(c), data[c].to_numpy()) for c in data.columns]
+        elif isinstance(data, dict):
+            items = [(str(k), v) for k, v in data.items()]
+        else:
+            raise TypeError(
+                f"the data are a CSV path, a pandas DataFrame or a dict of arrays, not "
+                f"{type(data).__name__}"
+            )
+        for name, values in items:
+            key = _DATA_ALIASES.get(name, name).lower()
+            if key in _DATA_COLUMNS or key in _LABEL_COLUMNS:
+                columns[key] = values
+    for name in list(kwargs):
+        key = _DATA_ALIASES.get(name, name)
+        if key in _DATA_COLUMNS:
+            columns[key] = kwargs.pop(name)
+    if is_path:
+        if columns:
+            raise ValueError("give the data as a CSV path or as columns, not both")
+        return None
+    if not columns:
+        raise ValueError(
+            "no data: give a CSV path, a DataFrame or dict of columns, or the columns as "
+            "keywords (z=..., amplitude=..., phase=...; or z_nm=..., amplitude_nm=..., "
+            "phase_deg=...)"
+        )
+    return columns
+
+
+def _csv_text(columns: Dict[str, Any]) -> str:
+    """The columns as the CSV the command line reads, every number exact (repr)."""
+    if not any(c in columns for c in _POSITIONS + ["setpoint_ratio"]):
+        raise ValueError(
+            "no position column: give z (m) or one of " + ", ".join(_POSITIONS)
+            + " (or setpoint_ratio)"
+        )
+    arrays = {}
+    for name, values in columns.items():
+        a = _np.asarray(values)
+        if a.ndim != 1:
+            raise ValueError(f"column {name} is not one-dimensional (shape {a.shape})")
+        if name in _LABEL_COLUMNS:
+            text = [str(v) for v in a]
+            if any("," in t or "\n" in t or '"' in t for t in text):
+                raise ValueError(f"column {name} holds a label with a comma, quote or newline")
+            arrays[name] = text
+            continue
+        try:
+            a = a.astype(float)
+        except (TypeError, ValueError):
+            raise ValueError(f"column {name} is not numbers") from None
+        bad = _np.flatnonzero(~_np.isfinite(a))
+        if bad.size:
+            raise ValueError(f"column {name} holds {a[bad[0]]} at index {bad[0]}: every value must be a finite number")
+        arrays[name] = [repr(float(v)) for v in a]
+    lengths = {name: len(v) for name, v in arrays.items()}
+    if len(set(lengths.values())) > 1:
+        raise ValueError(
+            "the columns have different lengths: "
+            + ", ".join(f"{k} {n}" for k, n in lengths.items())
+        )
+    names = list(arrays)
+    rows = zip(*(arrays[n] for n in names))
+    return ",".join(names) + "\n" + "".join(",".join(r) + "\n" for r in rows)
+
+
+def _run_on_data(command: str, data: Any, setup: Optional[Setup], kwargs: Dict[str, Any]) -> Result:
+    """Run ``command`` on a data file: ``data``'s path, or the columns given as arrays
+    written to a CSV of its own (exact values) for the run."""
+    import tempfile
+
+    columns = _data_columns(data, kwargs)
+    args = _argv(command, _options(setup, kwargs))
+    if columns is None:
+        return Result(command, _tapsim.run([args[0], _os.fspath(data)] + args[1:]))
+    text = _csv_text(columns)
+    with tempfile.TemporaryDirectory(prefix="tapsim-") as tmp:
+        path = _os.path.join(tmp, "data.csv")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(text)
+        return Result(command, _tapsim.run([args[0], path] + args[1:]))
+
+
+def fit(data: Any = None, setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
+    """A measured approach curve fitted by the simulator (``tapsim fit``). The data: a
+    CSV path (position, amplitude and/or phase columns with units in the header, as
+    ``tapsim fit`` reads it), a pandas DataFrame or a dict whose columns are named so,
+    or arrays as keywords -- ``z=``, ``amplitude=`` (m) and ``phase=`` (degrees), or
+    by their CSV names (``z_nm=``, ``amplitude_ratio=``, ``phase_deg=``, ...): the
+    same numbers, bit for bit, as the command line on that CSV. Returns ``parameters``
+    (value, std_err, interval_68, interval_95, identifiable), ``identifiability``
+    (singular_values, condition_number, correlations, notes), chi_square,
+    ``converged``, ``diagnosis`` (describes_data, reasons, worst_points), the
+    ``minima`` found, the fitted curve; ``profile=True`` adds ``profiles``.
+    ``law=["hybrid", "jkr"]`` fits each law: ``laws`` (one report per law) and
+    ``comparison`` (ranking by AIC and BIC, ``verdict`` in words)."""
+    return _run_on_data("fit", data, setup, kwargs)
+
+
+def reconstruct(data: Any = None, setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
+    """The force and the loss an AM curve implies (``tapsim reconstruct``). The data as
+    :func:`fit` takes them (position, amplitude and phase): columns closest_m, force_n,
+    e_ts_j, in_phase_force_n, frequency_shift (with ``with_law=True`` also
+    law_approach_force_n and law_retract_force_n), and notes."""
+    return _run_on_data("reconstruct", data, setup, kwargs)
 
 
 def tap_many(setups: Iterable[Setup], /, **common: Any) -> List[Result]:

@@ -215,6 +215,40 @@ def test_a_scanned_image_opens_in_gwyddion(tmp_path):
         assert png.stat().st_size > 0
 
 
+def test_results_go_to_pandas_and_xarray_with_every_column():
+    pytest.importorskip("pandas")
+    pytest.importorskip("xarray")
+    # An approach curve: a row per point, every column the same numbers.
+    a = tapsim.approach(points=6)
+    df = a.to_pandas()
+    assert len(df) == 12 and df.attrs["command"] == "approach"
+    for key in ("separation_m", "amplitude_m", "phase_deg", "e_ts_j", "direction"):
+        np.testing.assert_array_equal(df[key].to_numpy(), np.asarray(a[key]))
+    # A map: a row per cell; as xarray a grid over (modulus_pa, work_of_adhesion_j_m2).
+    m = tapsim.map(steps=3)
+    ds = m.to_xarray()
+    assert ds["phase_deg"].dims == ("modulus_pa", "work_of_adhesion_j_m2")
+    np.testing.assert_array_equal(ds["modulus_pa"].values, m.modulus_pa)
+    for key in ("phase_deg", "e_ts_j", "amplitude_ratio"):
+        grid = np.ma.filled(np.ma.asarray(m.grid[key]).astype(float), np.nan)
+        np.testing.assert_array_equal(ds[key].values, grid)
+        np.testing.assert_array_equal(m.to_pandas()[key].to_numpy(), grid.reshape(-1))
+    assert ds.attrs["law"] == "hybrid"
+    # A scanned image: (direction, y_m, x_m), x ascending both ways.
+    lines, pixels = 3, 4
+    s = tapsim.scan(lines=lines, pixels=pixels)
+    img = s.to_xarray()
+    assert img["topography_m"].shape == (2, lines, pixels)
+    trace = s.direction == "trace"
+    np.testing.assert_array_equal(
+        img["topography_m"].sel(direction="trace").values,
+        s.topography_m[trace].reshape(lines, pixels),
+    )
+    back = s.topography_m[~trace].reshape(lines, pixels)[:, ::-1]
+    np.testing.assert_array_equal(img["topography_m"].sel(direction="retrace").values, back)
+    assert len(s.to_pandas()) == 2 * lines * pixels
+
+
 def test_results_show_their_keys():
     r = tapsim.tap()
     assert "phase_deg" in dir(r) and "phase_deg" in r
@@ -289,6 +323,43 @@ def test_fit_reads_the_curve_approach_writes_and_gives_it_back(cli, tmp_path):
         rising = tmp_path / "rising.csv"
         rising.write_text("z_nm,phase_deg\n8,120\n9,121\n10,122\n")
         tapsim.fit(rising)
+
+
+def test_fit_takes_arrays_and_gives_the_command_lines_numbers_bit_for_bit(cli, tmp_path):
+    # The curve as arrays (keywords in SI, by CSV name, or a dict) fits exactly as the
+    # same numbers in a CSV do on the command line.
+    path = tmp_path / "curve.csv"
+    tapsim.approach(**{"from": "18.5nm"}, to="8nm", points=8, no_retract=True, csv=str(path))
+    table = np.genfromtxt(path, delimiter=",", names=True)
+    z, amplitude, phase = table["separation_m"], table["amplitude_m"], table["phase_deg"]
+    mine = tmp_path / "mine.csv"
+    mine.write_text(
+        "z_m,amplitude_m,phase_deg\n"
+        + "".join(f"{float(a)!r},{float(b)!r},{float(c)!r}\n" for a, b, c in zip(z, amplitude, phase))
+    )
+    flags = dict(modulus="0.8GPa", work_of_adhesion="0.12J/m^2")
+    expected = cli("fit", str(mine), "--modulus=0.8GPa", "--work-of-adhesion=0.12J/m^2")
+    values = [p["value"] for p in expected["parameters"]]
+    for r in [
+        tapsim.fit(z=z, amplitude=amplitude, phase=phase, **flags),
+        tapsim.fit(z_m=z, amplitude_m=amplitude, phase_deg=phase, **flags),
+        tapsim.fit({"z_m": z, "amplitude_m": amplitude, "phase_deg": phase}, **flags),
+    ]:
+        assert [p["value"] for p in r.parameters] == values
+        assert r.chi_square == expected["chi_square"]
+    # Bad arrays: a clear exception each.
+    for bad, says in [
+        (dict(z=z, amplitude=amplitude[:-1], phase=phase), "different lengths"),
+        (dict(z=z, phase=np.where(np.arange(len(z)) == 3, np.nan, phase)), "finite number"),
+        (dict(amplitude=amplitude, phase=phase), "no position column"),
+        (dict(z=z.reshape(2, -1), phase=phase), "one-dimensional"),
+    ]:
+        with pytest.raises(ValueError, match=says):
+            tapsim.fit(**bad, **flags)
+    with pytest.raises(ValueError, match="not both"):
+        tapsim.fit(path, z=z)
+    with pytest.raises(TypeError, match="a pandas DataFrame or a dict"):
+        tapsim.fit([1, 2, 3])
 
 
 def test_fit_ranks_several_laws(cli, tmp_path):
