@@ -16,5 +16,5 @@ def test_the_quickstart_notebook_runs_clean(tmp_path):
     outputs = [o for cell in nb.cells if cell.cell_type == "code" for o in cell.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
     assert not [o for o in outputs if o.get("name") == "stderr"], "warnings on stderr"
-    # Its two figures are drawn.
-    assert sum("image/png" in o.get("data", {}) for o in outputs) == 2
+    # Its three figures are drawn (the approach, the contrast, the image by xarray).
+    assert sum("image/png" in o.get("data", {}) for o in outputs) == 3
