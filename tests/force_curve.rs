@@ -324,3 +324,51 @@ fn the_command_prints_the_curve_and_refuses_what_is_no_force_curve() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// With the higher eigenmodes: one mode through the several-mode integrator (every
+/// step integrated, no closed-form free flight) gives the one-mode curve — an
+/// independent integration; with two and three modes the books close, the contact
+/// loses its same loop and the tip snaps in where the support reaches α̂_A.
+#[test]
+fn higher_modes_ring_and_one_mode_meets_the_point_mass() {
+    use tapsim::dynamics::modes::ModeSet;
+    use tapsim::instrument::force_curve::force_curve_modes;
+    let s = setup(LawKind::Hybrid);
+    let fast = Ramp {
+        velocity_m_s: 10e-6,
+        ..Ramp::default()
+    };
+    let one = run(LawKind::Hybrid, &fast);
+    for count in [1, 2, 3] {
+        let set = ModeSet::euler_bernoulli(&s.cantilever, count).unwrap();
+        let m =
+            force_curve_modes(&s, &Numerics::default(), &set, &fast, &Analysis::default()).unwrap();
+        let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+        assert!(
+            m.energy_balance_rel < 1e-6,
+            "{count}: {}",
+            m.energy_balance_rel
+        );
+        assert!(rel(m.contact_loss_j, one.contact_loss_j) < 1e-6, "{count}");
+        let snap = (m.snap_in.unwrap().piezo_m, one.snap_in.unwrap().piezo_m);
+        assert!((snap.0 - snap.1).abs() < 1e-15, "{count}: {snap:?}");
+        assert!(
+            rel(m.channels.adhesion_n, one.channels.adhesion_n) < 1e-6,
+            "{count}"
+        );
+        if count == 1 {
+            assert!(rel(m.drive_work_j, one.drive_work_j) < 1e-6);
+            assert!(rel(m.turn_m, one.turn_m) < 1e-6);
+        }
+    }
+    // A ramp the highest mode cannot be stepped through is refused before any work.
+    let set = ModeSet::euler_bernoulli(&s.cantilever, 3).unwrap();
+    let slow = Ramp {
+        velocity_m_s: 0.1e-6,
+        ..Ramp::default()
+    };
+    let err = force_curve_modes(&s, &Numerics::default(), &set, &slow, &Analysis::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("take fewer modes"), "{err}");
+}

@@ -17,8 +17,10 @@ use super::peakforce::check_setpoint;
 use super::qnm::{Analysis, Channels, ForcePoint};
 use crate::dynamics::budget::budgeted;
 use crate::dynamics::march::{CycleIntegrals, Phase, Simulation};
-use crate::dynamics::model::Drive;
-use crate::dynamics::numeric::Ignore;
+use crate::dynamics::model::{Drive, State};
+use crate::dynamics::modes::system::{ModeIntegral, Modes, force_integral, integral};
+use crate::dynamics::modes::{Modal, ModeSet};
+use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver};
 use crate::dynamics::observed::{Recorder, Sampling};
 use crate::dynamics::setup::{Cantilever, Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
@@ -56,6 +58,10 @@ impl Default for Ramp {
     }
 }
 
+/// How many times a steady state's work budget a force curve with higher modes may take
+/// (some 20 s of work on three modes).
+pub const MODES_BUDGET: u64 = 100;
+
 /// The farthest an approach goes past its start looking for the trigger, m.
 pub const MAX_TRAVEL_M: f64 = 1e-6;
 
@@ -72,9 +78,14 @@ impl Ramp {
     /// far as the trigger may need — [`MAX_TRAVEL_M`], or what the lever's
     /// [`MAX_LEG_PERIODS`] allow at this velocity if less.
     pub fn travel_m(&self, cantilever: &Cantilever) -> f64 {
+        self.travel_with(cantilever.resonance_hz)
+    }
+
+    /// [`Ramp::travel_m`] where the fastest motion integrated has frequency `fastest_hz`.
+    fn travel_with(&self, fastest_hz: f64) -> f64 {
         match self.turn_m {
             Some(turn) => self.start_m - turn,
-            None => MAX_TRAVEL_M.min(MAX_LEG_PERIODS * self.velocity_m_s / cantilever.resonance_hz),
+            None => MAX_TRAVEL_M.min(MAX_LEG_PERIODS * self.velocity_m_s / fastest_hz),
         }
     }
 
@@ -127,8 +138,21 @@ impl Ramp {
         }
         let f0 = cantilever.resonance_hz;
         let travel = self.travel_m(cantilever);
+        // (Without a turn the travel is cut to what may be integrated; the sample must
+        // be within it.)
+        let to_sample = self.start_m / self.velocity_m_s * f0;
+        if self.turn_m.is_none() && to_sample > MAX_LEG_PERIODS {
+            return Err(Error::NotApplicable(format!(
+                "at {} µm/s the support takes {to_sample:.0} periods of the {:.4} kHz \
+                 cantilever to reach the sample from {:.4} nm; at most {MAX_LEG_PERIODS} are \
+                 integrated a leg: raise the velocity or start nearer",
+                self.velocity_m_s * 1e6,
+                f0 * 1e-3,
+                self.start_m * 1e9
+            )));
+        }
         let periods = travel / self.velocity_m_s * f0;
-        if periods > MAX_LEG_PERIODS || self.dwell_s * f0 > MAX_LEG_PERIODS {
+        if periods > MAX_LEG_PERIODS * (1.0 + 1e-12) || self.dwell_s * f0 > MAX_LEG_PERIODS {
             return Err(Error::NotApplicable(format!(
                 "a ramp of {:.4} nm at {} µm/s (dwell {} s) lasts {:.0} periods of the \
                  {:.4} kHz cantilever a leg; at most {MAX_LEG_PERIODS} are integrated: raise \
@@ -226,13 +250,39 @@ struct Leg {
     approach: bool,
 }
 
+/// The energies of the legs so far (units of kL²): what the contact and damping took,
+/// the support's work, and the change of the lever's energy.
+#[derive(Debug, Clone, Copy, Default)]
+struct Energies {
+    contact: f64,
+    damping: f64,
+    drive: f64,
+    mechanical: f64,
+}
+
 /// The recorded legs: samples, each leg's (first sample, time offset τ₀, approach).
 struct Record {
     samples: Vec<(f64, f64, f64, f64, f64, Branch)>,
     legs: Vec<(usize, f64, Leg)>,
-    integrals: Option<CycleIntegrals>,
+    energies: Energies,
     /// Whether a leg needed more points than a record holds.
     overflowed: bool,
+}
+
+/// A cantilever the ramp moves: one leg at a time.
+trait Lever {
+    /// March `leg` (τ from 0), recording it into `record` (its samples' τ from the leg's
+    /// start; the energies added); with a `trigger` (units of kL) stop where the force
+    /// first reaches it. How long the leg lasted (τ) and whether the trigger ended it.
+    fn leg(&mut self, leg: Leg, trigger: Option<f64>, record: &mut Record) -> Result<(f64, bool)>;
+    /// The lever's energy now, units of kL².
+    fn energy(&self) -> f64;
+}
+
+/// The point-mass lever.
+struct OneMode<'a> {
+    sim: Simulation<'a, AnyLaw>,
+    phase: Phase,
 }
 
 /// Run a force–distance curve on `setup` (its cantilever, contact and law; the tapping
@@ -246,15 +296,98 @@ pub fn force_curve(
     analysis.check()?;
     ramp.check(&setup.cantilever)?;
     let p = Prepared::new(setup, numerics)?;
+    let mut sim = p.simulation();
+    sim.cpl.a0 = 0.0;
+    sim.tol.h_max = 2.0 * PI / numerics.min_steps_per_period;
+    let start = ramp.start_m / p.setup.cantilever.free_amplitude_m;
+    let lever = OneMode {
+        phase: at_rest(&sim, start),
+        sim,
+    };
+    run(
+        &p,
+        lever,
+        ramp,
+        analysis,
+        (p.steady.max_steps, ramp.travel_m(&p.setup.cantilever)),
+    )
+}
+
+/// [`force_curve`] with the cantilever's higher eigenmodes of `set` marched with the
+/// first (bimodal AFM's model, [`crate::dynamics::modes`]; their drives off): the tip is
+/// the sum of the modes, and the ringing after each jump shows every mode's.
+pub fn force_curve_modes(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    set: &ModeSet,
+    ramp: &Ramp,
+    analysis: &Analysis,
+) -> Result<ForceCurve> {
+    use crate::dynamics::modes::system::plain_len;
+    analysis.check()?;
+    ramp.check(&setup.cantilever)?;
+    let (p, modal) = crate::dynamics::modes::prepare(setup, set, numerics)?;
+    // Every mode's period is stepped through (no closed-form free flight): the highest
+    // mode sets the work, some 40 steps a period of it, at the least.
+    let fastest = modal.modes.iter().map(|m| m.r).fold(1.0f64, f64::max);
+    let cant = &p.setup.cantilever;
+    let travel_m = ramp.travel_with(cant.resonance_hz * fastest);
+    // (Without a turn the support must reach the sample within what may be integrated.)
+    let reach_m = if ramp.turn_m.is_some() {
+        travel_m
+    } else {
+        ramp.start_m.max(travel_m)
+    };
+    let leg_periods = (reach_m / ramp.velocity_m_s).max(ramp.dwell_s) * cant.resonance_hz * fastest;
+    if leg_periods > MAX_LEG_PERIODS * (1.0 + 1e-12) {
+        return Err(Error::NotApplicable(format!(
+            "a leg of this ramp lasts {leg_periods:.0} periods of the highest of {} modes \
+             ({:.4} kHz); at most {MAX_LEG_PERIODS} are integrated: raise the velocity, \
+             shorten the ramp or the dwell, or take fewer modes",
+            modal.modes.len(),
+            cant.resonance_hz * fastest * 1e-3
+        )));
+    }
+    let budget = p.steady.max_steps.saturating_mul(MODES_BUDGET);
+    match modal.modes.len() {
+        1 => run(
+            &p,
+            SeveralModes::<1, { plain_len(1) }>::new(&p, &modal, numerics, ramp),
+            ramp,
+            analysis,
+            (budget, travel_m),
+        ),
+        2 => run(
+            &p,
+            SeveralModes::<2, { plain_len(2) }>::new(&p, &modal, numerics, ramp),
+            ramp,
+            analysis,
+            (budget, travel_m),
+        ),
+        _ => run(
+            &p,
+            SeveralModes::<3, { plain_len(3) }>::new(&p, &modal, numerics, ramp),
+            ramp,
+            analysis,
+            (budget, travel_m),
+        ),
+    }
+}
+
+/// The ramp's legs with `lever`, and what the curve shows.
+fn run<Lv: Lever>(
+    p: &Prepared,
+    mut lever: Lv,
+    ramp: &Ramp,
+    analysis: &Analysis,
+    (budget, travel_m): (u64, f64),
+) -> Result<ForceCurve> {
     let cant = &p.setup.cantilever;
     let (k, l) = (cant.stiffness_n_m, cant.free_amplitude_m);
     let w0 = 2.0 * PI * cant.resonance_hz;
     let scale = p.setup.contact.separation_scale_m();
-    let mut sim = p.simulation();
-    sim.cpl.a0 = 0.0;
-    sim.tol.h_max = 2.0 * PI / numerics.min_steps_per_period;
     let start = ramp.start_m / l;
-    if sim.cpl.alpha_hat(0.0, start) <= p.law.jump_in_alpha_hat() {
+    if p.cpl.a1 * start <= p.law.jump_in_alpha_hat() {
         return Err(Error::NotApplicable(format!(
             "the ramp starts at {:.4} nm, inside the law's reach for contact (it jumps in \
              at {:.4} nm): start farther out",
@@ -263,24 +396,31 @@ pub fn force_curve(
         )));
     }
     let speed = ramp.velocity_m_s / (l * w0);
-    let travel = ramp.travel_m(cant) / l;
+    let travel = travel_m / l;
     let trigger = ramp.trigger_n.map(|f| f / (k * l));
-    let record = budgeted(p.steady.max_steps, || {
-        let mut phase = at_rest(&sim, start);
+    let record = budgeted(budget, || {
         let mut record = Record {
             samples: Vec::new(),
             legs: Vec::new(),
-            integrals: None,
+            energies: Energies::default(),
             overflowed: false,
         };
         let mut t0 = 0.0;
+        let mut march =
+            |leg: Leg, trigger, record: &mut Record, t0: &mut f64| -> Result<(f64, bool)> {
+                let first = record.samples.len();
+                let (span, triggered) = lever.leg(leg, trigger, record)?;
+                record.legs.push((first, *t0, leg));
+                *t0 += span;
+                Ok((leg.from + leg.speed * span, triggered))
+            };
         let approach = Leg {
             from: start,
             speed: -speed,
             span: travel / speed,
             approach: true,
         };
-        let (turn, triggered) = leg(&mut sim, &mut phase, approach, trigger, &mut record, t0)?;
+        let (turn, triggered) = march(approach, trigger, &mut record, &mut t0)?;
         if let (Some(f), None, false) = (ramp.trigger_n, ramp.turn_m, triggered) {
             return Err(Error::NotApplicable(format!(
                 "the force did not reach the trigger of {:.4} nN with the support {:.4} nm past \
@@ -290,7 +430,6 @@ pub fn force_curve(
                 record.samples.iter().map(|s| s.4).fold(0.0, f64::max) * k * l * 1e9
             )));
         }
-        t0 += phase.tau;
         if ramp.dwell_s > 0.0 {
             let dwell = Leg {
                 from: turn,
@@ -298,8 +437,7 @@ pub fn force_curve(
                 span: ramp.dwell_s * w0,
                 approach: false,
             };
-            leg(&mut sim, &mut phase, dwell, None, &mut record, t0)?;
-            t0 += phase.tau;
+            march(dwell, None, &mut record, &mut t0)?;
         }
         let retract = Leg {
             from: turn,
@@ -307,7 +445,7 @@ pub fn force_curve(
             span: (start - turn) / speed,
             approach: false,
         };
-        leg(&mut sim, &mut phase, retract, None, &mut record, t0)?;
+        march(retract, None, &mut record, &mut t0)?;
         if record.overflowed {
             return Err(Error::NotApplicable(
                 "the force curve needs more than 10⁶ recorded points: raise the velocity or \
@@ -315,10 +453,10 @@ pub fn force_curve(
                     .into(),
             ));
         }
-        Ok((record, turn, triggered, phase))
+        Ok((record, turn, triggered))
     });
-    let (record, turn, triggered, phase) = record?;
-    let integrals = record.integrals.expect("a ramp has legs");
+    let (record, turn, triggered) = record?;
+    let e = record.energies;
     let curve = to_si(&record, (k, l, w0, scale));
     // A switch at α = 0 (Hertz, DMT, JKR) is located to round-off of the ramp's lengths
     // and the force there to round-off of the peak: those are zeros.
@@ -345,12 +483,7 @@ pub fn force_curve(
         }
     };
     let energy = k * l * l;
-    let final_energy = 0.5 * (phase.x * phase.x + phase.v * phase.v) * energy;
-    let (drive, contact, damping) = (
-        integrals.e_drive * energy,
-        integrals.e_ts * energy,
-        integrals.e_damp * energy,
-    );
+    let (drive, contact, damping) = (e.drive * energy, e.contact * energy, e.damping * energy);
     let exchanged = 0.5
         * curve
             .windows(2)
@@ -372,10 +505,8 @@ pub fn force_curve(
         },
         damping_loss_j: damping,
         drive_work_j: drive,
-        final_energy_j: final_energy,
-        energy_balance_rel: ((drive - contact - damping - integrals.delta_mechanical * energy)
-            / books)
-            .abs(),
+        final_energy_j: lever.energy() * energy,
+        energy_balance_rel: ((drive - contact - damping - e.mechanical * energy) / books).abs(),
         curve,
     })
 }
@@ -397,83 +528,265 @@ fn at_rest(sim: &Simulation<'_, AnyLaw>, start: f64) -> Phase {
     phase
 }
 
-/// March one leg, recording it; with a `trigger` (units of kL) stop where the force
-/// first reaches it. The support's position where the leg ended (units of L) and
-/// whether the trigger ended it.
-fn leg(
-    sim: &mut Simulation<'_, AnyLaw>,
-    phase: &mut Phase,
-    leg: Leg,
-    trigger: Option<f64>,
-    record: &mut Record,
-    t0: f64,
-) -> Result<(f64, bool)> {
-    phase.tau = 0.0;
-    sim.osc.drive = Drive::Ramp {
-        position: leg.from,
-        speed: leg.speed,
-    };
-    // The span one call may cover: the whole leg.
-    sim.osc.omega = 2.0 * PI / leg.span;
-    let first = record.samples.len();
-    let mut recorder = Recorder::sampling(sim.law, sim.cpl, sim.osc, RAMP_CURVE);
-    if let Some(last) = record.samples.last() {
-        // Go on from the last leg's end, which is this leg's start.
-        recorder
-            .samples
-            .push((0.0, last.1, last.2, last.3, last.4, last.5));
+impl Lever for OneMode<'_> {
+    fn energy(&self) -> f64 {
+        0.5 * (self.phase.x * self.phase.x + self.phase.v * self.phase.v)
     }
-    let mut triggered = false;
-    match trigger {
-        None => {
-            let c = sim.advance(phase, leg.span, &mut recorder)?;
-            add(c, record);
+
+    fn leg(&mut self, leg: Leg, trigger: Option<f64>, record: &mut Record) -> Result<(f64, bool)> {
+        let (sim, phase) = (&mut self.sim, &mut self.phase);
+        phase.tau = 0.0;
+        sim.osc.drive = Drive::Ramp {
+            position: leg.from,
+            speed: leg.speed,
+        };
+        // The span one call may cover: the whole leg.
+        sim.osc.omega = 2.0 * PI / leg.span;
+        let first = record.samples.len();
+        let mut recorder = Recorder::sampling(sim.law, sim.cpl, sim.osc, RAMP_CURVE);
+        if let Some(last) = record.samples.last() {
+            // Go on from the last leg's end, which is this leg's start.
+            recorder
+                .samples
+                .push((0.0, last.1, last.2, last.3, last.4, last.5));
         }
-        Some(level) => {
-            // A lever period at a time; the period that reaches the trigger is marched
-            // again to the first time it does (bisection on the span).
-            let chunk = 2.0 * PI;
-            while phase.tau < leg.span - 1e-12 * leg.span {
-                let span = chunk.min(leg.span - phase.tau);
-                let (before, kept) = (*phase, recorder.samples.len());
-                let c = sim.advance(phase, span, &mut recorder)?;
-                if c.max_force < level {
-                    add(c, record);
-                    continue;
-                }
-                recorder.samples.truncate(kept);
-                let (mut lo, mut hi) = (0.0, span);
-                while hi - lo > 1e-9 * chunk {
-                    let mid = 0.5 * (lo + hi);
-                    let mut trial = before;
-                    let c = sim.advance(&mut trial, mid, &mut Ignore)?;
-                    if c.max_force >= level {
-                        hi = mid;
-                    } else {
-                        lo = mid;
-                    }
-                }
-                *phase = before;
-                let c = sim.advance(phase, hi, &mut recorder)?;
+        let add = |c: CycleIntegrals, record: &mut Record| {
+            let e = &mut record.energies;
+            e.contact += c.e_ts;
+            e.damping += c.e_damp;
+            e.drive += c.e_drive;
+            e.mechanical += c.delta_mechanical;
+        };
+        let mut triggered = false;
+        match trigger {
+            None => {
+                let c = sim.advance(phase, leg.span, &mut recorder)?;
                 add(c, record);
-                triggered = true;
-                break;
+            }
+            Some(level) => {
+                // A lever period at a time; the period that reaches the trigger is
+                // marched again to the first time it does (bisection on the span).
+                let chunk = 2.0 * PI;
+                while phase.tau < leg.span - 1e-12 * leg.span {
+                    let span = chunk.min(leg.span - phase.tau);
+                    let (before, kept) = (*phase, recorder.samples.len());
+                    let c = sim.advance(phase, span, &mut recorder)?;
+                    if c.max_force < level {
+                        add(c, record);
+                        continue;
+                    }
+                    recorder.samples.truncate(kept);
+                    let hi = first_reach(span, |s| {
+                        let mut trial = before;
+                        Ok(sim.advance(&mut trial, s, &mut Ignore)?.max_force >= level)
+                    })?;
+                    *phase = before;
+                    let c = sim.advance(phase, hi, &mut recorder)?;
+                    add(c, record);
+                    triggered = true;
+                    break;
+                }
+            }
+        }
+        record.overflowed |= recorder.overflowed;
+        let skip = usize::from(first > 0);
+        record.samples.extend(recorder.samples.drain(skip..));
+        Ok((phase.tau, triggered))
+    }
+}
+
+/// The first span s in (0, `span`] at which `reached(s)` (monotone: false, then true)
+/// holds, to 1e-9 of a lever period (bisection).
+fn first_reach(span: f64, mut reached: impl FnMut(f64) -> Result<bool>) -> Result<f64> {
+    let (mut lo, mut hi) = (0.0, span);
+    while hi - lo > 1e-9 * 2.0 * PI {
+        let mid = 0.5 * (lo + hi);
+        if reached(mid)? {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(hi)
+}
+
+/// The cantilever's first `M` eigenmodes (`P` = their state's length).
+struct SeveralModes<'a, const M: usize, const P: usize> {
+    modes: Modes<'a, AnyLaw, M>,
+    y: State<P>,
+    branch: Branch,
+}
+
+impl<'a, const M: usize, const P: usize> SeveralModes<'a, M, P> {
+    fn new(p: &'a Prepared, modal: &Modal, numerics: &Numerics, ramp: &Ramp) -> Self {
+        let mut modes = Modes::<_, M>::of(p, modal);
+        for m in &mut modes.modes {
+            m.drive = 0.0;
+        }
+        modes.cpl.a0 = 0.0;
+        // Every mode's period resolved (the longest step set for the fastest mode).
+        let fastest = modes.modes.iter().map(|m| m.r).fold(1.0f64, f64::max);
+        modes.tol.h_max = 2.0 * PI / numerics.min_steps_per_period / fastest;
+        let start = ramp.start_m / p.setup.cantilever.free_amplitude_m;
+        modes.support = (start, 0.0);
+        // At rest: each mode holds its share cᵢ/rᵢ² of the static force.
+        let mut y = State::<P>::zeros();
+        let mut x = 0.0;
+        for _ in 0..8 {
+            let f = modes.force(x, 0.0, Branch::Free);
+            for (i, m) in modes.modes.iter().enumerate() {
+                y[2 * i] = m.gain * f / (m.r * m.r);
+            }
+            x = Modes::<AnyLaw, M>::tip(&y);
+        }
+        Self {
+            modes,
+            y,
+            branch: Branch::Free,
+        }
+    }
+
+    /// Integrals of the state (from what `y` carries): Σ damping, ∫f.
+    fn carried(&self, y: &State<P>) -> (f64, f64) {
+        let damping = (0..M)
+            .map(|i| {
+                let m = &self.modes.modes[i];
+                m.damping / m.gain * y[integral(M, i, ModeIntegral::Damping)]
+            })
+            .sum();
+        (damping, y[force_integral(M)])
+    }
+
+    fn energy_of(&self, y: &State<P>) -> f64 {
+        (0..M)
+            .map(|i| {
+                let m = &self.modes.modes[i];
+                (y[2 * i + 1].powi(2) + (m.r * y[2 * i]).powi(2)) / (2.0 * m.gain)
+            })
+            .sum()
+    }
+}
+
+/// Records the modes' tip at every step's end in contact and [`MODES_SAMPLES`] a lever
+/// period out of it (both sides of every switch), and the largest force at every
+/// step's end.
+struct TipRecorder<'r, 'a, const M: usize> {
+    modes: &'r Modes<'a, AnyLaw, M>,
+    samples: Vec<(f64, f64, f64, f64, f64, Branch)>,
+    overflowed: bool,
+    max_force: f64,
+}
+
+/// Samples a lever period a force curve with higher modes records out of contact (their
+/// steps are many times shorter than the lever's period).
+const MODES_SAMPLES: f64 = 32.0;
+
+impl<'r, 'a, const M: usize> TipRecorder<'r, 'a, M> {
+    fn new(modes: &'r Modes<'a, AnyLaw, M>) -> Self {
+        Self {
+            modes,
+            samples: Vec::new(),
+            overflowed: false,
+            max_force: f64::NEG_INFINITY,
+        }
+    }
+
+    fn push<const N: usize>(&mut self, tau: f64, y: &State<N>, branch: Branch) {
+        if self.samples.len() >= RAMP_CURVE.max_samples {
+            self.overflowed = true;
+            return;
+        }
+        let x: f64 = (0..M).map(|i| y[2 * i]).sum();
+        let v: f64 = (0..M).map(|i| y[2 * i + 1]).sum();
+        let alpha = self.modes.cpl.alpha_hat(x, self.modes.x_b(tau));
+        let f = self.modes.force(x, tau, branch) + 0.0;
+        self.samples.push((tau, x, v, alpha, f, branch));
+    }
+}
+
+impl<const M: usize> StepObserver for TipRecorder<'_, '_, M> {
+    fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch) {
+        let x: f64 = (0..M).map(|i| to.y[2 * i]).sum();
+        self.max_force = self.max_force.max(self.modes.force(x, to.tau, branch));
+        match self.samples.last() {
+            Some(last) if last.5 == branch => {
+                // Every step in contact (the force curve's area is taken over them);
+                // out of it, where the force is weak or none, a few a lever period.
+                if branch != Branch::Free || to.tau - last.0 >= 2.0 * PI / MODES_SAMPLES {
+                    self.push(to.tau, &to.y, branch);
+                }
+            }
+            _ => {
+                self.push(from.tau, &from.y, branch);
+                self.push(to.tau, &to.y, branch);
             }
         }
     }
-    record.overflowed |= recorder.overflowed;
-    let skip = usize::from(first > 0);
-    record.samples.extend(recorder.samples.drain(skip..));
-    record.legs.push((first, t0, leg));
-    Ok((leg.from + leg.speed * phase.tau, triggered))
 }
 
-/// Add a span's integrals to the record's.
-fn add(integrals: CycleIntegrals, record: &mut Record) {
-    record.integrals = Some(match record.integrals {
-        Some(before) => before.then(&integrals),
-        None => integrals,
-    });
+impl<const M: usize, const P: usize> Lever for SeveralModes<'_, M, P> {
+    fn energy(&self) -> f64 {
+        self.energy_of(&self.y)
+    }
+
+    fn leg(&mut self, leg: Leg, trigger: Option<f64>, record: &mut Record) -> Result<(f64, bool)> {
+        self.modes.support = (leg.from, leg.speed);
+        let first = record.samples.len();
+        let mut rec = TipRecorder::new(&self.modes);
+        if let Some(last) = record.samples.last() {
+            rec.samples
+                .push((0.0, last.1, last.2, last.3, last.4, last.5));
+        }
+        let (y0, e0) = (self.y, self.energy_of(&self.y));
+        let (mut y, mut branch, mut tau, mut work_hat) = (self.y, self.branch, 0.0, 0.0);
+        let mut triggered = false;
+        // A lever period at a time while a trigger is looked for; else 256 (one pass
+        // integrates a branch in one segment, whose steps are bounded).
+        let chunk = 2.0 * PI * if trigger.is_some() { 1.0 } else { 256.0 };
+        while tau < leg.span - 1e-12 * leg.span {
+            let end = (tau + chunk).min(leg.span);
+            let kept = rec.samples.len();
+            let (y1, b1, tally) = self.modes.pass_observed(tau, y, branch, end, &mut rec)?;
+            let reached =
+                trigger.is_some_and(|level| rec.samples[kept..].iter().any(|s| s.4 >= level));
+            if !reached {
+                (y, branch, tau) = (y1, b1, end);
+                work_hat += tally.work_hat;
+                continue;
+            }
+            let level = trigger.expect("reached a trigger");
+            rec.samples.truncate(kept);
+            let modes = &self.modes;
+            let at = first_reach(end - tau, |s| {
+                let mut probe = TipRecorder::new(modes);
+                modes.pass_observed(tau, y, branch, tau + s, &mut probe)?;
+                Ok(probe.max_force >= level)
+            })?;
+            let (y1, b1, tally) = self
+                .modes
+                .pass_observed(tau, y, branch, tau + at, &mut rec)?;
+            (y, branch, tau) = (y1, b1, tau + at);
+            work_hat += tally.work_hat;
+            triggered = true;
+            break;
+        }
+        // The leg's last state, whatever the spacing.
+        if rec.samples.last().is_none_or(|s| s.0 < tau) {
+            rec.push(tau, &y, branch);
+        }
+        let ((d0, f0), (d1, f1)) = (self.carried(&y0), self.carried(&y));
+        let e = &mut record.energies;
+        e.contact += self.modes.cpl.f_scale / self.modes.cpl.a1 * work_hat;
+        e.damping += d1 - d0;
+        e.drive -= leg.speed * (f1 - f0);
+        e.mechanical += self.energy_of(&y) - e0;
+        record.overflowed |= rec.overflowed;
+        let skip = usize::from(first > 0);
+        record.samples.extend(rec.samples.drain(skip..));
+        self.y = y;
+        self.branch = branch;
+        Ok((tau, triggered))
+    }
 }
 
 /// The record in SI: time from the ramp's start, the support, deflection, separation

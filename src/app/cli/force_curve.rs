@@ -6,7 +6,7 @@ use crate::app::config::{TapInputs, force, length, time, velocity};
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::dynamics::setup::significant;
 use crate::error::{Error, Result};
-use crate::instrument::force_curve::{Jump, Ramp, force_curve};
+use crate::instrument::force_curve::{Jump, Ramp, force_curve, force_curve_modes};
 use crate::instrument::peakforce::check_setpoint;
 use crate::instrument::qnm::{Analysis, Channels, ForcePoint};
 use crate::physics::params::ELECTRONVOLT_J;
@@ -41,6 +41,13 @@ use clap::Args;
 ///   tapsim force-curve --law jkr --plot jkr.png
 ///   tapsim force-curve --to -2nm --no-trigger --dwell 1ms --csv curve.csv
 ///   tapsim force-curve --stiffness 0.4N/m --resonance 70kHz --velocity 500nm/s
+///   tapsim force-curve --modes 2 --velocity 10um/s   # the second mode rings too
+///
+/// With --modes 2 (or 3) the cantilever's higher eigenmodes are marched with the first
+/// (bimodal AFM's model, their drives off): the tip is their sum, and every mode rings
+/// after a jump. Each of their periods is stepped through (seconds of work on the
+/// defaults); a ramp whose leg lasts more than 200 000 periods of the highest mode is
+/// refused.
 ///
 /// JSON keys (--json): law, start_m, turn_m, triggered, trigger_n, velocity_m_s,
 /// dwell_s, snap_in and pull_off (each null or t_s, piezo_m, separation_m, force_n),
@@ -88,6 +95,8 @@ pub struct ForceCurveArgs {
     /// separation_m, force_n, approach, contact).
     #[arg(long, requires = "json")]
     curve: bool,
+    #[command(flatten)]
+    modes: crate::app::config::ModeInputs,
     #[command(flatten)]
     pub(super) out: super::SweepOutput,
 }
@@ -152,14 +161,19 @@ impl ForceCurveArgs {
 
 /// Run the subcommand.
 pub fn run(args: ForceCurveArgs) -> Result<()> {
-    let inputs = args.inputs.clone().with_config()?;
+    let mut inputs = args.inputs.clone().with_config()?;
+    inputs.takes_modes = true;
     inputs.no_setpoint("force-curve")?;
     let (setup, numerics) = inputs.resolve()?;
+    let set = args.modes.mode_set(&inputs.mode_file, &setup.cantilever)?;
     let ramp = args.ramp();
     ramp.check(&setup.cantilever)?;
     let analysis = args.window.analysis()?;
     let busy = Busy::new("force-curve: ramping the support", args.out.quiet);
-    let result = force_curve(&setup, &numerics, &ramp, &analysis);
+    let result = match &set {
+        Some(set) => force_curve_modes(&setup, &numerics, set, &ramp, &analysis),
+        None => force_curve(&setup, &numerics, &ramp, &analysis),
+    };
     busy.finish_and_clear();
     let c = result?;
     let shown = c.thinned(args.points.map_or(2048, |n| n as usize));

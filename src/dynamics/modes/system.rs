@@ -91,6 +91,9 @@ pub struct Modes<'a, L, const M: usize> {
     pub cpl: Coupling,
     /// Integrator tolerances.
     pub tol: Tolerances,
+    /// The support moving as x_b = p + uτ ((p, u); (0, 0) for a still support): a leg of
+    /// a force–distance ramp ([`crate::instrument::force_curve`]); α̂ = a₀ + a₁(Σqᵢ + x_b).
+    pub support: (f64, f64),
 }
 
 impl<'a, const M: usize> Modes<'a, AnyLaw, M> {
@@ -116,6 +119,7 @@ impl<'a, const M: usize> Modes<'a, AnyLaw, M> {
             law: &p.law,
             cpl: p.cpl,
             tol,
+            support: (0.0, 0.0),
         }
     }
 }
@@ -133,10 +137,23 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
         (0..M).map(|i| y[v(i)]).sum()
     }
 
-    /// f_ts at tip deflection `x` on `branch`.
+    /// The support's position x_b at τ (units of A₀₁).
     #[inline]
-    pub fn force(&self, x: f64, branch: Branch) -> f64 {
-        -self.cpl.f_scale * self.law.t_hat(self.cpl.alpha_hat(x, 0.0), branch)
+    pub fn x_b(&self, tau: f64) -> f64 {
+        self.support.0 + self.support.1 * tau
+    }
+
+    /// The separation coordinate Σqᵢ + x_b of state `y` at τ (what the law's levels are
+    /// set in, in units of A₀₁).
+    #[inline]
+    pub fn reach<const S: usize>(&self, tau: f64, y: &State<S>) -> f64 {
+        Self::tip(y) + self.x_b(tau)
+    }
+
+    /// f_ts at tip deflection `x` at τ on `branch`.
+    #[inline]
+    pub fn force(&self, x: f64, tau: f64, branch: Branch) -> f64 {
+        -self.cpl.f_scale * self.law.t_hat(self.cpl.alpha_hat(x, self.x_b(tau)), branch)
     }
 
     /// The right-hand side (and the variational equations δqᵢ″ = −(rᵢ/Qᵢ)δqᵢ′ − rᵢ²δqᵢ +
@@ -144,7 +161,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
     #[inline]
     pub fn rhs<const S: usize>(&self, branch: Branch, tau: f64, y: &State<S>, dy: &mut State<S>) {
         let x = Self::tip(y);
-        let alpha = self.cpl.alpha_hat(x, 0.0);
+        let alpha = self.cpl.alpha_hat(x, self.x_b(tau));
         let f = -self.cpl.f_scale * self.law.t_hat(alpha, branch);
         for (i, m) in self.modes.iter().enumerate() {
             let (s, c) = (m.omega * tau).sin_cos();
@@ -176,13 +193,13 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
     /// Gantmacher's jump matrix, S = I + (g⁺ − g⁻)∇hᵀ/(∇h·g⁻) with h = α̂ − level): the
     /// force steps by Δf, each velocity's rate by cᵢΔf, and a perturbation δx of the tip
     /// moves the switch by −δx/x′, so δqᵢ′ gains cᵢΔf·δx/x′.
-    pub fn saltation<const S: usize>(&self, y: &mut State<S>, from: Branch, to: Branch) {
+    pub fn saltation<const S: usize>(&self, tau: f64, y: &mut State<S>, from: Branch, to: Branch) {
         if S != tangent_len(M) {
             return;
         }
         let x = Self::tip(y);
-        let velocity = Self::tip_velocity(y);
-        let step = self.force(x, to) - self.force(x, from);
+        let velocity = Self::tip_velocity(y) + self.support.1;
+        let step = self.force(x, tau, to) - self.force(x, tau, from);
         if velocity == 0.0 || step == 0.0 {
             return;
         }
@@ -267,12 +284,13 @@ impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
         };
         let h = end.tau - start.tau;
         let mut lo = start.tau;
+        let shift = |t: f64| self.modes.x_b(t);
         for k in 1..=PROBES {
             let t = start.tau + h * k as f64 / PROBES as f64;
             let x = if k == PROBES {
-                Modes::<L, M>::tip(y)
+                self.modes.reach(tau, y)
             } else {
-                tip_at::<M, S>(&start, &end, t)
+                tip_at::<M, S>(&start, &end, t) + shift(t)
             };
             if beyond(x) {
                 let falling = self.below.is_some_and(|l| x < l - SNAP);
@@ -280,7 +298,7 @@ impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
                     if falling { self.below } else { self.above }.expect("a level was passed");
                 let at = bracketed_root(
                     "a switch of the force law",
-                    |t| tip_at::<M, S>(&start, &end, t) - level,
+                    |t| tip_at::<M, S>(&start, &end, t) + shift(t) - level,
                     lo,
                     t,
                     // (The tolerance is relative to 1 + |τ|: 1e-14 of the step, but
@@ -296,8 +314,8 @@ impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
         }
         // Within reach of a level it is heading for: there (a fold's square-root
         // singularity would otherwise shrink the steps towards it without end).
-        let x = Modes::<L, M>::tip(y);
-        let heading = Modes::<L, M>::tip_velocity(y);
+        let x = self.modes.reach(tau, y);
+        let heading = Modes::<L, M>::tip_velocity(y) + self.modes.support.1;
         let near = |l: Option<f64>, sign: f64| {
             l.is_some_and(|l| (x - l).abs() <= SNAP && sign * heading > 0.0)
         };
@@ -305,7 +323,9 @@ impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
             self.hit = Some((start, tau, near(self.below, -1.0)));
             return true;
         }
-        self.min_tip = self.min_tip.min(lowest_tip::<M, S>(&start, &end));
+        self.min_tip = self
+            .min_tip
+            .min(lowest_tip::<M, S>(&start, &end, self.modes.support));
         if let Some(o) = self.observer.as_deref_mut() {
             o.step(&start, &end, self.branch);
         }
@@ -313,17 +333,22 @@ impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
     }
 }
 
-/// The lowest tip deflection Σqᵢ over a step: its ends, or the turning point inside it
-/// where the Hermite cubic of Σqᵢ has its minimum.
-fn lowest_tip<const M: usize, const S: usize>(a: &StepEnd<S>, b: &StepEnd<S>) -> f64 {
+/// The lowest separation coordinate Σqᵢ + x_b over a step (the support at (p, u)): its
+/// ends, or the turning point inside it where the Hermite cubic has its minimum.
+fn lowest_tip<const M: usize, const S: usize>(
+    a: &StepEnd<S>,
+    b: &StepEnd<S>,
+    (p, u): (f64, f64),
+) -> f64 {
     let h = b.tau - a.tau;
     let sum = |e: &StepEnd<S>, part: fn(usize) -> usize| (0..M).map(|i| e.y[part(i)]).sum::<f64>();
-    let (x0, x1) = (sum(a, q), sum(b, q));
-    let (d0, d1) = (h * sum(a, v), h * sum(b, v));
+    let (x0, x1) = (sum(a, q) + p + u * a.tau, sum(b, q) + p + u * b.tau);
+    let (d0, d1) = (h * (sum(a, v) + u), h * (sum(b, v) + u));
     let ends = x0.min(x1);
     if d0 < 0.0 && d1 > 0.0 {
         let t = hermite_turn_fraction((x0, d0), (x1, d1), true);
-        ends.min(tip_at::<M, S>(a, b, a.tau + t * h))
+        let at = a.tau + t * h;
+        ends.min(tip_at::<M, S>(a, b, at) + p + u * at)
     } else {
         ends
     }
@@ -385,8 +410,8 @@ pub struct PassTally {
     pub contact_time: f64,
     /// Jumps into contact.
     pub jumps_in: u32,
-    /// The smallest tip deflection: at a step end or a switch, or at a turning point
-    /// inside a step.
+    /// The smallest separation coordinate Σqᵢ + x_b (the tip deflection, the support
+    /// still): at a step end or a switch, or at a turning point inside a step.
     pub min_tip: f64,
 }
 
@@ -430,12 +455,12 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
         h: &mut f64,
     ) -> Result<(State<S>, Branch, PassTally)> {
         let mut tally = PassTally {
-            min_tip: Self::tip(&y),
-            alpha_hat_ends: (self.cpl.alpha_hat(Self::tip(&y), 0.0), f64::NAN),
+            min_tip: self.reach(tau0, &y),
+            alpha_hat_ends: (self.cpl.alpha_hat(self.reach(tau0, &y), 0.0), f64::NAN),
             ..PassTally::default()
         };
         let mut tau = tau0;
-        let alpha = |y: &State<S>| self.cpl.alpha_hat(Self::tip(y), 0.0);
+        let alpha = |tau: f64, y: &State<S>| self.cpl.alpha_hat(self.reach(tau, y), 0.0);
         let mut switches = 0u32;
         while tau1 - tau > 1e-13 * tau1.abs().max(1.0) {
             let exits = self.law.exits(branch);
@@ -459,7 +484,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                     dy
                 },
             });
-            let alpha_start = alpha(&y);
+            let alpha_start = alpha(tau, &y);
             *h = run(&mut seg, tau, tau1, y, &self.tol, *h).map_err(|e| match e {
                 Error::Numerical(why) => Error::Numerical(format!(
                     "{why} (on the {} branch from τ = {tau:.6}, α̂ = {alpha_start:.6})",
@@ -502,8 +527,8 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                             run(&mut to, start.tau, at, start.y, &self.tol, at - start.tau)?;
                             y_at = to.end.unwrap_or(start.y);
                         }
-                        let miss = Self::tip(&y_at) - level;
-                        let speed = Self::tip_velocity(&y_at);
+                        let miss = self.reach(at, &y_at) - level;
+                        let speed = Self::tip_velocity(&y_at) + self.support.1;
                         if miss.abs() <= SNAP || speed == 0.0 {
                             break;
                         }
@@ -532,7 +557,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 }
                 None => (tau1, seg.end.unwrap_or(y), branch),
             };
-            let alpha_end = alpha(&next_y);
+            let alpha_end = alpha(next_tau, &next_y);
             let (w_end, w_start) = (
                 self.law.work_hat(alpha_end, branch),
                 self.law.work_hat(alpha_start, branch),
@@ -544,11 +569,14 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
             if branch == Branch::Contact {
                 tally.contact_time += next_tau - tau;
             }
-            tally.min_tip = tally.min_tip.min(Self::tip(&next_y)).min(seg_min);
+            tally.min_tip = tally
+                .min_tip
+                .min(self.reach(next_tau, &next_y))
+                .min(seg_min);
             y = next_y;
             tau = next_tau;
             if next_branch != branch {
-                self.saltation(&mut y, branch, next_branch);
+                self.saltation(tau, &mut y, branch, next_branch);
                 if next_branch == Branch::Contact {
                     tally.jumps_in += 1;
                 }
@@ -563,7 +591,7 @@ impl<L: ForceLaw, const M: usize> Modes<'_, L, M> {
                 }
             }
         }
-        tally.alpha_hat_ends.1 = alpha(&y);
+        tally.alpha_hat_ends.1 = alpha(tau, &y);
         Ok((y, branch, tally))
     }
 }
