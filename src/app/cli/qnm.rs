@@ -6,7 +6,7 @@ use crate::analysis::qnm_map::{QnmCell, map_cells};
 use crate::analysis::sweep::Shard;
 use crate::app::config::{force, number};
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
-use crate::app::report::heatmap::{Cell, HeatMap};
+use crate::app::report::heatmap::HeatMap;
 use crate::app::report::part::{self, Job};
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
@@ -226,30 +226,19 @@ fn typed<T: serde::Serialize, U: serde::de::DeserializeOwned>(records: &[T]) -> 
 
 /// The QNM channels over the grid.
 fn map_heat_maps(title: &str, works: &[f64], moduli: &[f64], cells: &[QnmCell]) -> Vec<HeatMap> {
-    let panel = |what: &str, label: &str, value: &dyn Fn(&QnmCell) -> Option<f64>| HeatMap {
-        title: format!("{what} ({title})"),
-        x_label: "work of adhesion Δγ (J/m²)".into(),
-        y_label: "composite modulus E* (GPa)".into(),
-        value_label: label.into(),
-        empty_label: "not held or n/a".into(),
-        x: works.to_vec(),
-        y: moduli.iter().map(|e| e * 1e-9).collect(),
-        log_axes: true,
-        cells: cells
-            .chunks(works.len())
-            .map(|row| {
-                row.iter()
-                    .map(|c| match value(c) {
-                        Some(value) => Cell::Value {
-                            value,
-                            period_one: c.regime.as_deref() == Some("period-1"),
-                            grazing: false,
-                        },
-                        None => Cell::NotApplicable,
-                    })
-                    .collect()
-            })
-            .collect(),
+    let panel = |what: &str, label: &str, value: &dyn Fn(&QnmCell) -> Option<f64>| {
+        HeatMap::parameter_grid(
+            (format!("{what} ({title})"), label, "not held or n/a"),
+            (works, moduli),
+            cells
+                .chunks(works.len())
+                .map(|row| {
+                    row.iter()
+                        .map(|c| value(c).map(|v| (v, c.regime.as_deref() == Some("period-1"))))
+                        .collect()
+                })
+                .collect(),
+        )
     };
     vec![
         panel("adhesion", "adhesion (nN)", &|c| {

@@ -79,6 +79,41 @@ impl HeatMap {
         }
     }
 
+    /// A panel over the (Δγ, E*) grid of a map: `values[j][i]` at work of adhesion i
+    /// and modulus j, each its value and whether its motion is period-1 (None: grey,
+    /// `empty_label`), log axes, E* in GPa.
+    pub fn parameter_grid(
+        (title, value_label, empty_label): (String, &str, &str),
+        (works_j_m2, moduli_pa): (&[f64], &[f64]),
+        values: Vec<Vec<Option<(f64, bool)>>>,
+    ) -> Self {
+        Self {
+            title,
+            x_label: "work of adhesion Δγ (J/m²)".into(),
+            y_label: "composite modulus E* (GPa)".into(),
+            value_label: value_label.into(),
+            x: works_j_m2.to_vec(),
+            y: moduli_pa.iter().map(|e| e * 1e-9).collect(),
+            cells: values
+                .into_iter()
+                .map(|row| {
+                    row.into_iter()
+                        .map(|v| match v {
+                            Some((value, period_one)) => Cell::Value {
+                                value,
+                                period_one,
+                                grazing: false,
+                            },
+                            None => Cell::NotApplicable,
+                        })
+                        .collect()
+                })
+                .collect(),
+            empty_label: empty_label.into(),
+            log_axes: true,
+        }
+    }
+
     /// The range of the values (both ends equal if there is one value; `None` if none).
     pub fn value_range(&self) -> Option<(f64, f64)> {
         let values = self.cells.iter().flatten().filter_map(|c| match c {

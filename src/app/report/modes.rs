@@ -502,32 +502,21 @@ pub fn map_heat_maps(
     moduli: &[f64],
     cells: &[crate::analysis::bimodal::ModalCell],
 ) -> Vec<super::heatmap::HeatMap> {
-    use super::heatmap::{Cell, HeatMap};
+    use super::heatmap::HeatMap;
     use crate::analysis::bimodal::ModalCell;
-    let panel = |what: &str, label: &str, value: &dyn Fn(&ModalCell) -> Option<f64>| HeatMap {
-        title: format!("{title}: {what}"),
-        x_label: "work of adhesion Δγ (J/m²)".into(),
-        y_label: "composite modulus E* (GPa)".into(),
-        value_label: label.into(),
-        empty_label: "no periodic state, or law n/a".into(),
-        x: works.to_vec(),
-        y: moduli.iter().map(|e| e * 1e-9).collect(),
-        log_axes: true,
-        cells: cells
-            .chunks(works.len())
-            .map(|row| {
-                row.iter()
-                    .map(|c| match value(c) {
-                        Some(value) => Cell::Value {
-                            value,
-                            period_one: true,
-                            grazing: false,
-                        },
-                        None => Cell::NotApplicable,
-                    })
-                    .collect()
-            })
-            .collect(),
+    let panel = |what: &str, label: &str, value: &dyn Fn(&ModalCell) -> Option<f64>| {
+        HeatMap::parameter_grid(
+            (
+                format!("{title}: {what}"),
+                label,
+                "no periodic state, or law n/a",
+            ),
+            (works, moduli),
+            cells
+                .chunks(works.len())
+                .map(|row| row.iter().map(|c| value(c).map(|v| (v, true))).collect())
+                .collect(),
+        )
     };
     vec![
         panel("second-mode phase", "φ₂ (deg)", &|c| c.phase2_deg),
