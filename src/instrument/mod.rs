@@ -20,6 +20,7 @@ pub mod peakforce_scan;
 pub mod probe;
 pub mod qnm;
 pub mod repeats;
+pub mod sader;
 pub mod scan;
 pub mod spectrum;
 pub mod thermal;

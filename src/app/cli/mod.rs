@@ -61,6 +61,7 @@ mod scan;
 mod shard;
 mod tap;
 mod thermal;
+mod thermal_psd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
