@@ -117,3 +117,96 @@ fn a_qnm_image_reads_back_from_its_gsf_files() {
     assert!(!dir.join("part.gwy").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A sharded image merges into the Gwyddion files one whole run writes, byte for byte
+/// (`merge --out image.gwy --out image.gsf`), in both imaging modes: the parts carry the
+/// image's size and metadata. A map's parts have no image to write; a place no one may
+/// write (sysfs, read-only for root too) is refused before any work, nothing written.
+#[test]
+fn a_sharded_image_merges_into_the_whole_runs_gwyddion_files() {
+    let dir = scratch("gwyddion_merge");
+    let run = |args: &[&str]| run_limited(args, &dir, Duration::from_secs(120));
+    for mode in ["tapping", "peakforce"] {
+        let scan = |extra: &[&str]| {
+            let mut args = vec![
+                "scan",
+                "--mode",
+                mode,
+                "--lines",
+                "4",
+                "--pixels",
+                "6",
+                "--line-rate",
+                "10",
+                "--quiet",
+            ];
+            args.extend_from_slice(extra);
+            let out = run(&args);
+            assert_eq!(out.code, Some(0), "{args:?}: {}", out.stderr);
+        };
+        scan(&["--gwy", "whole.gwy", "--gsf", "whole.gsf"]);
+        scan(&["--shard", "0/2", "--part", "p0.json"]);
+        scan(&["--shard", "1/2", "--part", "p1.json"]);
+        let out = run(&[
+            "merge",
+            "p1.json",
+            "p0.json",
+            "--out",
+            "merged.gwy",
+            "--out",
+            "merged.gsf",
+            "--quiet",
+        ]);
+        assert_eq!(out.code, Some(0), "{mode}: {}", out.stderr);
+        let whole = std::fs::read(dir.join("whole.gwy")).unwrap();
+        assert_eq!(&whole[..4], b"GWYP");
+        assert_eq!(
+            whole,
+            std::fs::read(dir.join("merged.gwy")).unwrap(),
+            "{mode}"
+        );
+        let mut files = 0;
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let name = entry.unwrap().file_name().into_string().unwrap();
+            if let Some(channel) = name.strip_prefix("whole_") {
+                let merged = dir.join(format!("merged_{channel}"));
+                assert_eq!(
+                    std::fs::read(dir.join(&name)).unwrap(),
+                    std::fs::read(&merged).unwrap(),
+                    "{mode}: {name}"
+                );
+                files += 1;
+            }
+        }
+        assert!(files >= 10, "{mode}: {files} channel files");
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            std::fs::remove_file(entry.unwrap().path()).unwrap();
+        }
+    }
+    let out = run(&[
+        "map", "--steps", "2", "--shard", "0/1", "--part", "map.json", "--quiet",
+    ]);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let out = run(&["merge", "map.json", "--out", "map.gwy"]);
+    assert_eq!(out.code, Some(1));
+    assert!(out.stderr.contains("scanned image's"), "{}", out.stderr);
+    assert!(!dir.join("map.gwy").exists());
+    if std::path::Path::new("/sys/kernel").is_dir() {
+        let out = run(&[
+            "scan",
+            "--lines",
+            "2",
+            "--pixels",
+            "4",
+            "--gwy",
+            "/sys/image.gwy",
+            "--csv",
+            "new.csv",
+        ]);
+        assert_eq!(out.code, Some(1), "{}", out.stderr);
+        assert!(out.stderr.contains("/sys/image.gwy"), "{}", out.stderr);
+        assert!(out.elapsed < Duration::from_secs(5));
+        assert!(!dir.join("new.csv").exists());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

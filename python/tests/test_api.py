@@ -175,6 +175,16 @@ def _read_gsf(path):
     return header, data.reshape(int(header["YRes"]), int(header["XRes"]))
 
 
+def test_an_image_file_where_none_may_be_written_is_an_exception(tmp_path):
+    # sysfs refuses every writer, root too; nothing else of the run is written.
+    if not os.path.isdir("/sys/kernel"):
+        pytest.skip("no sysfs here")
+    csv = tmp_path / "image.csv"
+    with pytest.raises(ValueError, match="/sys/image.gwy"):
+        tapsim.scan(lines=2, pixels=4, gwy="/sys/image.gwy", csv=str(csv))
+    assert not csv.exists()
+
+
 def test_a_scanned_image_opens_in_gwyddion(tmp_path):
     import shutil
 

@@ -40,6 +40,50 @@ impl ImageFiles {
         Ok(())
     }
 
+    /// The Gwyddion files among `merge --out` paths (by extension), and the others.
+    pub(super) fn among(paths: &[std::path::PathBuf]) -> Result<(Self, Vec<std::path::PathBuf>)> {
+        let of = |ext: &str| {
+            let mut it = paths
+                .iter()
+                .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext)));
+            let first = it.next().cloned();
+            match it.next() {
+                Some(second) => Err(Error::NotApplicable(format!(
+                    "--out {} and {}: one .{ext} file is written",
+                    first
+                        .as_ref()
+                        .map_or(String::new(), |p| p.display().to_string()),
+                    second.display()
+                ))),
+                None => Ok(first),
+            }
+        };
+        let files = ImageFiles {
+            gwy: of("gwy")?,
+            gsf: of("gsf")?,
+        };
+        files.check()?;
+        let rest = paths
+            .iter()
+            .filter(|p| {
+                !p.extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("gwy") || e.eq_ignore_ascii_case("gsf"))
+            })
+            .cloned()
+            .collect();
+        Ok((files, rest))
+    }
+
+    /// The refusal of Gwyddion files for parts that carry no image (a map's, or a scan's
+    /// written by a tapsim before images had them).
+    pub(super) fn no_image(&self) -> Error {
+        Error::NotApplicable(
+            "a .gwy or .gsf file is a scanned image's: these parts carry none (a map's or \
+             batch's, or a scan's from an older tapsim: scan again)"
+                .into(),
+        )
+    }
+
     /// Whether any was asked for.
     pub(super) fn any(&self) -> bool {
         self.gwy.is_some() || self.gsf.is_some()

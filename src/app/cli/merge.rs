@@ -28,7 +28,8 @@ pub struct MergeArgs {
     #[arg(required = true)]
     parts: Vec<PathBuf>,
     /// Write an output, by its extension: .csv (the CSV), .json (the JSON --json
-    /// prints), .png or .svg (a map's heat maps). May be repeated.
+    /// prints), .png or .svg (a map's or image's heat maps), .gwy or .gsf (an image's
+    /// Gwyddion files, as `scan --gwy/--gsf` writes them). May be repeated.
     #[arg(long)]
     out: Vec<PathBuf>,
     #[command(flatten)]
@@ -56,9 +57,9 @@ pub fn run(args: MergeArgs) -> Result<()> {
             .and_then(|e| e.to_str())
             .unwrap_or_default()
             .to_ascii_lowercase();
-        if !["csv", "json", "png", "svg"].contains(&ext.as_str()) {
+        if !["csv", "json", "png", "svg", "gwy", "gsf"].contains(&ext.as_str()) {
             return Err(Error::NotApplicable(format!(
-                "--out {}: give a .csv, .json, .png or .svg file",
+                "--out {}: give a .csv, .json, .png, .svg, or an image's .gwy or .gsf file",
                 path.display()
             )));
         }
@@ -69,6 +70,10 @@ pub fn run(args: MergeArgs) -> Result<()> {
         .map(|p| Ok((p.display().to_string(), read(p)?)))
         .collect::<Result<Vec<_>>>()?;
     let merged = part::merge(parts)?;
+    let (files, _) = super::image::ImageFiles::among(&args.out)?;
+    if files.any() && !matches!(merged.job, Job::Scan { .. } | Job::QnmScan { .. }) {
+        return Err(files.no_image());
+    }
     match &merged.job {
         Job::Map {
             law,
@@ -103,11 +108,12 @@ pub fn run(args: MergeArgs) -> Result<()> {
             lines,
             pixels,
             peak_force_n,
+            image,
             ..
         } => super::qnm::emit_scan(
             &args.output,
             &args.out,
-            (*lines, *pixels, *peak_force_n),
+            ((*lines, *pixels, *peak_force_n), image.as_ref()),
             &merged.records,
         ),
     }

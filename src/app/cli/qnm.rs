@@ -357,6 +357,7 @@ pub(super) fn scan(
                 pixels,
                 retrace,
                 peak_force_n: q.setpoint_n,
+                image: Some(part::ImageInfo { size_m, meta }),
             },
             &part::Config::Whole(
                 serde_json::to_value((sample, numerics, per_pixel, q.settings(), exact))
@@ -374,35 +375,7 @@ pub(super) fn scan(
     let shape = (lines.len(), pixels, q.setpoint_n);
     out.write_files_drawn(&rows, |path| draw(shape, &rows, path))?;
     if files.any() {
-        let values: Vec<(bool, usize, f64, Vec<f64>)> = rows
-            .iter()
-            .map(|r| {
-                let p = &r.pixel;
-                let v = vec![
-                    p.topography_m,
-                    p.peak_force_n,
-                    p.error_n,
-                    p.adhesion_n,
-                    p.dissipation_j,
-                    p.deformation_m,
-                    p.dmt_modulus_pa.unwrap_or(f64::NAN),
-                ];
-                (r.direction == "trace", r.line, p.x_m, v)
-            })
-            .collect();
-        let names = [
-            ("Topography", "m"),
-            ("Peak force", "N"),
-            ("Peak force error", "N"),
-            ("Adhesion", "N"),
-            ("Dissipation", "J"),
-            ("Deformation", "m"),
-            ("DMT modulus", "Pa"),
-        ];
-        files.write(
-            &super::image::channels(&values, (lines.len(), pixels), size_m, &names),
-            &meta,
-        )?;
+        files.write(&image_channels(&rows, (lines.len(), pixels), size_m), &meta)?;
     }
     if out.json {
         return out.print_json(&rows);
@@ -477,21 +450,69 @@ pub(super) fn scan(
     Ok(())
 }
 
+/// The Gwyddion channels of a QNM image's `rows` ([`super::image::channels`]).
+fn image_channels(
+    rows: &[Row],
+    shape: (usize, usize),
+    size_m: (f64, f64),
+) -> Vec<crate::app::report::gwyddion::Channel> {
+    let values: Vec<(bool, usize, f64, Vec<f64>)> = rows
+        .iter()
+        .map(|r| {
+            let p = &r.pixel;
+            let v = vec![
+                p.topography_m,
+                p.peak_force_n,
+                p.error_n,
+                p.adhesion_n,
+                p.dissipation_j,
+                p.deformation_m,
+                p.dmt_modulus_pa.unwrap_or(f64::NAN),
+            ];
+            (r.direction == "trace", r.line, p.x_m, v)
+        })
+        .collect();
+    let names = [
+        ("Topography", "m"),
+        ("Peak force", "N"),
+        ("Peak force error", "N"),
+        ("Adhesion", "N"),
+        ("Dissipation", "J"),
+        ("Deformation", "m"),
+        ("DMT modulus", "Pa"),
+    ];
+    super::image::channels(&values, shape, size_m, &names)
+}
+
 /// Write a whole QNM scan's outputs from its records: `tapsim merge` writes a sharded
-/// image's through this.
+/// image's through this, its Gwyddion files among them (from the `image` the parts
+/// carry).
 pub(super) fn emit_scan<T: serde::Serialize>(
     out: &super::SweepOutput,
     extra: &[std::path::PathBuf],
-    shape: (usize, usize, f64),
+    (shape, image): ((usize, usize, f64), Option<&part::ImageInfo>),
     records: &[T],
 ) -> Result<()> {
     let rows: Vec<Row> = typed(records)?;
+    let (files, extra) = super::image::ImageFiles::among(extra)?;
+    let image = match image {
+        Some(image) => Some(image),
+        None if files.any() => return Err(files.no_image()),
+        None => None,
+    };
     out.emit(
-        ("scan", extra),
+        ("scan", &extra),
         records,
         || crate::app::report::records::columns_json(records),
         Some(&|path| draw(shape, &rows, path)),
-    )
+    )?;
+    match image {
+        Some(image) if files.any() => files.write(
+            &image_channels(&rows, (shape.0, shape.1), image.size_m),
+            &image.meta,
+        ),
+        _ => Ok(()),
+    }
 }
 
 /// The plot of a QNM scan of (lines, pixels) at the peak force setpoint: profiles of

@@ -379,11 +379,22 @@ pub fn run(args: ScanArgs) -> Result<()> {
         })
         .collect();
     bar.finish_and_clear();
+    let image = part::ImageInfo {
+        size_m: (sample.length_m, sample.width_m),
+        meta: super::image::meta(
+            "tapping (amplitude modulation)",
+            first_setup,
+            &args.sample,
+            (args.lines, args.pixels, args.line_rate),
+            format!("A/A0 = {}", args.setpoint),
+        ),
+    };
     let job = Job::Scan {
         lines: args.lines,
         pixels: args.pixels,
         retrace: !args.no_retrace,
         setpoint: args.setpoint,
+        image: Some(image.clone()),
     };
     if let Some(shard) = shard {
         let config = serde_json::to_value((
@@ -412,38 +423,9 @@ pub fn run(args: ScanArgs) -> Result<()> {
     args.out
         .write_files_drawn(&rows, |path| draw(&job, &rows, path))?;
     if args.images.any() {
-        let mut names = vec![
-            ("Topography", "m"),
-            ("Amplitude A/A0", ""),
-            ("Amplitude error", ""),
-            ("Phase", "deg"),
-        ];
-        let higher = rows.first().map_or(0, |r| r.pixel.modes.len());
-        let mode_names: Vec<String> = (2..2 + higher).map(|k| format!("Phase {k}")).collect();
-        names.extend(mode_names.iter().map(|n| (n.as_str(), "deg")));
-        let values: Vec<(bool, usize, f64, Vec<f64>)> = rows
-            .iter()
-            .map(|r| {
-                let p = &r.pixel;
-                let mut v = vec![p.topography_m, p.amplitude_ratio, p.error, p.phase_deg];
-                v.extend(p.modes.iter().map(|m| m.phase_deg));
-                (r.direction == "trace", r.line, p.x_m, v)
-            })
-            .collect();
         args.images.write(
-            &super::image::channels(
-                &values,
-                (args.lines, args.pixels),
-                (sample.length_m, sample.width_m),
-                &names,
-            ),
-            &super::image::meta(
-                "tapping (amplitude modulation)",
-                first_setup,
-                &args.sample,
-                (args.lines, args.pixels, args.line_rate),
-                format!("A/A0 = {}", args.setpoint),
-            ),
+            &image_channels(&rows, (args.lines, args.pixels), image.size_m),
+            &image.meta,
         )?;
     }
     if args.out.json {
@@ -580,36 +562,99 @@ pub(super) trait ScanRecord: serde::Serialize {
     fn point(&self) -> Option<Point>;
 }
 
-impl ScanRecord for Row {
-    fn point(&self) -> Option<Point> {
+impl Row {
+    /// What a plot shows of this pixel.
+    fn point_of(&self) -> Point {
         let p = &self.pixel;
-        Some((
+        (
             self.direction == "trace",
             self.y_m,
             p.x_m,
             p.topography_m,
             p.phase_deg,
             p.modes.first().map(|m| m.phase_deg),
-        ))
+        )
+    }
+}
+
+impl ScanRecord for Row {
+    fn point(&self) -> Option<Point> {
+        Some(self.point_of())
     }
 }
 
 impl ScanRecord for Box<RawValue> {
     fn point(&self) -> Option<Point> {
-        serde_json::from_str::<Row>(self.get()).ok()?.point()
+        Some(serde_json::from_str::<Row>(self.get()).ok()?.point_of())
     }
 }
 
+/// The Gwyddion channels of a scanned image's `rows` ([`super::image::channels`]):
+/// topography, amplitude, amplitude error and phase, and each higher mode's phase.
+fn image_channels(
+    rows: &[Row],
+    shape: (usize, usize),
+    size_m: (f64, f64),
+) -> Vec<crate::app::report::gwyddion::Channel> {
+    let mut names = vec![
+        ("Topography", "m"),
+        ("Amplitude A/A0", ""),
+        ("Amplitude error", ""),
+        ("Phase", "deg"),
+    ];
+    let higher = rows.first().map_or(0, |r| r.pixel.modes.len());
+    let mode_names: Vec<String> = (2..2 + higher).map(|k| format!("Phase {k}")).collect();
+    names.extend(mode_names.iter().map(|n| (n.as_str(), "deg")));
+    let values: Vec<(bool, usize, f64, Vec<f64>)> = rows
+        .iter()
+        .map(|r| {
+            let p = &r.pixel;
+            let mut v = vec![p.topography_m, p.amplitude_ratio, p.error, p.phase_deg];
+            v.extend(p.modes.iter().map(|m| m.phase_deg));
+            (r.direction == "trace", r.line, p.x_m, v)
+        })
+        .collect();
+    super::image::channels(&values, shape, size_m, &names)
+}
+
 /// Write a whole scan's outputs from its records: `tapsim merge` writes a sharded
-/// image's through this ([`super::SweepOutput::emit`]).
+/// image's through this ([`super::SweepOutput::emit`]), its Gwyddion files
+/// ([`super::image::ImageFiles`]) among them.
 pub(super) fn emit<T: ScanRecord>(
     out: &super::SweepOutput,
     extra: &[std::path::PathBuf],
     job: &Job,
     records: &[T],
 ) -> Result<()> {
+    let (files, extra) = super::image::ImageFiles::among(extra)?;
+    if files.any() {
+        let Job::Scan {
+            lines,
+            pixels,
+            image: Some(image),
+            ..
+        } = job
+        else {
+            return Err(files.no_image());
+        };
+        let rows = records
+            .iter()
+            .map(|r| serde_json::to_value(r).and_then(serde_json::from_value::<Row>))
+            .collect::<std::result::Result<Vec<Row>, _>>()
+            .map_err(|e| Error::Numerical(format!("a scan record does not read back: {e}")))?;
+        out.emit(
+            ("scan", &extra),
+            records,
+            || crate::app::report::records::columns_json(records),
+            Some(&|path| draw(job, records, path)),
+        )?;
+        return files.write(
+            &image_channels(&rows, (*lines, *pixels), image.size_m),
+            &image.meta,
+        );
+    }
     out.emit(
-        ("scan", extra),
+        ("scan", &extra),
         records,
         || crate::app::report::records::columns_json(records),
         Some(&|path| draw(job, records, path)),

@@ -88,6 +88,9 @@ pub enum Job {
         retrace: bool,
         /// The peak-force setpoint in N.
         peak_force_n: f64,
+        /// What an image file needs beyond the records.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        image: Option<ImageInfo>,
     },
     /// `tapsim scan --lines N`: one record per pixel, each line an item.
     Scan {
@@ -99,7 +102,20 @@ pub enum Job {
         retrace: bool,
         /// The amplitude setpoint A/A₀.
         setpoint: f64,
+        /// What an image file needs beyond the records.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        image: Option<ImageInfo>,
     },
+}
+
+/// What a scanned image's Gwyddion file needs beyond its pixel records: the scanned
+/// area's size and the run's parameters as metadata.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImageInfo {
+    /// The image's x and y extents, m.
+    pub size_m: (f64, f64),
+    /// The run's parameters, (name, value).
+    pub meta: Vec<(String, String)>,
 }
 
 impl Job {
