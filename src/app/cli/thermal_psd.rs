@@ -3,6 +3,7 @@
 //! beside it when the lever's plan is given.
 
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
+use crate::dynamics::setup::significant;
 use crate::error::{Error, Result};
 use crate::instrument::sader::{AIR, Fluid, Plan, WATER, reynolds, sader_stiffness};
 use crate::instrument::spectrum::{Calibration, Psd, SpectralWindow, calibrate, sho_psd};
@@ -153,7 +154,7 @@ pub fn read_psd(path: &Path, how: &PsdReading) -> Result<Psd> {
     let step = (freq_hz[freq_hz.len() - 1] - freq_hz[0]) / (freq_hz.len() - 1) as f64;
     if freq_hz
         .windows(2)
-        .any(|w| ((w[1] - w[0]) / step - 1.0).abs() > 1e-3)
+        .any(|w| ((w[1] - w[0]) / step - 1.0).abs() > 1e-2)
     {
         return Err(fail(
             "the frequencies are not evenly spaced (a Welch or FFT estimate's bins are)".into(),
@@ -359,11 +360,11 @@ pub fn run(job: PsdRun, out: &super::SweepOutput) -> Result<()> {
         c.stiffness_sd_n_m
     );
     outln!(
-        "  background {:.4e} ± {:.2e} m²/Hz under a resonance of {:.4e} m²/Hz at f = 0; \
-         scatter {:.1} % a bin",
-        c.background_m2_hz,
-        c.background_sd_m2_hz,
-        c.low_frequency_m2_hz,
+        "  background {} ± {} pm²/Hz under a resonance of {} pm²/Hz at f = 0; scatter \
+         {:.1} % a bin",
+        significant(c.background_m2_hz * 1e24),
+        significant(c.background_sd_m2_hz * 1e24),
+        significant(c.low_frequency_m2_hz * 1e24),
         100.0 * c.scatter
     );
     if let Some(s) = &report.sader {
@@ -414,12 +415,17 @@ fn charts(report: &Report, c: &Calibration, bins: &[Bin]) -> Vec<Chart> {
             .collect()
     };
     let mut overview = vec![
-        Series::new("measured", pick(&all, |b| b.psd_m2_hz), Style::Line, 2),
+        Series::new(
+            "the file's spectrum",
+            pick(&all, |b| b.psd_m2_hz),
+            Style::Line,
+            2,
+        ),
         Series::new(&fit_name, pick(&all, |b| b.fit_m2_hz), Style::Dashed, 1),
     ];
     let mut zoom = vec![
         Series::new(
-            "measured (every bin)",
+            "the file's spectrum (every bin)",
             pick(&near, |b| b.psd_m2_hz),
             Style::Line,
             2,
@@ -438,7 +444,7 @@ fn charts(report: &Report, c: &Calibration, bins: &[Bin]) -> Vec<Chart> {
     vec![
         Chart {
             name: "thermal_spectrum".into(),
-            title: format!("measured thermal spectrum, {}", report.psd_file),
+            title: format!("thermal spectrum read from {}", report.psd_file),
             x: Axis::log("frequency f (kHz)", "freq_khz"),
             y: Axis::log("deflection PSD S_z (pm²/Hz)", "psd_pm2_hz"),
             legend: Corner::LowerLeft,
