@@ -25,6 +25,21 @@
 //! dependencies. Where a new piece goes: a force law is a file in [`physics::law`]; an
 //! instrument mode a file in [`instrument`]; a way of using the simulations a file in
 //! [`analysis`]; a command a file in `app/cli/`.
+//!
+//! # Where to start
+//!
+//! The user guide is the book in `docs/` (by task: how-to guides, explanation,
+//! reference, validation); its library page runs these layers from Rust. The entry
+//! points, one a layer:
+//!
+//! - the paper: [`contact::hybrid`], [`contact::jkr`] and [`contact::lj`] (the
+//!   quasi-static cycles and their losses), [`law::LawKind`] (the force laws);
+//! - the cantilever: [`tap`] on a [`TapSetup`] ([`default_setup`] is the built-in one)
+//!   gives the steady state and what a lock-in reads of it ([`TapObservables`]);
+//! - the instrument: [`instrument::lockin`], [`instrument::feedback`],
+//!   [`instrument::scan`], [`instrument::thermal`], [`instrument::force_curve`];
+//! - its uses: [`analysis::setpoint`] (states at a setpoint), [`analysis::contrast`],
+//!   [`analysis::fit`].
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -62,7 +77,8 @@ pub use physics::law::{LawKind, LawSpec};
 pub use physics::params::Contact;
 pub use physics::summary::{HysteresisSummary, LjSummary};
 
-/// The README's Rust blocks, compiled and run as doctests so its numbers stay true.
+/// The user guide's Rust blocks (docs/src/reference/library.md), compiled and run as
+/// doctests so its numbers stay true.
 #[cfg(doctest)]
-#[doc = include_str!("../README.md")]
-pub struct ReadmeDoctests;
+#[doc = include_str!("../docs/src/reference/library.md")]
+pub struct GuideDoctests;

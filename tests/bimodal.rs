@@ -356,7 +356,7 @@ fn the_several_mode_solver_agrees_with_the_brute_force_march() {
 /// The small-amplitude limit against the several-mode solver: φ₂ − 90° of a beam's
 /// second mode (Euler–Bernoulli defaults, A₀₂ = 0.1 nm) against cot φ₂ =
 /// −(Q₂/k₂)⟨∂F_ts/∂z⟩ over the one-mode orbit (tapsim's `mean_force_gradient_n_m`):
-/// within 2 % as the issue asks, and within what README states (0.7 % for Hertz,
+/// within 2 % as the issue asks, and within what the guide states (0.7 % for Hertz,
 /// 1.3 % for the hybrid law).
 #[test]
 fn the_several_mode_phase_meets_the_small_amplitude_limit() {
@@ -442,7 +442,7 @@ fn window_averages_without_a_common_period_agree_with_the_brute_force_march() {
         t2.phase_deg,
         t2.phase_std_err_deg
     );
-    // README and docs/design.md: φ₂ within 8e-5°, A₂ 7e-7, φ₁ 2.6e-4°, A₁ 1.4e-7.
+    // the guide and docs/src/explanation/design.md: φ₂ within 8e-5°, A₂ 7e-7, φ₁ 2.6e-4°, A₁ 1.4e-7.
     assert!((a1 - t1.amplitude_ratio.unwrap()).abs() < 2e-7);
     assert!((phi1 - t1.phase_deg).abs() < 3e-4);
     assert!((a2 - t2.amplitude_ratio.unwrap()).abs() < 1e-6);

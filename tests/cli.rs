@@ -332,7 +332,7 @@ fn fig6_csv_holds_the_curves_of_eq_26() {
             let expect = tapsim::contact::spring::hysteresis(5.0, k, Default::default())
                 .unwrap()
                 .w_hat;
-            // To the CSV's 10 significant digits (README, Output conventions): half a unit
+            // To the CSV's 10 significant digits (docs/src/reference/output.md): half a unit
             // of the tenth digit in Ŵ, and as much again through k̂, whose rounding moves
             // Ŵ by at most as much relatively (|d ln Ŵ/d ln k̂| ≤ 1: Ŵ = Ŵ_rigid + c/k̂).
             assert!((w - expect).abs() <= 1e-9 * expect, "{k}: {w} {expect}");
@@ -1025,7 +1025,7 @@ fn branches_flags_the_orbits_that_graze_where_a_piece_ends() {
 
 #[test]
 fn map_counts_its_grazing_cells_where_readme_says() {
-    // README (Speed): on the 10 x 10 default grid, 64 cells where the law applies: 52
+    // The guide (Speed): on the 10 x 10 default grid, 64 cells where the law applies: 52
     // period-1 and 12 long locks, every lock grazing a switch, none irregular; the note
     // on stderr counts them.
     let out = tapsim(&["map", "--steps", "10", "--json"]);

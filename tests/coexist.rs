@@ -58,7 +58,7 @@ fn on_the_defaults_the_estimates_lie_near_both_exact_states() {
         assert!((root.amplitude - ratio).abs() < 0.01, "{root:?}");
         assert!((root.phase_deg - phase).abs() < 3.0, "{root:?}");
     }
-    // And the search started from them reaches the attractive state the README names.
+    // And the search started from them reaches the attractive state the guide names.
     let run = tap(&setup, &numerics, Observe::default()).unwrap();
     let others = coexisting(&setup, &numerics, &run.observables, Search::HarmonicBalance).unwrap();
     assert_eq!(others.len(), 1);

@@ -1,4 +1,4 @@
-//! Tapping-mode dynamics (docs/design.md §2): free response, conservative and hysteretic laws,
+//! Tapping-mode dynamics (docs/src/explanation/design.md §2): free response, conservative and hysteretic laws,
 //! energy balance, phase from energy, and the quasi-static limit (26).
 
 use std::f64::consts::PI;

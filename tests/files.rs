@@ -232,7 +232,7 @@ fn peak_memory(args: &[&str], dir: &Path) -> (u64, Output) {
     (watcher.join().unwrap(), out)
 }
 
-/// The bound README.md states.
+/// The bound the guide states.
 const MEMORY_BOUND: u64 = 300 << 20;
 
 #[test]

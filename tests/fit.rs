@@ -154,7 +154,7 @@ fn a_noisy_approach_curve_is_fitted_back_from_three_starts() {
         assert!(r.converged, "{}", r.termination);
         let dof = r.degrees_of_freedom as f64;
         assert!((r.reduced_chi_square - 1.0).abs() < 3.0 * (2.0 / dof).sqrt());
-        // README: χ²/dof = 0.76, E* to ±2.3 %, Δγ to ±1.4 %, correlation +0.991.
+        // The guide: χ²/dof = 0.76, E* to ±2.3 %, Δγ to ±1.4 %, correlation +0.991.
         assert!((r.reduced_chi_square - 0.76).abs() < 5e-3);
         let rel = |k: usize| r.parameters[k].std_err.unwrap() / r.parameters[k].value.unwrap();
         assert!((rel(0) - 0.023).abs() < 5e-4 && (rel(1) - 0.014).abs() < 5e-4);
@@ -254,7 +254,7 @@ fn a_curve_over_both_branches_is_fitted_back_within_one_percent_from_three_start
             r.reduced_chi_square
         );
         assert!(rel(0).abs() < 0.01 && rel(1).abs() < 0.01, "{got:?}");
-        // README: within 0.1 %, ±0.44 % and ±0.35 %.
+        // The guide: within 0.1 %, ±0.44 % and ±0.35 %.
         assert!(rel(0).abs() < 1e-3 && rel(1).abs() < 1e-3, "{got:?}");
         let err = |k: usize| 100.0 * r.parameters[k].std_err.unwrap() / got[k];
         assert_eq!(
@@ -593,7 +593,7 @@ fn a_second_mode_lifts_the_trade_off_between_modulus_and_adhesion() {
         100.0 * rel(&both, 1)
     );
     assert!(corr(&first).abs() > 0.95);
-    // README: +0.978 and −0.590; ±1.16 %, ±1.34 % and ±0.14 %, ±0.14 %.
+    // The guide: +0.978 and −0.590; ±1.16 %, ±1.34 % and ±0.14 %, ±0.14 %.
     assert_eq!(
         format!(
             "{:+.3} {:+.3} {:.2} {:.2} {:.2} {:.2}",
@@ -690,7 +690,7 @@ fn the_68_percent_intervals_cover_the_truth_in_68_percent_of_replicas() {
     );
     assert!((e - 0.68).abs() <= 0.05, "E*: {e}");
     assert!((w - 0.68).abs() <= 0.05, "Δγ: {w}");
-    // README: 68.0 % and 67.5 % (these seeds).
+    // The guide: 68.0 % and 67.5 % (these seeds).
     assert_eq!((e, w), (0.68, 0.675));
 }
 
@@ -750,6 +750,6 @@ fn a_degeneracy_on_the_repulsive_branch_is_flagged_and_the_attractive_branch_lif
         "{notes}"
     );
     assert!(c_both < c_rep / 10.0);
-    // README: 1125 and 11.
+    // The guide: 1125 and 11.
     assert_eq!((c_rep.round(), c_both.round()), (1125.0, 11.0));
 }

@@ -271,7 +271,7 @@ fn the_command_prints_the_curve_and_refuses_what_is_no_force_curve() {
     // The library's numbers, printed.
     let c = run(LawKind::Hybrid, &Ramp::default());
     let num = |k: &str| json[k].as_f64().unwrap();
-    // The defaults README.md states: from 20 nm at 1 µm/s to the 5 nN trigger.
+    // The defaults the guide states: from 20 nm at 1 µm/s to the 5 nN trigger.
     assert_eq!(
         (num("start_m"), num("velocity_m_s"), num("trigger_n")),
         (20e-9, 1e-6, 5e-9)

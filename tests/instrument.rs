@@ -922,7 +922,7 @@ fn lock_ins_on_modes_without_a_common_period_read_the_window_averages() {
             m.phase_deg,
             m.phase_std_err_deg
         );
-        // README: A₂/A₀₂ within 1.4e-5, φ₂ within 3e-4°.
+        // The guide: A₂/A₀₂ within 1.4e-5, φ₂ within 3e-4°.
         assert!((a - m.amplitude_ratio.unwrap()).abs() < 2e-5);
         assert!((phi - m.phase_deg).abs() < 4e-4);
     }

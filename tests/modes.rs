@@ -372,7 +372,7 @@ fn lozano_garcia_phi1_is_one_curve_and_phi2_separates_the_materials() {
         least2 > 20.0 * worst1 && least2 > 2.0,
         "phi2 differs by {least2}°"
     );
-    // README: the φ₂ curves lie 8.0–12.8° apart over the amplitudes both reach (A₁/A₀₁
+    // The guide: the φ₂ curves lie 8.0–12.8° apart over the amplitudes both reach (A₁/A₀₁
     // 0.61–0.94; an outside check over setpoints 0.95–0.2 found 7.3–12.6°).
     eprintln!("phi2 apart by {least2:.2}–{most2:.2}°");
     assert!((least2 - 8.0).abs() < 0.05, "{least2}");

@@ -1,5 +1,5 @@
 //! Several eigenmodes from the command line: `tap`, `approach` and `contrast` with
-//! `--modes`, parameter files with `[[mode]]` tables, refusals, and the README's
+//! `--modes`, parameter files with `[[mode]]` tables, refusals, and the guide's
 //! numbers.
 
 mod common;
@@ -41,7 +41,7 @@ fn bimodal_tap_reports_every_mode_and_the_readme_numbers() {
         }
         assert!(num(m, "energy_balance_rel") <= 1e-6);
     }
-    // README: φ₁ = 75.775°, A₂/A₀₂ = 0.4959 and φ₂ = 29.73° on the defaults; the second
+    // The guide: φ₁ = 75.775°, A₂/A₀₂ = 0.4959 and φ₂ = 29.73° on the defaults; the second
     // mode at 1.875 MHz (25/4 f₀, the beam's 1.880 MHz moved by −0.27 %); E_ts 20.46 eV.
     assert!((num(&modes[0], "phase_deg") - 75.775).abs() < 5e-4);
     assert!((num(&modes[1], "amplitude_ratio") - 0.4959).abs() < 5e-5);
@@ -60,7 +60,7 @@ fn bimodal_tap_reports_every_mode_and_the_readme_numbers() {
 
 /// Drives with no common period (`--ratio-tolerance 0`: the beam's f₂ = 6.266893 f₀ as
 /// it is): `tap` reports window averages, each with its error, and says what they are.
-/// README: φ₂ = 29.80° and A₂/A₀₂ = 0.4972 there (29.73° and 0.4959 at 25/4).
+/// The guide: φ₂ = 29.80° and A₂/A₀₂ = 0.4972 there (29.73° and 0.4959 at 25/4).
 /// The least separation is the orbit's, turning points inside integrator steps
 /// included (issue 45: it was taken at segment ends only, the jump-in level on the
 /// defaults). Against an independent integration of the same equations: −3.044 nm on
@@ -97,7 +97,7 @@ fn modes_without_a_common_period_are_averaged_over_windows() {
         ] {
             assert!(m[key].is_number(), "{key}");
         }
-        // README: errors below 1e-6°, far below the digits printed.
+        // The guide: errors below 1e-6°, far below the digits printed.
         assert!(num(m, "phase_std_err_deg") < 1e-6);
     }
     assert!((num(&modes[1], "phase_deg") - 29.80).abs() < 5e-3);
@@ -279,7 +279,7 @@ fn a_bimodal_approach_lists_both_phases() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// README: the bimodal contrast B − A at A₁/A₀₁ = 0.8 under each law, on the repulsive
+/// The guide: the bimodal contrast B − A at A₁/A₀₁ = 0.8 under each law, on the repulsive
 /// branch; on the attractive one, under the hybrid law, B's higher modes hold the setpoint
 /// in two coexisting states, and no phase of B is given.
 #[test]
@@ -306,7 +306,7 @@ fn the_readme_bimodal_contrast() {
         assert!((num(row, "delta_phase2_deg") - d2).abs() < 5e-4, "{row}");
         assert!((num(row, "delta_phase1_deg") - d1).abs() < 5e-4, "{row}");
     }
-    // README: on the attractive branch under the hybrid law, Δφ₂ = −25.498°,
+    // The guide: on the attractive branch under the hybrid law, Δφ₂ = −25.498°,
     // Δφ₁ = +2.632° (what the scan shows, `a_bimodal_scan_rests_on_…`).
     let hybrid = rows
         .iter()
@@ -372,7 +372,7 @@ fn a_bimodal_scan_rests_on_states_the_setpoint_solver_lists() {
             "pixel {pixel}: φ₁ {phi1}, φ₂ {phi2}, z {z:e} among {states:?}"
         );
     }
-    // README: the scan's contrast B − A, Δφ₂ = −25.5°, Δφ₁ = +2.6°.
+    // The guide: the scan's contrast B − A, Δφ₂ = −25.5°, Δφ₁ = +2.6°.
     let delta = |f: &dyn Fn(&serde_json::Value) -> f64| f(&pixels[7]) - f(&pixels[3]);
     let d2 = delta(&|p| num(&p["modes"][0], "phase_deg"));
     let d1 = delta(&|p| num(p, "phase_deg"));

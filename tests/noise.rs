@@ -187,7 +187,7 @@ fn tap_reports_the_thermal_noise_of_its_orbit() {
     let sigma_phi = noise["sigma_phase_deg"].as_f64().unwrap();
     assert!((sigma_phi / lib.sigma_phase_rad.to_degrees() - 1.0).abs() < 1e-9);
     assert_eq!(noise["lockin_order"].as_u64(), Some(4));
-    // README's numbers: the defaults at 1 kHz and at 100 Hz.
+    // The guide's numbers: the defaults at 1 kHz and at 100 Hz.
     let sigma_a_pm = noise["sigma_amplitude_m"].as_f64().unwrap() * 1e12;
     assert_eq!(format!("{sigma_phi:.4} {sigma_a_pm:.2}"), "0.1413 4.49");
     let narrow = &json(&["--temperature", "300K", "--enbw", "100Hz"])["thermal_noise"];
@@ -222,7 +222,7 @@ fn tap_reports_the_thermal_noise_of_its_orbit() {
 
 /// `contrast --temperature`: each phase on a stable period-1 orbit carries its thermal
 /// noise, each row |Δφ|/√(σ_first² + σ_last²); a phase from a long mode lock none. The
-/// README's answer: on the defaults (polymers A and B at A/A₀ = 0.8, repulsive branch)
+/// The guide's answer: on the defaults (polymers A and B at A/A₀ = 0.8, repulsive branch)
 /// the hybrid's contrast is 99, 24 and 13 times its noise at ENBW 100 Hz, 1 kHz and
 /// 10 kHz, and JKR's Δφ lies 190, 46 and 25 σ_Δ from the hybrid's.
 #[test]
@@ -389,7 +389,7 @@ fn a_scan_under_the_thermal_force_scatters_as_the_linear_theory_says() {
         let seen = sigma_of(name);
         eprintln!("{name}: pixel scatter {seen:.4}°, linear theory at 80 Hz {predicted:.4}°");
         assert!(seen / predicted > 0.6 && seen / predicted < 1.6);
-        // README's numbers.
+        // The guide's numbers.
         let expected = if name == "A" {
             ("0.0151", "0.0183")
         } else {

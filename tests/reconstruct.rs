@@ -51,7 +51,7 @@ fn the_inversion_recovers_an_exponential_force_from_its_closed_form_projection()
         .fold(0.0, f64::max);
     eprintln!("largest error {:.3} % of F₀", 100.0 * worst);
     assert!(worst < 0.01, "largest error {:.3} % of F₀", 100.0 * worst);
-    // The README's number, to its printed digits.
+    // The guide's number, to its printed digits.
     assert_eq!(format!("{:.2}", 100.0 * worst), "0.85");
 }
 
@@ -128,7 +128,7 @@ fn a_simulated_dmt_curve_gives_back_its_force() {
         .iter()
         .fold((0.0f64, 0.0f64), |(lo, hi), &f| (lo.min(f), hi.max(f)));
     assert!(lo < -2e-9 && hi > 8e-9, "range {lo:e}..{hi:e} N");
-    // The README's indentation, to its printed digits.
+    // The guide's indentation, to its printed digits.
     assert_eq!(format!("{:.1}", -r.points[0].closest_m * 1e9), "2.2");
     let worst = r
         .points
@@ -142,7 +142,7 @@ fn a_simulated_dmt_curve_gives_back_its_force() {
         "largest error {:.2} % of max|F|",
         100.0 * worst
     );
-    // The README's number, to its printed digits.
+    // The guide's number, to its printed digits.
     assert_eq!(format!("{:.1}", 100.0 * worst), "2.1");
     for q in &r.points {
         let sim = points
@@ -192,7 +192,7 @@ fn the_loss_from_the_phase_meets_the_integrated_loss_of_a_hysteretic_law() {
     }
     eprintln!("{touching} points, E_ts off by {worst:e} at most");
     assert!(touching >= 10, "{touching}");
-    assert!(worst < 1e-4, "the README's 1e-4: {worst:e}");
+    assert!(worst < 1e-4, "the guide's 1e-4: {worst:e}");
     // What the inversion makes of the loop: near the jump-in a force more than twice as
     // attractive as either branch of the law ever is — a spike, not a force.
     let p = Prepared::new(&setup, &Numerics::default()).unwrap();

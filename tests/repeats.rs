@@ -105,7 +105,7 @@ fn the_step_scanned_fast_overshoots_and_loses_the_sample_as_exactly() {
         "0.01",
     ];
     let (fast, exact) = against_exact(&args);
-    // The README's artefacts: the overshoot after the step up (trace) and the amplitude
+    // The guide's artefacts: the overshoot after the step up (trace) and the amplitude
     // running away after the step down (retrace), within 1 % of their sizes.
     let artefacts = |v: &serde_json::Value| {
         let (z, ratio) = (column(v, "topography_m"), column(v, "amplitude_ratio"));
@@ -186,7 +186,7 @@ fn a_loop_that_settles_skips_and_one_on_a_long_lock_marches_every_period() {
         repeats.marched
     );
     // At 0.95 on the attractive branch the only motion is a long lock grazing the
-    // jump-in (README): its state never repeats after one period, nothing is skipped,
+    // jump-in (the guide): its state never repeats after one period, nothing is skipped,
     // and the pixels are the exact march's.
     let flat = [Region {
         until_m: 1e-6,

@@ -22,7 +22,7 @@ fn every_state_at_the_setpoint_is_a_state_tap_finds_at_its_separation() {
     assert_eq!(v["separation_m"], states[0]["separation_m"]);
     assert_eq!(v["phase_deg"], states[0]["phase_deg"]);
     assert_eq!(num(&v, "setpoint"), 0.8);
-    // README's numbers.
+    // The guide's numbers.
     let at = |i: usize, key: &str| num(&states[i], key);
     assert!((at(0, "separation_m") * 1e9 - 16.7895).abs() < 5e-5);
     assert!((at(0, "phase_deg") - 123.632).abs() < 5e-4);
@@ -156,7 +156,7 @@ fn contrast_and_tap_at_a_setpoint_agree_and_the_apparent_height_is_the_step_in_z
 
 #[test]
 fn readme_contrast_numbers() {
-    // README: Δφ (deg) and Δz_c (nm) between the default polymers at 0.8 and 0.9.
+    // The guide: Δφ (deg) and Δz_c (nm) between the default polymers at 0.8 and 0.9.
     let rows = json(&["contrast", "--setpoints", "0.9,0.8", "--quiet", "--json"]);
     let row = |law: &str, r: f64, branch: &str| {
         common::rows(&rows)
@@ -198,7 +198,7 @@ fn tap_names_the_other_stable_state_at_its_separation() {
     let o = &other[0];
     assert_eq!(o["branch"], "attractive");
     assert_eq!(num(o, "separation_m"), 16e-9);
-    // README: A/A₀ = 0.7622, φ = 127.21°.
+    // The guide: A/A₀ = 0.7622, φ = 127.21°.
     assert!((num(o, "amplitude_ratio") - 0.7622).abs() < 5e-5);
     assert!((num(o, "phase_deg") - 127.21).abs() < 5e-3);
     let from_rest = v["attractors"]

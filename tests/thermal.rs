@@ -347,7 +347,7 @@ fn the_thermal_averages_errors_are_the_spread_of_seeds() {
 }
 
 /// `tap --temperature` averages over the thermal motion where the deterministic state
-/// grazes a switch (README: the hybrid defaults at 20 nm), and not on a stable period-1
+/// grazes a switch (the guide: the hybrid defaults at 20 nm), and not on a stable period-1
 /// orbit away from every switch (the defaults, where the linear noise theory speaks).
 #[test]
 fn tap_averages_a_grazing_state_over_the_thermal_motion() {
@@ -443,7 +443,7 @@ fn approach_averages_the_grazing_points_over_the_thermal_motion() {
         .position(|h| h == "thermal_average_e_ts_j")
         .expect("the average's columns");
     let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
-    // The same number, to the CSV's 10 significant digits (README, Output conventions).
+    // The same number, to the CSV's 10 significant digits (docs/src/reference/output.md).
     let (in_csv, in_json) = (
         rows[0][column].parse::<f64>().unwrap(),
         common::num(a, "e_ts_j"),

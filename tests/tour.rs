@@ -1,4 +1,5 @@
-//! The README's CLI tour, run as a new user runs it: every command of the tour block
+//! The README's five-minute tour and the guide's CLI tour (docs/src/reference/
+//! cli-tour.md), run as a new user runs them: every command of the tour blocks
 //! succeeds, and the commands that name an effect show it (a touch, a neck, a viscous
 //! share, a non-empty contrast).
 
@@ -6,12 +7,13 @@ mod common;
 
 use std::path::Path;
 
-/// The tour's commands, as the README lists them: one per line (a trailing `\` joins the
-/// next), comments (`#` after whitespace) dropped, `tapsim` first.
-fn tour() -> Vec<Vec<String>> {
-    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
-        .expect("README.md");
-    let start = readme.find("## CLI tour").expect("a CLI tour section");
+/// The commands of the first `sh` block after `heading` in `file` (from the repository's
+/// root): one per line (a trailing `\` joins the next), comments (`#` after whitespace)
+/// dropped, `tapsim` first.
+fn tour_block(file: &str, heading: &str) -> Vec<Vec<String>> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+    let readme = std::fs::read_to_string(&path).expect(file);
+    let start = readme.find(heading).expect("the tour's heading");
     let block = &readme[start..];
     let block = &block[block.find("```sh\n").expect("a sh block") + 6..];
     let block = &block[..block.find("```").expect("the block ends")];
@@ -41,6 +43,13 @@ fn tour() -> Vec<Vec<String>> {
     commands
 }
 
+/// Both tours' commands, the README's first.
+fn tour() -> Vec<Vec<String>> {
+    let mut commands = tour_block("README.md", "## Five-minute tour");
+    commands.extend(tour_block("docs/src/reference/cli-tour.md", "# CLI tour"));
+    commands
+}
+
 /// Run a tour command in `dir` (the tour's example files from the repository), with
 /// `extra` arguments; its stdout.
 fn run(args: &[String], extra: &[&str], dir: &Path) -> String {
@@ -66,21 +75,24 @@ fn has(args: &[String], flag: &str) -> bool {
 /// commands are run again with --json for their numbers: a rest-separation state
 /// touches the sample (or, where a law's effect is named, dissipates through it); the
 /// two-material contrast has a Δφ on the repulsive branch at every setpoint, JKR's 5 to
-/// 7 times the hybrid's (README).
+/// 7 times the hybrid's (the guide).
 #[test]
 fn every_tour_command_runs_and_shows_its_effect() {
     let commands = tour();
     assert!(commands.len() > 30, "{}", commands.len());
     let dir = common::scratch("tour");
-    // Two at a time from one queue, as the machine has two cores; a merge after the
-    // parts it reads.
+    // Two at a time from one queue, as the machine has two cores.
     // (`reproduce --out results --json` is the one command left out: tests/cli.rs runs
     // it as written, checks every file it lists and compares them with results/.)
     let commands: Vec<_> = commands
         .into_iter()
         .filter(|c| c[0] != "reproduce")
         .collect();
-    let (merges, rest): (Vec<_>, Vec<_>) = commands.into_iter().partition(|c| c[0] == "merge");
+    // The commands that read what others write (a merge its parts, a fit its curve) run
+    // after them.
+    let (merges, rest): (Vec<_>, Vec<_>) = commands
+        .into_iter()
+        .partition(|c| matches!(c[0].as_str(), "merge" | "fit" | "reconstruct"));
     let next = std::sync::atomic::AtomicUsize::new(0);
     std::thread::scope(|s| {
         for _ in 0..2 {
@@ -290,7 +302,7 @@ fn a_state_out_of_reach_says_so_and_prints_zeros_as_zero() {
     assert!(err.contains("no peak-force panels"), "{err}");
 }
 
-/// README ("Built-in defaults of `tapsim tap`"): a stable period-1 orbit found in 11
+/// The guide ("Built-in defaults of `tapsim tap`"): a stable period-1 orbit found in 11
 /// periods, A/A₀ = 0.9415, φ = 75.739°, E_ts = 20.46 eV, grazing margin 3.77 nm — as
 /// `tap --json` prints them.
 #[test]

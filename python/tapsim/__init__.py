@@ -16,7 +16,7 @@ Quick start::
     c = tapsim.approach(points=40)          # columns as numpy arrays
     m = tapsim.map(steps=10)                # m.grid["phase_deg"] is a 2-D array
 
-See ``help(tapsim.Result)`` and the README's "Python" section.
+See ``help(tapsim.Result)`` and the guide's Python page (docs/src/how-to/python.md).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@
 //! Nanotechnology 20, 165703, 2009).
 //!
 //! With the motion z ≈ z̄ + A cos θ (θ = ωt − φ) the steady state's projections onto
-//! cos θ and sin θ give, at each z_c, two numbers of the force alone (docs/design.md,
+//! cos θ and sin θ give, at each z_c, two numbers of the force alone (docs/src/explanation/design.md,
 //! "Force reconstruction"):
 //!
 //! - the in-phase force ⟨F_ts cos θ⟩ = k[A(1 − Ω²) − A₀F̂₀ cos φ]/2 (F̂₀ the drive in
@@ -105,7 +105,7 @@ pub struct Reconstruction {
 
 /// The in-phase force ⟨F_ts cos θ⟩ (N) and the energy dissipated per cycle (J) at
 /// amplitude `amplitude_m` and phase lag `phase_deg`, from the harmonic balance of the
-/// driven oscillator (docs/design.md, "Force reconstruction"; the second is Cleveland et
+/// driven oscillator (docs/src/explanation/design.md, "Force reconstruction"; the second is Cleveland et
 /// al., APL 72, 2613, 1998).
 pub fn harmonic_balance(probe: &Probe, amplitude_m: f64, phase_deg: f64) -> (f64, f64) {
     let (k, a0, w, q) = (

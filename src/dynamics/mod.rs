@@ -2,7 +2,7 @@
 //! its higher modes, [`modes`]) against a hysteretic tip–sample force law, marched with
 //! every branch switch located ([`march`]); periodic orbits by shooting, irregular
 //! motion by windows, the attractors at a separation, continuation of orbit families,
-//! and the observables of one steady cycle (docs/design.md §2).
+//! and the observables of one steady cycle (docs/src/explanation/design.md §2).
 //!
 //! May import: the foundation and [`crate::physics`]. Imported by the instrument,
 //! analysis and application layers.

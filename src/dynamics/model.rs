@@ -1,4 +1,4 @@
-//! The point-mass cantilever in dimensionless form (docs/design.md §2).
+//! The point-mass cantilever in dimensionless form (docs/src/explanation/design.md §2).
 //!
 //! Time τ = ω₀t, deflection x = z/L for a length unit L (the free amplitude A₀ in tapping),
 //! forces in units of kL, energies in units of kL². The equation of motion

@@ -22,7 +22,7 @@ use std::path::PathBuf;
 /// times the true error where checked against finer meshes, mu = 1 to 30). The loss
 /// with a spring (--k-hat, any k̂ > 0; far out, where a soft spring lands, the approach
 /// branch is the rigid sphere's) is the production mesh's, not extrapolated. Results are
-/// cached, keyed by mu, the traced range, the mesh and the solver's source (see README:
+/// cached, keyed by mu, the traced range, the mesh and the solver's source (see the guide, docs/src/reference/output.md:
 /// $TAPSIM_CACHE, else ~/.cache/tapsim); --no-cache recomputes.
 ///
 /// JSON keys (--json): tabor_mu, hysteresis (false: no loop, and then only w_hat = 0,

@@ -83,7 +83,7 @@ use std::path::PathBuf;
 /// thermal_rms_m, integration_error_m, attractors, well_defined, harmonics (harmonics 2…10 of
 /// the deflection and the force over a periodic orbit: order, deflection_amplitude_m,
 /// deflection_phase_deg, force_amplitude_n, force_phase_deg; null for irregular
-/// motion), and more (see README).
+/// motion), and more (see the guide, docs/src/how-to/tap.md).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct TapArgs {

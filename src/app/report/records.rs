@@ -2,7 +2,7 @@
 //! equal-length arrays, from anything that serialises to a JSON object; and the one
 //! document every `--json` prints.
 //!
-//! The JSON conventions (README, "Output conventions"): every document is one object whose first key
+//! The JSON conventions (docs/src/reference/output.md): every document is one object whose first key
 //! is `format_version` ([`FORMAT_VERSION`]); a single result's fields are its keys; many
 //! results are columns (one array per field, one entry per result); a map is its axes
 //! plus a `grid` of rows. A numerical error estimate is a sibling key `<name>_error`, a

@@ -1,5 +1,5 @@
 //! The cantilever's eigenmodes in SI units, the rectangular-beam defaults, and the
-//! dimensionless model they make with the first mode's units (docs/design.md §2b).
+//! dimensionless model they make with the first mode's units (docs/src/explanation/design.md §2b).
 
 use crate::dynamics::setup::Cantilever;
 use crate::error::{Error, Result, positive};

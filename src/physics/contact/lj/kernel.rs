@@ -1,5 +1,5 @@
 //! The axisymmetric influence kernel of the Lennard-Jones problem and its discretisation
-//! for piecewise-linear tractions (docs/design.md §1).
+//! for piecewise-linear tractions (docs/src/explanation/design.md §1).
 //!
 //! With h̄ = h/ε and x = r/√(Rε) the gap obeys
 //! h̄(x) = ᾱ + 1 + x²/2 − (32/(3π)) μ^{3/2} ∫₀^∞ f(h̄(y)) G(x, y) dy,

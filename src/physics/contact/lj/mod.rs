@@ -1,5 +1,5 @@
 //! The full Lennard-Jones numerical solution of the adhesive sphere (the paper's §3.1,
-//! docs/design.md §1): the ground truth the hybrid theory is judged against.
+//! docs/src/explanation/design.md §1): the ground truth the hybrid theory is judged against.
 //!
 //! May import: the foundation and the rest of [`crate::physics::contact`].
 
