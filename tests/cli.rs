@@ -1768,3 +1768,94 @@ fn every_command_takes_quiet_and_names_the_files_it_writes() {
     common::refused(&["tap", "--resonance", "300"], "did you mean 300kHz?");
     common::refused(&["tap", "--sample-modulus", "2"], "did you mean 2GPa?");
 }
+
+/// The reference a terminal gives, generated from the command line's own definitions:
+/// `--version` names the commit (the one git itself reports, where this is a checkout);
+/// `completions` knows every command and flag; `man` writes a page per command; `--help`
+/// wraps to the terminal's width (every command's page within 80 columns at
+/// COLUMNS=80) and the sample's flags show their defaults.
+#[test]
+fn version_completions_man_pages_and_help_come_from_the_definitions() {
+    let bin = env!("CARGO_BIN_EXE_tapsim");
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(bin)
+            .args(args)
+            .env("COLUMNS", "80")
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let version = run(&["--version"]);
+    assert!(
+        version.starts_with(&format!("tapsim {} (commit ", env!("CARGO_PKG_VERSION"))),
+        "{version}"
+    );
+    let git = std::process::Command::new("git")
+        .args(["rev-parse", "--short=12", "HEAD"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output();
+    if let Some(git) = git.ok().filter(|o| o.status.success()) {
+        let commit = String::from_utf8(git.stdout).unwrap();
+        assert!(version.contains(commit.trim()), "{version} vs {commit}");
+    }
+    // The commands, as --help lists them.
+    let help = run(&["--help"]);
+    let commands: Vec<&str> = help
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter(|l| !l.starts_with("   "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .collect();
+    assert!(commands.len() >= 20, "{commands:?}");
+    let bash = run(&["completions", "bash"]);
+    for c in &commands {
+        assert!(bash.contains(c), "bash completions lack {c}");
+    }
+    assert!(bash.contains("--psd") && bash.contains("--setpoint"));
+    assert!(run(&["completions", "zsh"]).starts_with("#compdef tapsim"));
+    let dir = common::scratch("man");
+    run(&["man", "--out", dir.to_str().unwrap(), "--quiet"]);
+    for c in
+        std::iter::once("tapsim".to_string()).chain(commands.iter().map(|c| format!("tapsim-{c}")))
+    {
+        let page = std::fs::read_to_string(dir.join(format!("{c}.1"))).unwrap_or_default();
+        assert!(
+            page.starts_with(".ie") || page.contains(".TH"),
+            "{c}.1: {}",
+            &page[..page.len().min(80)]
+        );
+    }
+    let tap = std::fs::read_to_string(dir.join("tapsim-tap.1")).unwrap();
+    assert!(tap.contains("setpoint"));
+    for c in &commands {
+        let text = run(&[c, "--help"]);
+        let widest = text.lines().map(|l| l.chars().count()).max().unwrap_or(0);
+        assert!(widest <= 80, "{c} --help: a line of {widest} columns");
+    }
+    let tap_help = run(&["tap", "--help"]);
+    for default in [
+        "20nm",
+        "0.5GPa",
+        "0.1J/m^2",
+        "0.3nm",
+        "default 40",
+        "default 400",
+    ] {
+        assert!(
+            tap_help.contains(default),
+            "tap --help does not show {default}"
+        );
+    }
+    common::refused(
+        &["man", "--out", dir.join("missing").to_str().unwrap()],
+        "existing directory",
+    );
+}

@@ -67,10 +67,11 @@ pub const DEFAULT_TIP_MODULUS: f64 = 169e9;
 /// A sphere-on-flat contact in SI units, every field optional.
 #[derive(Debug, Clone, Default, Args)]
 pub struct ContactInputs {
-    /// Tip radius R [m; e.g. 20nm].
+    /// Tip radius R [m; the built-in sample's 20nm].
     #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Contact (SI)")]
     pub radius: Option<f64>,
-    /// Composite modulus E* [Pa; e.g. 1GPa]. Or give --tip-modulus/--sample-modulus.
+    /// Composite modulus E* [Pa; the built-in sample's 0.593GPa, from the tip's and the
+    /// sample's moduli]. Or give --tip-modulus/--sample-modulus.
     #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)",
           conflicts_with_all = ["tip_modulus", "sample_modulus"])]
     pub modulus: Option<f64>,
@@ -80,16 +81,17 @@ pub struct ContactInputs {
     /// Poisson ratio of the tip [default 0.28].
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)")]
     pub tip_poisson: Option<f64>,
-    /// Young's modulus of the sample [Pa; e.g. 2GPa].
+    /// Young's modulus of the sample [Pa; the built-in sample's 0.5GPa, a soft polymer].
     #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)")]
     pub sample_modulus: Option<f64>,
     /// Poisson ratio of the sample [default 0.4].
     #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)")]
     pub sample_poisson: Option<f64>,
-    /// Work of adhesion Δγ [J/m²; e.g. 50mJ/m^2].
+    /// Work of adhesion Δγ [J/m²; the built-in sample's 0.1J/m^2].
     #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, help_heading = "Contact (SI)")]
     pub work_of_adhesion: Option<f64>,
-    /// Range ε of the Lennard-Jones law (10), the equilibrium gap [m; e.g. 0.3nm].
+    /// Range ε of the Lennard-Jones law (10), the equilibrium gap [m; the built-in
+    /// sample's 0.3nm].
     #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Contact (SI)")]
     pub range: Option<f64>,
 }

@@ -46,6 +46,7 @@ mod curve_data;
 mod figure;
 mod fit;
 mod force_curve;
+mod generated;
 mod hysteresis;
 mod image;
 mod lj;
@@ -64,6 +65,14 @@ mod thermal;
 mod thermal_psd;
 
 use clap::{Parser, Subcommand};
+
+/// `tapsim --version`: the crate's version and the commit it was built from.
+const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (commit ",
+    env!("TAPSIM_COMMIT"),
+    ")"
+);
 use std::process::ExitCode;
 
 /// tapsim — tapping-mode AFM with adhesion hysteresis done right.
@@ -74,7 +83,7 @@ use std::process::ExitCode;
 /// support stiffness k̂ = μεk/(RΔγ). SI inputs accept unit suffixes (10nm, 1GPa,
 /// 50mJ/m^2, 40N/m); bare numbers are SI base units.
 #[derive(Debug, Parser)]
-#[command(name = "tapsim", version, propagate_version = true)]
+#[command(name = "tapsim", version = VERSION, propagate_version = true)]
 pub struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -100,6 +109,8 @@ enum Command {
     Lj(lj::LjArgs),
     Figure(figure::FigureArgs),
     Reproduce(reproduce::ReproduceArgs),
+    Completions(generated::CompletionsArgs),
+    Man(generated::ManArgs),
 }
 
 impl Command {
@@ -123,7 +134,8 @@ impl Command {
             Command::Merge(a) => a.output.quiet,
             Command::Hysteresis(a) => a.quiet,
             Command::Lj(a) => a.quiet,
-            Command::Figure(_) | Command::Reproduce(_) => true,
+            Command::Man(a) => a.quiet,
+            Command::Figure(_) | Command::Reproduce(_) | Command::Completions(_) => true,
         };
         !quiet
     }
@@ -163,7 +175,9 @@ impl Command {
             | Command::Hysteresis(_)
             | Command::Lj(_)
             | Command::Figure(_)
-            | Command::Reproduce(_) => Ok(()),
+            | Command::Reproduce(_)
+            | Command::Completions(_)
+            | Command::Man(_) => Ok(()),
         }
     }
 }
@@ -538,6 +552,8 @@ fn run_command(command: Command) -> crate::Result<()> {
         Command::Lj(args) => lj::run(args),
         Command::Figure(args) => figure::run(args),
         Command::Reproduce(args) => reproduce::run(args),
+        Command::Completions(args) => generated::completions(args),
+        Command::Man(args) => generated::man(args),
     }
 }
 
