@@ -1840,7 +1840,28 @@ fn version_completions_man_pages_and_help_come_from_the_definitions() {
         let widest = text.lines().map(|l| l.chars().count()).max().unwrap_or(0);
         assert!(widest <= 80, "{c} --help: a line of {widest} columns");
     }
+    // -h is the summary: the common flags, a fraction of --help's page; the numerics and
+    // the laws' own parameters wait for --help.
+    for c in [
+        "tap",
+        "approach",
+        "contrast",
+        "map",
+        "scan",
+        "fit",
+        "force-curve",
+    ] {
+        let (short, long) = (run(&[c, "-h"]), run(&[c, "--help"]));
+        let (s, l) = (short.lines().count(), long.lines().count());
+        assert!(2 * s < l, "{c}: -h {s} lines, --help {l}");
+    }
+    let short = run(&["tap", "-h"]);
+    assert!(
+        !short.contains("--rtol") && !short.contains("--hamaker"),
+        "{short}"
+    );
     let tap_help = run(&["tap", "--help"]);
+    assert!(tap_help.contains("--rtol") && tap_help.contains("--hamaker"));
     for default in [
         "20nm",
         "0.5GPa",

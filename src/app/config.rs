@@ -76,16 +76,16 @@ pub struct ContactInputs {
           conflicts_with_all = ["tip_modulus", "sample_modulus"])]
     pub modulus: Option<f64>,
     /// Young's modulus of the tip [Pa; default 169GPa, silicon].
-    #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)")]
     pub tip_modulus: Option<f64>,
     /// Poisson ratio of the tip [default 0.28].
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)")]
     pub tip_poisson: Option<f64>,
     /// Young's modulus of the sample [Pa; the built-in sample's 0.5GPa, a soft polymer].
     #[arg(long, allow_hyphen_values = true, value_parser = pressure, help_heading = "Contact (SI)")]
     pub sample_modulus: Option<f64>,
     /// Poisson ratio of the sample [default 0.4].
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = number, help_heading = "Contact (SI)")]
     pub sample_poisson: Option<f64>,
     /// Work of adhesion Δγ [J/m²; the built-in sample's 0.1J/m^2].
     #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, help_heading = "Contact (SI)")]
@@ -265,7 +265,9 @@ impl Args for LawParamInputs {
                         units::parse(param.name, text, dim).map_err(|e| e.to_string())
                     })
                     .help(param.help)
-                    .help_heading("Contact (SI)"),
+                    .help_heading("Contact (SI)")
+                    // The laws' own parameters: in --help, not in -h's summary.
+                    .hide_short_help(true),
             )
         })
     }
@@ -305,24 +307,24 @@ pub struct TapInputs {
     #[arg(long, aliases = ["A0", "a0"], allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
     pub free_amplitude: Option<f64>,
     /// Drive frequency [Hz; default: the resonance frequency].
-    #[arg(long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Cantilever")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Cantilever")]
     pub drive_frequency: Option<f64>,
     /// Rest tip–sample separation z_c, α = z_c + z [m; default 16nm]. (Also --zc.)
     #[arg(long, alias = "zc", allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
     pub separation: Option<f64>,
     /// Relative tolerance of the integrator [default 1e-9; absolute: 1e-2 of it].
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
     pub rtol: Option<f64>,
     /// Most cycles to integrate looking for the steady state [default 20000].
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
     pub max_cycles: Option<f64>,
     /// Periodic steady state: how closely the state must return after n periods, in
     /// units of A₀ [default 1e-9 for tap, 1e-7 per setpoint for sweeps].
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
     pub tolerance: Option<f64>,
     /// Irregular (not periodic) motion: standard error the averages must reach, A and
     /// E_ts relative, φ in rad [default 1e-3].
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = number, help_heading = "Numerics")]
     pub average_tolerance: Option<f64>,
     /// The amplitude setpoint A/A₀ (a parameter file's `setpoint`, or `tap`'s and `map`'s
     /// --setpoint): exclusive with `separation`.
@@ -867,16 +869,16 @@ pub struct ModeInputs {
     pub modes: Option<u8>,
     /// Free amplitude A₀₂ of the second mode at its resonance [m; default A₀/40; 0: not
     /// driven].
-    #[arg(long, value_name = "A02", allow_hyphen_values = true, value_parser = length, help_heading = "Eigenmodes")]
+    #[arg(hide_short_help = true, long, value_name = "A02", allow_hyphen_values = true, value_parser = length, help_heading = "Eigenmodes")]
     pub drive2_amplitude: Option<f64>,
     /// Spring constant k₂ of the second mode [N/m; default k (f₂/f₀)²].
-    #[arg(long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Eigenmodes")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = stiffness, help_heading = "Eigenmodes")]
     pub mode2_stiffness: Option<f64>,
     /// Resonance f₂ of the second mode [Hz; default 6.267 f₀, a rectangular beam's].
-    #[arg(long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Eigenmodes")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Eigenmodes")]
     pub mode2_resonance: Option<f64>,
     /// Quality factor Q₂ of the second mode [default Q f₂/f₀].
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Eigenmodes")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = number, help_heading = "Eigenmodes")]
     pub mode2_quality: Option<f64>,
     /// How far (relative) a higher mode's resonance may be moved so that it is a
     /// ratio p/q of the first drive frequency (q ≤ 32), making the motion periodic over
@@ -884,7 +886,7 @@ pub struct ModeInputs {
     /// beam's f₂ = 6.267 f₀ becomes 25/4 f₀]. 0 keeps every frequency as given: with no
     /// common period, `tap` reports averages over windows, each with its error, and
     /// `scan` marches the modes as they are.
-    #[arg(long, allow_hyphen_values = true, value_parser = number, help_heading = "Eigenmodes")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = number, help_heading = "Eigenmodes")]
     pub ratio_tolerance: Option<f64>,
 }
 

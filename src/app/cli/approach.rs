@@ -78,7 +78,7 @@ pub struct ApproachArgs {
     /// Each point draws noise of its own (a seed derived from its place along the
     /// curve, JSON thermal_average.seed): the errors of neighbouring points are
     /// independent.
-    #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
+    #[arg(hide_short_help = true, long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
     thermal_periods: usize,
     #[command(flatten)]
     modes: crate::app::config::ModeInputs,

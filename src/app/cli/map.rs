@@ -73,7 +73,7 @@ pub struct MapArgs {
           conflicts_with = "amplitude_setpoint")]
     setpoint: Option<f64>,
     /// The amplitude setpoint as an amplitude (e.g. 16nm): --setpoint A_sp/A₀.
-    #[arg(long, allow_hyphen_values = true, value_parser = crate::app::config::length)]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = crate::app::config::length)]
     amplitude_setpoint: Option<f64>,
     /// With a setpoint: the branch every cell is solved on [default: repulsive].
     #[arg(long, value_enum, ignore_case = true)]
@@ -92,7 +92,7 @@ pub struct MapArgs {
     /// Each cell draws noise of its own (a seed derived from its parameters, as `tap
     /// --temperature` at them draws: JSON thermal_average.seed), so the errors of
     /// neighbouring cells are independent.
-    #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
+    #[arg(hide_short_help = true, long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
     thermal_periods: usize,
     #[command(flatten)]
     split: super::shard::ShardArgs,

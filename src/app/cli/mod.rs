@@ -284,10 +284,10 @@ pub struct NoiseArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = crate::app::config::temperature, help_heading = "Thermal noise")]
     pub temperature: Option<f64>,
     /// The lock-in's equivalent noise bandwidth for --temperature [Hz; default 1kHz].
-    #[arg(long, allow_hyphen_values = true, value_parser = crate::app::config::frequency, help_heading = "Thermal noise")]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = crate::app::config::frequency, help_heading = "Thermal noise")]
     pub enbw: Option<f64>,
     /// The lock-in's filter order (1–4) for --temperature [default 4].
-    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=4), help_heading = "Thermal noise")]
+    #[arg(hide_short_help = true, long, value_parser = clap::value_parser!(u8).range(1..=4), help_heading = "Thermal noise")]
     pub lockin_order: Option<u8>,
 }
 

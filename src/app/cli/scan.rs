@@ -108,7 +108,12 @@ pub struct ScanArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 0.0)]
     proportional_gain: f64,
     /// Lock-in filter order (1–4).
-    #[arg(long, allow_hyphen_values = true, default_value_t = 4)]
+    #[arg(
+        hide_short_help = true,
+        long,
+        allow_hyphen_values = true,
+        default_value_t = 4
+    )]
     lockin_order: usize,
     /// Lock-in time constant, in drive periods (at most 1000).
     #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 2.0)]

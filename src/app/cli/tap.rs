@@ -99,6 +99,7 @@ pub struct TapArgs {
     pub(super) plot: Option<PathBuf>,
     /// Cycles recorded for --trajectory and --plot.
     #[arg(
+        hide_short_help = true,
         long,
         allow_hyphen_values = true,
         default_value_t = 3,
@@ -115,7 +116,7 @@ pub struct TapArgs {
     /// Look for other stable period-1 states at z_c also by following every family of
     /// period-1 orbits in from 1.2 A₀ (besides the default search from the roots of the
     /// first-harmonic balance; about a hundred times slower).
-    #[arg(long, help_heading = "Numerics")]
+    #[arg(hide_short_help = true, long, help_heading = "Numerics")]
     all_states: bool,
     /// Amplitude setpoint A/A₀ (between 0 and 1), as an AFM's z feedback holds it,
     /// instead of a rest separation: every stable period-1 steady state whose amplitude
@@ -125,7 +126,7 @@ pub struct TapArgs {
           conflicts_with = "amplitude_setpoint")]
     setpoint: Option<f64>,
     /// The amplitude setpoint as an amplitude (e.g. 16nm): --setpoint A_sp/A₀.
-    #[arg(long, allow_hyphen_values = true, value_parser = length)]
+    #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = length)]
     amplitude_setpoint: Option<f64>,
     /// With a setpoint: the branch whose states are listed [default: all]. Attractive:
     /// the phase lag above the free oscillator's (90° at resonance), net attractive
@@ -140,7 +141,7 @@ pub struct TapArgs {
     /// grazes a switch or is not a stable period-1 orbit: eight independent records of
     /// an eighth each (after ten decay times of settling), whose spread gives the
     /// standard errors.
-    #[arg(long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
+    #[arg(hide_short_help = true, long, default_value_t = super::DEFAULT_THERMAL_PERIODS, help_heading = "Thermal noise")]
     thermal_periods: usize,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long, help_heading = "Output")]
