@@ -192,3 +192,28 @@ fn the_documentation_stands_on_its_own() {
         );
     }
 }
+
+/// The command reference in the book is the command line's own `--help`, current: what
+/// `tapsim man --markdown` writes now.
+#[test]
+fn the_command_reference_is_current() {
+    let dir = std::env::temp_dir().join(format!("tapsim-docs-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fresh = dir.join("commands.md");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_tapsim"))
+        .args(["man", "--markdown", fresh.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let fresh = std::fs::read_to_string(&fresh).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let committed = std::fs::read_to_string(root().join("docs/src/reference/commands.md")).unwrap();
+    assert!(
+        fresh == committed,
+        "docs/src/reference/commands.md is stale: run `tapsim man --markdown docs/src/reference/commands.md`"
+    );
+}

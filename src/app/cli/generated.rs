@@ -18,15 +18,24 @@ pub struct CompletionsArgs {
 }
 
 /// Write a man page for tapsim and for each command into a directory (tapsim.1,
-/// tapsim-tap.1, …), from the same text as --help.
+/// tapsim-tap.1, …), from the same text as --help; or, with --markdown, every command's
+/// --help as one Markdown page (the guide's command reference).
 ///
 ///   tapsim man --out ~/.local/share/man/man1 && man tapsim-tap
+///   tapsim man --markdown docs/src/reference/commands.md
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct ManArgs {
     /// The directory to write the pages into (it must exist).
-    #[arg(long)]
-    out: PathBuf,
+    #[arg(
+        long,
+        required_unless_present = "markdown",
+        conflicts_with = "markdown"
+    )]
+    out: Option<PathBuf>,
+    /// Write every command's --help, at 80 columns, as one Markdown page.
+    #[arg(long, value_name = "FILE.md")]
+    markdown: Option<PathBuf>,
     /// No notes of files written on stderr.
     #[arg(long, short = 'q')]
     pub(super) quiet: bool,
@@ -41,12 +50,46 @@ pub fn completions(args: CompletionsArgs) -> Result<()> {
     Ok(())
 }
 
-/// Write the man pages.
+/// Every command's --help at 80 columns, as Markdown: the guide's command reference.
+pub fn reference() -> String {
+    let mut root = super::Cli::command().term_width(80);
+    let mut text = String::from(
+        "# Command reference\n\nEvery command's `--help`, generated from the command line's own \
+         definitions (`tapsim man --markdown docs/src/reference/commands.md`; a test checks \
+         this page is current). `-h` shows a one-screen summary of the same.\n",
+    );
+    text.push_str(&format!(
+        "\n## tapsim\n\n```text\n{}\n```\n",
+        root.render_long_help().to_string().trim_end()
+    ));
+    for sub in root.get_subcommands_mut() {
+        let name = sub.get_name().to_string();
+        let mut sub = sub
+            .clone()
+            .term_width(80)
+            .bin_name(format!("tapsim {name}"));
+        text.push_str(&format!(
+            "\n## tapsim {name}\n\n```text\n{}\n```\n",
+            sub.render_long_help().to_string().trim_end()
+        ));
+    }
+    text
+}
+
+/// Write the man pages, or the Markdown reference.
 pub fn man(args: ManArgs) -> Result<()> {
-    if !args.out.is_dir() {
+    if let Some(path) = &args.markdown {
+        return crate::app::report::output::write_bytes(path, reference().as_bytes());
+    }
+    let Some(out) = args.out else {
+        return Err(Error::NotApplicable(
+            "give --out DIR or --markdown FILE.md".into(),
+        ));
+    };
+    if !out.is_dir() {
         return Err(Error::NotApplicable(format!(
             "--out {}: give an existing directory",
-            args.out.display()
+            out.display()
         )));
     }
     let root = super::Cli::command();
@@ -65,7 +108,7 @@ pub fn man(args: ManArgs) -> Result<()> {
             .title(name.to_uppercase())
             .render(&mut page)
             .map_err(|e| Error::Numerical(format!("the man page of {name}: {e}")))?;
-        crate::app::report::output::write_bytes(&args.out.join(format!("{name}.1")), &page)?;
+        crate::app::report::output::write_bytes(&out.join(format!("{name}.1")), &page)?;
     }
     Ok(())
 }

@@ -91,25 +91,73 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    #[command(
+        about = "One cantilever tapping one sample: its steady state, what a lock-in reads, the loss per cycle."
+    )]
     Tap(tap::TapArgs),
+    #[command(
+        about = "Approach–retract curves: amplitude, phase and loss against the rest separation or setpoint."
+    )]
     Approach(approach::ApproachArgs),
+    #[command(
+        about = "The period-1 orbit families through the rest separation, stable and unstable, through folds."
+    )]
     Branches(branches::BranchesArgs),
+    #[command(
+        about = "A bifurcation diagram along an approach: period doublings, locks and irregular windows."
+    )]
     Bifurcation(bifurcation::BifurcationArgs),
+    #[command(about = "Phase contrast between materials at amplitude setpoints, law by law.")]
     Contrast(contrast::ContrastArgs),
+    #[command(
+        about = "Fit a measured approach curve: the material's parameters and which law the data support."
+    )]
     Fit(fit::FitArgs),
+    #[command(
+        about = "The force and the loss a measured AM curve implies (Sader–Jarvis, Hölscher)."
+    )]
     Reconstruct(reconstruct::ReconstructArgs),
+    #[command(
+        about = "A map over work of adhesion and modulus: phase, loss and height, in parallel or sharded."
+    )]
     Map(map::MapArgs),
+    #[command(
+        about = "Scan a line or an image over a sample with the lock-in and z feedback in the loop."
+    )]
     Scan(scan::ScanArgs),
+    #[command(
+        about = "The free cantilever's thermal spectrum, and the calibration of a simulated or measured one."
+    )]
     Thermal(thermal::ThermalArgs),
+    #[command(
+        about = "Off-resonance (PeakForce-type) tapping: a force curve every cycle, the QNM channels."
+    )]
     Peakforce(peakforce::PeakForceArgs),
+    #[command(
+        about = "A force–distance curve: snap-in, pull-off, adhesion, indentation and the energy books."
+    )]
     ForceCurve(force_curve::ForceCurveArgs),
+    #[command(about = "Run many cases from a file, in parallel or sharded.")]
     Batch(batch::BatchArgs),
+    #[command(about = "Join the parts of a sharded map, batch or image into one run's outputs.")]
     Merge(merge::MergeArgs),
+    #[command(
+        about = "The paper's closed forms: jump-in, jump-out and the hysteresis loss of JKR and the hybrid law."
+    )]
     Hysteresis(hysteresis::HysteresisArgs),
+    #[command(
+        about = "The full Lennard-Jones solution: the S-curve, its folds and the loss with an error estimate."
+    )]
     Lj(lj::LjArgs),
+    #[command(about = "Draw the paper's figures.")]
     Figure(figure::FigureArgs),
+    #[command(
+        about = "Regenerate results/: the paper's figures, the tapping figures and their headline numbers."
+    )]
     Reproduce(reproduce::ReproduceArgs),
+    #[command(about = "Print a shell's completion script.")]
     Completions(generated::CompletionsArgs),
+    #[command(about = "Write man pages, or the Markdown command reference.")]
     Man(generated::ManArgs),
 }
 
