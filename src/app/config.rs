@@ -417,6 +417,30 @@ pub fn read_text(path: &Path, max_bytes: u64, refuse: impl Fn(String) -> Error) 
     String::from_utf8(bytes).map_err(|_| refuse("not UTF-8 text".into()))
 }
 
+/// A CSV data file at `path` (at most `max_bytes`, [`read_input`]): its header and its
+/// rows, cells trimmed; `fail` words a refusal (a row's names it, counting the header as
+/// row 1).
+pub fn read_csv(
+    path: &Path,
+    max_bytes: u64,
+    fail: impl Fn(String) -> Error,
+) -> Result<(csv::StringRecord, Vec<csv::StringRecord>)> {
+    let bytes = read_input(path, max_bytes, &fail)?;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(bytes.as_slice());
+    let headers = reader
+        .headers()
+        .map_err(|e| fail(format!("no CSV header: {e}")))?
+        .clone();
+    let rows = reader
+        .records()
+        .enumerate()
+        .map(|(row, record)| record.map_err(|e| fail(format!("row {}: {e}", row + 2))))
+        .collect::<Result<Vec<_>>>()?;
+    Ok((headers, rows))
+}
+
 /// A settable quantity: its key (a flag's name, also the TOML key), its dimension, and
 /// where it lives in [`TapInputs`].
 type Field = (

@@ -134,14 +134,7 @@ pub fn read_curve(
         text: path.display().to_string(),
         reason,
     };
-    let bytes = crate::app::config::read_input(path, MAX_DATA_BYTES, fail)?;
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(bytes.as_slice());
-    let headers = reader
-        .headers()
-        .map_err(|e| fail(format!("no CSV header: {e}")))?
-        .clone();
+    let (headers, rows) = crate::app::config::read_csv(path, MAX_DATA_BYTES, fail)?;
     let mut at: HashMap<Kind, (usize, f64)> = HashMap::new();
     for (i, h) in headers.iter().enumerate() {
         if let Some((kind, scale)) = column_kind(h) {
@@ -236,8 +229,7 @@ pub fn read_curve(
     let (mut a2, mut p2) = (Vec::new(), Vec::new());
     let mut segments = Vec::new();
     let mut label: Option<String> = None;
-    for (row, record) in reader.records().enumerate() {
-        let record = record.map_err(|e| fail(format!("row {}: {e}", row + 2)))?;
+    for (row, record) in rows.iter().enumerate() {
         if direction_col.is_some_and(|c| record.get(c).is_some_and(|v| v != direction)) {
             continue;
         }

@@ -2,7 +2,7 @@
 
 use super::thermal_psd::{FitFields, FluidChoice, PsdReading, PsdRun};
 use crate::app::config::{frequency, length, number, stiffness, temperature, time, viscosity};
-use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
+use crate::app::report::chart::{Chart, Series, Style};
 use crate::dynamics::grazing::{BOLTZMANN_J_K, ROOM_TEMPERATURE_K};
 use crate::dynamics::setup::default_setup;
 use crate::error::{Error, Result};
@@ -358,25 +358,5 @@ fn charts(
         .fold((f64::INFINITY, 0.0_f64), |(lo, hi), y| {
             (lo.min(y), hi.max(y))
         });
-    vec![
-        Chart {
-            name: "thermal_spectrum".into(),
-            title: title.clone(),
-            x: Axis::log("frequency f (kHz)", "freq_khz"),
-            y: Axis::log("deflection PSD S_z (pm²/Hz)", "psd_pm2_hz"),
-            legend: Corner::LowerLeft,
-            series: overview,
-            labels: Vec::new(),
-        },
-        Chart {
-            name: "thermal_resonance".into(),
-            title: "around the resonance (10 linewidths either side)".into(),
-            x: Axis::linear("frequency f (kHz)", "freq_khz"),
-            y: Axis::log("deflection PSD S_z (pm²/Hz)", "psd_pm2_hz")
-                .with_range(0.7 * lo, 8.0 * hi),
-            legend: Corner::UpperRight,
-            series: resonance,
-            labels: Vec::new(),
-        },
-    ]
+    super::thermal_psd::spectrum_charts(title, (overview, resonance), Some((0.7 * lo, 8.0 * hi)))
 }

@@ -62,14 +62,7 @@ pub fn read_psd(path: &Path, how: &PsdReading) -> Result<Psd> {
         text: path.display().to_string(),
         reason,
     };
-    let bytes = crate::app::config::read_input(path, MAX_PSD_BYTES, fail)?;
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(bytes.as_slice());
-    let headers = reader
-        .headers()
-        .map_err(|e| fail(format!("no CSV header: {e}")))?
-        .clone();
+    let (headers, rows) = crate::app::config::read_csv(path, MAX_PSD_BYTES, fail)?;
     let (fi, f_scale) = headers
         .iter()
         .enumerate()
@@ -122,8 +115,7 @@ pub fn read_psd(path: &Path, how: &PsdReading) -> Result<Psd> {
         )));
     }
     let (mut freq_hz, mut values) = (Vec::new(), Vec::new());
-    for (row, record) in reader.records().enumerate() {
-        let record = record.map_err(|e| fail(format!("row {}: {e}", row + 2)))?;
+    for (row, record) in rows.iter().enumerate() {
         let cell = |i: usize, what: &str| -> Result<f64> {
             let text = record.get(i).unwrap_or("");
             text.parse::<f64>()
@@ -441,12 +433,27 @@ fn charts(report: &Report, c: &Calibration, bins: &[Bin]) -> Vec<Chart> {
             0,
         ));
     }
+    spectrum_charts(
+        format!("thermal spectrum read from {}", report.psd_file),
+        (overview, zoom),
+        None,
+    )
+}
+
+/// A thermal spectrum's two panels: `overview` over the whole range (log-log), `zoom`
+/// around the resonance (its density axis over `zoom_range` where given), in pm²/Hz.
+pub(super) fn spectrum_charts(
+    title: String,
+    (overview, zoom): (Vec<Series>, Vec<Series>),
+    zoom_range: Option<(f64, f64)>,
+) -> Vec<Chart> {
+    let density = Axis::log("deflection PSD S_z (pm²/Hz)", "psd_pm2_hz");
     vec![
         Chart {
             name: "thermal_spectrum".into(),
-            title: format!("thermal spectrum read from {}", report.psd_file),
+            title,
             x: Axis::log("frequency f (kHz)", "freq_khz"),
-            y: Axis::log("deflection PSD S_z (pm²/Hz)", "psd_pm2_hz"),
+            y: density.clone(),
             legend: Corner::LowerLeft,
             series: overview,
             labels: Vec::new(),
@@ -455,7 +462,10 @@ fn charts(report: &Report, c: &Calibration, bins: &[Bin]) -> Vec<Chart> {
             name: "thermal_resonance".into(),
             title: "around the resonance (10 linewidths either side)".into(),
             x: Axis::linear("frequency f (kHz)", "freq_khz"),
-            y: Axis::log("deflection PSD S_z (pm²/Hz)", "psd_pm2_hz"),
+            y: match zoom_range {
+                Some((lo, hi)) => density.with_range(lo, hi),
+                None => density,
+            },
             legend: Corner::UpperRight,
             series: zoom,
             labels: Vec::new(),
