@@ -2,6 +2,8 @@
 //! page in one click, a book in docs/ whose table of contents lists every page, and no
 //! link that leads nowhere.
 
+mod common;
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -216,4 +218,31 @@ fn the_command_reference_is_current() {
         fresh == committed,
         "docs/src/reference/commands.md is stale: run `tapsim man --markdown docs/src/reference/commands.md`"
     );
+}
+
+/// The how-to pages' recipes are commands the tours run (`tests/tour.rs`), word for word.
+#[test]
+fn every_recipe_is_a_command_the_tours_run() {
+    let tours = common::tour();
+    let mut recipes = 0;
+    for page in pages() {
+        let text = std::fs::read_to_string(&page).unwrap();
+        if !text.contains("## Recipes") {
+            continue;
+        }
+        let rel = page
+            .strip_prefix(root())
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        for command in common::tour_block(&rel, "## Recipes") {
+            assert!(
+                tours.contains(&command),
+                "{rel}: `tapsim {}` is in no tour",
+                command.join(" ")
+            );
+            recipes += 1;
+        }
+    }
+    assert!(recipes >= 15, "{recipes} recipes");
 }

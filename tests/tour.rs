@@ -7,49 +7,6 @@ mod common;
 
 use std::path::Path;
 
-/// The commands of the first `sh` block after `heading` in `file` (from the repository's
-/// root): one per line (a trailing `\` joins the next), comments (`#` after whitespace)
-/// dropped, `tapsim` first.
-fn tour_block(file: &str, heading: &str) -> Vec<Vec<String>> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
-    let readme = std::fs::read_to_string(&path).expect(file);
-    let start = readme.find(heading).expect("the tour's heading");
-    let block = &readme[start..];
-    let block = &block[block.find("```sh\n").expect("a sh block") + 6..];
-    let block = &block[..block.find("```").expect("the block ends")];
-    let mut commands = Vec::new();
-    let mut current = String::new();
-    for line in block.lines() {
-        let code = match line.find(" #") {
-            Some(i) => &line[..i],
-            None => line,
-        };
-        let code = code.trim();
-        let (code, joined) = match code.strip_suffix('\\') {
-            Some(c) => (c, true),
-            None => (code, false),
-        };
-        current.push(' ');
-        current.push_str(code);
-        if !joined {
-            let words: Vec<String> = current.split_whitespace().map(String::from).collect();
-            if !words.is_empty() {
-                assert_eq!(words[0], "tapsim", "{current}");
-                commands.push(words[1..].to_vec());
-            }
-            current.clear();
-        }
-    }
-    commands
-}
-
-/// Both tours' commands, the README's first.
-fn tour() -> Vec<Vec<String>> {
-    let mut commands = tour_block("README.md", "## Five-minute tour");
-    commands.extend(tour_block("docs/src/reference/cli-tour.md", "# CLI tour"));
-    commands
-}
-
 /// Run a tour command in `dir` (the tour's example files from the repository), with
 /// `extra` arguments; its stdout.
 fn run(args: &[String], extra: &[&str], dir: &Path) -> String {
@@ -78,7 +35,7 @@ fn has(args: &[String], flag: &str) -> bool {
 /// 7 times the hybrid's (the guide).
 #[test]
 fn every_tour_command_runs_and_shows_its_effect() {
-    let commands = tour();
+    let commands = common::tour();
     assert!(commands.len() > 30, "{}", commands.len());
     let dir = common::scratch("tour");
     // Two at a time from one queue, as the machine has two cores.
