@@ -199,13 +199,9 @@ fn the_documentation_stands_on_its_own() {
 /// `tapsim man --markdown` writes now.
 #[test]
 fn the_command_reference_is_current() {
-    let dir = std::env::temp_dir().join(format!("tapsim-docs-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch("docs");
     let fresh = dir.join("commands.md");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_tapsim"))
-        .args(["man", "--markdown", fresh.to_str().unwrap(), "--quiet"])
-        .output()
-        .unwrap();
+    let out = common::tapsim(&["man", "--markdown", fresh.to_str().unwrap(), "--quiet"]);
     assert!(
         out.status.success(),
         "{}",

@@ -290,12 +290,15 @@ pub struct TrajectorySample {
     pub branch: Branch,
 }
 
+/// One recorded point of the motion: (τ, x, x', α̂, f_ts, branch).
+pub type Sample = (f64, f64, f64, f64, f64, Branch);
+
 /// Records the trajectory (dimensionless samples, converted by [`Recorder::to_si`]):
 /// step ends plus points on each step's Hermite interpolant, and closed-form free flight
 /// sampled evenly, as densely as its [`Sampling`] says.
 pub(crate) struct Recorder<'a, L: ForceLaw> {
-    /// (τ, x, x', α̂, f_ts, branch).
-    pub samples: Vec<(f64, f64, f64, f64, f64, Branch)>,
+    /// The samples recorded.
+    pub samples: Vec<Sample>,
     /// Whether samples were dropped at the sampling's `max_samples`.
     pub overflowed: bool,
     law: &'a L,

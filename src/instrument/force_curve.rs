@@ -21,7 +21,7 @@ use crate::dynamics::model::{Drive, State};
 use crate::dynamics::modes::system::{ModeIntegral, Modes, force_integral, integral};
 use crate::dynamics::modes::{Modal, ModeSet};
 use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver};
-use crate::dynamics::observed::{Recorder, Sampling};
+use crate::dynamics::observed::{Recorder, Sample, Sampling};
 use crate::dynamics::setup::{Cantilever, Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
 use crate::physics::law::{AnyLaw, Branch, ForceLaw, Internal};
@@ -262,11 +262,29 @@ struct Energies {
 
 /// The recorded legs: samples, each leg's (first sample, time offset τ₀, approach).
 struct Record {
-    samples: Vec<(f64, f64, f64, f64, f64, Branch)>,
+    samples: Vec<Sample>,
     legs: Vec<(usize, f64, Leg)>,
     energies: Energies,
     /// Whether a leg needed more points than a record holds.
     overflowed: bool,
+}
+
+impl Record {
+    /// A new leg's recording starts from the last leg's end, which is its start (at the
+    /// leg's τ = 0): that sample, if there is one.
+    fn leg_start(&self) -> Option<Sample> {
+        self.samples
+            .last()
+            .map(|last| (0.0, last.1, last.2, last.3, last.4, last.5))
+    }
+
+    /// Append a leg's recorded `samples` (their first, the last leg's end, dropped where
+    /// a leg came before) and whether they `overflowed`.
+    fn append(&mut self, samples: &mut Vec<Sample>, overflowed: bool) {
+        let skip = usize::from(!self.samples.is_empty());
+        self.overflowed |= overflowed;
+        self.samples.extend(samples.drain(skip..));
+    }
 }
 
 /// A cantilever the ramp moves: one leg at a time.
@@ -542,14 +560,8 @@ impl Lever for OneMode<'_> {
         };
         // The span one call may cover: the whole leg.
         sim.osc.omega = 2.0 * PI / leg.span;
-        let first = record.samples.len();
         let mut recorder = Recorder::sampling(sim.law, sim.cpl, sim.osc, RAMP_CURVE);
-        if let Some(last) = record.samples.last() {
-            // Go on from the last leg's end, which is this leg's start.
-            recorder
-                .samples
-                .push((0.0, last.1, last.2, last.3, last.4, last.5));
-        }
+        recorder.samples.extend(record.leg_start());
         let add = |c: CycleIntegrals, record: &mut Record| {
             let e = &mut record.energies;
             e.contact += c.e_ts;
@@ -588,9 +600,7 @@ impl Lever for OneMode<'_> {
                 }
             }
         }
-        record.overflowed |= recorder.overflowed;
-        let skip = usize::from(first > 0);
-        record.samples.extend(recorder.samples.drain(skip..));
+        record.append(&mut recorder.samples, recorder.overflowed);
         Ok((phase.tau, triggered))
     }
 }
@@ -672,7 +682,7 @@ impl<'a, const M: usize, const P: usize> SeveralModes<'a, M, P> {
 /// step's end.
 struct TipRecorder<'r, 'a, const M: usize> {
     modes: &'r Modes<'a, AnyLaw, M>,
-    samples: Vec<(f64, f64, f64, f64, f64, Branch)>,
+    samples: Vec<Sample>,
     overflowed: bool,
     max_force: f64,
 }
@@ -731,12 +741,8 @@ impl<const M: usize, const P: usize> Lever for SeveralModes<'_, M, P> {
 
     fn leg(&mut self, leg: Leg, trigger: Option<f64>, record: &mut Record) -> Result<(f64, bool)> {
         self.modes.support = (leg.from, leg.speed);
-        let first = record.samples.len();
         let mut rec = TipRecorder::new(&self.modes);
-        if let Some(last) = record.samples.last() {
-            rec.samples
-                .push((0.0, last.1, last.2, last.3, last.4, last.5));
-        }
+        rec.samples.extend(record.leg_start());
         let (y0, e0) = (self.y, self.energy_of(&self.y));
         let (mut y, mut branch, mut tau, mut work_hat) = (self.y, self.branch, 0.0, 0.0);
         let mut triggered = false;
@@ -780,9 +786,7 @@ impl<const M: usize, const P: usize> Lever for SeveralModes<'_, M, P> {
         e.damping += d1 - d0;
         e.drive -= leg.speed * (f1 - f0);
         e.mechanical += self.energy_of(&y) - e0;
-        record.overflowed |= rec.overflowed;
-        let skip = usize::from(first > 0);
-        record.samples.extend(rec.samples.drain(skip..));
+        record.append(&mut rec.samples, rec.overflowed);
         self.y = y;
         self.branch = branch;
         Ok((tau, triggered))

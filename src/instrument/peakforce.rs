@@ -19,7 +19,7 @@ use crate::dynamics::budget::budgeted;
 use crate::dynamics::march::{Phase, Simulation};
 use crate::dynamics::model::Drive;
 use crate::dynamics::numeric::Ignore;
-use crate::dynamics::observed::Recorder;
+use crate::dynamics::observed::{Recorder, Sample};
 use crate::dynamics::setup::{Cantilever, Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
 use crate::physics::law::{AnyLaw, Branch, MAX_INTERNAL};
@@ -206,7 +206,7 @@ pub(crate) fn force_points(
     p: &Prepared,
     sim: &Simulation<'_, AnyLaw>,
     separation_m: f64,
-    samples: &[(f64, f64, f64, f64, f64, Branch)],
+    samples: &[Sample],
 ) -> Vec<ForcePoint> {
     let cant = &p.setup.cantilever;
     let (k, l) = (cant.stiffness_n_m, cant.free_amplitude_m);

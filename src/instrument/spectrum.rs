@@ -226,8 +226,6 @@ pub struct Calibration {
 /// widened by the correlation of neighbouring bins that the spectrum's window makes
 /// ([`SpectralWindow::error_factor`]).
 pub fn calibrate(psd: &Psd, temperature_k: f64) -> Result<Calibration> {
-    let fail =
-        |why: &str| Error::Numerical(format!("the thermal spectrum cannot be fitted: {why}"));
     if psd.freq_hz.len() != psd.density.len() || psd.freq_hz.len() < 8 {
         return Err(fail("fewer than 8 bins"));
     }
@@ -334,8 +332,6 @@ pub fn calibrate(psd: &Psd, temperature_k: f64) -> Result<Calibration> {
 /// resonance (at most half its frequency away), from the guess (f₀', Q', S₀') and the
 /// background `background` S₀'.
 fn fit_window(psd: &Psd, guess: (f64, f64, f64), background: f64) -> Result<ShoFit> {
-    let fail =
-        |why: &str| Error::Numerical(format!("the thermal spectrum cannot be fitted: {why}"));
     let (f0, q0, _) = guess;
     let reach = (20.0 * f0 / q0).min(0.5 * f0);
     let bins: Vec<(f64, f64)> = psd
@@ -374,6 +370,11 @@ fn fit_window(psd: &Psd, guess: (f64, f64, f64), background: f64) -> Result<ShoF
         }
     }
     Err(fail("the weighted fit does not settle"))
+}
+
+/// Why the thermal spectrum cannot be fitted.
+fn fail(why: &str) -> Error {
+    Error::Numerical(format!("the thermal spectrum cannot be fitted: {why}"))
 }
 
 /// The most passes of the weighted fit.

@@ -213,7 +213,7 @@ impl Command {
                 a.out.check()?;
                 a.images.check()
             }
-            Command::Thermal(a) => a.out.check(),
+            Command::Thermal(a) => a.check(),
             Command::Peakforce(a) => a.check(),
             Command::ForceCurve(a) => a.check(),
             Command::Batch(a) => a.out.check(),

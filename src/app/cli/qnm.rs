@@ -8,6 +8,7 @@ use crate::app::config::{force, number};
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::app::report::heatmap::HeatMap;
 use crate::app::report::part::{self, Job};
+use crate::app::report::records::typed;
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
 use crate::instrument::peakforce::{Modulation, PeakForceFeedback, check_setpoint};
@@ -188,7 +189,7 @@ pub(super) fn emit_map<T: serde::Serialize>(
     (works, moduli): (&[f64], &[f64]),
     records: &[T],
 ) -> Result<()> {
-    let cells: Vec<QnmCell> = typed(records)?;
+    let cells: Vec<QnmCell> = typed(records, "QNM")?;
     let title = format!("{law} law, peak force {} nN", setpoint_n * 1e9);
     out.emit(
         ("map", extra),
@@ -210,18 +211,6 @@ pub(super) fn emit_map<T: serde::Serialize>(
         );
     }
     Ok(())
-}
-
-/// Records (computed, or read back from part files) as the values they hold.
-fn typed<T: serde::Serialize, U: serde::de::DeserializeOwned>(records: &[T]) -> Result<Vec<U>> {
-    records
-        .iter()
-        .map(|r| {
-            serde_json::to_value(r)
-                .and_then(serde_json::from_value)
-                .map_err(|e| Error::NotApplicable(format!("a record that is not a QNM one: {e}")))
-        })
-        .collect()
 }
 
 /// The QNM channels over the grid.
@@ -493,13 +482,11 @@ pub(super) fn emit_scan<T: serde::Serialize>(
     (shape, image): ((usize, usize, f64), Option<&part::ImageInfo>),
     records: &[T],
 ) -> Result<()> {
-    let rows: Vec<Row> = typed(records)?;
+    let rows: Vec<Row> = typed(records, "QNM")?;
     let (files, extra) = super::image::ImageFiles::among(extra)?;
-    let image = match image {
-        Some(image) => Some(image),
-        None if files.any() => return Err(files.no_image()),
-        None => None,
-    };
+    if files.any() && image.is_none() {
+        return Err(files.no_image());
+    }
     out.emit(
         ("scan", &extra),
         records,

@@ -632,38 +632,27 @@ pub(super) fn emit<T: ScanRecord>(
     records: &[T],
 ) -> Result<()> {
     let (files, extra) = super::image::ImageFiles::among(extra)?;
-    if files.any() {
-        let Job::Scan {
+    let image = match job {
+        _ if !files.any() => None,
+        Job::Scan {
             lines,
             pixels,
             image: Some(image),
             ..
-        } = job
-        else {
-            return Err(files.no_image());
-        };
-        let rows = records
-            .iter()
-            .map(|r| serde_json::to_value(r).and_then(serde_json::from_value::<Row>))
-            .collect::<std::result::Result<Vec<Row>, _>>()
-            .map_err(|e| Error::Numerical(format!("a scan record does not read back: {e}")))?;
-        out.emit(
-            ("scan", &extra),
-            records,
-            || crate::app::report::records::columns_json(records),
-            Some(&|path| draw(job, records, path)),
-        )?;
-        return files.write(
-            &image_channels(&rows, (*lines, *pixels), image.size_m),
-            &image.meta,
-        );
-    }
+        } => Some(((*lines, *pixels), image)),
+        _ => return Err(files.no_image()),
+    };
     out.emit(
         ("scan", &extra),
         records,
         || crate::app::report::records::columns_json(records),
         Some(&|path| draw(job, records, path)),
-    )
+    )?;
+    let Some((shape, image)) = image else {
+        return Ok(());
+    };
+    let rows: Vec<Row> = crate::app::report::records::typed(records, "scan")?;
+    files.write(&image_channels(&rows, shape, image.size_m), &image.meta)
 }
 
 /// The plot of a scan: profiles of one line, heat maps of an image.

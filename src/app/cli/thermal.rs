@@ -146,9 +146,17 @@ struct Bin {
     fit_m2_hz: f64,
 }
 
+impl ThermalArgs {
+    /// Refuse, before any work, output files that cannot be written (the parameter
+    /// file --save-config among them).
+    pub(super) fn check(&self) -> Result<()> {
+        self.out.check()?;
+        super::check_targets([self.save_config.as_deref()])
+    }
+}
+
 /// Run the subcommand.
 pub fn run(args: ThermalArgs) -> Result<()> {
-    args.out.check()?;
     let t = args.temperature.unwrap_or(ROOM_TEMPERATURE_K);
     if let Some(path) = &args.psd {
         let fluid = args.fluid.fluid();
@@ -173,9 +181,6 @@ pub fn run(args: ThermalArgs) -> Result<()> {
             },
             &args.out,
         );
-    }
-    if let Some(path) = &args.save_config {
-        super::check_targets([Some(path.as_path())])?;
     }
     let c = default_setup().cantilever;
     let k = args.stiffness.unwrap_or(c.stiffness_n_m);

@@ -271,9 +271,6 @@ pub struct PsdRun<'a> {
 /// Calibrate from a measured spectrum.
 pub fn run(job: PsdRun, out: &super::SweepOutput) -> Result<()> {
     crate::error::positive("temperature", job.temperature_k)?;
-    if let Some(path) = job.save_config {
-        super::check_targets([Some(path.as_path())])?;
-    }
     let psd = read_psd(job.path, &job.reading)?;
     let c = calibrate(&psd, job.temperature_k)?;
     let sader = job

@@ -129,6 +129,24 @@ fn flat(record: Map<String, Value>) -> Map<String, Value> {
     out
 }
 
+/// Records (computed, or read back from part files) as the values they hold; `what`
+/// names their kind where one is not.
+pub fn typed<T: Serialize, U: serde::de::DeserializeOwned>(
+    records: &[T],
+    what: &str,
+) -> Result<Vec<U>> {
+    records
+        .iter()
+        .map(|r| {
+            serde_json::to_value(r)
+                .and_then(serde_json::from_value)
+                .map_err(|e| {
+                    Error::NotApplicable(format!("a record that is not a {what} one: {e}"))
+                })
+        })
+        .collect()
+}
+
 /// One JSON object whose fields are arrays (one entry per record, null where a record
 /// lacks the field), in record-field order. Records are converted one at a time.
 pub fn columns_json<T: Serialize>(records: &[T]) -> Result<Value> {
