@@ -511,6 +511,70 @@ fn a_fast_scan_shows_the_feedback_artefacts() {
     assert!(high > 0.85, "highest amplitude on the retrace {high}");
 }
 
+/// The I gain an instrument panel shows (m of z per m of amplitude error and second) is
+/// the rate at which the piezo moves per metre of error, in physical time: far from the
+/// sample the error stands still at (1 − setpoint)·A₀, and z_c falls at I·that, in
+/// m/s — the march's own periods converted by the drive frequency.
+#[test]
+fn the_integral_gain_per_second_is_the_rate_the_piezo_moves_per_metre_of_error() {
+    use tapsim::instrument::feedback::{PiController, hold};
+    let setup = default_setup();
+    let p = Prepared::new(&setup, &Numerics::default()).unwrap();
+    let omega = p.simulation().osc.omega;
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let mut lockin = LockIn::new(4, 2.0 * period, omega).unwrap();
+    let mut controller = PiController::new(0.8, 0.0, 0.002).unwrap();
+    let drive_hz = setup.cantilever.drive_frequency_hz;
+    let i_gain = controller.integral_gain_per_s(drive_hz);
+    assert!((i_gain - 600.0).abs() < 1e-9, "{i_gain}");
+    assert_eq!(controller.integral_time_s(drive_hz), None);
+    let a0 = setup.cantilever.free_amplitude_m;
+    let mut phase = p.simulation().free_steady_start();
+    let (samples, _) = hold(
+        &p,
+        (1.5 * a0, &mut phase),
+        &mut lockin,
+        &mut controller,
+        &mut ThermalForce::none(),
+        400,
+    )
+    .unwrap();
+    // The lock-in settled on the free oscillation (A = A₀), still far out.
+    let (a, b) = (&samples[100], &samples[300]);
+    assert!(b.separation_m > 1.1 * a0, "{b:?}");
+    let error_m = (a.amplitude_ratio - 0.8) * a0;
+    let rate = (b.separation_m - a.separation_m) / (200.0 / drive_hz);
+    assert!(
+        (rate + i_gain * error_m).abs() < 1e-6 * rate.abs(),
+        "z_c moves at {rate:e} m/s; I gain × error = {:e} m/s",
+        i_gain * error_m
+    );
+    let pi = PiController::new(0.8, 0.5, 0.002).unwrap();
+    let t = pi.integral_time_s(drive_hz).unwrap();
+    assert!((t - 0.5 / 600.0).abs() < 1e-15, "{t}");
+}
+
+/// `--integral-gain` in the units of an instrument panel (per second) is the same loop as
+/// K_i per drive period, the scan says both, and a gain past the most is refused in the
+/// units it was given.
+#[test]
+fn scan_takes_the_integral_gain_per_second_as_a_panel_shows_it() {
+    let per_period = common::tapsim(&["scan", "--pixels", "8", "--integral-gain", "0.004"]);
+    let per_second = common::tapsim(&["scan", "--pixels", "8", "--integral-gain", "1200/s"]);
+    assert!(per_period.status.success() && per_second.status.success());
+    assert_eq!(per_period.stdout, per_second.stdout);
+    let text = String::from_utf8_lossy(&per_second.stdout);
+    assert!(
+        text.contains("z feedback: I gain 1200 s⁻¹ (K_i = 0.004 a drive period), P gain 0 m/m"),
+        "{text}"
+    );
+    common::refused(
+        &["scan", "--integral-gain", "4e5/s"],
+        "an integral gain of 400000/s is K_i = 1.333 a drive period at 300 kHz: from 0 to 300000/s",
+    );
+    common::refused(&["scan", "--integral-gain", "-1/s"], "from 0 to 300000/s");
+}
+
 /// A sample whose first region is raised: the loop engages there and the line starts
 /// with the piezo that much higher (rest separation of the defaults at 0.8 plus the
 /// height), holding the setpoint from the first pixel on.

@@ -21,7 +21,9 @@ pub const MAX_PROPORTIONAL: f64 = 10.0;
 /// The largest integral gain K_i (A₀ per unit of A/A₀ error and drive period).
 pub const MAX_INTEGRAL: f64 = 1.0;
 
-/// A PI controller on the amplitude error, in units of A₀ and drive periods.
+/// A PI controller on the amplitude error, in units of A₀ and drive periods. Its
+/// proportional gain K_p is also the P gain of an instrument panel in SI (metres of z per
+/// metre of amplitude error); [`Self::integral_gain_per_s`] gives the I gain.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PiController {
     /// The amplitude setpoint A/A₀.
@@ -70,6 +72,23 @@ impl PiController {
             integral,
             last_error: None,
         })
+    }
+
+    /// The integral gain as an instrument panel in SI units shows it, s⁻¹: metres of z
+    /// per metre of amplitude error and second (Nanonis' "I gain" on an amplitude
+    /// signal). The controller moves z_c by K_i·A₀·e a drive period for an error e in
+    /// units of A₀, so the rate per metre of error is K_i·f_drive — a change of units,
+    /// not an approximation.
+    pub fn integral_gain_per_s(&self, drive_hz: f64) -> f64 {
+        self.integral * drive_hz
+    }
+
+    /// The integral time T_i = K_p/(K_i·f_drive), s: the "time constant" an instrument
+    /// panel shows beside a P gain (u = K_p·(e + ∫e dt/T_i)); `None` where either gain
+    /// is zero.
+    pub fn integral_time_s(&self, drive_hz: f64) -> Option<f64> {
+        (self.proportional > 0.0 && self.integral > 0.0)
+            .then(|| self.proportional / self.integral_gain_per_s(drive_hz))
     }
 
     /// The move of the rest separation (in units of A₀) after a period whose lock-in

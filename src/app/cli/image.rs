@@ -212,6 +212,7 @@ pub(super) fn meta(
     sample: &Option<std::path::PathBuf>,
     (lines, pixels, line_rate): (usize, usize, f64),
     setpoint: String,
+    feedback: &str,
 ) -> Vec<(String, String)> {
     let c = &setup.cantilever;
     vec![
@@ -221,6 +222,7 @@ pub(super) fn meta(
         ),
         ("Mode".into(), mode.into()),
         ("Setpoint".into(), setpoint),
+        ("Feedback".into(), feedback.into()),
         ("Law".into(), setup.law.to_string()),
         (
             "Sample".into(),

@@ -8,7 +8,7 @@ use crate::app::report::part::{self, Job};
 use crate::app::sample::{BLEND, Sample};
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
-use crate::instrument::feedback::PiController;
+use crate::instrument::feedback::{MAX_INTEGRAL, PiController};
 use crate::instrument::lockin::LockIn;
 use crate::instrument::modal::ModalProbe;
 use crate::instrument::repeats::{DEFAULT_TOLERANCE, Repeats};
@@ -101,10 +101,15 @@ pub struct ScanArgs {
     /// Lines per second (each direction).
     #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 4.0)]
     line_rate: f64,
-    /// Integral gain K_i of the z feedback (A₀ per unit of A/A₀ error per drive period).
-    #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 0.002)]
-    integral_gain: f64,
-    /// Proportional gain K_p (A₀ per unit of A/A₀ error).
+    /// Integral gain of the z feedback: K_i, the move of z_c in A₀ per unit of A/A₀
+    /// error and drive period; or, ending in /s, the I gain an instrument panel in SI
+    /// shows (metres of z per metre of amplitude error and second, K_i·f_drive: 0.002 at
+    /// 300 kHz is 600/s).
+    #[arg(long, allow_hyphen_values = true, value_parser = integral_gain,
+          default_value_t = IntegralGain::PerPeriod(0.002))]
+    integral_gain: IntegralGain,
+    /// Proportional gain K_p: the move of z_c per step of the amplitude error, both in
+    /// one length unit (an instrument panel's P gain in m/m).
     #[arg(long, allow_hyphen_values = true, value_parser = number, default_value_t = 0.0)]
     proportional_gain: f64,
     /// Lock-in filter order (1–4).
@@ -267,6 +272,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
                     &args.sample,
                     (args.lines, args.pixels, args.line_rate),
                     format!("peak force {} nN", q.setpoint_n * 1e9),
+                    &format!("peak-force feedback, gain {} a cycle", q.gain),
                 ),
                 (sample.length_m, sample.width_m),
             ),
@@ -318,7 +324,21 @@ pub fn run(args: ScanArgs) -> Result<()> {
         None => 0.0,
     };
     let lockin = LockIn::new(args.lockin_order, args.lockin_periods * period_hat, omega)?;
-    let controller = PiController::new(args.setpoint, args.proportional_gain, args.integral_gain)?;
+    let k_i = args.integral_gain.per_period(drive_hz);
+    if let IntegralGain::PerSecond(g) = args.integral_gain {
+        if !(g >= 0.0 && k_i <= MAX_INTEGRAL) {
+            return Err(Error::OutOfRange(format!(
+                "an integral gain of {g}/s is K_i = {} a drive period at {} kHz: \
+                 from 0 to {}/s (K_i = {MAX_INTEGRAL}; a loop that moves the sample by A₀ \
+                 and more per period on a small error only throws the tip about)",
+                crate::dynamics::setup::significant(k_i),
+                drive_hz * 1e-3,
+                MAX_INTEGRAL * drive_hz
+            )));
+        }
+    }
+    let controller = PiController::new(args.setpoint, args.proportional_gain, k_i)?;
+    let feedback = feedback_panel(&controller, drive_hz);
     let bar = args
         .out
         .progress("scan", mine.len() * (args.pixels * directions + 1));
@@ -392,6 +412,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
             &args.sample,
             (args.lines, args.pixels, args.line_rate),
             format!("A/A0 = {}", args.setpoint),
+            &feedback,
         ),
     };
     let job = Job::Scan {
@@ -408,7 +429,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
             (sample.length_m, sample.width_m),
             &numerics,
             (per_pixel, args.lockin_order, args.lockin_periods),
-            (args.proportional_gain, args.integral_gain),
+            (args.proportional_gain, controller.integral),
             (args.temperature, args.seed, args.exact),
             &set,
         ))
@@ -446,6 +467,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
         args.setpoint,
         args.pixels
     );
+    outln!("z feedback: {feedback}");
     let higher = rows.first().map_or(0, |r| r.pixel.modes.len());
     let mut head = format!(
         "{:>10} {:>10} {:>8} {:>12} {:>10} {:>10} {:>10}",
@@ -766,4 +788,59 @@ fn images(rows: &[Point], lines: usize, pixels: usize, setpoint: f64) -> Vec<Hea
         maps.push(map("phase", "lock-in phase φ (deg)", |p| p.4));
     }
     maps
+}
+
+/// The z feedback's integral gain as the user gives it: per drive period (K_i) or per
+/// second (an instrument panel's I gain).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum IntegralGain {
+    /// K_i: A₀ of z_c per unit of A/A₀ error and drive period.
+    PerPeriod(f64),
+    /// The I gain, s⁻¹ (m of z per m of amplitude error and second).
+    PerSecond(f64),
+}
+
+impl IntegralGain {
+    /// K_i at the drive frequency `drive_hz`.
+    fn per_period(self, drive_hz: f64) -> f64 {
+        match self {
+            IntegralGain::PerPeriod(k) => k,
+            IntegralGain::PerSecond(g) => g / drive_hz,
+        }
+    }
+}
+
+impl std::fmt::Display for IntegralGain {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            IntegralGain::PerPeriod(k) => write!(f, "{k}"),
+            IntegralGain::PerSecond(g) => write!(f, "{g}/s"),
+        }
+    }
+}
+
+/// `0.002` (K_i, per drive period) or `600/s` (the I gain, per second).
+fn integral_gain(s: &str) -> std::result::Result<IntegralGain, String> {
+    let t = s.trim();
+    match t.strip_suffix("/s").or_else(|| t.strip_suffix("s^-1")) {
+        Some(g) => number(g.trim()).map(IntegralGain::PerSecond),
+        None => number(t).map(IntegralGain::PerPeriod),
+    }
+}
+
+/// The gains as tapsim takes them and as an instrument panel in SI shows them.
+fn feedback_panel(c: &PiController, drive_hz: f64) -> String {
+    let mut text = format!(
+        "I gain {} s⁻¹ (K_i = {} a drive period), P gain {} m/m",
+        crate::dynamics::setup::significant(c.integral_gain_per_s(drive_hz)),
+        crate::dynamics::setup::significant(c.integral),
+        c.proportional
+    );
+    if let Some(t) = c.integral_time_s(drive_hz) {
+        text += &format!(
+            ", integral time {} ms",
+            crate::dynamics::setup::significant(t * 1e3)
+        );
+    }
+    text
 }
