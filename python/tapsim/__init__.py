@@ -342,6 +342,7 @@ class Setup:
         self._options = dict(options)
 
     def replace(self, **changes: Any) -> "Setup":
+        """A new Setup with ``changes`` applied (a value of None removes the key)."""
         options = dict(self._options)
         for key, value in changes.items():
             if value is None:
@@ -351,9 +352,11 @@ class Setup:
         return Setup(**options)
 
     def copy(self) -> "Setup":
+        """A deep copy (list values included)."""
         return Setup(**_copy.deepcopy(self._options))
 
     def to_dict(self) -> Dict[str, Any]:
+        """The keyword arguments as a dict."""
         return dict(self._options)
 
     def __eq__(self, other: object) -> bool:
