@@ -242,3 +242,83 @@ fn every_recipe_is_a_command_the_tours_run() {
     }
     assert!(recipes >= 15, "{recipes} recipes");
 }
+
+/// Every output the README and the book show under a command (a ```console block) is
+/// what that command prints now, line for line (`...` standing for lines left out,
+/// `[..]` for part of a line): the numbers the pages print are the program's. Each
+/// page's commands run in order in a directory of its own (a later command may read a
+/// file an earlier one wrote).
+#[test]
+fn every_output_the_docs_show_is_what_tapsim_prints() {
+    let mut files = vec![root().join("README.md")];
+    files.extend(pages());
+    let jobs: Vec<(PathBuf, Vec<common::Shown>)> = files
+        .into_iter()
+        .map(|f| {
+            let shown = common::console_blocks(&std::fs::read_to_string(&f).unwrap());
+            (f, shown)
+        })
+        .filter(|(_, shown)| !shown.is_empty())
+        .collect();
+    let count: usize = jobs.iter().map(|(_, s)| s.len()).sum();
+    assert!(count >= 20, "{count} commands shown with their output");
+    let failures = std::sync::Mutex::new(Vec::new());
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| {
+                while let Some((file, shown)) =
+                    jobs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+                {
+                    let rel = file.strip_prefix(root()).unwrap().display().to_string();
+                    let dir = common::scratch(&rel.replace('/', "_"));
+                    for one in shown {
+                        let r = common::run_limited(
+                            &common::with_examples(&one.args),
+                            &dir,
+                            std::time::Duration::from_secs(60),
+                        );
+                        let actual: Vec<&str> = r.stdout.lines().collect();
+                        if r.code != Some(0) || !common::shows(&one.output, &actual) {
+                            failures.lock().unwrap().push(format!(
+                                "{rel}:{}: `tapsim {}` (exit {:?}) printed\n{}\nwhere the page shows\n{}\n{}",
+                                one.line,
+                                one.args.join(" "),
+                                r.code,
+                                r.stdout,
+                                one.output.join("\n"),
+                                r.stderr
+                            ));
+                        }
+                    }
+                    let _ = std::fs::remove_dir_all(&dir);
+                }
+            });
+        }
+    });
+    let failures = failures.into_inner().unwrap();
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+}
+
+/// The matcher itself: `...` and `[..]` stand for what they say and no more.
+#[test]
+fn the_output_matcher_elides_only_what_it_is_told_to() {
+    let s = |v: &[&str]| v.iter().map(|l| l.to_string()).collect::<Vec<_>>();
+    assert!(common::shows(&s(&["a", "...", "d"]), &["a", "b", "c", "d"]));
+    assert!(common::shows(
+        &s(&["...", "c", "..."]),
+        &["a", "b", "c", "d"]
+    ));
+    assert!(!common::shows(&s(&["a", "d"]), &["a", "b", "c", "d"]));
+    assert!(!common::shows(&s(&["a", "b"]), &["a", "b", "c"]));
+    assert!(common::shows(&s(&["A = 0.9[..] nm"]), &["A = 0.9415 nm  "]));
+    assert!(!common::shows(&s(&["A = 0.9[..] nm"]), &["A = 0.8415 nm"]));
+    assert!(!common::shows(&s(&["x [..]y[..] z"]), &["x  z"]));
+    let shown = common::console_blocks(
+        "text\n```console\n$ tapsim tap \\\n    --json\n{\n...\n```\n```sh\n$ tapsim no\n```\n",
+    );
+    assert_eq!(shown.len(), 1);
+    assert_eq!(shown[0].args, ["tap", "--json"]);
+    assert_eq!(shown[0].output, ["{", "..."]);
+    assert_eq!(shown[0].line, 3);
+}

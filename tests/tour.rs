@@ -1,6 +1,5 @@
-//! The README's five-minute tour and the guide's CLI tour (docs/src/reference/
-//! cli-tour.md), run as a new user runs them: every command of the tour blocks
-//! succeeds, and the commands that name an effect show it (a touch, a neck, a viscous
+//! The guide's CLI tour (docs/src/reference/cli-tour.md), run as a new user runs it:
+//! every command of the tour block succeeds, and the commands that name an effect show it (a touch, a neck, a viscous
 //! share, a non-empty contrast).
 
 mod common;
@@ -10,14 +9,7 @@ use std::path::Path;
 /// Run a tour command in `dir` (the tour's example files from the repository), with
 /// `extra` arguments; its stdout.
 fn run(args: &[String], extra: &[&str], dir: &Path) -> String {
-    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
-    let mut all: Vec<String> = args
-        .iter()
-        .map(|a| match a.strip_prefix("examples/") {
-            Some(rest) => examples.join(rest).to_string_lossy().into_owned(),
-            None => a.clone(),
-        })
-        .collect();
+    let mut all = common::with_examples(args);
     all.extend(extra.iter().map(|s| s.to_string()));
     let r = common::run_limited(&all, dir, std::time::Duration::from_secs(120));
     assert_eq!(r.code, Some(0), "tapsim {}: {}", all.join(" "), r.stderr);
@@ -35,7 +27,8 @@ fn has(args: &[String], flag: &str) -> bool {
 /// 7 times the hybrid's (the guide).
 #[test]
 fn every_tour_command_runs_and_shows_its_effect() {
-    let commands = common::tour();
+    // (The README's tour shows what each command prints: tests/docs.rs runs it.)
+    let commands = common::tour_block("docs/src/reference/cli-tour.md", "# CLI tour");
     assert!(commands.len() > 30, "{}", commands.len());
     let dir = common::scratch("tour");
     // Two at a time from one queue, as the machine has two cores.

@@ -249,9 +249,116 @@ pub fn tour_block(file: &str, heading: &str) -> Vec<Vec<String>> {
     commands
 }
 
-/// Both tours' commands, the README's first.
+/// A command a page shows in a ```console block (`$ tapsim …`, continued over lines
+/// ending in `\`), and the lines of output shown under it.
+pub struct Shown {
+    /// The page's line of the `$`.
+    pub line: usize,
+    /// The arguments after `tapsim`.
+    pub args: Vec<String>,
+    /// The output shown: `...` stands for lines left out, `[..]` for part of a line.
+    pub output: Vec<String>,
+}
+
+/// The commands and outputs of every ```console block of a Markdown `text`.
+pub fn console_blocks(text: &str) -> Vec<Shown> {
+    let mut shown: Vec<Shown> = Vec::new();
+    let (mut inside, mut joined) = (false, false);
+    for (i, line) in text.lines().enumerate() {
+        let fence = line.trim_start();
+        if fence.starts_with("```") {
+            inside = !inside && fence == "```console";
+            continue;
+        }
+        if !inside {
+            continue;
+        }
+        let continued = |code: &str, shown: &mut Vec<Shown>| {
+            let (code, more) = match code.trim_end().strip_suffix('\\') {
+                Some(c) => (c, true),
+                None => (code, false),
+            };
+            let last = shown.last_mut().expect("a command");
+            last.args.extend(code.split_whitespace().map(String::from));
+            more
+        };
+        if let Some(command) = line.strip_prefix("$ ") {
+            let mut words = command.split_whitespace();
+            assert_eq!(words.next(), Some("tapsim"), "line {}: {line}", i + 1);
+            shown.push(Shown {
+                line: i + 1,
+                args: Vec::new(),
+                output: Vec::new(),
+            });
+            let rest = command.trim_start()["tapsim".len()..].to_string();
+            joined = continued(&rest, &mut shown);
+        } else if joined {
+            joined = continued(line, &mut shown);
+        } else {
+            let last = shown
+                .last_mut()
+                .expect("a ```console block starts with `$ tapsim`");
+            last.output.push(line.trim_end().to_string());
+        }
+    }
+    shown
+}
+
+/// Whether the `actual` lines are what `shown` shows: line for line, where a line `...`
+/// stands for any number of lines and `[..]` within a line for any part of it.
+pub fn shows(shown: &[String], actual: &[&str]) -> bool {
+    fn line(shown: &str, actual: &str) -> bool {
+        let actual = actual.trim_end();
+        let pieces: Vec<&str> = shown.split("[..]").collect();
+        if pieces.len() == 1 {
+            return shown == actual;
+        }
+        let (first, last) = (pieces[0], pieces[pieces.len() - 1]);
+        if !actual.starts_with(first) || !actual[first.len()..].ends_with(last) {
+            return false;
+        }
+        let mut rest = &actual[first.len()..actual.len() - last.len()];
+        for piece in &pieces[1..pieces.len() - 1] {
+            match rest.find(piece) {
+                Some(at) => rest = &rest[at + piece.len()..],
+                None => return false,
+            }
+        }
+        true
+    }
+    match shown.split_first() {
+        None => actual.is_empty(),
+        Some((first, rest)) if first == "..." => {
+            (0..=actual.len()).any(|skip| shows(rest, &actual[skip..]))
+        }
+        Some((first, rest)) => {
+            !actual.is_empty() && line(first, actual[0]) && shows(rest, &actual[1..])
+        }
+    }
+}
+
+/// The arguments as a tour gives them, with `examples/…` pointing into the repository's
+/// examples wherever the command runs.
+pub fn with_examples(args: &[String]) -> Vec<String> {
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    args.iter()
+        .map(|a| match a.strip_prefix("examples/") {
+            Some(rest) => examples.join(rest).to_string_lossy().into_owned(),
+            None => a.clone(),
+        })
+        .collect()
+}
+
+/// Both tours' commands, the README's first (every ```console block of its section).
 pub fn tour() -> Vec<Vec<String>> {
-    let mut commands = tour_block("README.md", "## Five-minute tour");
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let section = &readme[readme.find("## Five-minute tour").expect("the tour")..];
+    let section = &section[..section[3..].find("\n## ").map_or(section.len(), |i| i + 3)];
+    let mut commands: Vec<Vec<String>> = console_blocks(section)
+        .into_iter()
+        .map(|shown| shown.args)
+        .collect();
     commands.extend(tour_block("docs/src/reference/cli-tour.md", "# CLI tour"));
     commands
 }
