@@ -1860,8 +1860,19 @@ fn version_completions_man_pages_and_help_come_from_the_definitions() {
         !short.contains("--rtol") && !short.contains("--hamaker"),
         "{short}"
     );
+    // One screen: each option a line, its value named by its unit, its default kept; the
+    // rest of its help in --help.
+    assert!(short.lines().count() <= 40, "tap -h: {short}");
+    for line in [
+        "--radius <m>               Tip radius R [20nm]",
+        "--work-of-adhesion <J/m²>  Work of adhesion Δγ [0.1J/m^2]",
+        "--plot <FILE>",
+    ] {
+        assert!(short.contains(line), "tap -h lacks {line:?}: {short}");
+    }
     let tap_help = run(&["tap", "--help"]);
     assert!(tap_help.contains("--rtol") && tap_help.contains("--hamaker"));
+    assert!(tap_help.contains("Range ε of the Lennard-Jones law (10), the equilibrium gap [m;"));
     for default in [
         "20nm",
         "0.5GPa",

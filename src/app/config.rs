@@ -309,7 +309,7 @@ pub struct TapInputs {
     /// Drive frequency [Hz; default: the resonance frequency].
     #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = frequency, help_heading = "Cantilever")]
     pub drive_frequency: Option<f64>,
-    /// Rest tip–sample separation z_c, α = z_c + z [m; default 16nm]. (Also --zc.)
+    /// Rest tip–sample separation z_c [m; default 16nm]; the gap is α = z_c + z. (Also --zc.)
     #[arg(long, alias = "zc", allow_hyphen_values = true, value_parser = length, help_heading = "Cantilever")]
     pub separation: Option<f64>,
     /// Relative tolerance of the integrator [default 1e-9; absolute: 1e-2 of it].

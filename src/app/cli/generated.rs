@@ -2,7 +2,7 @@
 //! the command line's own definitions, so that they never drift from its flags.
 
 use crate::error::{Error, Result};
-use clap::{Args, CommandFactory};
+use clap::Args;
 use std::path::PathBuf;
 
 /// Print the completion script of SHELL for every command and flag.
@@ -43,7 +43,7 @@ pub struct ManArgs {
 
 /// Print the completions.
 pub fn completions(args: CompletionsArgs) -> Result<()> {
-    let mut command = super::Cli::command();
+    let mut command = super::command();
     let mut script = Vec::new();
     clap_complete::generate(args.shell, &mut command, "tapsim", &mut script);
     out!("{}", String::from_utf8_lossy(&script));
@@ -52,7 +52,7 @@ pub fn completions(args: CompletionsArgs) -> Result<()> {
 
 /// Every command's --help at 80 columns, as Markdown: the guide's command reference.
 pub fn reference() -> String {
-    let mut root = super::Cli::command().term_width(80);
+    let mut root = super::command().term_width(80);
     let mut text = String::from(
         "# Command reference\n\nEvery command's `--help`, generated from the command line's own \
          definitions (`tapsim man --markdown docs/src/reference/commands.md`; a test checks \
@@ -92,7 +92,7 @@ pub fn man(args: ManArgs) -> Result<()> {
             out.display()
         )));
     }
-    let root = super::Cli::command();
+    let root = super::command();
     let mut pages = vec![("tapsim".to_string(), root.clone())];
     for sub in root.get_subcommands() {
         let name = format!("tapsim-{}", sub.get_name());

@@ -75,7 +75,7 @@ pub struct MapArgs {
     /// The amplitude setpoint as an amplitude (e.g. 16nm): --setpoint A_sp/A₀.
     #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = crate::app::config::length)]
     amplitude_setpoint: Option<f64>,
-    /// With a setpoint: the branch every cell is solved on [default: repulsive].
+    /// The branch every cell is solved on at a setpoint [default: repulsive].
     #[arg(long, value_enum, ignore_case = true)]
     branch: Option<BranchChoice>,
     /// With a setpoint, --temperature adds each cell's thermal phase noise σ_φ through

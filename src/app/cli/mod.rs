@@ -83,16 +83,127 @@ use std::process::ExitCode;
 /// support stiffness k̂ = μεk/(RΔγ). SI inputs accept unit suffixes (10nm, 1GPa,
 /// 50mJ/m^2, 40N/m); bare numbers are SI base units.
 #[derive(Debug, Parser)]
-#[command(name = "tapsim", version = VERSION, propagate_version = true)]
+#[command(name = "tapsim", version = VERSION)]
 pub struct Cli {
     #[command(subcommand)]
     command: Command,
 }
 
+/// The command line's definition as it parses and prints: every option's `-h` line is
+/// the first clause of its help (up to the first `:`, `;` or `. ` outside brackets),
+/// `--help` the whole text — so `-h` is a summary a screen holds, generated from the
+/// same definitions.
+pub(super) fn command() -> clap::Command {
+    fn summarised(command: clap::Command) -> clap::Command {
+        let names: Vec<String> = command
+            .get_subcommands()
+            .map(|s| s.get_name().to_string())
+            .collect();
+        let mut command = command.mut_args(|arg| {
+            let Some(help) = arg.get_help().map(|h| h.to_string()) else {
+                return arg;
+            };
+            // A value named by its unit where the help gives one ("[m; default 20nm]"):
+            // `--radius <m>` rather than `--radius <RADIUS>`.
+            let unnamed = arg.get_value_names().is_some_and(|names| {
+                names.len() == 1 && *names[0] == arg.get_id().as_str().to_uppercase()
+            });
+            const UNITS: [&str; 10] = ["m", "Pa", "J/m²", "N/m", "Hz", "K", "s", "N", "m/s", "J"];
+            let unit = help
+                .split_once('[')
+                .and_then(|(_, rest)| rest.split_once(';'))
+                .and_then(|(unit, _)| UNITS.into_iter().find(|u| *u == unit));
+            // A file is a FILE (`--plot <FILE>`, not `--plot <PLOT>`).
+            let is_path = arg.get_value_parser().type_id()
+                == clap::builder::ValueParser::path_buf().type_id();
+            let arg = if is_path && unnamed {
+                arg.value_name("FILE")
+            } else {
+                arg
+            };
+            let (arg, first) = match unit {
+                Some(unit) if unnamed => (
+                    arg.value_name(unit),
+                    // The unit is the value's name: the summary keeps the value.
+                    first_clause(&help)
+                        .replace(&format!("[{unit}; the built-in sample's "), "[")
+                        .replace(&format!("[{unit}; "), "["),
+                ),
+                _ => (arg, first_clause(&help)),
+            };
+            let first = first_bracket_short(&first);
+            if first == help || arg.get_long_help().is_some() {
+                return arg;
+            }
+            arg.long_help(help).help(first)
+        });
+        for name in names {
+            command = command.mut_subcommand(name, summarised);
+        }
+        command
+    }
+    summarised(<Cli as clap::CommandFactory>::command())
+}
+
+/// `text` with its first bracket cut at its first comma: `[0.5GPa, a soft polymer]`
+/// becomes `[0.5GPa]`.
+fn first_bracket_short(text: &str) -> String {
+    let Some(open) = text.find('[') else {
+        return text.to_string();
+    };
+    let Some(close) = text[open..].find(']').map(|c| open + c) else {
+        return text.to_string();
+    };
+    match text[open..close].find(", ") {
+        Some(comma) => format!("{}]{}", &text[..open + comma], &text[close + 1..]),
+        None => text.to_string(),
+    }
+}
+
+/// `help` up to its first `:`, `;`, `. ` or parenthesis outside brackets, after at
+/// least 15 bytes (a clause that says something); the rest is for `--help`.
+fn first_clause(help: &str) -> String {
+    let mut depth = 0i32;
+    let mut chars = help.char_indices().peekable();
+    while let Some((i, c)) = chars.next() {
+        match c {
+            // A parenthesis is for --help; a bracket after it (the default) stays.
+            '(' if depth == 0 && i >= 15 => {
+                let bracket = help[i..]
+                    .find('[')
+                    .and_then(|b| Some((b, help[i + b..].find(']')?)))
+                    .map(|(b, e)| format!(" {}", &help[i + b..=i + b + e]));
+                return format!("{}{}", help[..i].trim_end(), bracket.unwrap_or_default());
+            }
+            '(' | '[' => depth += 1,
+            ')' | ']' => depth -= 1,
+            ':' | ';' if depth == 0 && i >= 15 => return help[..i].to_string(),
+            '.' if depth == 0
+                && i >= 15
+                && chars.peek().is_some_and(|(_, n)| n.is_whitespace()) =>
+            {
+                return help[..i].to_string();
+            }
+            _ => {}
+        }
+    }
+    help.to_string()
+}
+
+/// Parse `args` (the program's name first) with [`command`].
+fn parse<I, T>(args: I) -> std::result::Result<Cli, clap::Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let matches = command().try_get_matches_from(args)?;
+    <Cli as clap::FromArgMatches>::from_arg_matches(&matches)
+}
+
 #[derive(Debug, Subcommand)]
 enum Command {
     #[command(
-        about = "One cantilever tapping one sample: its steady state, what a lock-in reads, the loss per cycle."
+        about = "A tapping cantilever's steady state: what a lock-in reads, the loss per cycle."
     )]
     Tap(tap::TapArgs),
     #[command(
@@ -537,15 +648,16 @@ pub struct Refused {
 /// to stderr unless `--quiet`. A refusal carries the command line's message.
 pub fn run_captured(args: &[String]) -> std::result::Result<String, Refused> {
     let cli =
-        Cli::try_parse_from(std::iter::once("tapsim".to_string()).chain(args.iter().cloned()))
-            .map_err(|e| Refused {
+        parse(std::iter::once("tapsim".to_string()).chain(args.iter().cloned())).map_err(|e| {
+            Refused {
                 message: e
                     .render()
                     .to_string()
                     .trim_start_matches("error: ")
                     .trim_end()
                     .to_string(),
-            })?;
+            }
+        })?;
     crate::app::lj_cache::install();
     crate::app::report::output::announce_writes(cli.command.announces_writes());
     CAPTURED.with_borrow_mut(|c| *c = Some(String::new()));
@@ -607,7 +719,7 @@ fn run_command(command: Command) -> crate::Result<()> {
 
 /// Run the command line with the process arguments; the exit code to return.
 pub fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match parse(std::env::args_os()) {
         Ok(cli) => cli,
         Err(e) if e.use_stderr() => {
             // clap quotes the offending input: not a 10 000-character one whole.

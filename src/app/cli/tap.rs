@@ -111,7 +111,7 @@ pub struct TapArgs {
     /// same at tolerances / 100, 3 rest, 4 and 5 ramps from z_c ± 0.1 A₀, then phases
     /// of the free oscillation. A state that grazes a switch lists its attractors from
     /// 6 starts without it. At most 64.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=64), help_heading = "Numerics")]
+    #[arg(hide_short_help = true, long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=64), help_heading = "Numerics")]
     starts: Option<u64>,
     /// Look for other stable period-1 states at z_c also by following every family of
     /// period-1 orbits in from 1.2 A₀ (besides the default search from the roots of the
@@ -128,7 +128,7 @@ pub struct TapArgs {
     /// The amplitude setpoint as an amplitude (e.g. 16nm): --setpoint A_sp/A₀.
     #[arg(hide_short_help = true, long, allow_hyphen_values = true, value_parser = length)]
     amplitude_setpoint: Option<f64>,
-    /// With a setpoint: the branch whose states are listed [default: all]. Attractive:
+    /// The branch whose states a setpoint lists [default: all]. Attractive:
     /// the phase lag above the free oscillator's (90° at resonance), net attractive
     /// force; repulsive: below it.
     #[arg(long, value_enum, ignore_case = true)]
