@@ -1872,7 +1872,7 @@ fn version_completions_man_pages_and_help_come_from_the_definitions() {
     }
     let tap_help = run(&["tap", "--help"]);
     assert!(tap_help.contains("--rtol") && tap_help.contains("--hamaker"));
-    assert!(tap_help.contains("Range ε of the Lennard-Jones law (10), the equilibrium gap [m;"));
+    assert!(tap_help.contains("Range ε of the Lennard-Jones law [m; the built-in sample's 0.3nm]"));
     for default in [
         "20nm",
         "0.5GPa",

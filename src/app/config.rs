@@ -90,8 +90,8 @@ pub struct ContactInputs {
     /// Work of adhesion Δγ [J/m²; the built-in sample's 0.1J/m^2].
     #[arg(long, allow_hyphen_values = true, value_parser = surface_energy, help_heading = "Contact (SI)")]
     pub work_of_adhesion: Option<f64>,
-    /// Range ε of the Lennard-Jones law (10), the equilibrium gap [m; the built-in
-    /// sample's 0.3nm].
+    /// Range ε of the Lennard-Jones law [m; the built-in sample's 0.3nm]: the
+    /// equilibrium gap of eq. (10).
     #[arg(long, allow_hyphen_values = true, value_parser = length, help_heading = "Contact (SI)")]
     pub range: Option<f64>,
 }

@@ -160,34 +160,106 @@ fn first_bracket_short(text: &str) -> String {
     }
 }
 
-/// `help` up to its first `:`, `;`, `. ` or parenthesis outside brackets, after at
-/// least 15 bytes (a clause that says something); the rest is for `--help`.
+/// The summary of `help`: its first clause — up to the first `: `, `; ` or sentence end
+/// (`. ` before a capital) outside brackets, after at least 15 bytes — without its
+/// parenthetical remarks (` (…)`); the rest is for `--help`.
 fn first_clause(help: &str) -> String {
-    let mut depth = 0i32;
-    let mut chars = help.char_indices().peekable();
-    while let Some((i, c)) = chars.next() {
+    let chars: Vec<char> = help.chars().collect();
+    let (mut out, mut depth, mut i) = (String::new(), 0i32, 0);
+    while i < chars.len() {
+        let c = chars[i];
+        let next = chars.get(i + 1).copied();
+        let spaced = next.is_some_and(char::is_whitespace);
         match c {
-            // A parenthesis is for --help; a bracket after it (the default) stays.
-            '(' if depth == 0 && i >= 15 => {
-                let bracket = help[i..]
-                    .find('[')
-                    .and_then(|b| Some((b, help[i + b..].find(']')?)))
-                    .map(|(b, e)| format!(" {}", &help[i + b..=i + b + e]));
-                return format!("{}{}", help[..i].trim_end(), bracket.unwrap_or_default());
+            '(' if depth == 0 && out.ends_with(' ') => {
+                // Skip the remark to its closing parenthesis, and the space before it.
+                let mut inner = 0;
+                while i < chars.len() {
+                    match chars[i] {
+                        '(' => inner += 1,
+                        ')' if inner == 1 => break,
+                        ')' => inner -= 1,
+                        _ => {}
+                    }
+                    i += 1;
+                }
+                out.pop();
+                // "…, eq. (8)" loses its "eq." with the number.
+                for word in [", eq.", " eq.", ", eqs.", " eqs."] {
+                    if let Some(kept) = out.strip_suffix(word) {
+                        out = kept.to_string();
+                        break;
+                    }
+                }
+                i += 1;
+                continue;
             }
             '(' | '[' => depth += 1,
             ')' | ']' => depth -= 1,
-            ':' | ';' if depth == 0 && i >= 15 => return help[..i].to_string(),
+            ':' | ';' if depth == 0 && out.len() >= 15 && spaced => return out,
             '.' if depth == 0
-                && i >= 15
-                && chars.peek().is_some_and(|(_, n)| n.is_whitespace()) =>
+                && out.len() >= 15
+                && spaced
+                && chars
+                    .get(i + 2)
+                    .is_some_and(|n| n.is_uppercase() || n.is_ascii_digit()) =>
             {
-                return help[..i].to_string();
+                return out;
             }
             _ => {}
         }
+        out.push(c);
+        i += 1;
     }
-    help.to_string()
+    // A sentence's full stop goes; an ellipsis stays.
+    match out.strip_suffix('.') {
+        Some(kept) if !kept.ends_with("..") || kept.ends_with("...") => kept.to_string(),
+        _ => out,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The summary keeps what says what a flag is and its default, and leaves the
+    /// remarks, the equation numbers and the next sentences to --help.
+    #[test]
+    fn a_summary_is_the_first_clause_without_remarks() {
+        for (help, summary) in [
+            (
+                "Dimensionless support stiffness k̂ = μεk/(RΔγ), eq. (23) [> 0]",
+                "Dimensionless support stiffness k̂ = μεk/(RΔγ) [> 0]",
+            ),
+            (
+                "Amplitude setpoint A/A₀ in place of a rest separation (between 0 and 1; as \
+                 an AFM's z feedback holds it): every stable state",
+                "Amplitude setpoint A/A₀ in place of a rest separation",
+            ),
+            (
+                "Quality factor Q [default 400]. (Also --Q.)",
+                "Quality factor Q [default 400]",
+            ),
+            (
+                "The branch whose states a setpoint lists [default: all]. Attractive: the \
+                 phase lag above",
+                "The branch whose states a setpoint lists [default: all]",
+            ),
+            (
+                "Cantilever eigenmodes [1 to 3; default 1]. 2 is bimodal AFM",
+                "Cantilever eigenmodes [1 to 3; default 1]",
+            ),
+            (
+                "A material, name:key=value,... (repeat; at least two).",
+                "A material, name:key=value,...",
+            ),
+            (
+                "Tabor parameter μ, eq. (8) [dimensionless]",
+                "Tabor parameter μ [dimensionless]",
+            ),
+            ("Print help", "Print help"),
+        ] {
+            assert_eq!(super::first_clause(help), summary, "{help}");
+        }
+    }
 }
 
 /// Parse `args` (the program's name first) with [`command`].

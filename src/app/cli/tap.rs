@@ -118,8 +118,8 @@ pub struct TapArgs {
     /// first-harmonic balance; about a hundred times slower).
     #[arg(hide_short_help = true, long, help_heading = "Numerics")]
     all_states: bool,
-    /// Amplitude setpoint A/A₀ (between 0 and 1), as an AFM's z feedback holds it,
-    /// instead of a rest separation: every stable period-1 steady state whose amplitude
+    /// Amplitude setpoint A/A₀ in place of a rest separation (between 0 and 1; as an
+    /// AFM's z feedback holds it): every stable period-1 steady state whose amplitude
     /// is the setpoint, on each branch (--branch), with the rest separation z_c that
     /// gives it. Not with --separation, --trajectory or --plot.
     #[arg(long, value_name = "A/A0", allow_hyphen_values = true, value_parser = number,
