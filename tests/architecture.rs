@@ -575,3 +575,70 @@ fn within_a_layer_the_stated_order_holds() {
     }
     assert!(broken.is_empty(), "{}", broken.join("\n"));
 }
+
+/// Each crate of the build and the features it is built with, as `cargo tree` shows
+/// them for the package `package` with the dependency kinds `edges`.
+fn features(package: &str, edges: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args([
+            "tree",
+            "--offline",
+            "--locked",
+            "--prefix",
+            "none",
+            "-p",
+            package,
+        ])
+        .args(["-e", edges, "-f", "{p} [{f}]"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo tree: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut crates: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for line in String::from_utf8(out.stdout).unwrap().lines() {
+        let line = line.trim_end_matches(" (*)");
+        let Some((name, features)) = line.rsplit_once(" [") else {
+            continue;
+        };
+        // "serde v1.0.229" (a path dependency adds its folder in parentheses).
+        let name: String = name.split(" (").next().unwrap().to_string();
+        crates
+            .entry(name)
+            .or_default()
+            .insert(features.trim_end_matches(']').to_string());
+    }
+    crates
+}
+
+/// One build of every dependency serves the run (`cargo run --release`), the tests
+/// (`cargo test --release`: the dev-dependencies too) and the Python package (maturin,
+/// in the same target/): no crate the run builds is built with other features for the
+/// tests or for the package, which would build it and everything above it a second
+/// time (Cargo.toml turns those features on for tapsim itself; docs/src/speed.md).
+#[test]
+fn the_run_the_tests_and_the_python_package_share_one_build_of_each_dependency() {
+    let run = features("tapsim", "normal,build");
+    assert!(run.len() > 100, "{} crates", run.len());
+    for (what, other) in [
+        ("the tests", features("tapsim", "normal,build,dev")),
+        (
+            "the Python package",
+            features("tapsim-python", "normal,build"),
+        ),
+    ] {
+        for (name, built) in &run {
+            if let Some(there) = other.get(name) {
+                assert_eq!(
+                    built, there,
+                    "{name} is built with features {built:?} for the run and {there:?} for {what}: \
+                     turn those on in Cargo.toml too"
+                );
+            }
+        }
+    }
+}
