@@ -90,9 +90,9 @@ pub struct Cli {
 }
 
 /// The command line's definition as it parses and prints: every option's `-h` line is
-/// the first clause of its help (up to the first `:`, `;` or `. ` outside brackets),
-/// `--help` the whole text — so `-h` is a summary a screen holds, generated from the
-/// same definitions.
+/// the first clause of its help ([`first_clause`]), its value named by its unit or
+/// FILE, `--help` the whole text — so `-h` is a summary a screen holds, generated from
+/// the same definitions.
 pub(super) fn command() -> clap::Command {
     fn summarised(command: clap::Command) -> clap::Command {
         let names: Vec<String> = command
