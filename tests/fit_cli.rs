@@ -339,3 +339,75 @@ fn several_laws_are_refused_outside_fit() {
         "tapsim fit --law a,b",
     );
 }
+
+/// The curve a new user fits first — `tapsim approach --csv` on the defaults, from 24 nm
+/// in, crossing the onset of contact — holds points that graze a switch of the law (mode
+/// locks one draw among several): the fit leaves out the rows the file flags (counted
+/// here from the file itself), says so, and from a start at 1 GPa and 0.2 J/m² comes
+/// back to the truth — E* from the tip's and the sample's moduli — to 1e-5.
+/// `--keep-grazing` fits every row.
+#[test]
+fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
+    let dir = scratch("fit-grazing");
+    let csv = dir.join("approach.csv");
+    let csv = csv.to_str().unwrap();
+    let out = tapsim(&[
+        "approach",
+        "--points",
+        "40",
+        "--no-retract",
+        "--csv",
+        csv,
+        "--quiet",
+    ]);
+    assert!(out.status.success());
+    let mut reader = csv::Reader::from_path(csv).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    let at = headers.iter().position(|h| h == "grazing").unwrap();
+    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    let grazing = rows.iter().filter(|r| &r[at] == "true").count();
+    assert!(grazing >= 1 && grazing < rows.len() / 2, "{grazing}");
+    let start = [
+        "fit",
+        csv,
+        "--fit",
+        "modulus,work-of-adhesion",
+        "--modulus",
+        "1GPa",
+        "--work-of-adhesion",
+        "0.2J/m^2",
+    ];
+    let v = json(&[&start[..], &["--json", "--quiet"]].concat());
+    assert_eq!(num(&v, "grazing_points_left_out"), grazing as f64);
+    assert_eq!(
+        num(&v, "degrees_of_freedom"),
+        (2 * (rows.len() - grazing) - 2) as f64
+    );
+    assert_eq!(v["converged"], true);
+    // 1/E* = (1 − ν_tip²)/E_tip + (1 − ν²)/E: silicon on the built-in polymer.
+    let modulus = 1.0 / ((1.0 - 0.28f64.powi(2)) / 169e9 + (1.0 - 0.4f64.powi(2)) / 0.5e9);
+    let fitted = |i: usize| v["parameters"][i]["value"].as_f64().unwrap();
+    assert!((fitted(0) / modulus - 1.0).abs() < 1e-5, "{}", fitted(0));
+    assert!((fitted(1) / 0.1 - 1.0).abs() < 1e-5, "{}", fitted(1));
+    let text =
+        String::from_utf8_lossy(&tapsim(&[&start[..], &["--quiet"]].concat()).stdout).into_owned();
+    assert!(
+        text.contains(&format!(
+            "note: {grazing} of the file's points are flagged grazing"
+        )),
+        "{text}"
+    );
+    let kept = json(
+        &[
+            &start[..],
+            &["--keep-grazing", "--max-curves", "3", "--json", "--quiet"],
+        ]
+        .concat(),
+    );
+    assert_eq!(num(&kept, "grazing_points_left_out"), 0.0);
+    assert_eq!(
+        num(&kept, "degrees_of_freedom"),
+        (2 * rows.len() - 2) as f64
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -40,6 +40,10 @@ pub struct Reading {
     pub phase: PhaseConvention,
     /// The deflection sensitivity for amplitudes in volts, m/V.
     pub invols_m_per_v: Option<f64>,
+    /// Leave out the rows a `grazing` column flags (a simulated curve's points whose
+    /// turning point passes a switch of the law closer than the thermal motion: one
+    /// draw among coexisting mode locks, which no fit can match point for point).
+    pub skip_grazing: bool,
 }
 
 /// What a column holds.
@@ -58,6 +62,7 @@ enum Kind {
     MeanForce,
     Direction,
     Segment,
+    Grazing,
 }
 
 /// A column's kind and the factor that makes its values SI, by the header's name.
@@ -88,6 +93,7 @@ fn column_kind(name: &str) -> Option<(Kind, f64)> {
         "mean_force_n" => Some((Kind::MeanForce, 1.0)),
         "direction" => Some((Kind::Direction, 1.0)),
         "segment" => Some((Kind::Segment, 1.0)),
+        "grazing" => Some((Kind::Grazing, 1.0)),
         _ => None,
     }
 }
@@ -111,6 +117,9 @@ pub struct Columns {
     pub amplitude2_m: Option<Vec<f64>>,
     /// Its phases, degrees.
     pub phase2_deg: Option<Vec<f64>>,
+    /// How many rows of the direction read were left out as grazing
+    /// ([`Reading::skip_grazing`]).
+    pub grazing_left_out: usize,
 }
 
 /// The farthest position a curve may give, in m: a scanner's range (100 µm).
@@ -225,12 +234,25 @@ pub fn read_curve(
     let phase2 = at.get(&Kind::Phase2).copied();
     let direction_col = at.get(&Kind::Direction).map(|&(i, _)| i);
     let segment = at.get(&Kind::Segment).map(|&(i, _)| i);
+    let grazing = at
+        .get(&Kind::Grazing)
+        .map(|&(i, _)| i)
+        .filter(|_| reading.skip_grazing);
+    let mut grazing_left_out = 0;
     let (mut z, mut a, mut p, mut d) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut a2, mut p2) = (Vec::new(), Vec::new());
     let mut segments = Vec::new();
     let mut label: Option<String> = None;
     for (row, record) in rows.iter().enumerate() {
         if direction_col.is_some_and(|c| record.get(c).is_some_and(|v| v != direction)) {
+            continue;
+        }
+        if grazing.is_some_and(|c| {
+            record
+                .get(c)
+                .is_some_and(|v| v.trim().eq_ignore_ascii_case("true"))
+        }) {
+            grazing_left_out += 1;
             continue;
         }
         let value = |(col, scale): (usize, f64), what: &str| -> Result<f64> {
@@ -342,5 +364,6 @@ pub fn read_curve(
         mean_deflection_m: deflection.map(|_| d),
         amplitude2_m: amp2.map(|_| a2),
         phase2_deg: phase2.map(|_| p2),
+        grazing_left_out,
     })
 }

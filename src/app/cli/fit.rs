@@ -78,6 +78,12 @@ pub struct FitArgs {
     /// [m/V, e.g. 50nm]; fit `sensitivity` if you doubt it.
     #[arg(long, value_parser = length)]
     invols: Option<f64>,
+    /// Fit the rows a `grazing` column flags too. By default they are left out (with a
+    /// note): where a curve tapsim simulated grazes a switch of the law, its value is one
+    /// draw among coexisting mode locks that perturbations below the thermal motion
+    /// pick, which a fitted curve cannot match point for point.
+    #[arg(long)]
+    keep_grazing: bool,
     /// The amplitude's standard deviation [m]. With --sigma-phase: the weights, taken as
     /// given. Without either: 0.02 nm and 0.05° relative weights, the scale estimated
     /// from the residuals (χ²/dof; the noise they imply is reported).
@@ -278,7 +284,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     let (setup, numerics) = first.resolve()?;
     let modes = args.modes.mode_set(&first.mode_file, &setup.cantilever)?;
     let numerics = crate::analysis::sweep::sweep_numerics(numerics, (false, false));
-    let data = measured(&args, &setup, modes)?;
+    let (data, grazing_left_out) = measured(&args, &setup, modes)?;
     if args.max_curves == 0 {
         return Err(Error::NotApplicable(
             "--max-curves must be at least 1".into(),
@@ -374,6 +380,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         if args.profile {
             v["profiles"] = serde_json::to_value(&profiles).expect("profiles serialise");
         }
+        v["grazing_points_left_out"] = grazing_left_out.into();
         outln!("{}", crate::app::report::records::document(&v)?);
     } else {
         use crate::app::report::fit_text;
@@ -388,6 +395,13 @@ pub fn run(args: FitArgs) -> Result<()> {
             outln!("");
             out!("{}", fit_text::comparison(c));
         }
+        if grazing_left_out > 0 {
+            outln!(
+                "note: {grazing_left_out} of the file's points are flagged grazing (one draw \
+                 among coexisting mode locks near a switch of the law) and were left out of \
+                 the fit; --keep-grazing fits them too"
+            );
+        }
     }
     Ok(())
 }
@@ -397,7 +411,7 @@ fn measured(
     args: &FitArgs,
     setup: &crate::dynamics::setup::TapSetup,
     modes: Option<crate::dynamics::modes::ModeSet>,
-) -> Result<Measured> {
+) -> Result<(Measured, usize)> {
     let second_a0 = modes
         .as_ref()
         .and_then(|m| m.higher.first())
@@ -410,6 +424,7 @@ fn measured(
         phase_deg,
         amplitude2_m,
         phase2_deg,
+        grazing_left_out,
         ..
     } = read_curve(
         &args.data,
@@ -419,6 +434,7 @@ fn measured(
         &super::curve_data::Reading {
             phase: args.phase_convention,
             invols_m_per_v: args.invols,
+            skip_grazing: !args.keep_grazing,
         },
     )?;
     // Several modes simulated (--modes 2) whether or not the data hold the second's
@@ -461,7 +477,7 @@ fn measured(
                 .into(),
         ));
     }
-    Ok(Measured {
+    let data = Measured {
         second_mode,
         position_m,
         setpoint_ratio,
@@ -470,7 +486,8 @@ fn measured(
         phase_deg,
         sigma_amplitude_m: args.sigma_amplitude.unwrap_or(0.02e-9),
         sigma_phase_deg: args.sigma_phase.unwrap_or(0.05),
-    })
+    };
+    Ok((data, grazing_left_out))
 }
 
 /// Whether any standard deviation was given.
