@@ -263,38 +263,29 @@ fn every_output_the_docs_show_is_what_tapsim_prints() {
     let count: usize = jobs.iter().map(|(_, s)| s.len()).sum();
     assert!(count >= 20, "{count} commands shown with their output");
     let failures = std::sync::Mutex::new(Vec::new());
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    std::thread::scope(|s| {
-        for _ in 0..2 {
-            s.spawn(|| {
-                while let Some((file, shown)) =
-                    jobs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
-                {
-                    let rel = file.strip_prefix(root()).unwrap().display().to_string();
-                    let dir = common::scratch(&rel.replace('/', "_"));
-                    for one in shown {
-                        let r = common::run_limited(
-                            &common::with_examples(&one.args),
-                            &dir,
-                            std::time::Duration::from_secs(60),
-                        );
-                        let actual: Vec<&str> = r.stdout.lines().collect();
-                        if r.code != Some(0) || !common::shows(&one.output, &actual) {
-                            failures.lock().unwrap().push(format!(
-                                "{rel}:{}: `tapsim {}` (exit {:?}) printed\n{}\nwhere the page shows\n{}\n{}",
-                                one.line,
-                                one.args.join(" "),
-                                r.code,
-                                r.stdout,
-                                one.output.join("\n"),
-                                r.stderr
-                            ));
-                        }
-                    }
-                    let _ = std::fs::remove_dir_all(&dir);
-                }
-            });
+    common::two_at_a_time(&jobs, |(file, shown)| {
+        let rel = file.strip_prefix(root()).unwrap().display().to_string();
+        let dir = common::scratch(&rel.replace('/', "_"));
+        for one in shown {
+            let r = common::run_limited(
+                &common::with_examples(&one.args),
+                &dir,
+                std::time::Duration::from_secs(60),
+            );
+            let actual: Vec<&str> = r.stdout.lines().collect();
+            if r.code != Some(0) || !common::shows(&one.output, &actual) {
+                failures.lock().unwrap().push(format!(
+                    "{rel}:{}: `tapsim {}` (exit {:?}) printed\n{}\nwhere the page shows\n{}\n{}",
+                    one.line,
+                    one.args.join(" "),
+                    r.code,
+                    r.stdout,
+                    one.output.join("\n"),
+                    r.stderr
+                ));
+            }
         }
+        let _ = std::fs::remove_dir_all(&dir);
     });
     let failures = failures.into_inner().unwrap();
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));

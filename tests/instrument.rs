@@ -80,26 +80,12 @@ fn the_lock_in_reads_a_settled_orbit_as_tap_does() {
 /// marching in time) within 0.01 nm.
 #[test]
 fn the_z_feedback_rests_where_the_setpoint_solver_puts_the_state() {
-    use tapsim::instrument::feedback::{PiController, hold};
+    use tapsim::instrument::feedback::PiController;
     use tapsim::setpoint::{PhaseBranch, states_at_setpoint};
     let setup = default_setup();
     let numerics = Numerics::default();
-    let p = Prepared::new(&setup, &numerics).unwrap();
-    let omega = p.simulation().osc.omega;
-    let period = 2.0 * std::f64::consts::PI / omega;
-    let mut lockin = LockIn::new(4, 2.0 * period, omega).unwrap();
     let mut controller = PiController::new(0.8, 0.0, 0.002).unwrap();
-    let a0 = setup.cantilever.free_amplitude_m;
-    let mut phase = p.simulation().free_steady_start();
-    let (samples, _) = hold(
-        &p,
-        (1.2 * a0, &mut phase),
-        &mut lockin,
-        &mut controller,
-        &mut ThermalForce::none(),
-        8000,
-    )
-    .unwrap();
+    let samples = hold_on_defaults(&mut controller, 1.2, 8000);
     // It starts free, far from the sample.
     assert!((samples[0].amplitude_ratio - 1.0).abs() < 1e-4);
     let tail = &samples[7500..];
@@ -118,6 +104,32 @@ fn the_z_feedback_rests_where_the_setpoint_solver_puts_the_state() {
     assert!(PiController::new(1.2, 0.0, 0.002).is_err());
     assert!(PiController::new(0.8, -1.0, 0.002).is_err());
     assert!(PiController::new(0.8, 0.0, 0.0).is_err());
+}
+
+/// `controller` holding the defaults for `periods` drive periods, read by a fourth-order
+/// lock-in of T = 2 periods, from the free oscillation at `start` A₀: what it read and
+/// where it put the piezo, period by period.
+fn hold_on_defaults(
+    controller: &mut tapsim::instrument::feedback::PiController,
+    start: f64,
+    periods: usize,
+) -> Vec<tapsim::instrument::feedback::LoopSample> {
+    let setup = default_setup();
+    let p = Prepared::new(&setup, &Numerics::default()).unwrap();
+    let omega = p.simulation().osc.omega;
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let mut lockin = LockIn::new(4, 2.0 * period, omega).unwrap();
+    let mut phase = p.simulation().free_steady_start();
+    let (samples, _) = tapsim::instrument::feedback::hold(
+        &p,
+        (start * setup.cantilever.free_amplitude_m, &mut phase),
+        &mut lockin,
+        controller,
+        &mut ThermalForce::none(),
+        periods,
+    )
+    .unwrap();
+    samples
 }
 
 /// The modes of `set` on `setup`, prepared at the instrument's marching tolerances.
@@ -517,28 +529,15 @@ fn a_fast_scan_shows_the_feedback_artefacts() {
 /// m/s — the march's own periods converted by the drive frequency.
 #[test]
 fn the_integral_gain_per_second_is_the_rate_the_piezo_moves_per_metre_of_error() {
-    use tapsim::instrument::feedback::{PiController, hold};
+    use tapsim::instrument::feedback::PiController;
     let setup = default_setup();
-    let p = Prepared::new(&setup, &Numerics::default()).unwrap();
-    let omega = p.simulation().osc.omega;
-    let period = 2.0 * std::f64::consts::PI / omega;
-    let mut lockin = LockIn::new(4, 2.0 * period, omega).unwrap();
     let mut controller = PiController::new(0.8, 0.0, 0.002).unwrap();
     let drive_hz = setup.cantilever.drive_frequency_hz;
     let i_gain = controller.integral_gain_per_s(drive_hz);
     assert!((i_gain - 600.0).abs() < 1e-9, "{i_gain}");
     assert_eq!(controller.integral_time_s(drive_hz), None);
     let a0 = setup.cantilever.free_amplitude_m;
-    let mut phase = p.simulation().free_steady_start();
-    let (samples, _) = hold(
-        &p,
-        (1.5 * a0, &mut phase),
-        &mut lockin,
-        &mut controller,
-        &mut ThermalForce::none(),
-        400,
-    )
-    .unwrap();
+    let samples = hold_on_defaults(&mut controller, 1.5, 400);
     // The lock-in settled on the free oscillation (A = A₀), still far out.
     let (a, b) = (&samples[100], &samples[300]);
     assert!(b.separation_m > 1.1 * a0, "{b:?}");

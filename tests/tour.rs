@@ -43,18 +43,7 @@ fn every_tour_command_runs_and_shows_its_effect() {
     let (merges, rest): (Vec<_>, Vec<_>) = commands
         .into_iter()
         .partition(|c| matches!(c[0].as_str(), "merge" | "fit" | "reconstruct"));
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    std::thread::scope(|s| {
-        for _ in 0..2 {
-            s.spawn(|| {
-                while let Some(args) =
-                    rest.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
-                {
-                    check(args, &dir);
-                }
-            });
-        }
-    });
+    common::two_at_a_time(&rest, |args| check(args, &dir));
     for args in &merges {
         check(args, &dir);
     }

@@ -60,6 +60,23 @@ pub fn run_limited<S: AsRef<OsStr>>(args: &[S], dir: &Path, limit: Duration) -> 
     }
 }
 
+/// Run `work` on every item, two at a time from one queue (the machine has two cores);
+/// a panic in either thread fails the caller.
+pub fn two_at_a_time<T: Sync>(items: &[T], work: impl Fn(&T) + Sync) {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| {
+                while let Some(item) =
+                    items.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+                {
+                    work(item);
+                }
+            });
+        }
+    });
+}
+
 /// Run the binary with `args`.
 pub fn tapsim(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_tapsim"))
