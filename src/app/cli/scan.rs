@@ -6,7 +6,7 @@ use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::app::report::heatmap::HeatMap;
 use crate::app::report::part::{self, Job};
 use crate::app::sample::{BLEND, Sample};
-use crate::dynamics::setup::Prepared;
+use crate::dynamics::setup::{Prepared, significant};
 use crate::error::{Error, Result};
 use crate::instrument::feedback::{MAX_INTEGRAL, PiController};
 use crate::instrument::lockin::LockIn;
@@ -325,19 +325,27 @@ pub fn run(args: ScanArgs) -> Result<()> {
     };
     let lockin = LockIn::new(args.lockin_order, args.lockin_periods * period_hat, omega)?;
     let k_i = args.integral_gain.per_period(drive_hz);
-    if let IntegralGain::PerSecond(g) = args.integral_gain {
-        if !(g >= 0.0 && k_i <= MAX_INTEGRAL) {
-            return Err(Error::OutOfRange(format!(
-                "an integral gain of {g}/s is K_i = {} a drive period at {} kHz: \
+    // The controller's own bound on K_i, said in the units the gain was given in.
+    let controller =
+        PiController::new(args.setpoint, args.proportional_gain, k_i).map_err(|e| {
+            match (args.integral_gain, &e) {
+                (
+                    IntegralGain::PerSecond(g),
+                    Error::InvalidParameter {
+                        name: "integral gain",
+                        ..
+                    },
+                ) => Error::OutOfRange(format!(
+                    "an integral gain of {g}/s is K_i = {} a drive period at {} kHz: \
                  from 0 to {}/s (K_i = {MAX_INTEGRAL}; a loop that moves the sample by A₀ \
                  and more per period on a small error only throws the tip about)",
-                crate::dynamics::setup::significant(k_i),
-                drive_hz * 1e-3,
-                MAX_INTEGRAL * drive_hz
-            )));
-        }
-    }
-    let controller = PiController::new(args.setpoint, args.proportional_gain, k_i)?;
+                    significant(k_i),
+                    drive_hz * 1e-3,
+                    MAX_INTEGRAL * drive_hz
+                )),
+                _ => e,
+            }
+        })?;
     let feedback = feedback_panel(&controller, drive_hz);
     let bar = args
         .out
@@ -832,15 +840,12 @@ fn integral_gain(s: &str) -> std::result::Result<IntegralGain, String> {
 fn feedback_panel(c: &PiController, drive_hz: f64) -> String {
     let mut text = format!(
         "I gain {} s⁻¹ (K_i = {} a drive period), P gain {} m/m",
-        crate::dynamics::setup::significant(c.integral_gain_per_s(drive_hz)),
-        crate::dynamics::setup::significant(c.integral),
+        significant(c.integral_gain_per_s(drive_hz)),
+        significant(c.integral),
         c.proportional
     );
     if let Some(t) = c.integral_time_s(drive_hz) {
-        text += &format!(
-            ", integral time {} ms",
-            crate::dynamics::setup::significant(t * 1e3)
-        );
+        text += &format!(", integral time {} ms", significant(t * 1e3));
     }
     text
 }
