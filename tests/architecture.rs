@@ -412,6 +412,35 @@ fn no_module_imports_itself_round_a_circle() {
     assert!(said.is_empty(), "import circles:\n{}", said.join("\n"));
 }
 
+/// A new force law is one file plus its line in the registry: the rigid law (eq. (12))
+/// was added so: no module imports it, its type is named in no other file, its entry
+/// only in the registry's list (`physics::law`, which declares the file), and the
+/// command line, parameter files, reports and Python reach it through the registry
+/// alone (tests/dynamics.rs runs it by name).
+#[test]
+fn a_law_added_as_the_registry_says_is_imported_by_the_registry_alone() {
+    let rigid: Module = ["physics", "law", "rigid"].map(String::from).to_vec();
+    let edges = graph(&src());
+    assert!(edges.contains_key(&rigid), "no src/physics/law/rigid.rs");
+    let importers: Vec<String> = edges
+        .iter()
+        .filter(|(_, to)| to.contains(&rigid))
+        .map(|(from, _)| name(from))
+        .collect();
+    assert!(importers.is_empty(), "{importers:?}");
+    let mut files = Vec::new();
+    sources(&src(), &mut files);
+    let naming = |what: &str| -> Vec<String> {
+        files
+            .iter()
+            .filter(|f| code_only(&std::fs::read_to_string(f).unwrap()).contains(what))
+            .map(|f| f.strip_prefix(src()).unwrap().display().to_string())
+            .collect()
+    };
+    assert_eq!(naming("RigidLaw"), ["physics/law/rigid.rs"]);
+    assert_eq!(naming("rigid::RIGID"), ["physics/law/mod.rs"]);
+}
+
 #[test]
 fn the_library_names_none_of_the_applications_dependencies() {
     // The dependencies behind the `app` feature, as Cargo.toml lists them.

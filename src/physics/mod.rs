@@ -4,8 +4,8 @@
 //! cantilever is integrated against, and the quasi-static cycles and their summaries.
 //!
 //! May import: the foundation ([`crate::error`], [`crate::numeric`]). Imported by every
-//! layer above. A new force law is a file in [`law`] and its entry in the law
-//! registry (`law/registry.rs`, [`law::LAWS`]).
+//! layer above. A new force law is a file in [`law`] and its line in the law
+//! registry, [`law::LAWS`].
 
 pub mod contact;
 pub mod law;

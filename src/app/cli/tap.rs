@@ -28,8 +28,8 @@ use std::path::PathBuf;
 /// by a flag or a TOML file (--config; keys are the flags' names, flags win; a file
 /// may hold `setpoint` and `branch` in place of `separation`).
 ///
-/// Laws (--law; each explained under it below): hybrid (default), hybrid-attractive,
-/// jkr, dmt, hertz, lj, none. On top of any of them but none: a viscous sample
+/// Laws: the paper's hybrid (the default) and the others --law lists, each explained
+/// under it below. On top of any of them but none: a viscous sample
 /// (--viscosity, Kelvin–Voigt) and a capillary neck (--rupture-distance, which on jkr,
 /// hybrid and lj outlives the contact); on hertz and dmt, a relaxing sample instead
 /// (--unrelaxed-modulus and --relaxation-time: a standard linear solid, whose memory

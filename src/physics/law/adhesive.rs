@@ -4,15 +4,79 @@
 //! numerical solution. The JKR-based laws jump out at the rigid-grip point C of eq. (8).
 
 use super::fold_branch::{FarField, FoldBranch, Side};
-use super::{Branch, ForceLaw};
+use super::registry::not_applicable;
+use super::{AnyLaw, Branch, ForceLaw, LawInfo, LawSpec};
 use crate::error::{Error, Result, positive};
 use crate::numeric::{bracketed_root, lagrange};
 use crate::physics::contact::hybrid::JumpIn;
 use crate::physics::contact::jkr;
 use crate::physics::contact::lj::LjSolution;
+use crate::physics::contact::lj::Reach;
 use crate::physics::contact::lj::curve::CurvePoint;
 use crate::physics::contact::semi_rigid::{self, EighthPower};
+use crate::physics::params::Contact;
 use std::sync::OnceLock;
+
+/// The registry's entry for the paper's hybrid law.
+pub(super) const HYBRID: LawInfo = LawInfo {
+    name: "hybrid",
+    help: "the paper's hybrid law: force-free approach, jump-in at α̂_A of eq. (17), \
+           JKR contact branch (5), jump-out at α̂_C (8); loop area Ŵ_hybrid (18)",
+    build: |_, contact| {
+        let mu = contact.tabor_mu();
+        AdhesiveLaw::hybrid(mu, JumpIn::Fit)
+            .map(AnyLaw::Adhesive)
+            .map_err(|e| not_applicable("hybrid", mu, e))
+    },
+    hertzian: false,
+    touches_at_range: false,
+};
+
+/// The registry's entry for the hybrid law with a semi-rigid attraction on approach.
+pub(super) const HYBRID_ATTRACTIVE: LawInfo = LawInfo {
+    name: "hybrid-attractive",
+    help: "the hybrid law with Greenwood's semi-rigid attraction (12), (14) on the \
+           approach branch, jumping in at that curve's own fold (15)",
+    build: |_, contact| {
+        let mu = contact.tabor_mu();
+        AdhesiveLaw::hybrid_attractive(mu)
+            .map(AnyLaw::Adhesive)
+            .map_err(|e| not_applicable("hybrid-attractive", mu, e))
+    },
+    hertzian: false,
+    touches_at_range: false,
+};
+
+/// The registry's entry for classic JKR.
+pub(super) const JKR: LawInfo = LawInfo {
+    name: "jkr",
+    help: "classic JKR: no force before contact, jump-in at α = 0, jump-out at α̂_C (8)",
+    build: |_, _| Ok(AnyLaw::Adhesive(AdhesiveLaw::jkr())),
+    hertzian: false,
+    touches_at_range: false,
+};
+
+/// The registry's entry for the tabulated Lennard-Jones law.
+pub(super) const LJ: LawInfo = LawInfo {
+    name: "lj",
+    help: "the Lennard-Jones law (10) tabulated from the full numerical solution: both \
+           branches, jumps at its folds A and C (first use per μ solves it)",
+    build: |_: &LawSpec, contact: &Contact| {
+        let mu = contact.tabor_mu();
+        let solution = crate::physics::contact::lj::obtain(mu, Reach::Springs).map_err(|e| {
+            match e {
+                // No loop: no hysteretic law to tabulate (a cell a map skips).
+                Error::NoHysteresis(why) => Error::NotApplicable(why),
+                other => other,
+            }
+        })?;
+        AdhesiveLaw::lennard_jones(&solution)
+            .map(AnyLaw::Adhesive)
+            .map_err(|e| not_applicable("lj", mu, e))
+    },
+    hertzian: false,
+    touches_at_range: false,
+};
 
 /// Nodes of the contact-branch tables (uniform in √(α̂_C − α̂)).
 const CONTACT_NODES: usize = 8193;

@@ -1,9 +1,37 @@
 //! Conservative reference laws: Hertz, DMT (as VEDA and dForce define it), and no force.
 
-use super::{Branch, ForceLaw};
+use super::{AnyLaw, Branch, ForceLaw, LawInfo};
 use crate::error::{Result, positive};
 use crate::physics::params::Contact;
 use std::f64::consts::PI;
+
+/// The registry's entry for DMT.
+pub(super) const DMT: LawInfo = LawInfo {
+    name: "dmt",
+    help: "DMT as VEDA and dForce define it: −HR/(6d²) outside, Hertz plus constant \
+           adhesion inside, d = α + ε; conservative",
+    build: |spec, contact| Ok(AnyLaw::Dmt(DmtLaw::new(contact, spec.hamaker_j)?)),
+    hertzian: true,
+    touches_at_range: true,
+};
+
+/// The registry's entry for Hertz.
+pub(super) const HERTZ: LawInfo = LawInfo {
+    name: "hertz",
+    help: "Hertz repulsion (4/3)E*√R δ^{3/2} for indentation δ = −α > 0; conservative",
+    build: |_, _| Ok(AnyLaw::Hertz(HertzLaw)),
+    hertzian: true,
+    touches_at_range: false,
+};
+
+/// The registry's entry for no force.
+pub(super) const NONE: LawInfo = LawInfo {
+    name: "none",
+    help: "no tip–sample force (a free cantilever)",
+    build: |_, _| Ok(AnyLaw::None(NoForce)),
+    hertzian: false,
+    touches_at_range: false,
+};
 
 /// Hertz repulsion T̂ = −(4/3)(−α̂)^{3/2} for α̂ < 0, zero otherwise: (4/3)E*√R δ^{3/2}
 /// in the scales of eq. (3) (the large-â limit of eq. (5)).

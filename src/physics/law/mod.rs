@@ -8,8 +8,9 @@
 //! ways at the same separation; hysteretic laws enclose [`ForceLaw::loop_area_hat`].
 //!
 //! May import: the foundation, [`crate::physics::params`] and
-//! [`crate::physics::contact`]. A new law: a file here, its entry in the registry
-//! (`registry.rs`), its `LawKind` variant and its construction in `AnyLaw::new`.
+//! [`crate::physics::contact`]. A new law: a file here (its force and its [`LawInfo`])
+//! and its line in the registry, [`LAWS`] (the rigid law, `law/rigid.rs`, was added
+//! that way).
 
 /// The methods of a wrapper around a contact law (`elastic_law()`) that leaves the
 /// law's elastic part as it is: force, slope and work function per branch, the
@@ -56,28 +57,43 @@ mod capillary;
 mod conservative;
 mod fold_branch;
 mod registry;
+mod rigid;
 mod sls;
 mod table;
 mod viscous;
+
+/// The registry: every law, in the order of the help. A new law is a file here (its
+/// force, implementing [`ForceLaw`], and its [`LawInfo`]), its `mod` line above and its
+/// line here; nothing else changes (a law with no variant of its own in [`AnyLaw`] is
+/// called through [`AnyLaw::Dyn`], as the rigid law's is).
+pub const LAWS: [&LawInfo; 8] = [
+    &adhesive::HYBRID,
+    &adhesive::HYBRID_ATTRACTIVE,
+    &adhesive::JKR,
+    &conservative::DMT,
+    &conservative::HERTZ,
+    &adhesive::LJ,
+    &rigid::RIGID,
+    &conservative::NONE,
+];
 
 pub use adhesive::AdhesiveLaw;
 pub use capillary::{Capillary, Neck};
 pub use conservative::{DmtLaw, HertzLaw, NoForce};
 pub use fold_branch::{FarField, FoldBranch, Side};
 pub use registry::{
-    CONTACT_ANGLE, HAMAKER, LAW_PARAMS, LAWS, LawInfo, LawParam, LawSpec, RELAXATION_TIME,
+    CONTACT_ANGLE, HAMAKER, LAW_PARAMS, LawInfo, LawKind, LawParam, LawSpec, RELAXATION_TIME,
     RUPTURE_DISTANCE, SURFACE_TENSION, UNRELAXED_MODULUS, VISCOSITY,
 };
 pub use sls::StandardLinearSolid;
 pub use table::UniformTable;
 pub use viscous::KelvinVoigt;
 
-use crate::error::{Error, Result};
-use crate::physics::contact::hybrid::JumpIn;
-use crate::physics::contact::lj::Reach;
+use crate::error::Result;
 use crate::physics::params::Contact;
 use serde::{Deserialize, Serialize};
 use std::fmt;
+use std::sync::Arc;
 
 /// The state of the contact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -256,65 +272,6 @@ pub trait ForceLaw: Send + Sync {
     }
 }
 
-/// The laws on offer (their names and help text are in the registry, [`LAWS`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum LawKind {
-    /// The paper's hybrid law, eqs. (17), (5), (8), (18).
-    #[default]
-    Hybrid,
-    /// The hybrid law with Greenwood's semi-rigid attraction, eqs. (12), (14), (15).
-    HybridAttractive,
-    /// Classic JKR.
-    Jkr,
-    /// DMT as VEDA and dForce define it.
-    Dmt,
-    /// Hertz.
-    Hertz,
-    /// The Lennard-Jones law (10), tabulated from the full numerical solution.
-    Lj,
-    /// No tip–sample force.
-    None,
-}
-
-impl LawKind {
-    /// Every law, in the order of the help (the registry's).
-    pub const ALL: [LawKind; LAWS.len()] = {
-        let mut all = [LawKind::Hybrid; LAWS.len()];
-        let mut i = 0;
-        while i < LAWS.len() {
-            all[i] = LAWS[i].kind;
-            i += 1;
-        }
-        all
-    };
-
-    /// What the registry says of this law.
-    pub fn info(self) -> &'static LawInfo {
-        LAWS.iter()
-            .find(|l| l.kind == self)
-            .expect("every law is registered")
-    }
-
-    /// The law a user names (as `--law` takes it), if any.
-    pub fn from_name(name: &str) -> Option<Self> {
-        LAWS.iter()
-            .find(|l| l.name.eq_ignore_ascii_case(name.trim()))
-            .map(|l| l.kind)
-    }
-
-    /// The names of every law as a user types them.
-    pub fn names() -> Vec<String> {
-        LAWS.iter().map(|l| l.name.to_string()).collect()
-    }
-}
-
-impl fmt::Display for LawKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.info().name)
-    }
-}
-
 /// One of the laws, chosen at run time.
 #[derive(Debug, Clone)]
 #[allow(
@@ -336,6 +293,70 @@ pub enum AnyLaw {
     Viscous(Box<Rheology>),
     /// Any of the above with a capillary neck.
     Capillary(Necked),
+    /// A law with no variant of its own, called through a pointer (one indirect call
+    /// per evaluation): how a law a file adds joins without touching this enum.
+    Dyn(DynLaw),
+}
+
+/// A law behind a shared pointer, for [`AnyLaw::Dyn`].
+#[derive(Clone)]
+pub struct DynLaw(pub Arc<dyn ForceLaw>);
+
+impl fmt::Debug for DynLaw {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("DynLaw(..)")
+    }
+}
+
+impl ForceLaw for DynLaw {
+    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.0.t_hat(alpha_hat, branch)
+    }
+    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.0.slope_hat(alpha_hat, branch)
+    }
+    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.0.work_hat(alpha_hat, branch)
+    }
+    fn jump_in_alpha_hat(&self) -> f64 {
+        self.0.jump_in_alpha_hat()
+    }
+    fn jump_out_alpha_hat(&self) -> f64 {
+        self.0.jump_out_alpha_hat()
+    }
+    fn exits(&self, branch: Branch) -> Exits {
+        self.0.exits(branch)
+    }
+    fn free_branch_is_force_free(&self) -> bool {
+        self.0.free_branch_is_force_free()
+    }
+    fn loop_area_hat(&self) -> f64 {
+        self.0.loop_area_hat()
+    }
+    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+        self.0.capillary_work_hat(alpha_hat, branch)
+    }
+    fn is_rate_dependent(&self) -> bool {
+        self.0.is_rate_dependent()
+    }
+    fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
+        self.0.dissipative_t_hat(state)
+    }
+    fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
+        self.0.dissipative_slopes_hat(state)
+    }
+    fn internal_states(&self) -> usize {
+        self.0.internal_states()
+    }
+    fn internal_rates_hat(&self, state: &ContactState) -> [f64; MAX_INTERNAL] {
+        self.0.internal_rates_hat(state)
+    }
+    fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
+        self.0.free_relaxation_rates()
+    }
+    fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
+        self.0.internal_slopes_hat(state)
+    }
 }
 
 /// A law with a capillary neck, behind a call: its methods inlined into the hot dispatch
@@ -452,42 +473,12 @@ impl AnyLaw {
     /// not take.
     pub fn new(spec: &LawSpec, contact: &Contact, resonance_hz: f64) -> Result<Self> {
         spec.check()?;
-        let kind = spec.kind;
-        let mu = contact.tabor_mu();
-        let refuse = |why: String| {
-            Error::NotApplicable(format!(
-                "the {kind} law does not apply at Tabor parameter mu = {mu:.4}: {why}; \
-                 use the DMT law (small mu) or JKR"
-            ))
-        };
-        let elastic = match kind {
-            LawKind::Hybrid => AnyLaw::Adhesive(
-                AdhesiveLaw::hybrid(mu, JumpIn::Fit).map_err(|e| refuse(e.to_string()))?,
-            ),
-            LawKind::HybridAttractive => AnyLaw::Adhesive(
-                AdhesiveLaw::hybrid_attractive(mu).map_err(|e| refuse(e.to_string()))?,
-            ),
-            LawKind::Jkr => AnyLaw::Adhesive(AdhesiveLaw::jkr()),
-            LawKind::Dmt => AnyLaw::Dmt(DmtLaw::new(contact, spec.hamaker_j)?),
-            LawKind::Hertz => AnyLaw::Hertz(HertzLaw),
-            LawKind::Lj => AnyLaw::Adhesive(
-                AdhesiveLaw::lennard_jones(
-                    &crate::physics::contact::lj::obtain(mu, Reach::Springs).map_err(
-                        |e| match e {
-                            // No loop: no hysteretic law to tabulate (a cell a map skips).
-                            Error::NoHysteresis(why) => Error::NotApplicable(why),
-                            other => other,
-                        },
-                    )?,
-                )
-                .map_err(|e| refuse(e.to_string()))?,
-            ),
-            LawKind::None => AnyLaw::None(NoForce),
-        };
+        let info = spec.kind.info();
+        let elastic = (info.build)(spec, contact)?;
         let elastic = match spec.neck() {
             Some(neck) => {
                 // The gap at contact: DMT's d = α + ε, the other laws' d = α.
-                let contact_gap_m = if kind == LawKind::Dmt {
+                let contact_gap_m = if info.touches_at_range {
                     contact.range_m
                 } else {
                     0.0
@@ -536,6 +527,7 @@ macro_rules! dispatch {
             AnyLaw::None($l) => $e,
             AnyLaw::Capillary($l) => $e,
             AnyLaw::Viscous($l) => $e,
+            AnyLaw::Dyn($l) => $e,
         }
     };
 }
@@ -572,29 +564,37 @@ impl ForceLaw for AnyLaw {
     }
     #[inline]
     fn is_rate_dependent(&self) -> bool {
-        matches!(self, AnyLaw::Viscous(_))
+        match self {
+            AnyLaw::Viscous(_) => true,
+            AnyLaw::Dyn(l) => l.is_rate_dependent(),
+            _ => false,
+        }
     }
     fn internal_states(&self) -> usize {
         match self {
             AnyLaw::Viscous(l) => l.internal_states(),
+            AnyLaw::Dyn(l) => l.internal_states(),
             _ => 0,
         }
     }
     fn internal_rates_hat(&self, state: &ContactState) -> [f64; MAX_INTERNAL] {
         match self {
             AnyLaw::Viscous(l) => l.internal_rates_hat(state),
+            AnyLaw::Dyn(l) => l.internal_rates_hat(state),
             _ => [0.0; MAX_INTERNAL],
         }
     }
     fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
         match self {
             AnyLaw::Viscous(l) => l.internal_slopes_hat(state),
+            AnyLaw::Dyn(l) => l.internal_slopes_hat(state),
             _ => InternalSlopes::default(),
         }
     }
     fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
         match self {
             AnyLaw::Viscous(l) => l.free_relaxation_rates(),
+            AnyLaw::Dyn(l) => l.free_relaxation_rates(),
             _ => None,
         }
     }
@@ -615,7 +615,7 @@ mod tests {
     fn every_law_is_registered_once_under_a_name_that_parses_back() {
         for kind in LawKind::ALL {
             assert_eq!(
-                LAWS.iter().filter(|l| l.kind == kind).count(),
+                LAWS.iter().filter(|l| l.name == kind.info().name).count(),
                 1,
                 "{kind:?}"
             );

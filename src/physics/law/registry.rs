@@ -1,69 +1,164 @@
-//! The registry of force laws: each law's name, help and parameters, and the
-//! specification a setup carries ([`LawSpec`]). Everything that lists, names, parses or
-//! documents laws (the command line, parameter files, reports) reads it from here.
+//! What the registry of force laws says of each law ([`LawInfo`]: its name, help and
+//! constructor), the handle that names one ([`LawKind`]), the parameters some laws take
+//! ([`LawParam`]) and the specification a setup carries ([`LawSpec`]). Everything that
+//! lists, names, parses or documents laws (the command line, parameter files, reports)
+//! reads it from here; the list itself, [`LAWS`], sits beside the laws' modules.
 
-use super::LawKind;
+use super::{AnyLaw, LAWS};
 use crate::error::{Error, Result};
+use crate::physics::params::Contact;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
-/// What the registry says of one law.
+/// What the registry says of one law: its name, its help, how to build it and the
+/// few facts the wrappers around it ask.
 #[derive(Debug)]
 pub struct LawInfo {
-    /// The law.
-    pub kind: LawKind,
     /// Its name as a user types it.
     pub name: &'static str,
     /// One paragraph of help.
     pub help: &'static str,
+    /// The law on `contact` with the parameters of `spec` (the elastic law only: a
+    /// neck or a rate-dependent sample is wrapped around it by [`AnyLaw::new`]).
+    /// Refuses where the law does not apply.
+    pub build: fn(&LawSpec, &Contact) -> Result<AnyLaw>,
+    /// Whether its contact is Hertzian (a standard-linear-solid sample runs Lee and
+    /// Radok's hereditary Hertz integral over it).
+    pub hertzian: bool,
+    /// Whether the bodies touch at the gap ε (d = α + ε, as DMT and the rigid law
+    /// define it) rather than at α = 0: where a capillary neck starts.
+    pub touches_at_range: bool,
 }
 
-/// Every law, in the order of the help.
-pub const LAWS: [LawInfo; 7] = [
-    LawInfo {
-        kind: LawKind::Hybrid,
-        name: "hybrid",
-        help: "the paper's hybrid law: force-free approach, jump-in at α̂_A of eq. (17), \
- \
-           JKR contact branch (5), jump-out at α̂_C (8); loop area Ŵ_hybrid (18)",
-    },
-    LawInfo {
-        kind: LawKind::HybridAttractive,
-        name: "hybrid-attractive",
-        help: "the hybrid law with Greenwood's semi-rigid attraction (12), (14) on the \
- \
-           approach branch, jumping in at that curve's own fold (15)",
-    },
-    LawInfo {
-        kind: LawKind::Jkr,
-        name: "jkr",
-        help: "classic JKR: no force before contact, jump-in at α = 0, jump-out at α̂_C (8)",
-    },
-    LawInfo {
-        kind: LawKind::Dmt,
-        name: "dmt",
-        help: "DMT as VEDA and dForce define it: −HR/(6d²) outside, Hertz plus constant \
- \
-           adhesion inside, d = α + ε; conservative",
-    },
-    LawInfo {
-        kind: LawKind::Hertz,
-        name: "hertz",
-        help: "Hertz repulsion (4/3)E*√R δ^{3/2} for indentation δ = −α > 0; conservative",
-    },
-    LawInfo {
-        kind: LawKind::Lj,
-        name: "lj",
-        help: "the Lennard-Jones law (10) tabulated from the full numerical solution: both \
- \
-           branches, jumps at its folds A and C (first use per μ solves it)",
-    },
-    LawInfo {
-        kind: LawKind::None,
-        name: "none",
-        help: "no tip–sample force (a free cantilever)",
-    },
-];
+/// The refusal of a law `name` that does not apply at the contact's Tabor parameter
+/// `tabor_mu`, saying `why`.
+pub(super) fn not_applicable(name: &str, tabor_mu: f64, why: impl fmt::Display) -> Error {
+    Error::NotApplicable(format!(
+        "the {name} law does not apply at Tabor parameter mu = {tabor_mu:.4}: {why}; \
+         use the DMT law (small mu) or JKR"
+    ))
+}
+
+/// One of the laws of the registry ([`LAWS`]), by its place there. The laws the code
+/// itself names have a constant each (`LawKind::Hybrid`, …); any law, these included, is
+/// found by its name ([`LawKind::from_name`]), and a law a file adds needs no constant.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct LawKind(u8);
+
+#[allow(
+    non_upper_case_globals,
+    reason = "the laws read as the enum they were: LawKind::Hybrid, LawKind::Jkr, …"
+)]
+impl LawKind {
+    /// The paper's hybrid law, eqs. (17), (5), (8), (18).
+    pub const Hybrid: LawKind = LawKind::named("hybrid");
+    /// The hybrid law with Greenwood's semi-rigid attraction, eqs. (12), (14), (15).
+    pub const HybridAttractive: LawKind = LawKind::named("hybrid-attractive");
+    /// Classic JKR.
+    pub const Jkr: LawKind = LawKind::named("jkr");
+    /// DMT as VEDA and dForce define it.
+    pub const Dmt: LawKind = LawKind::named("dmt");
+    /// Hertz.
+    pub const Hertz: LawKind = LawKind::named("hertz");
+    /// The Lennard-Jones law (10), tabulated from the full numerical solution.
+    pub const Lj: LawKind = LawKind::named("lj");
+    /// No tip–sample force.
+    pub const None: LawKind = LawKind::named("none");
+
+    /// Every law, in the order of the help (the registry's).
+    pub const ALL: [LawKind; LAWS.len()] = {
+        let mut all = [LawKind(0); LAWS.len()];
+        let mut i = 0;
+        while i < LAWS.len() {
+            all[i] = LawKind(i as u8);
+            i += 1;
+        }
+        all
+    };
+
+    /// The registered law called `name` (at compile time: a name the registry lacks
+    /// does not compile).
+    const fn named(name: &str) -> LawKind {
+        /// Byte equality, as a const fn may write it.
+        const fn same(a: &[u8], b: &[u8]) -> bool {
+            if a.len() != b.len() {
+                return false;
+            }
+            let mut k = 0;
+            while k < a.len() {
+                if a[k] != b[k] {
+                    return false;
+                }
+                k += 1;
+            }
+            true
+        }
+        let mut i = 0;
+        while i < LAWS.len() {
+            if same(LAWS[i].name.as_bytes(), name.as_bytes()) {
+                return LawKind(i as u8);
+            }
+            i += 1;
+        }
+        panic!("no law of that name in the registry")
+    }
+
+    /// What the registry says of this law.
+    pub fn info(self) -> &'static LawInfo {
+        LAWS[usize::from(self.0)]
+    }
+
+    /// The law a user names (as `--law` takes it), if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        let name = name.trim();
+        (0..LAWS.len())
+            .find(|&i| LAWS[i].name.eq_ignore_ascii_case(name))
+            .map(|i| LawKind(i as u8))
+    }
+
+    /// The names of every law as a user types them.
+    pub fn names() -> Vec<String> {
+        LAWS.iter().map(|l| l.name.to_string()).collect()
+    }
+}
+
+impl Default for LawKind {
+    /// The paper's hybrid law.
+    fn default() -> Self {
+        LawKind::Hybrid
+    }
+}
+
+impl fmt::Display for LawKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.info().name)
+    }
+}
+
+impl fmt::Debug for LawKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "LawKind({})", self.info().name)
+    }
+}
+
+impl From<LawKind> for String {
+    fn from(kind: LawKind) -> String {
+        kind.info().name.to_string()
+    }
+}
+
+impl TryFrom<String> for LawKind {
+    type Error = String;
+    fn try_from(name: String) -> std::result::Result<Self, String> {
+        LawKind::from_name(&name).ok_or_else(|| {
+            format!(
+                "no law called {name:?}; the laws: {}",
+                LawKind::names().join(", ")
+            )
+        })
+    }
+}
 
 /// A parameter some laws take beyond the contact's own.
 #[derive(Debug)]
@@ -167,7 +262,7 @@ pub const CONTACT_ANGLE: LawParam = LawParam {
 
 /// Whether a law takes a standard-linear-solid sample: one whose contact is Hertzian.
 fn takes_a_relaxing_sample(law: LawKind) -> bool {
-    matches!(law, LawKind::Hertz | LawKind::Dmt)
+    law.info().hertzian
 }
 
 /// A standard-linear-solid sample's unrelaxed modulus.
