@@ -11,6 +11,7 @@ pub mod bimodal;
 pub mod coexist;
 pub mod contrast;
 pub mod fit;
+pub mod fm;
 pub mod identification;
 pub mod qnm_map;
 pub mod reconstruct;

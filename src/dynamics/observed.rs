@@ -4,7 +4,7 @@
 
 use super::free::FreeFlight;
 use super::march::CycleIntegrals;
-use super::model::{Coupling, Oscillator, V, X};
+use super::model::{Coupling, Drive, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver, hermite, internal_at};
 use super::setup::Prepared;
 use super::steady::{Motion, SteadyState};
@@ -187,7 +187,11 @@ impl TapObservables {
         let amp = c.amplitude();
         let omega = p.osc.omega;
         let q = cant.quality;
-        let f0 = cant.drive_over_k_a0();
+        // The drive the motion felt (a loop may have set it apart from the setup's).
+        let f0 = match p.osc.drive {
+            Drive::Force { amplitude } => amplitude,
+            _ => cant.drive_over_k_a0(),
+        };
         let mean_f = c.f_int / c.period;
         let virial = c.virial_int / c.period;
         // π F₀ A sin φ = π k Ω A²/Q + E_ts (units kA₀², per period), plus, per period of

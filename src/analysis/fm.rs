@@ -1,0 +1,324 @@
+//! Frequency-modulation AFM with settled loops: the state in which a phase-locked loop
+//! holds the drive 90° ahead of the motion and an amplitude controller holds the
+//! amplitude at its setpoint A, at a rest separation z_c. Two channels are read: the
+//! frequency shift Δf = f − f₀ and the excitation, whose rise above its free value is
+//! the energy the sample takes per cycle.
+//!
+//! The cantilever of the setup is driven by a force F cos(ωt + 90°) relative to its
+//! motion's first harmonic; the loops settle where the orbit's amplitude is A (the
+//! setup's free amplitude A₀: in FM the amplitude is held at its free value) and its
+//! phase lag behind the drive is 90°. Those two conditions fix the two unknowns, the
+//! drive frequency Ω = ω/ω₀ and the excitation F, which are found by Newton's method on
+//! the steady orbit (each evaluation a steady state of the existing solver, started from
+//! the last). The excitation is reported as the ratio to its free value at the same
+//! amplitude, F/F₀ with F₀ = kA/Q. Two closed forms follow from the first harmonic of
+//! the equation of motion, and the tests check the orbit against both: with the drive
+//! in quadrature, k(1 − Ω²)A²/2 = ⟨F_ts·q₁⟩ (q₁ the motion's first harmonic; to first
+//! order Δf/f₀ = −⟨F_ts q⟩/(kA²), Giessibl, Phys. Rev. B 56, 16010, 1997), and the
+//! energy balance, E_ts = (πkA²/Q)(F/F₀ − Ω) (Anczykowski, Gotsmann, Fuchs, Cleveland
+//! & Elings, Appl. Surf. Sci. 140, 376, 1999), exact up to the damping of the higher
+//! harmonics.
+//!
+//! What this is not (yet): the loops as they run in time, with their gains and
+//! bandwidths (issue 48); here they are ideal and settled.
+
+use crate::dynamics::march::{CycleIntegrals, Phase};
+use crate::dynamics::model::Drive;
+use crate::dynamics::motion::{Motion, StdErr, SteadyState};
+use crate::dynamics::numeric::Ignore;
+use crate::dynamics::observables::TapObservables;
+use crate::dynamics::observed::{Recorder, TrajectorySample};
+use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
+use crate::dynamics::shooting::eigenvalues;
+use crate::error::{Error, Result};
+use crate::physics::law::ForceLaw;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// The phase lag of the motion behind the drive the phase-locked loop holds, in degrees:
+/// the free cantilever's at resonance.
+pub const LOCKED_PHASE_DEG: f64 = 90.0;
+
+/// The tolerance of the loops' two conditions: the amplitude's relative error and the
+/// phase's error in radians.
+const TOLERANCE: f64 = 1e-12;
+
+/// Newton iterations before a point is given up.
+const MAX_ITERATIONS: usize = 40;
+
+/// The settled FM state at one rest separation.
+#[derive(Debug, Clone, Serialize)]
+pub struct FmState {
+    /// Rest separation z_c in m.
+    pub separation_m: f64,
+    /// Frequency shift Δf = f − f₀ in Hz.
+    pub frequency_shift_hz: f64,
+    /// The drive frequency over the free resonance, Ω = f/f₀.
+    pub frequency_ratio: f64,
+    /// The excitation over its free value at the same amplitude, F/F₀ (1 far from the
+    /// sample).
+    pub excitation_ratio: f64,
+    /// The energy the sample takes per cycle read from the excitation,
+    /// (πkA²/Q)(F/F₀ − Ω), in J: what the dissipation channel reports.
+    pub e_ts_from_excitation_j: f64,
+    /// Newton iterations taken.
+    pub iterations: usize,
+    /// The orbit's observables (amplitude, phase, E_ts from the law, forces, …). Its
+    /// Floquet multipliers are those of the orbit under a fixed drive (the loops'
+    /// own dynamics are not in them).
+    pub observables: TapObservables,
+    /// Where the next point of an approach starts.
+    #[serde(skip)]
+    pub next: FmGuess,
+}
+
+/// The setup's experiment driven at Ω with the excitation ratio `excitation` (F/F₀,
+/// the drive in units of kA being F/F₀/Q) rather than the setup's own drive.
+fn driven(setup: &TapSetup, numerics: &Numerics, omega: f64, excitation: f64) -> Result<Prepared> {
+    let mut at = setup.clone();
+    at.cantilever.drive_frequency_hz = omega * setup.cantilever.resonance_hz;
+    let mut p = Prepared::new(&at, numerics)?;
+    p.osc.drive = Drive::Force {
+        amplitude: excitation / setup.cantilever.quality,
+    };
+    Ok(p)
+}
+
+/// One drive period from the state (x, x') at drive phase 0 (the rest of the state,
+/// the branch, from `start`), at the unknowns `u` = (x, x', Ω, ln F/F₀): the residuals of
+/// the FM orbit (the return (Δx, Δx'), the amplitude's relative error, the phase's error
+/// in radians), the period's integrals and the state at its end.
+fn residuals(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    u: [f64; 4],
+    start: &Phase,
+) -> Result<([f64; 4], CycleIntegrals, Phase)> {
+    let p = driven(setup, numerics, u[2], u[3].exp())?;
+    let sim = p.simulation();
+    let mut phase = Phase {
+        tau: 0.0,
+        x: u[0],
+        v: u[1],
+        ..*start
+    };
+    let c = sim.cycle(&mut phase, &mut Ignore)?;
+    phase.tau = 0.0;
+    Ok((
+        [
+            phase.x - u[0],
+            phase.v - u[1],
+            c.amplitude() - 1.0,
+            c.phase() - LOCKED_PHASE_DEG.to_radians(),
+        ],
+        c,
+        phase,
+    ))
+}
+
+/// Where the loops settle at `setup`'s rest separation, holding the amplitude at the
+/// setup's free amplitude A₀ and the drive 90° ahead, from the guess `guess` (the last
+/// point's on an approach, [`FmGuess::free`] far from the sample).
+///
+/// The FM orbit is found directly, as a periodic orbit of the drive period with the two
+/// loop conditions, by Newton's method on (x, x', Ω, ln F/F₀) at drive phase 0 (the
+/// Jacobian by differences, four periods an iteration): under a fixed drive the same
+/// orbit may be unstable (where the attraction bends the resonance), which the loops
+/// stabilise; a search through the fixed-drive steady state would fall off it. Refuses
+/// a law with internal state (a relaxing sample) and a point where Newton's method does
+/// not meet the tolerance (an orbit that grazes a switch, or none near the guess).
+pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<FmState> {
+    let amplitude_m = setup.cantilever.free_amplitude_m;
+    let mut u = [
+        guess.phase.x,
+        guess.phase.v,
+        guess.omega,
+        guess.excitation.ln(),
+    ];
+    if driven(setup, numerics, u[2], u[3].exp())?
+        .law
+        .internal_states()
+        > 0
+    {
+        return Err(Error::NotApplicable(
+            "FM with a relaxing sample (a law with internal state) is not supported yet".into(),
+        ));
+    }
+    let mut start = guess.phase;
+    let (mut r, mut c, mut end) = residuals(setup, numerics, u, &start)?;
+    for iteration in 0..MAX_ITERATIONS {
+        if r.iter().all(|e| e.abs() < TOLERANCE) {
+            let p = driven(setup, numerics, u[2], u[3].exp())?;
+            let mut at = Phase {
+                tau: 0.0,
+                x: u[0],
+                v: u[1],
+                ..start
+            };
+            // ∂z(T)/∂(z, q): the monodromy is its square part.
+            let (_, derivative) = p.simulation().cycle_with_derivative(&mut at)?;
+            let monodromy = derivative.columns(0, derivative.nrows()).into_owned();
+            let state = SteadyState {
+                window: c,
+                cycles: iteration + 1,
+                converged: true,
+                motion: Motion::Periodic {
+                    period: 1,
+                    multipliers: eigenvalues(&monodromy),
+                },
+                std_err: StdErr::default(),
+            };
+            let observables = TapObservables::new(&p, &state)?;
+            let (omega, excitation) = (u[2], u[3].exp());
+            let cant = &setup.cantilever;
+            return Ok(FmState {
+                separation_m: setup.separation_m,
+                frequency_shift_hz: (omega - 1.0) * cant.resonance_hz,
+                frequency_ratio: omega,
+                excitation_ratio: excitation,
+                e_ts_from_excitation_j: PI * cant.stiffness_n_m * amplitude_m * amplitude_m
+                    / cant.quality
+                    * (excitation - omega),
+                iterations: iteration,
+                observables,
+                next: FmGuess {
+                    phase: end,
+                    omega,
+                    excitation,
+                },
+            });
+        }
+        // The Jacobian by forward differences.
+        let steps = [1e-7, 1e-7, 1e-8, 1e-7];
+        let mut jacobian = DMatrix::<f64>::zeros(4, 4);
+        for (k, h) in steps.into_iter().enumerate() {
+            let mut uk = u;
+            uk[k] += h;
+            let (rk, _, _) = residuals(setup, numerics, uk, &start)?;
+            for i in 0..4 {
+                jacobian[(i, k)] = (rk[i] - r[i]) / h;
+            }
+        }
+        let Some(du) = jacobian.lu().solve(&DVector::from_row_slice(&r)) else {
+            break;
+        };
+        // Steps no larger than the resonance's width in Ω, a factor 2 in the excitation
+        // and a fifth of the amplitude in the state.
+        let width = 1.0 / setup.cantilever.quality;
+        let scale = (du[2].abs() / width)
+            .max(du[3].abs() / 2f64.ln())
+            .max(du[0].hypot(du[1]) / 0.2)
+            .max(1.0);
+        for k in 0..4 {
+            u[k] -= du[k] / scale;
+        }
+        start = end;
+        (r, c, end) = residuals(setup, numerics, u, &start)?;
+    }
+    Err(Error::NotApplicable(format!(
+        "at z_c = {:.4} nm the loops did not settle in {MAX_ITERATIONS} iterations (return \
+         {:.2e}, amplitude error {:.2e}, phase error {:.2e} rad): the orbit there may graze a \
+         switch",
+        setup.separation_m * 1e9,
+        r[0].hypot(r[1]),
+        r[2],
+        r[3]
+    )))
+}
+
+/// Where a search for the settled FM state starts: an orbit's state at drive phase 0
+/// and the loops' (Ω, F/F₀).
+#[derive(Debug, Clone, Copy)]
+pub struct FmGuess {
+    /// The state (x, x' in units of A, the branch).
+    pub phase: Phase,
+    /// Ω.
+    pub omega: f64,
+    /// F/F₀.
+    pub excitation: f64,
+}
+
+impl FmGuess {
+    /// The free cantilever's orbit at resonance (far from the sample).
+    pub fn free(setup: &TapSetup, numerics: &Numerics) -> Result<Self> {
+        let p = driven(setup, numerics, 1.0, 1.0)?;
+        Ok(Self {
+            phase: p.simulation().free_steady_start(),
+            omega: 1.0,
+            excitation: 1.0,
+        })
+    }
+}
+
+/// One drive period of the settled FM orbit `state` of `setup`, recorded (SI; time from
+/// the period's start at drive phase 0).
+pub fn trajectory(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    state: &FmState,
+) -> Result<Vec<TrajectorySample>> {
+    let p = driven(
+        setup,
+        numerics,
+        state.frequency_ratio,
+        state.excitation_ratio,
+    )?;
+    let mut recorder = Recorder::new(&p.law, p.cpl, p.osc);
+    let mut phase = state.next.phase;
+    p.simulation().cycle(&mut phase, &mut recorder)?;
+    Ok(recorder.to_si(&p))
+}
+
+/// One point of an FM approach: the settled state, or why there is none.
+#[derive(Debug, Clone, Serialize)]
+pub struct FmPoint {
+    /// Rest separation z_c in m.
+    pub separation_m: f64,
+    /// The settled state (none where the loops find no stable period-1 orbit or do not
+    /// settle).
+    pub state: Option<FmState>,
+    /// Why there is no state.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// An FM approach: the settled state at each rest separation of `separations_m` in
+/// turn, each from the last settled one's (Ω, F/F₀), the first from the free
+/// cantilever's. A point where the loops do not settle is reported as such and the next
+/// starts from the last that did. `progress` is called after each point.
+pub fn approach(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    separations_m: &[f64],
+    mut progress: impl FnMut(),
+) -> Result<Vec<FmPoint>> {
+    let mut guess = FmGuess::free(setup, numerics)?;
+    let mut out = Vec::with_capacity(separations_m.len());
+    for &z in separations_m {
+        crate::interrupt::check()?;
+        let at = TapSetup {
+            separation_m: z,
+            ..setup.clone()
+        };
+        let point = match settle(&at, numerics, &guess) {
+            Ok(s) => {
+                guess = s.next;
+                FmPoint {
+                    separation_m: z,
+                    state: Some(s),
+                    note: None,
+                }
+            }
+            Err(Error::NotApplicable(why)) => FmPoint {
+                separation_m: z,
+                state: None,
+                note: Some(why),
+            },
+            Err(other) => return Err(other),
+        };
+        out.push(point);
+        progress();
+    }
+    Ok(out)
+}
