@@ -11,6 +11,7 @@
 
 pub mod average;
 pub mod feedback;
+pub mod fm;
 pub mod force_curve;
 pub mod lockin;
 pub mod modal;
