@@ -44,6 +44,7 @@ __all__ = [
     "thermal",
     "peakforce",
     "force_curve",
+    "fm",
     "hysteresis",
     "lj",
     "fit",
@@ -444,6 +445,17 @@ def force_curve(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
     curve as numpy arrays (``curve["force_n"]`` against ``curve["piezo_m"]``,
     ``curve["separation_m"]`` or ``curve["t_s"]``; at most ``points`` of them)."""
     return _run("force-curve", setup, kwargs)
+
+
+def fm(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
+    """An FM-AFM approach at constant amplitude (``tapsim fm``): the loops settled (drive
+    90 degrees ahead, amplitude held at the free amplitude), from ``from_`` to ``to``
+    in ``points`` points; per point the frequency shift ``frequency_shift_hz``, the
+    excitation ``excitation_ratio`` (F/F0) and the energy it reads per cycle
+    ``e_ts_from_excitation_j``, beside the law's own loss ``loop_loss_j``, ``grazing``
+    and, where the loops find no orbit, a ``note``. ``to_pandas()`` gives one row a
+    point."""
+    return _run("fm", setup, kwargs)
 
 
 def hysteresis(setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:

@@ -149,6 +149,20 @@ def test_force_curve_returns_its_jumps_and_the_curve_as_arrays():
         tapsim.force_curve(velocity="1m/s")
 
 
+def test_fm_returns_the_frequency_shift_and_the_dissipation_channel_per_point():
+    # JKR touches at every point from 19.5 nm: the excitation reads its loop per touch
+    # (Anczykowski's formula) to 1e-3; one row a point in pandas.
+    r = tapsim.fm(law="jkr", from_="19.5nm", to="17nm", points=4)
+    assert r.law == "jkr" and r.amplitude_m == pytest.approx(20e-9)
+    assert isinstance(r.frequency_shift_hz, np.ndarray) and len(r.frequency_shift_hz) == 4
+    np.testing.assert_allclose(r.e_ts_from_excitation_j, r.loop_loss_j, rtol=1e-3)
+    df = r.to_pandas()
+    assert list(df["separation_m"]) == pytest.approx([19.5e-9, 18.666e-9, 17.833e-9, 17e-9], rel=1e-3)
+    assert (df["excitation_ratio"] > 1.09).all()
+    with pytest.raises(ValueError, match="relaxing sample"):
+        tapsim.fm(law="hertz", unrelaxed_modulus="3GPa", relaxation_time="100ns")
+
+
 def test_scan_in_peakforce_mode_returns_the_qnm_channels_per_pixel():
     r = tapsim.scan(mode="peakforce", pixels=4, no_retrace=True)
     assert r.adhesion_n.shape == (4,) and r.topography_m.shape == (4,)

@@ -126,8 +126,8 @@ fn residuals(
 /// Jacobian by differences, four periods an iteration): under a fixed drive the same
 /// orbit may be unstable (where the attraction bends the resonance), which the loops
 /// stabilise; a search through the fixed-drive steady state would fall off it. Refuses
-/// a law with internal state (a relaxing sample) and a point where Newton's method does
-/// not meet the tolerance (an orbit that grazes a switch, or none near the guess).
+/// a point where Newton's method does not meet the tolerance (an orbit that grazes a
+/// switch, or none near the guess).
 pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<FmState> {
     let amplitude_m = setup.cantilever.free_amplitude_m;
     let mut u = [
@@ -136,15 +136,6 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
         guess.omega,
         guess.excitation.ln(),
     ];
-    if driven(setup, numerics, u[2], u[3].exp())?
-        .law
-        .internal_states()
-        > 0
-    {
-        return Err(Error::NotApplicable(
-            "FM with a relaxing sample (a law with internal state) is not supported yet".into(),
-        ));
-    }
     let mut start = guess.phase;
     let (mut r, mut c, mut end) = residuals(setup, numerics, u, &start)?;
     for iteration in 0..MAX_ITERATIONS {
@@ -240,9 +231,15 @@ pub struct FmGuess {
 }
 
 impl FmGuess {
-    /// The free cantilever's orbit at resonance (far from the sample).
+    /// The free cantilever's orbit at resonance (far from the sample). Refuses a law
+    /// with internal state (a relaxing sample), whose memory the search does not carry.
     pub fn free(setup: &TapSetup, numerics: &Numerics) -> Result<Self> {
         let p = driven(setup, numerics, 1.0, 1.0)?;
+        if p.law.internal_states() > 0 {
+            return Err(Error::OutOfRange(
+                "FM with a relaxing sample (a law with internal state) is not supported yet".into(),
+            ));
+        }
         Ok(Self {
             phase: p.simulation().free_steady_start(),
             omega: 1.0,

@@ -45,6 +45,7 @@ mod contrast;
 mod curve_data;
 mod figure;
 mod fit;
+mod fm;
 mod force_curve;
 mod generated;
 mod hysteresis;
@@ -293,6 +294,10 @@ enum Command {
     #[command(about = "Phase contrast between materials at amplitude setpoints, law by law.")]
     Contrast(contrast::ContrastArgs),
     #[command(
+        about = "FM-AFM approach: frequency shift and dissipation at constant amplitude, loops settled."
+    )]
+    Fm(fm::FmArgs),
+    #[command(
         about = "Fit a measured approach curve: the material's parameters and which law the data support."
     )]
     Fit(fit::FitArgs),
@@ -354,6 +359,7 @@ impl Command {
             Command::Branches(a) => a.out.quiet,
             Command::Bifurcation(a) => a.out.quiet,
             Command::Contrast(a) => a.out.quiet,
+            Command::Fm(a) => a.out.quiet,
             Command::Fit(a) => a.quiet,
             Command::Reconstruct(a) => a.quiet,
             Command::Map(a) => a.out.quiet,
@@ -382,6 +388,7 @@ impl Command {
                 check_targets([a.plot.as_deref(), a.trajectory.as_deref()])
             }
             Command::Approach(a) => a.out.check(),
+            Command::Fm(a) => a.out.check(),
             Command::Branches(a) => a.out.check(),
             Command::Bifurcation(a) => a.out.check(),
             Command::Contrast(a) => {
@@ -771,6 +778,7 @@ fn run_command(command: Command) -> crate::Result<()> {
         Command::Branches(args) => branches::run(args),
         Command::Bifurcation(args) => bifurcation::run(args),
         Command::Contrast(args) => contrast::run(args),
+        Command::Fm(args) => fm::run(args),
         Command::Fit(args) => fit::run(args),
         Command::Reconstruct(args) => reconstruct::run(args),
         Command::Map(args) => map::run(args),
