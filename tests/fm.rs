@@ -320,3 +320,68 @@ fn the_fm_command_reports_the_settled_states() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Sader–Jarvis on a simulated FM approach of the DMT law (A = 20 nm, 650 points from
+/// z_c = 30 to 17 nm: least separations from 10 nm out of contact to 3 nm into it)
+/// recovers the law's force, written here, within 2.5 % of the largest force (the
+/// adhesion, 12.56 nN) at every distance the orbits reach; measured 2.3e-2, the worst
+/// at the kink of the DMT force at contact. The formula's own error on this force, its
+/// input the shift a pure cosine would read (by quadrature of the law), is 1.5e-2 there:
+/// the 1 % issue 48 asks is not reached by the formula on this law at this sampling.
+#[test]
+fn sader_jarvis_recovers_the_dmt_force_from_an_fm_approach() {
+    let s = setup(LawKind::Dmt.into(), 20.0);
+    let states = approach(&s, 30.0, 17.0, 650);
+    let force = fm::sader_jarvis(&s, &states).unwrap();
+    let (r, e, eps) = (s.contact.radius_m, s.contact.modulus_pa, s.contact.range_m);
+    let h = 12.0 * PI * eps * eps * s.contact.work_of_adhesion_j_m2;
+    let dmt = |d: f64| {
+        if d > 0.0 {
+            -h * r / (6.0 * (d + eps).powi(2))
+        } else {
+            -h * r / (6.0 * eps * eps) + 4.0 / 3.0 * e * r.sqrt() * (-d).powf(1.5)
+        }
+    };
+    let ds: Vec<f64> = force.iter().map(|p| p.0).collect();
+    let largest = ds.iter().fold(0.0f64, |m, &d| m.max(dmt(d).abs()));
+    let worst = |f: &[f64]| {
+        ds.iter()
+            .zip(f)
+            .map(|(&d, &f)| (f - dmt(d)).abs() / largest)
+            .fold(0.0f64, f64::max)
+    };
+    let simulated = worst(&force.iter().map(|p| p.1).collect::<Vec<_>>());
+    // The shift a pure cosine z = D + A(1 + cos θ) reads: −⟨F A cos θ⟩/(kA²).
+    let (a, k) = (20e-9, s.cantilever.stiffness_n_m);
+    let shift: Vec<f64> = ds
+        .iter()
+        .map(|&d| {
+            let n = 20_000;
+            let sum = (0..n)
+                .map(|i| {
+                    let t = 2.0 * PI * (f64::from(i) + 0.5) / f64::from(n);
+                    dmt(d + a * (1.0 + t.cos())) * a * t.cos()
+                })
+                .sum::<f64>()
+                / f64::from(n);
+            -sum / (k * a * a)
+        })
+        .collect();
+    let formula = worst(&tapsim::analysis::reconstruct::sader_jarvis(
+        k,
+        &ds,
+        &vec![a; ds.len()],
+        &shift,
+    ));
+    eprintln!(
+        "{} distances from {:.3} to {:.3} nm: worst error {simulated:.2e} of {:.3} nN \
+         (the formula on a pure cosine: {formula:.2e})",
+        ds.len(),
+        ds[0] * 1e9,
+        ds[ds.len() - 1] * 1e9,
+        largest * 1e9
+    );
+    assert!(ds[0] < -2.5e-9 && ds[ds.len() - 1] > 9e-9);
+    assert!(simulated < 0.025, "{simulated}");
+    assert!(formula < 0.016, "{formula}");
+}

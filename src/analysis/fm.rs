@@ -319,3 +319,36 @@ pub fn approach(
     }
     Ok(out)
 }
+
+/// The force at each closest distance D an FM approach's orbits reach, from their
+/// frequency shifts: the Sader–Jarvis inversion (Sader & Jarvis, APL 84, 1801, 2004;
+/// [`crate::analysis::reconstruct::sader_jarvis`]) of the shift the first harmonic's
+/// balance gives, Ω_eff = (Ω² − 1)/2 = −⟨F_ts q₁⟩/(kA²) (to first order Δf/f₀), at the
+/// constant amplitude A; D is each orbit's least separation. `states` in any order of
+/// z_c, each a distinct D; returns (D in m, F in N, repulsive positive) by increasing D,
+/// the force beyond the farthest point taken as zero.
+pub fn sader_jarvis(setup: &TapSetup, states: &[FmState]) -> Result<Vec<(f64, f64)>> {
+    let mut points: Vec<(f64, f64)> = states
+        .iter()
+        .map(|s| {
+            let w = s.frequency_ratio;
+            (s.observables.min_separation_m, 0.5 * (w * w - 1.0))
+        })
+        .collect();
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if points.len() < 3 || points.windows(2).any(|p| p[0].0 >= p[1].0) {
+        return Err(Error::NotApplicable(
+            "the inversion needs at least 3 orbits, each reaching a distance of its own".into(),
+        ));
+    }
+    let closest: Vec<f64> = points.iter().map(|p| p.0).collect();
+    let shift: Vec<f64> = points.iter().map(|p| p.1).collect();
+    let amplitude = vec![setup.cantilever.free_amplitude_m; points.len()];
+    let force = crate::analysis::reconstruct::sader_jarvis(
+        setup.cantilever.stiffness_n_m,
+        &closest,
+        &amplitude,
+        &shift,
+    );
+    Ok(closest.into_iter().zip(force).collect())
+}
