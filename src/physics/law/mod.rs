@@ -52,6 +52,66 @@ macro_rules! elastic_part_from_inside {
     };
 }
 
+/// A [`ForceLaw`] whose every method is the one of the law in `self.0` (a law behind a
+/// box or a pointer); the hot calls out of line, so that the dispatch of [`AnyLaw`]
+/// keeps the other laws' calls inlined.
+macro_rules! forward_to_inner {
+    () => {
+        #[inline(never)]
+        fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.0.t_hat(alpha_hat, branch)
+        }
+        #[inline(never)]
+        fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.0.slope_hat(alpha_hat, branch)
+        }
+        fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.0.work_hat(alpha_hat, branch)
+        }
+        fn jump_in_alpha_hat(&self) -> f64 {
+            self.0.jump_in_alpha_hat()
+        }
+        fn jump_out_alpha_hat(&self) -> f64 {
+            self.0.jump_out_alpha_hat()
+        }
+        fn exits(&self, branch: Branch) -> Exits {
+            self.0.exits(branch)
+        }
+        fn free_branch_is_force_free(&self) -> bool {
+            self.0.free_branch_is_force_free()
+        }
+        fn loop_area_hat(&self) -> f64 {
+            self.0.loop_area_hat()
+        }
+        fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
+            self.0.capillary_work_hat(alpha_hat, branch)
+        }
+        fn is_rate_dependent(&self) -> bool {
+            self.0.is_rate_dependent()
+        }
+        #[inline(never)]
+        fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
+            self.0.dissipative_t_hat(state)
+        }
+        #[inline(never)]
+        fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
+            self.0.dissipative_slopes_hat(state)
+        }
+        fn internal_states(&self) -> usize {
+            self.0.internal_states()
+        }
+        fn internal_rates_hat(&self, state: &ContactState) -> [f64; MAX_INTERNAL] {
+            self.0.internal_rates_hat(state)
+        }
+        fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
+            self.0.free_relaxation_rates()
+        }
+        fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
+            self.0.internal_slopes_hat(state)
+        }
+    };
+}
+
 mod adhesive;
 mod capillary;
 mod conservative;
@@ -309,54 +369,7 @@ impl fmt::Debug for DynLaw {
 }
 
 impl ForceLaw for DynLaw {
-    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.0.t_hat(alpha_hat, branch)
-    }
-    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.0.slope_hat(alpha_hat, branch)
-    }
-    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.0.work_hat(alpha_hat, branch)
-    }
-    fn jump_in_alpha_hat(&self) -> f64 {
-        self.0.jump_in_alpha_hat()
-    }
-    fn jump_out_alpha_hat(&self) -> f64 {
-        self.0.jump_out_alpha_hat()
-    }
-    fn exits(&self, branch: Branch) -> Exits {
-        self.0.exits(branch)
-    }
-    fn free_branch_is_force_free(&self) -> bool {
-        self.0.free_branch_is_force_free()
-    }
-    fn loop_area_hat(&self) -> f64 {
-        self.0.loop_area_hat()
-    }
-    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.0.capillary_work_hat(alpha_hat, branch)
-    }
-    fn is_rate_dependent(&self) -> bool {
-        self.0.is_rate_dependent()
-    }
-    fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
-        self.0.dissipative_t_hat(state)
-    }
-    fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
-        self.0.dissipative_slopes_hat(state)
-    }
-    fn internal_states(&self) -> usize {
-        self.0.internal_states()
-    }
-    fn internal_rates_hat(&self, state: &ContactState) -> [f64; MAX_INTERNAL] {
-        self.0.internal_rates_hat(state)
-    }
-    fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
-        self.0.free_relaxation_rates()
-    }
-    fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
-        self.0.internal_slopes_hat(state)
-    }
+    forward_to_inner!();
 }
 
 /// A law with a capillary neck, behind a call: its methods inlined into the hot dispatch
@@ -367,46 +380,7 @@ impl ForceLaw for DynLaw {
 pub struct Necked(Box<Capillary<AnyLaw>>);
 
 impl ForceLaw for Necked {
-    #[inline(never)]
-    fn t_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.0.t_hat(alpha_hat, branch)
-    }
-    #[inline(never)]
-    fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.0.slope_hat(alpha_hat, branch)
-    }
-    fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.0.work_hat(alpha_hat, branch)
-    }
-    fn jump_in_alpha_hat(&self) -> f64 {
-        self.0.jump_in_alpha_hat()
-    }
-    fn jump_out_alpha_hat(&self) -> f64 {
-        self.0.jump_out_alpha_hat()
-    }
-    fn exits(&self, branch: Branch) -> Exits {
-        self.0.exits(branch)
-    }
-    fn free_branch_is_force_free(&self) -> bool {
-        self.0.free_branch_is_force_free()
-    }
-    fn loop_area_hat(&self) -> f64 {
-        self.0.loop_area_hat()
-    }
-    fn capillary_work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
-        self.0.capillary_work_hat(alpha_hat, branch)
-    }
-    fn is_rate_dependent(&self) -> bool {
-        self.0.is_rate_dependent()
-    }
-    #[inline(never)]
-    fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
-        self.0.dissipative_t_hat(state)
-    }
-    #[inline(never)]
-    fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
-        self.0.dissipative_slopes_hat(state)
-    }
+    forward_to_inner!();
 }
 
 /// A law on a sample with a rate-dependent response. One variant of [`AnyLaw`] holds
