@@ -137,6 +137,8 @@ impl AmplitudeController {
 /// One drive period of the loops.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct FmSample {
+    /// The rest separation z_c over the period, in m.
+    pub separation_m: f64,
     /// The drive frequency over the period, Ω.
     pub frequency_ratio: f64,
     /// The excitation over the period, F/F₀.
@@ -147,10 +149,20 @@ pub struct FmSample {
     pub phase_deg: f64,
 }
 
+impl FmSample {
+    /// The energy the dissipation channel reads per cycle in units of the free
+    /// cantilever's loss πkA²/Q: F/F₀ − Ω (Anczykowski et al. 1999), from the
+    /// excitation and frequency of this period, as an instrument reads it whether or not
+    /// its loops have settled.
+    pub fn dissipation_read(&self) -> f64 {
+        self.excitation_ratio - self.frequency_ratio
+    }
+}
+
 /// March `p`'s cantilever (its length unit the amplitude setpoint) for `periods` drive
-/// periods under the two loops, from the state `phase` at a drive period's start,
-/// driven at first at the free resonance with the free excitation. Every period's
-/// sample; `phase` is left at the end.
+/// periods at its rest separation under the two loops, from the state `phase` at a
+/// drive period's start, driven at first at the PLL's centre with the free excitation.
+/// Every period's sample; `phase` is left at the end.
 pub fn run(
     p: &Prepared,
     phase: &mut Phase,
@@ -158,12 +170,26 @@ pub fn run(
     amplitude: &mut AmplitudeController,
     periods: usize,
 ) -> Result<Vec<FmSample>> {
+    let z = vec![p.setup.separation_m; periods];
+    run_along(p, phase, (pll, amplitude), &z)
+}
+
+/// [`run`] with the rest separation moved to `separations_m[i]` (m) for period i: an
+/// approach or a scan under the loops, one period per entry.
+pub fn run_along(
+    p: &Prepared,
+    phase: &mut Phase,
+    (pll, amplitude): (&mut PhaseLockedLoop, &mut AmplitudeController),
+    separations_m: &[f64],
+) -> Result<Vec<FmSample>> {
     let quality = p.setup.cantilever.quality;
+    let scale = p.setup.contact.separation_scale_m();
     let (mut omega, mut excitation) = (pll.centre, 1.0);
-    let mut out = Vec::with_capacity(periods);
-    for _ in 0..periods {
+    let mut out = Vec::with_capacity(separations_m.len());
+    for &z in separations_m {
         crate::interrupt::check()?;
         let mut sim = p.simulation();
+        sim.cpl.a0 = z / scale;
         sim.osc.omega = omega;
         sim.osc.drive = Drive::Force {
             amplitude: excitation / quality,
@@ -180,6 +206,7 @@ pub fn run(
             ));
         }
         out.push(FmSample {
+            separation_m: z,
             frequency_ratio: omega,
             excitation_ratio: excitation,
             amplitude: a,
