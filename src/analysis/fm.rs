@@ -8,9 +8,9 @@
 //! motion's first harmonic; the loops settle where the orbit's amplitude is A (the
 //! setup's free amplitude A₀: in FM the amplitude is held at its free value) and its
 //! phase lag behind the drive is 90°. Those two conditions fix the two unknowns, the
-//! drive frequency Ω = ω/ω₀ and the excitation F, which are found by Newton's method on
-//! the steady orbit (each evaluation a steady state of the existing solver, started from
-//! the last). The excitation is reported as the ratio to its free value at the same
+//! drive frequency Ω = ω/ω₀ and the excitation F, which are found with the orbit itself
+//! by Newton's method over one drive period ([`settle`]). The excitation is reported as
+//! the ratio to its free value at the same
 //! amplitude, F/F₀ with F₀ = kA/Q. Two closed forms follow from the first harmonic of
 //! the equation of motion, and the tests check the orbit against both: with the drive
 //! in quadrature, k(1 − Ω²)A²/2 = ⟨F_ts·q₁⟩ (q₁ the motion's first harmonic; to first
@@ -19,8 +19,8 @@
 //! & Elings, Appl. Surf. Sci. 140, 376, 1999), exact up to the damping of the higher
 //! harmonics.
 //!
-//! What this is not (yet): the loops as they run in time, with their gains and
-//! bandwidths (issue 48); here they are ideal and settled.
+//! The loops as they run in time, with their gains, are [`crate::instrument::fm`]; they
+//! lock onto the state found here.
 
 use crate::dynamics::march::{CycleIntegrals, Phase};
 use crate::dynamics::model::Drive;
@@ -40,8 +40,8 @@ use std::f64::consts::PI;
 /// the free cantilever's at resonance.
 pub const LOCKED_PHASE_DEG: f64 = 90.0;
 
-/// The tolerance of the loops' two conditions: the amplitude's relative error and the
-/// phase's error in radians.
+/// The tolerance of the residuals: the orbit's return over one period (units of A), the
+/// amplitude's relative error and the phase's error in radians.
 const TOLERANCE: f64 = 1e-12;
 
 /// Newton iterations before a point is given up.
