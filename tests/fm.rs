@@ -425,3 +425,25 @@ fn slow_loops_read_a_dissipation_that_is_not_there() {
     assert!(default < 0.01, "{default}");
     assert!(slow > 0.01, "{slow}");
 }
+
+/// The state at a frequency-shift setpoint: on the hybrid defaults −300 Hz is first met on
+/// the way in between the approach's points at 20.5 and 20 nm (Δf −270 and −350 Hz);
+/// the state found there holds it to 1e-9 and lies where the approach's own settled
+/// states put it (a fine approach brackets its z_c); a setpoint never reached is refused
+/// with the shift that was.
+#[test]
+fn the_state_at_a_frequency_shift_setpoint_is_on_the_approach() {
+    let s = default_setup();
+    let n = Numerics::default();
+    let state = fm::at_shift(&s, &n, -300.0, (24e-9, 8e-9), 32).unwrap();
+    assert!((state.frequency_shift_hz + 300.0).abs() < 3e-7, "{state:?}");
+    let z = state.separation_m;
+    assert!(z < 20.5e-9 && z > 20.0e-9, "{z}");
+    // A fine approach across it: the shift passes −300 Hz between the neighbours of z.
+    let around = approach(&s, z * 1e9 + 0.01, z * 1e9 - 0.01, 3);
+    let (above, below) = (around[0].frequency_shift_hz, around[2].frequency_shift_hz);
+    assert!((above + 300.0) * (below + 300.0) < 0.0, "{above} {below}");
+    let err = fm::at_shift(&s, &n, -5000.0, (24e-9, 8e-9), 32).unwrap_err();
+    assert!(err.to_string().contains("not reached"), "{err}");
+    assert!(fm::at_shift(&s, &n, f64::NAN, (24e-9, 8e-9), 32).is_err());
+}

@@ -352,3 +352,85 @@ pub fn sader_jarvis(setup: &TapSetup, states: &[FmState]) -> Result<Vec<(f64, f6
     );
     Ok(closest.into_iter().zip(force).collect())
 }
+
+/// The settled state at which the frequency shift is `shift_hz`, as an FM instrument's z
+/// feedback holds it: an approach from `from_m` toward `to_m` in `steps` steps (each
+/// point from the last) until Δf first crosses the setpoint, then the secant method on
+/// z_c between the two points that bracket it (each trial settled from the nearer one),
+/// to 1e-9 of the setpoint's size in Hz. A setpoint the approach never reaches, or an
+/// approach that loses the orbit before it, is refused with what was reached.
+pub fn at_shift(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    shift_hz: f64,
+    (from_m, to_m): (f64, f64),
+    steps: usize,
+) -> Result<FmState> {
+    if !(shift_hz.is_finite() && shift_hz != 0.0) {
+        return Err(Error::NotApplicable(format!(
+            "a frequency-shift setpoint is a finite shift, not {shift_hz} Hz (zero is the \
+             free cantilever, met anywhere far from the sample)"
+        )));
+    }
+    let at = |z: f64| TapSetup {
+        separation_m: z,
+        ..setup.clone()
+    };
+    let mut last = settle(&at(from_m), numerics, &FmGuess::free(setup, numerics)?)?;
+    let steps = steps.max(2);
+    let mut reached = last.frequency_shift_hz;
+    for i in 1..=steps {
+        crate::interrupt::check()?;
+        let z = from_m + (to_m - from_m) * i as f64 / steps as f64;
+        let next = settle(&at(z), numerics, &last.next).map_err(|e| {
+            Error::NotApplicable(format!(
+                "the approach toward the setpoint {shift_hz} Hz lost the orbit at z_c = {:.4} \
+                 nm, having reached {reached:.4} Hz: {e}",
+                z * 1e9
+            ))
+        })?;
+        reached = next.frequency_shift_hz;
+        let (a, b) = (
+            last.frequency_shift_hz - shift_hz,
+            next.frequency_shift_hz - shift_hz,
+        );
+        if a * b <= 0.0 {
+            // The secant method inside the bracket [last, next].
+            let (mut lo, mut hi) = (last, next);
+            for _ in 0..60 {
+                let (flo, fhi) = (
+                    lo.frequency_shift_hz - shift_hz,
+                    hi.frequency_shift_hz - shift_hz,
+                );
+                if fhi.abs() <= 1e-9 * shift_hz.abs() {
+                    return Ok(hi);
+                }
+                if flo.abs() <= 1e-9 * shift_hz.abs() {
+                    return Ok(lo);
+                }
+                let t = (flo / (flo - fhi)).clamp(0.05, 0.95);
+                let z = lo.separation_m + t * (hi.separation_m - lo.separation_m);
+                let guess = if t < 0.5 { &lo.next } else { &hi.next };
+                let trial = settle(&at(z), numerics, guess)?;
+                if (trial.frequency_shift_hz - shift_hz) * flo <= 0.0 {
+                    hi = trial;
+                } else {
+                    lo = trial;
+                }
+            }
+            return Err(Error::NotApplicable(format!(
+                "the frequency shift did not settle on the setpoint {shift_hz} Hz between \
+                 z_c = {:.4} and {:.4} nm: it may jump there (a switch grazed)",
+                lo.separation_m * 1e9,
+                hi.separation_m * 1e9
+            )));
+        }
+        last = next;
+    }
+    Err(Error::NotApplicable(format!(
+        "the setpoint {shift_hz} Hz is not reached between z_c = {:.4} and {:.4} nm (the \
+         shift there: {reached:.4} Hz)",
+        from_m * 1e9,
+        to_m * 1e9
+    )))
+}
