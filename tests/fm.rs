@@ -289,6 +289,19 @@ fn the_fm_command_reports_the_settled_states() {
     let grazing = column("grazing");
     assert_eq!(grazing[0], true);
     assert!(grazing[1..].iter().all(|g| *g == false), "{grazing:?}");
+    // At a frequency-shift setpoint: the library's state; where the shift jumps across
+    // the setpoint (the hybrid law's jump into contact), no number.
+    let held = common::json(&["fm", "--setpoint", "-300Hz", "--json"]);
+    let z = held["separation_m"].as_f64().unwrap();
+    assert!(
+        (held["frequency_shift_hz"].as_f64().unwrap() + 300.0).abs() < 3e-7,
+        "{held}"
+    );
+    assert!(z > 20.0e-9 && z < 20.5e-9, "{held}");
+    let jump = common::tapsim(&["fm", "--setpoint", "-20Hz"]);
+    assert!(!jump.status.success() && jump.stdout.is_empty());
+    let said = String::from_utf8_lossy(&jump.stderr);
+    assert!(said.contains("jumps across the setpoint"), "{said}");
     let dir = std::env::temp_dir().join(format!("tapsim-fm-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let csv = dir.join("fm.csv");

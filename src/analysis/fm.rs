@@ -411,7 +411,17 @@ pub fn at_shift(
                 let t = (flo / (flo - fhi)).clamp(0.05, 0.95);
                 let z = lo.separation_m + t * (hi.separation_m - lo.separation_m);
                 let guess = if t < 0.5 { &lo.next } else { &hi.next };
-                let trial = settle(&at(z), numerics, guess)?;
+                let trial = settle(&at(z), numerics, guess).map_err(|e| {
+                    Error::NotApplicable(format!(
+                        "the frequency shift jumps across the setpoint {shift_hz} Hz between \
+                         z_c = {:.4} nm ({:.4} Hz) and {:.4} nm ({:.4} Hz), and no settled \
+                         orbit holds it in between ({e}): the loops cannot hold this setpoint",
+                        lo.separation_m * 1e9,
+                        lo.frequency_shift_hz,
+                        hi.separation_m * 1e9,
+                        hi.frequency_shift_hz
+                    ))
+                })?;
                 if (trial.frequency_shift_hz - shift_hz) * flo <= 0.0 {
                     hi = trial;
                 } else {

@@ -2,7 +2,7 @@
 
 use super::progress::Progress;
 use super::{SeparationRange, SweepOutput, SweepStart};
-use crate::analysis::fm::{FmPoint, approach};
+use crate::analysis::fm::{FmPoint, approach, at_shift};
 use crate::app::config::TapInputs;
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::dynamics::setup::significant;
@@ -27,8 +27,13 @@ use clap::Args;
 /// method on the orbit and the two loop conditions), each point from the last, from
 /// --from (1.2 A by default) to --to (0.4 A).
 ///
+/// With --setpoint (a frequency shift, e.g. -300Hz) the state the z feedback holds
+/// there is printed instead: the approach goes in until Δf first crosses the setpoint,
+/// and z_c is closed on to 1e-9 of it.
+///
 /// Examples:
 ///   tapsim fm                                        # hybrid law, A = 20 nm
+///   tapsim fm --setpoint -300Hz                      # the state at Δf = −300 Hz
 ///   tapsim fm --law jkr --from 20nm --to 17nm --plot fm.png
 ///   tapsim fm --law dmt --free-amplitude 1nm --from 2nm --to 0.5nm --csv fm.csv
 ///
@@ -45,6 +50,10 @@ pub struct FmArgs {
     pub(super) inputs: TapInputs,
     #[command(flatten)]
     range: SeparationRange,
+    /// A frequency-shift setpoint the z feedback holds (e.g. -20Hz): print the state
+    /// there, the first on the way in from --from, instead of the approach [Hz].
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::app::config::frequency)]
+    setpoint: Option<f64>,
     /// Points of the approach [default 40].
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..=10_000))]
     points: Option<u32>,
@@ -98,6 +107,42 @@ pub fn run(args: FmArgs) -> Result<()> {
     let separations: Vec<f64> = (0..n)
         .map(|i| from + (to - from) * i as f64 / (n - 1) as f64)
         .collect();
+    if let Some(shift_hz) = args.setpoint {
+        args.out
+            .refuse_plots("state at a frequency-shift setpoint", &[])?;
+        let busy = super::progress::Busy::new("fm: approaching the setpoint", args.out.quiet);
+        let state = at_shift(setup, &start.numerics, shift_hz, (from, to), n - 1);
+        busy.finish_and_clear();
+        let state = state?;
+        let row = Row::of(&FmPoint {
+            separation_m: state.separation_m,
+            state: Some(state),
+            note: None,
+        });
+        args.out.write_files(std::slice::from_ref(&row), Vec::new)?;
+        if args.out.json {
+            outln!("{}", crate::app::report::records::document(&row)?);
+            return Ok(());
+        }
+        outln!(
+            "FM, {} law: Δf = {} Hz held at z_c = {:.4} nm (amplitude {} nm): F/F₀ = {:.9}, \
+             E_ts from the excitation {:.4} eV, least separation {:.4} nm, peak force {:.4} nN{}",
+            setup.law,
+            significant(shift_hz),
+            row.separation_m * 1e9,
+            significant(setup.cantilever.free_amplitude_m * 1e9),
+            row.excitation_ratio.unwrap_or(f64::NAN),
+            row.e_ts_ev.unwrap_or(f64::NAN) + 0.0,
+            row.min_separation_m.unwrap_or(f64::NAN) * 1e9 + 0.0,
+            row.peak_force_n.unwrap_or(f64::NAN) * 1e9 + 0.0,
+            if row.grazing == Some(true) {
+                "; grazing: the orbit passes a switch within the thermal motion"
+            } else {
+                ""
+            }
+        );
+        return Ok(());
+    }
     let progress = Progress::counted("fm", n, args.out.quiet);
     let points = approach(setup, &start.numerics, &separations, || progress.inc(1));
     progress.finish_and_clear();
