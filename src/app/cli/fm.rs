@@ -61,6 +61,18 @@ pub struct FmArgs {
     pub(super) out: SweepOutput,
 }
 
+/// What a point whose orbit grazes a switch is marked with.
+const GRAZING: &str = "grazing: the orbit passes a switch within the thermal motion";
+
+/// [`GRAZING`] after `separator` for a grazing point, nothing otherwise.
+fn grazing_mark(grazing: Option<bool>, separator: &str) -> String {
+    if grazing == Some(true) {
+        format!("{separator}{GRAZING}")
+    } else {
+        String::new()
+    }
+}
+
 /// One point as written (CSV, JSON).
 #[derive(serde::Serialize)]
 struct Row {
@@ -135,11 +147,7 @@ pub fn run(args: FmArgs) -> Result<()> {
             row.e_ts_ev.unwrap_or(f64::NAN) + 0.0,
             row.min_separation_m.unwrap_or(f64::NAN) * 1e9 + 0.0,
             row.peak_force_n.unwrap_or(f64::NAN) * 1e9 + 0.0,
-            if row.grazing == Some(true) {
-                "; grazing: the orbit passes a switch within the thermal motion"
-            } else {
-                ""
-            }
+            grazing_mark(row.grazing, "; ")
         );
         return Ok(());
     }
@@ -195,11 +203,7 @@ pub fn run(args: FmArgs) -> Result<()> {
                 e + 0.0,
                 min * 1e9 + 0.0,
                 peak * 1e9 + 0.0,
-                if r.grazing == Some(true) {
-                    "  grazing: the orbit passes a switch within the thermal motion"
-                } else {
-                    ""
-                }
+                grazing_mark(r.grazing, "  ")
             ),
             _ => outln!(
                 "{:>9.4}  {}",
