@@ -1,6 +1,6 @@
 //! The `tapsim` command line, run as a user would.
 
-mod common;
+use crate::common;
 use common::{cells, json, num, scratch, tapsim};
 use std::path::PathBuf;
 use std::process::{Command, Output};

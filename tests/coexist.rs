@@ -78,7 +78,7 @@ fn same_states(a: &[SetpointState], b: &[SetpointState]) -> bool {
 }
 
 #[test]
-#[ignore = "release: about 30 s (cargo test --release --test coexist -- --ignored)"]
+#[ignore = "release: about 30 s (cargo test --release -- --ignored coexist::)"]
 fn the_default_search_finds_every_state_the_thorough_one_finds() {
     // Approach curves across the bistable zones of five setups: the hybrid defaults, the
     // issue's soft sample, JKR, hybrid with semi-rigid attraction, and a soft lever on

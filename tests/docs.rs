@@ -2,7 +2,7 @@
 //! page in one click, a book in docs/ whose table of contents lists every page, and no
 //! link that leads nowhere.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};

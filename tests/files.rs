@@ -3,7 +3,7 @@
 //! refused, an interrupted run leaves no temporary file; and how much memory the most
 //! demanding requests take.
 
-mod common;
+use crate::common;
 use common::scratch;
 use std::os::unix::fs::FileTypeExt;
 use std::path::Path;

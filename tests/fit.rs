@@ -131,7 +131,7 @@ fn noise_free_data_give_back_the_truth() {
 /// 2.3 %, Δγ to 1.4 %): within 1 % the issue asks for, the attractive branch alone does
 /// not determine them at this noise.
 #[test]
-#[ignore = "slow (about a minute in release: three fits of some 100 curves each): run with cargo test --release --test fit -- --ignored"]
+#[ignore = "slow (about a minute in release: three fits of some 100 curves each): run with cargo test --release -- --ignored fit::"]
 fn a_noisy_approach_curve_is_fitted_back_from_three_starts() {
     let truth = default_setup();
     let data = measured(&truth, &positions(30), 7);
@@ -192,7 +192,7 @@ fn a_noisy_approach_curve_is_fitted_back_from_three_starts() {
 /// the contact's stiffness, the attractive its adhesion, and together they undo the
 /// trade-off the attractive branch alone leaves (±2.3 %, ±1.4 % above).
 #[test]
-#[ignore = "slow (three fits of some 60 curves of 60 points, about 20 s in release): run with cargo test --release --test fit -- --ignored"]
+#[ignore = "slow (three fits of some 60 curves of 60 points, about 20 s in release): run with cargo test --release -- --ignored fit::"]
 fn a_curve_over_both_branches_is_fitted_back_within_one_percent_from_three_starts() {
     let truth = default_setup();
     let position_m: Vec<f64> = [span(18.5e-9, 8e-9, 30), span(12e-9, 4e-9, 30)]
@@ -543,7 +543,7 @@ fn nuisance_parameters_are_fitted_and_the_stiffness_symmetry_is_found() {
 /// (the second mode's phase follows the force gradient the first averages over). From
 /// a start 20 % off in E* and Δγ the fit with both modes gives back the truth to 1e-6.
 #[test]
-#[ignore = "slow (two-mode approach curves, about 16 s in release): run with cargo test --release --test fit -- --ignored"]
+#[ignore = "slow (two-mode approach curves, about 16 s in release): run with cargo test --release -- --ignored fit::"]
 fn a_second_mode_lifts_the_trade_off_between_modulus_and_adhesion() {
     use tapsim::dynamics::modes::ModeSet;
     use tapsim::fit::SecondMode;
@@ -632,7 +632,7 @@ fn a_second_mode_lifts_the_trade_off_between_modulus_and_adhesion() {
 /// linearised intervals on the noisy data above: the model is nearly straight over
 /// them here, so the two agree — each endpoint within 5 % of the interval's half-width.
 #[test]
-#[ignore = "slow (some 20 fits in release): run with cargo test --release --test fit -- --ignored"]
+#[ignore = "slow (some 20 fits in release): run with cargo test --release -- --ignored fit::"]
 fn profile_intervals_meet_the_linearised_ones_where_the_model_is_straight() {
     use tapsim::fit::profile;
     let truth = default_setup();
@@ -659,7 +659,7 @@ fn profile_intervals_meet_the_linearised_ones_where_the_model_is_straight() {
 /// truth, the 68 % intervals of E* and of Δγ hold the truth in 68 ± 5 % of them — the
 /// stated errors are the errors.
 #[test]
-#[ignore = "slow (200 fits in release, about a minute on two cores): run with cargo test --release --test fit -- --ignored"]
+#[ignore = "slow (200 fits in release, about a minute on two cores): run with cargo test --release -- --ignored fit::"]
 fn the_68_percent_intervals_cover_the_truth_in_68_percent_of_replicas() {
     use rayon::prelude::*;
     let truth = default_setup();

@@ -1,7 +1,7 @@
 //! `tapsim fit` from the command line: the CSV `tapsim approach --csv` writes, fitted
 //! back, and data refused with a message that says why.
 
-mod common;
+use crate::common;
 use common::{json, num, refused, scratch, tapsim};
 
 /// An approach curve `tapsim approach` writes (noise-free, the hybrid defaults) is read

@@ -89,7 +89,7 @@ fn jumps_once(data: &Measured) -> bool {
 /// intervals hold the truth, and the fit is called converged. Before the global stage
 /// these fits ended at E* ≈ 0.35 GPa with χ²/dof ≈ 8·10⁵ and called it converged.
 #[test]
-#[ignore = "slow (eight fits with their global stage, about two minutes in release): run with cargo test --release --test fit_global -- --ignored"]
+#[ignore = "slow (eight fits with their global stage, about two minutes in release): run with cargo test --release -- --ignored fit_global::"]
 fn a_branch_jumping_curve_is_fitted_back_from_starts_half_and_twice_the_truth() {
     for (e, w, seed) in [(0.8e9, 0.07, 11), (0.5e9, 0.05, 12)] {
         let truth = issue_setup(e, w);
@@ -124,7 +124,7 @@ fn a_branch_jumping_curve_is_fitted_back_from_starts_half_and_twice_the_truth() 
 /// and 0.1 J/m²): back to 1 % — it used to stall at the start after 138 curves and call
 /// that convergence.
 #[test]
-#[ignore = "slow (a fit with its global stage, some 5 s in release): run with cargo test --release --test fit_global -- --ignored"]
+#[ignore = "slow (a fit with its global stage, some 5 s in release): run with cargo test --release -- --ignored fit_global::"]
 fn the_help_example_fits_to_one_percent() {
     let truth = default_setup();
     let z: Vec<f64> = (0..30)
@@ -218,7 +218,7 @@ fn a_phase_offset_is_fitted_back() {
 /// that never reaches the sample (both laws give the free oscillation) cannot tell
 /// them apart, and the verdict says so.
 #[test]
-#[ignore = "slow (six fits, about three minutes in release): run with cargo test --release --test fit_global -- --ignored"]
+#[ignore = "slow (six fits, about three minutes in release): run with cargo test --release -- --ignored fit_global::"]
 fn the_law_that_made_the_data_is_preferred() {
     let law = |k| LawSpec::from_values(k, [None; tapsim::law::LAW_PARAMS.len()]);
     let cases = [
@@ -279,7 +279,7 @@ fn the_law_that_made_the_data_is_preferred() {
 /// fit: the values the law cannot take are points without a value, that side of the
 /// profile stops, and the other side still gives its interval.
 #[test]
-#[ignore = "slow (a profile of some ten fits, about 10 s in release): run with cargo test --release --test fit_global -- --ignored"]
+#[ignore = "slow (a profile of some ten fits, about 10 s in release): run with cargo test --release -- --ignored fit_global::"]
 fn a_profile_survives_a_trial_outside_the_law() {
     let truth = issue_setup(default_setup().contact.modulus_pa, 0.03);
     let z: Vec<f64> = (0..20).map(|i| 24e-9 - 16e-9 * i as f64 / 19.0).collect();
@@ -322,7 +322,7 @@ fn a_profile_survives_a_trial_outside_the_law() {
 /// printed, not asserted, until intervals carry the spread of such points (issue 43,
 /// item 5).
 #[test]
-#[ignore = "slow (100 fits, about two minutes in release on two cores): run with cargo test --release --test fit_global -- --ignored"]
+#[ignore = "slow (100 fits, about two minutes in release on two cores): run with cargo test --release -- --ignored fit_global::"]
 fn the_modulus_intervals_cover_the_branch_jumping_truth_in_68_percent_of_replicas() {
     use rayon::prelude::*;
     let (e, w) = (0.8e9, 0.07);

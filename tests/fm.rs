@@ -3,7 +3,7 @@
 //! harmonic of the equation of motion evaluated on the recorded orbit with force laws
 //! written here, and the dissipation channel against the law's own loss.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 use tapsim::analysis::fm::{self, FmState};

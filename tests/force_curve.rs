@@ -4,7 +4,7 @@
 //! books that close, the trigger and the dwell where they were asked, JKR losing more
 //! than the hybrid law — and bad input refused.
 
-mod common;
+use crate::common;
 use common::{run_limited, scratch};
 use std::time::Duration;
 use tapsim::instrument::force_curve::{ForceCurve, Ramp, force_curve};
@@ -199,7 +199,7 @@ fn a_thinned_curve_keeps_its_jumps_and_extremes() {
 /// k̂ < 1, where the spring's losses dominate. A heavily damped lever (Q = 1) rings out
 /// at once. Release only (about 3 s).
 #[test]
-#[ignore = "slow (three ramps down to 16 000 lever periods a leg at three (μ, k̂)): cargo test --release --test force_curve -- --ignored"]
+#[ignore = "slow (three ramps down to 16 000 lever periods a leg at three (μ, k̂)): cargo test --release -- --ignored force_curve::"]
 fn a_slow_ramp_converges_to_the_finite_stiffness_cycle_17_24_26() {
     use tapsim::physics::contact::hybrid;
     for (mu, k_hat) in [(5.0_f64, 2.0_f64), (10.0, 0.5), (3.0, 5.0)] {

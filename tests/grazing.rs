@@ -1,7 +1,7 @@
 //! Grazing near the onset of contact: the margin, the flag, the attractors that coexist,
 //! and an independent brute-force marcher to hold them against.
 
-mod common;
+use crate::common;
 
 use std::cell::RefCell;
 use tapsim::dynamics::model::Drive;
@@ -558,7 +558,7 @@ fn march(setup: &TapSetup, rtol: f64, from_rest: bool) -> Seen {
 }
 
 #[test]
-#[ignore = "slow: run with cargo test --release --test grazing -- --ignored"]
+#[ignore = "slow: run with cargo test --release -- --ignored grazing::"]
 fn near_onset_every_point_the_independent_marcher_finds_ill_posed_is_flagged() {
     let mut flagged_and_changed = 0;
     for k in 0..10 {

@@ -5,7 +5,7 @@
 //! independent `gwyfile` reader in the Python tests, and CI has Gwyddion itself open
 //! both.)
 
-mod common;
+use crate::common;
 use common::{run_limited, scratch};
 use std::collections::HashMap;
 use std::time::Duration;

@@ -15,7 +15,7 @@
 //! draws its own: the limit is on how long a refusal or a hopeless case takes, not on a
 //! large sweep asked for on purpose.
 
-mod common;
+use crate::common;
 use common::{Run, scratch};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};

@@ -3,7 +3,7 @@
 //! RC cascade, and its reading of a settled orbit against `tap`'s amplitude and phase
 //! (integrals over the period carried by the integrator).
 
-mod common;
+use crate::common;
 use common::column;
 use tapsim::dynamics::observables::TapObservables;
 use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};

@@ -2,7 +2,7 @@
 //! `--modes`, parameter files with `[[mode]]` tables, refusals, and the guide's
 //! numbers.
 
-mod common;
+use crate::common;
 use common::{json, num, refused, rows, scratch, tapsim};
 
 #[test]

@@ -2,7 +2,7 @@
 //! oscillator's thermal spectrum for a free cantilever (narrow- and wide-band limits),
 //! and against the Monte Carlo of the marcher watched by the lock-in on tapping orbits.
 
-mod common;
+use crate::common;
 
 use tapsim::dynamics::grazing::{BOLTZMANN_J_K, ROOM_TEMPERATURE_K};
 use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};

@@ -6,7 +6,7 @@
 //! against the hybrid law (the paper's point, as a QNM user meets it); bad input is
 //! refused (issue 47).
 
-mod common;
+use crate::common;
 use common::{run_limited, scratch};
 use std::time::Duration;
 use tapsim::instrument::peakforce::{Analysis, Modulation, at_setpoint, cycle};
@@ -385,7 +385,7 @@ fn hostile_values_of_the_commands_flags_end_cleanly() {
 /// Fig. 6 — one with k̂ < 1, where the spring's losses dominate. A heavily damped lever
 /// (Q = 1) rings out within a period. Release only (about 8 s).
 #[test]
-#[ignore = "slow (three modulations down to f_m = 1.25e-4 f₀ at three (μ, k̂)): cargo test --release --test peakforce -- --ignored"]
+#[ignore = "slow (three modulations down to f_m = 1.25e-4 f₀ at three (μ, k̂)): cargo test --release -- --ignored peakforce::"]
 fn slow_modulation_converges_to_the_finite_stiffness_loss_26() {
     use tapsim::physics::contact::hybrid;
     for (mu, k_hat) in [(5.0_f64, 2.0_f64), (10.0, 0.5), (3.0, 5.0)] {

@@ -3,7 +3,7 @@
 //! refused (parts) or recomputed (cache), never believed; nothing panics, hangs or prints
 //! a number that a whole run would not.
 
-mod common;
+use crate::common;
 use common::{Run, scratch};
 use serde_json::Value;
 use std::path::{Path, PathBuf};

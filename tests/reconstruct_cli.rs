@@ -1,7 +1,7 @@
 //! `tapsim reconstruct` from the command line: the CSV `tapsim approach --csv` writes,
 //! read back as the force that made it, and data refused with a message that says why.
 
-mod common;
+use crate::common;
 use common::{json, refused, scratch, tapsim};
 
 /// A DMT approach curve written by `tapsim approach --csv` gives back, through the

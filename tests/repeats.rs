@@ -3,7 +3,7 @@
 //! scanned fast and the discs image, and no period skipped where the motion does not
 //! repeat each period.
 
-mod common;
+use crate::common;
 use common::column;
 
 use tapsim::config::TapInputs;
@@ -47,14 +47,14 @@ fn against_exact(args: &[&str]) -> (serde_json::Value, serde_json::Value) {
 }
 
 #[test]
-#[ignore = "release: about 10 s in all (cargo test --release --test repeats -- --ignored)"]
+#[ignore = "release: about 10 s in all (cargo test --release -- --ignored repeats::)"]
 fn the_blend_images_as_the_exact_march_does() {
     against_exact(&["--pixels", "256", "--line-rate", "1", "--no-retrace"]);
     against_exact(&[]);
 }
 
 #[test]
-#[ignore = "release: about 10 s in all (cargo test --release --test repeats -- --ignored)"]
+#[ignore = "release: about 10 s in all (cargo test --release -- --ignored repeats::)"]
 fn the_bimodal_blend_images_as_the_exact_march_does() {
     // Two modes over a common period of four drive periods: the loop repeats every four.
     let (fast, exact) = against_exact(&["--modes", "2", "--pixels", "16", "--line-rate", "20"]);
@@ -76,7 +76,7 @@ fn the_bimodal_blend_images_as_the_exact_march_does() {
 }
 
 #[test]
-#[ignore = "release: about 10 s in all (cargo test --release --test repeats -- --ignored)"]
+#[ignore = "release: about 10 s in all (cargo test --release -- --ignored repeats::)"]
 fn the_discs_image_as_the_exact_march_does() {
     let discs = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/samples/discs.toml");
     let args = [
@@ -93,7 +93,7 @@ fn the_discs_image_as_the_exact_march_does() {
 }
 
 #[test]
-#[ignore = "release: about 10 s in all (cargo test --release --test repeats -- --ignored)"]
+#[ignore = "release: about 10 s in all (cargo test --release -- --ignored repeats::)"]
 fn the_step_scanned_fast_overshoots_and_loses_the_sample_as_exactly() {
     let step = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/samples/step.toml");
     let args = [

@@ -4,7 +4,7 @@
 //! starts — a different path (time-marching and shooting from fixed starts, no
 //! continuation, no root-finding).
 
-mod common;
+use crate::common;
 use common::{cells, json, num, scratch, tapsim};
 use serde_json::Value;
 

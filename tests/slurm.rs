@@ -1,7 +1,7 @@
 //! A real Slurm run of `examples/slurm/`: the job array computes a map in parts, the
 //! merge job (submitted with --dependency=afterok) joins them, and the result is the
 //! unsharded map byte for byte. Ignored by a plain `cargo test` (which says so): run it
-//! with `cargo test --test slurm -- --ignored` where a Slurm cluster answers (`.ci/slurm
+//! with `cargo test --release -- --ignored slurm::` where a Slurm cluster answers (`.ci/slurm
 //! up` starts a single-node one); CI does, with TAPSIM_REQUIRE_SLURM set so that it
 //! cannot pass without one.
 
@@ -36,7 +36,7 @@ fn sbatch(dir: &Path, args: &[&str]) -> std::process::Child {
 }
 
 #[test]
-#[ignore = "needs a Slurm cluster: `.ci/slurm up` (as root), then `cargo test --test slurm -- --ignored`"]
+#[ignore = "needs a Slurm cluster: `.ci/slurm up` (as root), then `cargo test --release -- --ignored slurm::`"]
 fn the_example_job_array_and_merge_job_give_the_unsharded_map_on_slurm() {
     if !slurm_is_up() {
         assert!(

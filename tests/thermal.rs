@@ -2,7 +2,7 @@
 //! marcher's noisy free flight against the exact step recursion, reproducible streams,
 //! no noise at T = 0, and the energy balance of a noisy tapping march.
 
-mod common;
+use crate::common;
 
 use tapsim::dynamics::free::FreeFlight;
 use tapsim::dynamics::grazing::{BOLTZMANN_J_K, ROOM_TEMPERATURE_K};

@@ -2,7 +2,7 @@
 //! every command of the tour block succeeds, and the commands that name an effect show it (a touch, a neck, a viscous
 //! share, a non-empty contrast).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
