@@ -330,13 +330,14 @@ pub(crate) struct Sampling {
 }
 
 impl Sampling {
-    /// A tapping trajectory: six points a step, 400 samples a drive period in free flight.
+    /// A tapping trajectory: six points a step, 400 samples a drive period in free flight,
+    /// and both sides of each switch (the force jumps there at one instant).
     pub fn trajectory(osc: &Oscillator) -> Self {
         Self {
             points_per_step: 6,
             free_samples: 400.0,
             free_period: osc.period(),
-            switch_starts: false,
+            switch_starts: true,
             max_samples: MAX_TRAJECTORY_SAMPLES,
         }
     }
