@@ -881,8 +881,8 @@ impl ModeFile {
 /// parameter file's `modes`, `[[mode]]` and `ratio-tolerance`.
 #[derive(Debug, Clone, Default, Args)]
 pub struct ModeInputs {
-    /// Cantilever eigenmodes simulated together, sharing the tip force [1 to 3;
-    /// default 1]. 2 is bimodal AFM: the first mode taps at the drive frequency while
+    /// Eigenmodes simulated together [1 to 3; default 1]. They share the tip force; 2
+    /// is bimodal AFM: the first mode taps at the drive frequency while
     /// the second, driven at its own resonance with a small amplitude, feels the force
     /// gradient over the first mode's orbit (its phase φ₂ is the compositional
     /// contrast). Higher modes default to a rectangular beam's (f₂ = 6.267 f₀,

@@ -93,8 +93,10 @@ pub struct TapArgs {
     /// force_n, branch).
     #[arg(long, help_heading = "Output")]
     pub(super) trajectory: Option<PathBuf>,
-    /// Plot deflection and force vs time, the force–separation loop and the phase
-    /// portrait (.png or .svg).
+    /// Plot the motion, the force loop and the phase portrait.
+    ///
+    /// Deflection and force against time, the force–separation loop and the phase
+    /// portrait, as .png or .svg.
     #[arg(long, help_heading = "Output")]
     pub(super) plot: Option<PathBuf>,
     /// Cycles recorded for --trajectory and --plot.

@@ -117,6 +117,7 @@ mod capillary;
 mod conservative;
 mod fold_branch;
 mod registry;
+mod reversible;
 mod rigid;
 mod sls;
 mod table;
@@ -126,8 +127,9 @@ mod viscous;
 /// force, implementing [`ForceLaw`], and its [`LawInfo`]), its `mod` line above and its
 /// line here; nothing else changes (a law with no variant of its own in [`AnyLaw`] is
 /// called through [`AnyLaw::Dyn`], as the rigid law's is).
-pub const LAWS: [&LawInfo; 8] = [
+pub const LAWS: [&LawInfo; 9] = [
     &adhesive::HYBRID,
+    &reversible::HYBRID_REVERSIBLE,
     &adhesive::HYBRID_ATTRACTIVE,
     &adhesive::JKR,
     &conservative::DMT,
