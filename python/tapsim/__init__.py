@@ -479,6 +479,7 @@ _DATA_COLUMNS = {
     "amplitude1_m", "amplitude1_nm", "amplitude1_ratio", "amplitude1_v",
     "phase_deg", "phase1_deg", "amplitude2_m", "amplitude2_nm", "amplitude2_ratio",
     "phase2_deg", "setpoint_ratio", "deflection_m", "deflection_nm", "mean_force_n",
+    "frequency_shift_hz", "df_hz", "excitation_ratio",
 }
 _DATA_ALIASES = {
     "z": "z_m", "amplitude": "amplitude_m", "phase": "phase_deg",
@@ -597,7 +598,9 @@ def fit(data: Any = None, setup: Optional[Setup] = None, /, **kwargs: Any) -> Re
 
 def reconstruct(data: Any = None, setup: Optional[Setup] = None, /, **kwargs: Any) -> Result:
     """The force and the loss an AM curve implies (``tapsim reconstruct``). The data as
-    :func:`fit` takes them (position, amplitude and phase): columns closest_m, force_n,
+    :func:`fit` takes them (position, amplitude and phase), or with ``mode="fm"`` an FM
+    curve (position, frequency_shift_hz, excitation_ratio, as :func:`fm` writes it):
+    columns closest_m, force_n,
     e_ts_j, in_phase_force_n, frequency_shift (with ``with_law=True`` also
     law_approach_force_n and law_retract_force_n), and notes."""
     return _run_on_data("reconstruct", data, setup, kwargs)

@@ -419,6 +419,20 @@ def test_reconstruct_gives_the_force_of_the_curve_approach_writes(cli, tmp_path)
         tapsim.reconstruct(amplitude_only)
 
 
+def test_reconstruct_inverts_an_fm_curve_from_a_file_or_a_data_frame(cli, tmp_path):
+    path = tmp_path / "fm.csv"
+    args = dict(law="dmt", to="17nm", points=80)
+    fm = tapsim.fm(**{"from": "30nm"}, csv=str(path), **args)
+    r = tapsim.reconstruct(path, mode="fm", law="dmt", with_law=True)
+    expected = cli("reconstruct", str(path), "--mode=fm", "--law=dmt", "--with-law")
+    assert r.force_n.tolist() == expected["force_n"]
+    # The columns of tapsim.fm as a DataFrame, exact rather than the CSV's ten digits.
+    framed = tapsim.reconstruct(fm.to_pandas(), mode="fm", law="dmt")
+    assert np.allclose(framed.force_n, r.force_n, rtol=0, atol=1e-6 * np.max(np.abs(r.force_n)))
+    with pytest.raises(ValueError, match="excitation over its free value"):
+        tapsim.reconstruct(dict(z_nm=[30, 25, 20], df_hz=[-1, -2, -5]), mode="fm")
+
+
 def test_a_bimodal_scan_gives_each_pixels_higher_modes_as_2d_columns(cli):
     args = dict(modes=2, pixels=2, line_rate=400, no_retrace=True)
     r = tapsim.scan(**args)

@@ -68,6 +68,22 @@ pub struct AmCurve {
     pub mean_deflection_m: Option<Vec<f64>>,
 }
 
+/// One branch of an FM curve: at each rest separation z_c, the frequency shift the PLL
+/// reads and the excitation the amplitude controller needs, at a held amplitude.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FmCurve {
+    /// Rest separations z_c, m (any order; they must give distinct closest distances).
+    pub separation_m: Vec<f64>,
+    /// Frequency shifts Δf, Hz.
+    pub frequency_shift_hz: Vec<f64>,
+    /// Excitations over their free value at the same amplitude, F/F₀ (F₀ = kA/Q).
+    pub excitation_ratio: Vec<f64>,
+    /// Amplitudes held, m (the probe's free amplitude where not given).
+    pub amplitude_m: Option<Vec<f64>>,
+    /// Mean deflections z̄, m (the closest distance is z_c + z̄ − A); zero if not given.
+    pub mean_deflection_m: Option<Vec<f64>>,
+}
+
 /// The reconstruction at one point of the curve.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ReconstructedPoint {
@@ -184,17 +200,7 @@ pub fn reconstruct(probe: &Probe, curve: &AmCurve) -> Result<Reconstruction> {
             "the curve's columns differ in length".into(),
         ));
     }
-    if n < 3 {
-        return Err(Error::NotApplicable(format!(
-            "a reconstruction needs at least 3 points of the curve ({n} given)"
-        )));
-    }
-    if n > MAX_POINTS {
-        return Err(Error::OutOfRange(format!(
-            "a reconstruction takes at most {MAX_POINTS} points (its integrals grow as the \
-             square of their number), not {n}"
-        )));
-    }
+    check_count(n)?;
     let zero = vec![0.0; n];
     let deflection = curve.mean_deflection_m.as_deref().unwrap_or(&zero);
     let mut points = Vec::with_capacity(n);
@@ -229,6 +235,104 @@ pub fn reconstruct(probe: &Probe, curve: &AmCurve) -> Result<Reconstruction> {
             e_ts_j: e_ts,
         });
     }
+    invert(probe, points, curve.mean_deflection_m.is_some())
+}
+
+/// The points' count checked as a reconstruction takes it.
+fn check_count(n: usize) -> Result<()> {
+    if n < 3 {
+        return Err(Error::NotApplicable(format!(
+            "a reconstruction needs at least 3 points of the curve ({n} given)"
+        )));
+    }
+    if n > MAX_POINTS {
+        return Err(Error::OutOfRange(format!(
+            "a reconstruction takes at most {MAX_POINTS} points (its integrals grow as the \
+             square of their number), not {n}"
+        )));
+    }
+    Ok(())
+}
+
+/// Reconstruct the force and the dissipation against the closest distance from one
+/// branch of an FM curve: at each point the first harmonic's balance with the drive in
+/// quadrature (the PLL's 90°) gives the in-phase force, −kA·Ω_eff with
+/// Ω_eff = ((f/f₀)² − 1)/2 (to first order Δf/f₀, Giessibl 1997), and the excitation
+/// the loss, E_ts = (πkA²/Q)(F/F₀ − f/f₀) (Anczykowski et al., Appl. Surf. Sci. 140,
+/// 376, 1999); Ω_eff is inverted by the Sader–Jarvis formula as for AM (module docs).
+/// `resonance_hz` is f₀, the free cantilever's, which Δf is counted from.
+pub fn reconstruct_fm(probe: &Probe, resonance_hz: f64, curve: &FmCurve) -> Result<Reconstruction> {
+    for (name, v) in [
+        ("stiffness", probe.stiffness_n_m),
+        ("quality factor", probe.quality),
+        ("free amplitude", probe.free_amplitude_m),
+        ("resonance frequency", resonance_hz),
+    ] {
+        crate::error::positive(name, v)?;
+    }
+    let n = curve.separation_m.len();
+    let lengths_match = curve.frequency_shift_hz.len() == n
+        && curve.excitation_ratio.len() == n
+        && [&curve.amplitude_m, &curve.mean_deflection_m]
+            .iter()
+            .all(|c| c.as_ref().is_none_or(|c| c.len() == n));
+    if !lengths_match {
+        return Err(Error::NotApplicable(
+            "the curve's columns differ in length".into(),
+        ));
+    }
+    check_count(n)?;
+    let (k, q) = (probe.stiffness_n_m, probe.quality);
+    let mut points = Vec::with_capacity(n);
+    for i in 0..n {
+        let z = curve.separation_m[i];
+        let a = curve
+            .amplitude_m
+            .as_ref()
+            .map_or(probe.free_amplitude_m, |a| a[i]);
+        let zbar = curve.mean_deflection_m.as_ref().map_or(0.0, |d| d[i]);
+        let ratio = 1.0 + curve.frequency_shift_hz[i] / resonance_hz;
+        let excitation = curve.excitation_ratio[i];
+        if ![z, a, zbar, ratio, excitation]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            return Err(Error::NotApplicable(format!(
+                "point {}: a value is not a finite number",
+                i + 1
+            )));
+        }
+        if a <= 0.0 || ratio <= 0.0 || excitation < 0.0 {
+            return Err(Error::NotApplicable(format!(
+                "point {}: the amplitude ({a:e} m), the frequency f₀ + Δf ({:e} Hz) and the \
+                 excitation ({excitation}) must be positive",
+                i + 1,
+                ratio * resonance_hz
+            )));
+        }
+        let shift = 0.5 * (ratio * ratio - 1.0);
+        points.push(ReconstructedPoint {
+            separation_m: z,
+            closest_m: z + zbar - a,
+            amplitude_m: a,
+            phase_deg: 90.0,
+            in_phase_force_n: -k * a * shift,
+            frequency_shift: shift,
+            force_n: 0.0,
+            e_ts_j: PI * k * a * a / q * (excitation - ratio),
+        });
+    }
+    invert(probe, points, curve.mean_deflection_m.is_some())
+}
+
+/// The force by the Sader–Jarvis formula from the points' in-phase parts, with the
+/// points kept that give one force at one distance, and the notes a reader needs.
+fn invert(
+    probe: &Probe,
+    points: Vec<ReconstructedPoint>,
+    with_mean_deflection: bool,
+) -> Result<Reconstruction> {
+    let n = points.len();
     let mut notes = Vec::new();
     // From the farthest z_c in: keep each point whose closest distance is nearer than
     // every farther point's (one force, one distance). On the attractive branch of AM
@@ -318,7 +422,7 @@ pub fn reconstruct(probe: &Probe, curve: &AmCurve) -> Result<Reconstruction> {
             100.0 * far_end_shift_ratio
         ));
     }
-    if curve.mean_deflection_m.is_none() {
+    if !with_mean_deflection {
         notes.push(
             "no mean deflection given: the closest distance is z_c − A (off by the static \
              deflection ⟨F_ts⟩/k)"

@@ -63,6 +63,8 @@ enum Kind {
     Direction,
     Segment,
     Grazing,
+    FrequencyShift,
+    Excitation,
 }
 
 /// A column's kind and the factor that makes its values SI, by the header's name.
@@ -94,6 +96,8 @@ fn column_kind(name: &str) -> Option<(Kind, f64)> {
         "direction" => Some((Kind::Direction, 1.0)),
         "segment" => Some((Kind::Segment, 1.0)),
         "grazing" => Some((Kind::Grazing, 1.0)),
+        "frequency_shift_hz" | "df_hz" => Some((Kind::FrequencyShift, 1.0)),
+        "excitation_ratio" => Some((Kind::Excitation, 1.0)),
         _ => None,
     }
 }
@@ -117,6 +121,10 @@ pub struct Columns {
     pub amplitude2_m: Option<Vec<f64>>,
     /// Its phases, degrees.
     pub phase2_deg: Option<Vec<f64>>,
+    /// Frequency shifts Δf (FM), Hz.
+    pub frequency_shift_hz: Option<Vec<f64>>,
+    /// Excitations over their free value, F/F₀ (FM).
+    pub excitation_ratio: Option<Vec<f64>>,
     /// How many rows of the direction read were left out as grazing
     /// ([`Reading::skip_grazing`]).
     pub grazing_left_out: usize,
@@ -200,10 +208,12 @@ pub fn read_curve(
         })
         .or(volts);
     let phase = at.get(&Kind::Phase).copied();
-    if amp.is_none() && phase.is_none() {
+    let shift = at.get(&Kind::FrequencyShift).copied();
+    let excitation = at.get(&Kind::Excitation).copied();
+    if amp.is_none() && phase.is_none() && shift.is_none() {
         return Err(fail(
-            "no amplitude (amplitude_nm, amplitude_m, amplitude_ratio, amplitude_v) or phase \
-             (phase_deg) column"
+            "no amplitude (amplitude_nm, amplitude_m, amplitude_ratio, amplitude_v), phase \
+             (phase_deg) or frequency shift (frequency_shift_hz, df_hz) column"
                 .into(),
         ));
     }
@@ -241,6 +251,7 @@ pub fn read_curve(
     let mut grazing_left_out = 0;
     let (mut z, mut a, mut p, mut d) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut a2, mut p2) = (Vec::new(), Vec::new());
+    let (mut df, mut ex) = (Vec::new(), Vec::new());
     let mut segments = Vec::new();
     let mut label: Option<String> = None;
     for (row, record) in rows.iter().enumerate() {
@@ -344,6 +355,17 @@ pub fn read_curve(
             let lag = reading.phase.lag_deg(value(c, "second mode's phase")?);
             p2.push(within(lag, degrees, "second mode's phase", "°")?);
         }
+        // A shift past half the resonance, an excitation a million times its free value:
+        // no PLL or amplitude controller reads these.
+        if let Some(c) = shift {
+            let f0 = cantilever.resonance_hz;
+            let v = value(c, "frequency shift")?;
+            df.push(within(v, (-0.5 * f0, 0.5 * f0), "frequency shift", " Hz")?);
+        }
+        if let Some(c) = excitation {
+            let v = value(c, "excitation ratio")?;
+            ex.push(within(v, (0.0, 1e6), "excitation ratio", "")?);
+        }
     }
     if z.is_empty() {
         return Err(fail(match direction_col {
@@ -364,6 +386,8 @@ pub fn read_curve(
         mean_deflection_m: deflection.map(|_| d),
         amplitude2_m: amp2.map(|_| a2),
         phase2_deg: phase2.map(|_| p2),
+        frequency_shift_hz: shift.map(|_| df),
+        excitation_ratio: excitation.map(|_| ex),
         grazing_left_out,
     })
 }

@@ -437,6 +437,13 @@ fn measured(
             skip_grazing: !args.keep_grazing,
         },
     )?;
+    if amplitude_m.is_none() && phase_deg.is_none() {
+        return Err(Error::NotApplicable(format!(
+            "{}: fit reads AM curves (an amplitude or a phase column); an FM curve's \
+             frequency shift is inverted by `tapsim reconstruct --mode fm`",
+            args.data.display()
+        )));
+    }
     // Several modes simulated (--modes 2) whether or not the data hold the second's
     // channels; those channels without the modes are refused.
     let second_mode = match (amplitude2_m.is_some() || phase2_deg.is_some(), modes) {

@@ -39,10 +39,11 @@ use clap::Args;
 ///
 /// JSON keys (--json): law, amplitude_m, and one array per column, an entry per point:
 /// separation_m, frequency_shift_hz, frequency_ratio, excitation_ratio,
-/// e_ts_from_excitation_j, e_ts_ev, min_separation_m, peak_force_n, jumps_in,
-/// loop_loss_j (the law's loop per touch times the touches, from the orbit), grazing
-/// and note (null where the point has a state). --csv FILE: the same columns; --plot
-/// FILE.png|svg: Δf and E_ts against z_c.
+/// e_ts_from_excitation_j, e_ts_ev, min_separation_m, peak_force_n, mean_force_n,
+/// jumps_in, loop_loss_j (the law's loop per touch times the touches, from the orbit),
+/// grazing and note (null where the point has a state). --csv FILE: the same columns
+/// (`tapsim reconstruct FILE --mode fm` inverts them); --plot FILE.png|svg: Δf and E_ts
+/// against z_c.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct FmArgs {
@@ -84,6 +85,7 @@ struct Row {
     e_ts_ev: Option<f64>,
     min_separation_m: Option<f64>,
     peak_force_n: Option<f64>,
+    mean_force_n: Option<f64>,
     jumps_in: Option<f64>,
     loop_loss_j: Option<f64>,
     grazing: Option<bool>,
@@ -102,6 +104,7 @@ impl Row {
             e_ts_ev: s.map(|s| s.e_ts_from_excitation_j / ELECTRONVOLT_J),
             min_separation_m: s.map(|s| s.observables.min_separation_m),
             peak_force_n: s.map(|s| s.observables.peak_force_n),
+            mean_force_n: s.map(|s| s.observables.mean_force_n),
             jumps_in: s.map(|s| s.observables.jumps_in),
             loop_loss_j: s.map(|s| s.observables.loop_area_j * s.observables.jumps_in),
             grazing: s.map(|s| s.observables.grazing),

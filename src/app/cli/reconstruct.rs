@@ -2,7 +2,9 @@
 //! dissipation against the closest distance.
 
 use super::curve_data::{Columns, read_curve};
-use crate::analysis::reconstruct::{AmCurve, Probe, Reconstruction, law_branches_hat, reconstruct};
+use crate::analysis::reconstruct::{
+    AmCurve, FmCurve, Probe, Reconstruction, law_branches_hat, reconstruct, reconstruct_fm,
+};
 use crate::app::config::TapInputs;
 use crate::app::report::display::fixed;
 use crate::app::report::reconstruct::{LawCurves, PlotRow, charts};
@@ -40,6 +42,16 @@ use std::path::PathBuf;
 /// start where the tip does not yet feel the sample (the force beyond it is taken as
 /// zero); points whose D is no nearer than a farther point's are left out and counted.
 ///
+/// With --mode fm the curve is an FM approach (as `tapsim fm --csv` writes it, or an
+/// instrument's): a position, the frequency shift (frequency_shift_hz or df_hz, counted
+/// from --resonance) and the excitation over its free value (excitation_ratio, F/F₀),
+/// at the amplitude held (an amplitude column, else --free-amplitude). The in-phase
+/// force is −kA((f/f₀)² − 1)/2 and the loss (πkA²/Q)(F/F₀ − f/f₀) (Anczykowski et al.
+/// 1999):
+///
+///   tapsim fm --law dmt --from 30nm --to 17nm --points 200 --csv fm.csv
+///   tapsim reconstruct fm.csv --mode fm --law dmt --with-law
+///
 /// What it makes of a hysteretic law: the inversion assumes one force at each distance.
 /// A contact that loses energy gives the mean of its approach and retract forces only
 /// where every orbit follows the same loop; a law that jumps in (adhesion hysteresis)
@@ -53,6 +65,10 @@ pub struct ReconstructArgs {
     /// Which rows of a `direction` column to read.
     #[arg(long, value_enum, default_value_t = Branch::Approach)]
     direction: Branch,
+    /// What the curve measured: amplitude and phase (am) or frequency shift and
+    /// excitation at a held amplitude (fm).
+    #[arg(long, value_enum, default_value_t = Mode::Am)]
+    mode: Mode,
     /// List and draw the setup's law at each D: its force on the way in (approach) and
     /// on the way out (retract), for curves it simulated.
     #[arg(long)]
@@ -80,6 +96,15 @@ enum Branch {
     Approach,
     /// The retract rows.
     Retract,
+}
+
+/// The kind of curve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Mode {
+    /// Amplitude modulation: amplitude and phase at a fixed drive.
+    Am,
+    /// Frequency modulation: frequency shift and excitation at a held amplitude.
+    Fm,
 }
 
 /// One row of the output: the reconstruction, and the law's forces where asked for.
@@ -114,6 +139,8 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
         amplitude_m,
         phase_deg,
         mean_deflection_m,
+        frequency_shift_hz,
+        excitation_ratio,
         ..
     } = read_curve(
         &args.data,
@@ -129,12 +156,6 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
             args.data.display()
         )));
     }
-    let (Some(amplitude_m), Some(phase_deg)) = (amplitude_m, phase_deg) else {
-        return Err(Error::NotApplicable(format!(
-            "{}: a reconstruction needs both the amplitude and the phase",
-            args.data.display()
-        )));
-    };
     let c = &setup.cantilever;
     let probe = Probe {
         stiffness_n_m: c.stiffness_n_m,
@@ -142,15 +163,53 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
         free_amplitude_m: c.free_amplitude_m,
         frequency_ratio: c.omega_ratio(),
     };
-    let r = reconstruct(
-        &probe,
-        &AmCurve {
-            separation_m: position_m,
-            amplitude_m,
-            phase_deg,
-            mean_deflection_m,
-        },
-    )?;
+    let r = match args.mode {
+        Mode::Am => {
+            let (Some(amplitude_m), Some(phase_deg)) = (amplitude_m, phase_deg) else {
+                return Err(Error::NotApplicable(format!(
+                    "{}: a reconstruction needs both the amplitude and the phase{}",
+                    args.data.display(),
+                    if frequency_shift_hz.is_some() {
+                        " (this is an FM curve: --mode fm)"
+                    } else {
+                        ""
+                    }
+                )));
+            };
+            reconstruct(
+                &probe,
+                &AmCurve {
+                    separation_m: position_m,
+                    amplitude_m,
+                    phase_deg,
+                    mean_deflection_m,
+                },
+            )?
+        }
+        Mode::Fm => {
+            let (Some(frequency_shift_hz), Some(excitation_ratio)) =
+                (frequency_shift_hz, excitation_ratio)
+            else {
+                return Err(Error::NotApplicable(format!(
+                    "{}: an FM reconstruction needs the frequency shift (frequency_shift_hz \
+                     or df_hz) and the excitation over its free value (excitation_ratio)",
+                    args.data.display()
+                )));
+            };
+            reconstruct_fm(
+                &probe,
+                c.resonance_hz,
+                &FmCurve {
+                    separation_m: position_m,
+                    frequency_shift_hz,
+                    excitation_ratio,
+                    amplitude_m,
+                    mean_deflection_m,
+                },
+            )?
+        }
+    };
+    let fm_resonance = (args.mode == Mode::Fm).then_some(c.resonance_hz);
     let law = if args.with_law {
         let p = Prepared::new(&setup, &numerics)?;
         let (scale, force) = (
@@ -229,7 +288,16 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
             })
             .collect();
         crate::app::report::plot::render_stack(
-            &charts(&plotted, &source, law.as_ref().map(|l| &l.0)),
+            &charts(
+                &plotted,
+                &source,
+                law.as_ref().map(|l| &l.0),
+                if fm_resonance.is_some() {
+                    "excitation"
+                } else {
+                    "phase"
+                },
+            ),
             path,
         )?;
     }
@@ -241,25 +309,52 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
     } else {
         out!(
             "{}",
-            text(&r, &rows, law.as_ref().map(|l| l.0.name.as_str()), &notes)
+            text(
+                &r,
+                &rows,
+                law.as_ref().map(|l| l.0.name.as_str()),
+                &notes,
+                fm_resonance
+            )
         );
     }
     Ok(())
 }
 
-fn text(r: &Reconstruction, rows: &[Row], law: Option<&str>, notes: &[String]) -> String {
+/// The table; with `fm_resonance` (f₀, Hz) an FM curve's, its frequency shift in the
+/// phase's place.
+fn text(
+    r: &Reconstruction,
+    rows: &[Row],
+    law: Option<&str>,
+    notes: &[String],
+    fm_resonance: Option<f64>,
+) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "force reconstruction (Sader–Jarvis on the in-phase force, amplitude along the \
-         curve) from {} points",
+        "force reconstruction (Sader–Jarvis on the in-phase force, {}) from {} points",
+        if fm_resonance.is_some() {
+            "FM: amplitude held"
+        } else {
+            "amplitude along the curve"
+        },
         r.points.len()
     );
     let _ = write!(
         s,
         "{:>9} {:>9} {:>9} {:>9} {:>10} {:>11}",
-        "z_c (nm)", "D (nm)", "A (nm)", "phi (deg)", "F (nN)", "E_ts (eV)"
+        "z_c (nm)",
+        "D (nm)",
+        "A (nm)",
+        if fm_resonance.is_some() {
+            "Δf (Hz)"
+        } else {
+            "phi (deg)"
+        },
+        "F (nN)",
+        "E_ts (eV)"
     );
     if let Some(law) = law {
         let _ = write!(
@@ -276,7 +371,13 @@ fn text(r: &Reconstruction, rows: &[Row], law: Option<&str>, notes: &[String]) -
             (p.separation_m * 1e9, 9),
             (p.closest_m * 1e9, 9),
             (p.amplitude_m * 1e9, 9),
-            (p.phase_deg, 9),
+            // (Δf back from Ω_eff = ((f/f₀)² − 1)/2.)
+            (
+                fm_resonance.map_or(p.phase_deg, |f0| {
+                    ((1.0 + 2.0 * p.frequency_shift).sqrt() - 1.0) * f0
+                }),
+                9,
+            ),
             (p.force_n * 1e9, 10),
             (p.e_ts_j / ELECTRONVOLT_J, 11),
         ];

@@ -28,8 +28,14 @@ pub struct LawCurves {
     pub retract_nn: Vec<f64>,
 }
 
-/// The force panel and the dissipation panel.
-pub fn charts(rows: &[PlotRow], source: &str, law: Option<&LawCurves>) -> Vec<Chart> {
+/// The force panel and the dissipation panel; `loss_from` names the channel the loss
+/// was read from (the phase in AM, the excitation in FM).
+pub fn charts(
+    rows: &[PlotRow],
+    source: &str,
+    law: Option<&LawCurves>,
+    loss_from: &str,
+) -> Vec<Chart> {
     let reconstructed = format!("reconstructed from {source}");
     let x = || Axis::linear("closest distance D = z_c + z̄ − A (nm)", "closest_nm");
     let mut series = Vec::new();
@@ -91,7 +97,7 @@ pub fn charts(rows: &[PlotRow], source: &str, law: Option<&LawCurves>) -> Vec<Ch
         labels: Vec::new(),
     };
     let loss = vec![Series::new(
-        &format!("E_ts from the phase ({source})"),
+        &format!("E_ts from the {loss_from} ({source})"),
         rows.iter().map(|r| (r.closest_nm, r.e_ts_ev)).collect(),
         Style::Markers,
         0,
