@@ -18,6 +18,7 @@ use crate::dynamics::model::Drive;
 use crate::dynamics::numeric::Ignore;
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
+use crate::instrument::thermal::ThermalForce;
 use serde::Serialize;
 
 /// A PI loop: output = centre + K_p·e + K_i·Σe, e the error each period.
@@ -159,19 +160,20 @@ impl FmSample {
     }
 }
 
+/// The loops and the thermal force they run under ([`ThermalForce::none`] for none).
+pub type Loops<'a> = (
+    &'a mut PhaseLockedLoop,
+    &'a mut AmplitudeController,
+    &'a mut ThermalForce,
+);
+
 /// March `p`'s cantilever (its length unit the amplitude setpoint) for `periods` drive
-/// periods at its rest separation under the two loops, from the state `phase` at a
-/// drive period's start, driven at first at the PLL's centre with the free excitation.
-/// Every period's sample; `phase` is left at the end.
-pub fn run(
-    p: &Prepared,
-    phase: &mut Phase,
-    pll: &mut PhaseLockedLoop,
-    amplitude: &mut AmplitudeController,
-    periods: usize,
-) -> Result<Vec<FmSample>> {
+/// periods at its rest separation under the two loops and the thermal force, from the
+/// state `phase` at a drive period's start, driven at first at the PLL's centre with
+/// the free excitation. Every period's sample; `phase` is left at the end.
+pub fn run(p: &Prepared, phase: &mut Phase, loops: Loops, periods: usize) -> Result<Vec<FmSample>> {
     let z = vec![p.setup.separation_m; periods];
-    run_along(p, phase, (pll, amplitude), &z)
+    run_along(p, phase, loops, &z)
 }
 
 /// [`run`] with the rest separation moved to `separations_m[i]` (m) for period i: an
@@ -179,7 +181,7 @@ pub fn run(
 pub fn run_along(
     p: &Prepared,
     phase: &mut Phase,
-    (pll, amplitude): (&mut PhaseLockedLoop, &mut AmplitudeController),
+    (pll, amplitude, force): Loops,
     separations_m: &[f64],
 ) -> Result<Vec<FmSample>> {
     let quality = p.setup.cantilever.quality;
@@ -195,7 +197,8 @@ pub fn run_along(
             amplitude: excitation / quality,
         };
         phase.tau = 0.0;
-        let c = sim.cycle(phase, &mut Ignore)?;
+        let (c, _) = force.march(&sim, phase, 1, &mut Ignore)?;
+        let c = c.expect("one period marched");
         phase.tau = 0.0;
         let (a, lag) = (c.amplitude(), c.phase());
         if !(a.is_finite() && lag.is_finite() && a > 0.0) {
