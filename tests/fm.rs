@@ -798,3 +798,44 @@ fn the_plls_thermal_frequency_noise_is_albrechts() {
     let fast = ratio(125);
     assert!(fast < 0.92, "{fast}");
 }
+
+/// A PLL whose centre frequency is not the cantilever's resonance (f₀ mismatch): within
+/// its capture range (here 600 Hz, about a linewidth f₀/(2Q)) it locks onto the same
+/// orbit all the same — the frequency within 1e-10 of the settled one, the integral
+/// term taking up the offset, so Δf counted from the wrong centre is off by exactly the
+/// mismatch; 3 kHz off it cannot capture, and the run says so (the lag leaves
+/// (0°, 180°)) instead of returning what a drifting loop read.
+#[test]
+fn a_pll_off_the_resonance_locks_or_says_it_lost_lock() {
+    use tapsim::dynamics::setup::Prepared;
+    use tapsim::instrument::fm::{AmplitudeController, PhaseLockedLoop, run};
+    let s = TapSetup {
+        separation_m: 19e-9,
+        ..setup(LawKind::Hybrid.into(), 20.0)
+    };
+    let settled = approach(&s, 19.0, 19.0, 2).pop().unwrap();
+    let p = Prepared::new(&s, &Numerics::default()).unwrap();
+    let q = s.cantilever.quality;
+    let march = |mismatch: f64| {
+        let mut phase = p.simulation().free_steady_start();
+        let (mut pll, mut agc) = (
+            PhaseLockedLoop::for_quality(q).unwrap(),
+            AmplitudeController::for_quality(q).unwrap(),
+        );
+        pll.centre = 1.0 + mismatch;
+        run(
+            &p,
+            &mut phase,
+            (&mut pll, &mut agc, &mut ThermalForce::none()),
+            4000,
+        )
+    };
+    let near = march(2e-3).unwrap();
+    let last = near.last().unwrap();
+    assert!(
+        (last.frequency_ratio - settled.frequency_ratio).abs() < 1e-10,
+        "{last:?} vs {settled:?}"
+    );
+    let far = march(1e-2).unwrap_err().to_string();
+    assert!(far.contains("lost lock") && far.contains("centre"), "{far}");
+}

@@ -208,6 +208,20 @@ pub fn run_along(
                     .into(),
             ));
         }
+        // The lock detector: a lag outside (0°, 180°) is a drive on the wrong side of
+        // the resonance by more than the phase detector can tell, and what the loop then
+        // reads is no frequency of the cantilever's.
+        if !(lag > 0.0 && lag < std::f64::consts::PI) {
+            return Err(Error::NotApplicable(format!(
+                "the PLL lost lock in period {} (the motion lagged the drive by {:.1}° at \
+                 Ω = {omega:.5}, centre {:.5}): its centre frequency is too far from the \
+                 cantilever's resonance for its gains to capture (or its gains are \
+                 unstable on this cantilever): set the centre to the free resonance",
+                out.len() + 1,
+                lag.to_degrees(),
+                pll.centre
+            )));
+        }
         out.push(FmSample {
             separation_m: z,
             frequency_ratio: omega,
