@@ -22,8 +22,7 @@
 //! The loops as they run in time, with their gains, are [`crate::instrument::fm`]; they
 //! lock onto the state found here.
 
-use crate::dynamics::march::{CycleIntegrals, Phase};
-use crate::dynamics::model::Drive;
+use crate::dynamics::march::{CycleIntegrals, Phase, Simulation};
 use crate::dynamics::motion::{Motion, StdErr, SteadyState};
 use crate::dynamics::numeric::Ignore;
 use crate::dynamics::observables::TapObservables;
@@ -31,7 +30,7 @@ use crate::dynamics::observed::{Recorder, TrajectorySample};
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::dynamics::shooting::eigenvalues;
 use crate::error::{Error, Result};
-use crate::physics::law::ForceLaw;
+use crate::physics::law::{AnyLaw, ForceLaw};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -73,16 +72,22 @@ pub struct FmState {
     pub next: FmGuess,
 }
 
-/// The setup's experiment driven at Ω with the excitation ratio `excitation` (F/F₀,
-/// the drive in units of kA being F/F₀/Q) rather than the setup's own drive.
-fn driven(setup: &TapSetup, numerics: &Numerics, omega: f64, excitation: f64) -> Result<Prepared> {
-    let mut at = setup.clone();
-    at.cantilever.drive_frequency_hz = omega * setup.cantilever.resonance_hz;
-    let mut p = Prepared::new(&at, numerics)?;
-    p.osc.drive = Drive::Force {
-        amplitude: excitation / setup.cantilever.quality,
-    };
-    Ok(p)
+/// `p`'s experiment driven at Ω with the excitation ratio `excitation` (F/F₀, the
+/// drive in units of kA being F/F₀/Q) rather than its own drive.
+fn driven(p: &Prepared, omega: f64, excitation: f64) -> Simulation<'_, AnyLaw> {
+    p.simulation_driven(omega, excitation / p.setup.cantilever.quality)
+}
+
+/// The whole of `p` so driven (its setup's drive frequency too), for what reads the
+/// setup: the observables, a recorded trajectory.
+fn driven_prepared(p: &Prepared, omega: f64, excitation: f64) -> Prepared {
+    let sim = driven(p, omega, excitation);
+    let (osc, tol) = (sim.osc, sim.tol);
+    let mut at = p.clone();
+    at.osc = osc;
+    at.tol = tol;
+    at.setup.cantilever.drive_frequency_hz = omega * at.setup.cantilever.resonance_hz;
+    at
 }
 
 /// One drive period from the state (x, x') at drive phase 0 (the rest of the state,
@@ -90,13 +95,11 @@ fn driven(setup: &TapSetup, numerics: &Numerics, omega: f64, excitation: f64) ->
 /// the FM orbit (the return (Δx, Δx'), the amplitude's relative error, the phase's error
 /// in radians), the period's integrals and the state at its end.
 fn residuals(
-    setup: &TapSetup,
-    numerics: &Numerics,
+    p: &Prepared,
     u: [f64; 4],
     start: &Phase,
 ) -> Result<([f64; 4], CycleIntegrals, Phase)> {
-    let p = driven(setup, numerics, u[2], u[3].exp())?;
-    let sim = p.simulation();
+    let sim = driven(p, u[2], u[3].exp());
     let mut phase = Phase {
         tau: 0.0,
         x: u[0],
@@ -137,10 +140,10 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
         guess.excitation.ln(),
     ];
     let mut start = guess.phase;
-    let (mut r, mut c, mut end) = residuals(setup, numerics, u, &start)?;
+    let p = Prepared::new(setup, numerics)?;
+    let (mut r, mut c, mut end) = residuals(&p, u, &start)?;
     for iteration in 0..MAX_ITERATIONS {
         if r.iter().all(|e| e.abs() < TOLERANCE) {
-            let p = driven(setup, numerics, u[2], u[3].exp())?;
             let mut at = Phase {
                 tau: 0.0,
                 x: u[0],
@@ -148,7 +151,7 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
                 ..start
             };
             // ∂z(T)/∂(z, q): the monodromy is its square part.
-            let (_, derivative) = p.simulation().cycle_with_derivative(&mut at)?;
+            let (_, derivative) = driven(&p, u[2], u[3].exp()).cycle_with_derivative(&mut at)?;
             let monodromy = derivative.columns(0, derivative.nrows()).into_owned();
             let state = SteadyState {
                 window: c,
@@ -160,7 +163,7 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
                 },
                 std_err: StdErr::default(),
             };
-            let observables = TapObservables::new(&p, &state)?;
+            let observables = TapObservables::new(&driven_prepared(&p, u[2], u[3].exp()), &state)?;
             let (omega, excitation) = (u[2], u[3].exp());
             let cant = &setup.cantilever;
             return Ok(FmState {
@@ -186,7 +189,7 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
         for (k, h) in steps.into_iter().enumerate() {
             let mut uk = u;
             uk[k] += h;
-            let (rk, _, _) = residuals(setup, numerics, uk, &start)?;
+            let (rk, _, _) = residuals(&p, uk, &start)?;
             for i in 0..4 {
                 jacobian[(i, k)] = (rk[i] - r[i]) / h;
             }
@@ -205,7 +208,7 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
             u[k] -= du[k] / scale;
         }
         start = end;
-        (r, c, end) = residuals(setup, numerics, u, &start)?;
+        (r, c, end) = residuals(&p, u, &start)?;
     }
     Err(Error::NotApplicable(format!(
         "at z_c = {:.4} nm the loops did not settle in {MAX_ITERATIONS} iterations (return \
@@ -234,7 +237,7 @@ impl FmGuess {
     /// The free cantilever's orbit at resonance (far from the sample). Refuses a law
     /// with internal state (a relaxing sample), whose memory the search does not carry.
     pub fn free(setup: &TapSetup, numerics: &Numerics) -> Result<Self> {
-        let p = driven(setup, numerics, 1.0, 1.0)?;
+        let p = driven_prepared(&Prepared::new(setup, numerics)?, 1.0, 1.0);
         if p.law.internal_states() > 0 {
             return Err(Error::OutOfRange(
                 "FM with a relaxing sample (a law with internal state) is not supported yet".into(),
@@ -255,12 +258,11 @@ pub fn trajectory(
     numerics: &Numerics,
     state: &FmState,
 ) -> Result<Vec<TrajectorySample>> {
-    let p = driven(
-        setup,
-        numerics,
+    let p = driven_prepared(
+        &Prepared::new(setup, numerics)?,
         state.frequency_ratio,
         state.excitation_ratio,
-    )?;
+    );
     let mut recorder = Recorder::new(&p.law, p.cpl, p.osc);
     let mut phase = state.next.phase;
     p.simulation().cycle(&mut phase, &mut recorder)?;

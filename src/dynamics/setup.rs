@@ -464,6 +464,18 @@ impl Prepared {
         }
     }
 
+    /// The simulation driven at Ω = `omega` with the force amplitude `drive` (units of
+    /// kA₀), its step bound h_max taken from that drive period as [`Prepared::new`]
+    /// takes it from its own: the experiment at another drive without building the law
+    /// again (FM's loops move both every period).
+    pub fn simulation_driven(&self, omega: f64, drive: f64) -> Simulation<'_, AnyLaw> {
+        let mut sim = self.simulation();
+        sim.osc.omega = omega;
+        sim.osc.drive = Drive::Force { amplitude: drive };
+        sim.tol.h_max = self.tol.h_max * self.osc.omega / omega;
+        sim
+    }
+
     /// The simulation with the rest separation moved to `separation_m` (a sweep step).
     pub(crate) fn simulation_at(&self, separation_m: f64) -> Result<Simulation<'_, AnyLaw>> {
         separation_in_range(separation_m, self.setup.cantilever.free_amplitude_m)?;

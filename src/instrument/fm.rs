@@ -14,7 +14,6 @@
 //! [`crate::analysis::fm::settle`]'s, which finds it directly.
 
 use crate::dynamics::march::Phase;
-use crate::dynamics::model::Drive;
 use crate::dynamics::numeric::Ignore;
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
@@ -190,12 +189,8 @@ pub fn run_along(
     let mut out = Vec::with_capacity(separations_m.len());
     for &z in separations_m {
         crate::interrupt::check()?;
-        let mut sim = p.simulation();
+        let mut sim = p.simulation_driven(omega, excitation / quality);
         sim.cpl.a0 = z / scale;
-        sim.osc.omega = omega;
-        sim.osc.drive = Drive::Force {
-            amplitude: excitation / quality,
-        };
         phase.tau = 0.0;
         let (c, _) = force.march(&sim, phase, 1, &mut Ignore)?;
         let c = c.expect("one period marched");
