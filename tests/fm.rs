@@ -484,14 +484,7 @@ fn reconstruct_inverts_an_fm_curve_from_the_command_line() {
         "dmt",
         "--json",
     ]);
-    let column = |v: &serde_json::Value, key: &str| -> Vec<f64> {
-        v[key]
-            .as_array()
-            .unwrap_or_else(|| panic!("{key}"))
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect()
-    };
+    let column = common::column;
     let (d, f) = (column(&v, "closest_m"), column(&v, "force_n"));
     assert_eq!(d.len(), 650);
     let dmt = dmt_force(&setup(LawKind::Dmt.into(), 20.0));
