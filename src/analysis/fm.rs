@@ -144,6 +144,8 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
     let (mut r, mut c, mut end) = residuals(&p, u, &start)?;
     for iteration in 0..MAX_ITERATIONS {
         if r.iter().all(|e| e.abs() < TOLERANCE) {
+            let (omega, excitation) = (u[2], u[3].exp());
+            let settled = driven_prepared(&p, omega, excitation);
             let mut at = Phase {
                 tau: 0.0,
                 x: u[0],
@@ -151,7 +153,7 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
                 ..start
             };
             // ∂z(T)/∂(z, q): the monodromy is its square part.
-            let (_, derivative) = driven(&p, u[2], u[3].exp()).cycle_with_derivative(&mut at)?;
+            let (_, derivative) = settled.simulation().cycle_with_derivative(&mut at)?;
             let monodromy = derivative.columns(0, derivative.nrows()).into_owned();
             let state = SteadyState {
                 window: c,
@@ -163,8 +165,7 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
                 },
                 std_err: StdErr::default(),
             };
-            let observables = TapObservables::new(&driven_prepared(&p, u[2], u[3].exp()), &state)?;
-            let (omega, excitation) = (u[2], u[3].exp());
+            let observables = TapObservables::new(&settled, &state)?;
             let cant = &setup.cantilever;
             return Ok(FmState {
                 separation_m: setup.separation_m,
@@ -237,14 +238,14 @@ impl FmGuess {
     /// The free cantilever's orbit at resonance (far from the sample). Refuses a law
     /// with internal state (a relaxing sample), whose memory the search does not carry.
     pub fn free(setup: &TapSetup, numerics: &Numerics) -> Result<Self> {
-        let p = driven_prepared(&Prepared::new(setup, numerics)?, 1.0, 1.0);
+        let p = Prepared::new(setup, numerics)?;
         if p.law.internal_states() > 0 {
             return Err(Error::OutOfRange(
                 "FM with a relaxing sample (a law with internal state) is not supported yet".into(),
             ));
         }
         Ok(Self {
-            phase: p.simulation().free_steady_start(),
+            phase: driven(&p, 1.0, 1.0).free_steady_start(),
             omega: 1.0,
             excitation: 1.0,
         })
