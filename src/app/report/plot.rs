@@ -382,35 +382,50 @@ fn draw_heatmap<DB: DrawingBackend>(
             legend_covers: 0,
         });
     }
+    // The key names only what the map shows.
+    let cells = map.cells.iter().flatten();
+    let (mut marked, mut grazing, mut empty) = (false, false, false);
+    for c in cells {
+        match c {
+            Cell::Value {
+                period_one,
+                grazing: g,
+                ..
+            } => {
+                marked |= !period_one;
+                grazing |= *g;
+            }
+            Cell::NotApplicable => empty = true,
+        }
+    }
     let key = ("sans-serif", 16).into_font().color(&BLACK);
-    let at = |dy: i32| (10, bottom + 14 + dy);
-    side.draw(&Circle::new(at(8), 6, BLACK.stroke_width(2)))
-        .map_err(|e| err(&e))?;
-    side.draw(&Text::new(
-        "not period-1",
-        (at(0).0 + 14, at(0).1),
-        key.clone(),
-    ))
-    .map_err(|e| err(&e))?;
-    side.draw(&Circle::new(at(32), 3, BLACK.filled()))
-        .map_err(|e| err(&e))?;
-    side.draw(&Text::new(
-        "grazes a switch",
-        (at(24).0 + 14, at(24).1),
-        key.clone(),
-    ))
-    .map_err(|e| err(&e))?;
-    side.draw(&Rectangle::new(
-        [at(48), (at(48).0 + 12, at(48).1 + 12)],
-        grey.filled(),
-    ))
-    .map_err(|e| err(&e))?;
-    side.draw(&Text::new(
-        map.empty_label.as_str(),
-        (at(48).0 + 18, at(48).1),
-        key,
-    ))
-    .map_err(|e| err(&e))?;
+    let mut dy = 0;
+    let mut at = || {
+        let here = (10, bottom + 14 + dy);
+        dy += 24;
+        here
+    };
+    if marked {
+        let p = at();
+        side.draw(&Circle::new((p.0, p.1 + 8), 6, BLACK.stroke_width(2)))
+            .map_err(|e| err(&e))?;
+        side.draw(&Text::new("not period-1", (p.0 + 14, p.1), key.clone()))
+            .map_err(|e| err(&e))?;
+    }
+    if grazing {
+        let p = at();
+        side.draw(&Circle::new((p.0, p.1 + 8), 3, BLACK.filled()))
+            .map_err(|e| err(&e))?;
+        side.draw(&Text::new("grazes a switch", (p.0 + 14, p.1), key.clone()))
+            .map_err(|e| err(&e))?;
+    }
+    if empty {
+        let p = at();
+        side.draw(&Rectangle::new([p, (p.0 + 12, p.1 + 12)], grey.filled()))
+            .map_err(|e| err(&e))?;
+        side.draw(&Text::new(map.empty_label.as_str(), (p.0 + 18, p.1), key))
+            .map_err(|e| err(&e))?;
+    }
     Ok(Drawn {
         area: plotted,
         legend_covers: 0,
