@@ -17,6 +17,7 @@ mod fit;
 mod fit_cli;
 mod fit_global;
 mod fm;
+mod fm_scan;
 mod force_curve;
 mod grazing;
 mod gwyddion;

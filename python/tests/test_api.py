@@ -172,6 +172,20 @@ def test_scan_in_peakforce_mode_returns_the_qnm_channels_per_pixel():
         tapsim.scan(peak_force="3nN")
 
 
+def test_scan_in_fm_mode_returns_the_topography_shift_and_dissipation_as_an_image():
+    lines, pixels = 2, 4
+    r = tapsim.scan(mode="fm", lines=lines, pixels=pixels)
+    img = r.to_xarray()
+    for key in ("topography_m", "frequency_shift_hz", "dissipation_j", "excitation_ratio"):
+        assert img[key].shape == (2, lines, pixels)
+    trace = img["dissipation_j"].sel(direction="trace").values
+    # The blend: A (the first half) loses seven times what B does, at -200 Hz held.
+    assert (trace[:, 0] > 5 * trace[:, -1]).all()
+    assert np.allclose(img["frequency_shift_hz"].sel(direction="trace").values[:, 0], -200.0)
+    with pytest.raises(ValueError, match="add --mode fm"):
+        tapsim.scan(frequency_shift="-100Hz")
+
+
 def _read_gsf(path):
     """A Gwyddion Simple Field file, read as Gwyddion's user guide describes the format:
     the magic line, ``name = value`` lines, one to four NULs to a multiple of 4, then

@@ -30,6 +30,8 @@ use crate::dynamics::observed::{Recorder, TrajectorySample};
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::dynamics::shooting::eigenvalues;
 use crate::error::{Error, Result};
+use crate::instrument::fm::FmDrive;
+use crate::instrument::fm_scan::Engagement;
 use crate::physics::law::{AnyLaw, ForceLaw};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -446,4 +448,37 @@ pub fn at_shift(
         from_m * 1e9,
         to_m * 1e9
     )))
+}
+
+/// Where an FM image engages over `setup`'s material: the settled state at the
+/// frequency shift `shift_hz` ([`at_shift`] from `range` in `steps` steps), as the
+/// instrument's loops take it up ([`Engagement`]), and the slope ∂Δf/∂z_c there in
+/// Hz/m, by the difference to a state settled 1e-3 A nearer the sample (on the way the
+/// approach came: the side of the curve the feedback holds).
+pub fn engagement(
+    setup: &TapSetup,
+    numerics: &Numerics,
+    shift_hz: f64,
+    range: (f64, f64),
+    steps: usize,
+) -> Result<(Engagement, f64)> {
+    let state = at_shift(setup, numerics, shift_hz, range, steps)?;
+    let dz = 1e-3 * setup.cantilever.free_amplitude_m * (range.0 - range.1).signum();
+    let nearer = TapSetup {
+        separation_m: state.separation_m - dz,
+        ..setup.clone()
+    };
+    let next = settle(&nearer, numerics, &state.next)?;
+    let slope = (state.frequency_shift_hz - next.frequency_shift_hz) / dz;
+    Ok((
+        Engagement {
+            phase: state.next.phase,
+            drive: FmDrive {
+                omega: state.frequency_ratio,
+                excitation: state.excitation_ratio,
+            },
+            separation_m: state.separation_m,
+        },
+        slope,
+    ))
 }

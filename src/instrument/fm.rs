@@ -56,6 +56,12 @@ impl Pi {
         })
     }
 
+    /// Preload the integral so that a zero error gives the correction `output`
+    /// (bumpless engagement on a settled state).
+    fn hold(&mut self, output: f64) {
+        self.sum = output / self.integral;
+    }
+
     /// The correction after a period with error `e`.
     fn update(&mut self, e: f64) -> f64 {
         self.sum += e;
@@ -96,6 +102,12 @@ impl PhaseLockedLoop {
         Self::new(1.0 / quality, 8.0 / (quality * quality))
     }
 
+    /// Hold the drive frequency Ω while the lag is the set one: the loop engaged on a
+    /// state already settled there.
+    pub fn hold(&mut self, omega: f64) {
+        self.filter.hold(self.centre - omega);
+    }
+
     /// The drive frequency Ω after a period in which the motion lagged the drive by
     /// `lag_rad`: a lag beyond the set one means the drive is above the resonance.
     pub fn update(&mut self, lag_rad: f64) -> f64 {
@@ -125,6 +137,12 @@ impl AmplitudeController {
     /// [`PhaseLockedLoop::for_quality`] says).
     pub fn for_quality(quality: f64) -> Result<Self> {
         Self::new(2.0, 16.0 / quality)
+    }
+
+    /// Hold the excitation F/F₀ while the amplitude is at its setpoint: the loop
+    /// engaged on a state already settled there.
+    pub fn hold(&mut self, excitation: f64) {
+        self.filter.hold(1.0 - excitation);
     }
 
     /// The excitation F/F₀ after a period whose amplitude was `amplitude` (units of
@@ -180,58 +198,96 @@ pub fn run(p: &Prepared, phase: &mut Phase, loops: Loops, periods: usize) -> Res
 pub fn run_along(
     p: &Prepared,
     phase: &mut Phase,
-    (pll, amplitude, force): Loops,
+    mut loops: Loops,
     separations_m: &[f64],
 ) -> Result<Vec<FmSample>> {
-    let quality = p.setup.cantilever.quality;
-    let scale = p.setup.contact.separation_scale_m();
-    let (mut omega, mut excitation) = (pll.centre, 1.0);
+    let mut drive = FmDrive {
+        omega: loops.0.centre,
+        excitation: 1.0,
+    };
     let mut out = Vec::with_capacity(separations_m.len());
-    for &z in separations_m {
-        crate::interrupt::check()?;
-        let mut sim = p.simulation_driven(omega, excitation / quality);
-        sim.cpl.a0 = z / scale;
-        phase.tau = 0.0;
-        let (c, _) = force.march(&sim, phase, 1, &mut Ignore)?;
-        let c = c.expect("one period marched");
-        phase.tau = 0.0;
-        let (a, lag) = (c.amplitude(), c.phase());
-        if !(a.is_finite() && lag.is_finite() && a > 0.0) {
-            return Err(Error::NotApplicable(
-                "the loops lost the cantilever (no amplitude left to lock on): their gains \
-                 are too high for it"
-                    .into(),
-            ));
-        }
-        // The lock detector: a lag outside (0°, 180°) is a drive on the wrong side of
-        // the resonance by more than the phase detector can tell, and what the loop then
-        // reads is no frequency of the cantilever's.
-        if !(lag > 0.0 && lag < std::f64::consts::PI) {
-            return Err(Error::NotApplicable(format!(
-                "the PLL lost lock in period {} (the motion lagged the drive by {:.1}° at \
-                 Ω = {omega:.5}, centre {:.5}): its centre frequency is too far from the \
-                 cantilever's resonance for its gains to capture (or its gains are \
-                 unstable on this cantilever): set the centre to the free resonance",
-                out.len() + 1,
-                lag.to_degrees(),
-                pll.centre
-            )));
-        }
-        out.push(FmSample {
-            separation_m: z,
-            frequency_ratio: omega,
-            excitation_ratio: excitation,
-            amplitude: a,
-            phase_deg: lag.to_degrees(),
-        });
-        omega = pll.update(lag);
-        excitation = amplitude.update(a);
-        if !(omega > 0.5 && omega < 2.0 && excitation > 0.0 && excitation < 1e3) {
-            return Err(Error::NotApplicable(format!(
-                "the loops ran away (Ω = {omega:.4}, F/F₀ = {excitation:.4}): their gains \
-                 make them unstable on this cantilever"
-            )));
-        }
+    for (i, &z) in separations_m.iter().enumerate() {
+        let sample = period(p, phase, &mut loops, &mut drive, (z, i + 1)).map_err(|e| match e {
+            Error::NotApplicable(why) if why.contains("lost lock") => Error::NotApplicable(format!(
+                "{why}: its centre frequency is too far from the cantilever's resonance for its \
+                 gains to capture (or its gains are unstable on this cantilever): set the \
+                 centre to the free resonance"
+            )),
+            other => other,
+        })?;
+        out.push(sample);
     }
     Ok(out)
+}
+
+/// What the loops drive the cantilever with over a period: the frequency Ω and the
+/// excitation F/F₀.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FmDrive {
+    /// Ω = f/f₀.
+    pub omega: f64,
+    /// F/F₀.
+    pub excitation: f64,
+}
+
+/// One drive period of `p`'s cantilever at rest separation `separation_m` (m) under
+/// `drive`, from the state `phase` at the period's start (left at its end), then the
+/// loops' update of `drive` for the next; `number` counts the periods for messages.
+/// The period's sample. Refuses where the loops lose the cantilever: no amplitude left,
+/// a lag outside (0°, 180°) (the lock lost), or a drive run away.
+pub fn period(
+    p: &Prepared,
+    phase: &mut Phase,
+    (pll, amplitude, force): &mut Loops,
+    drive: &mut FmDrive,
+    (separation_m, number): (f64, usize),
+) -> Result<FmSample> {
+    crate::interrupt::check()?;
+    let FmDrive { omega, excitation } = *drive;
+    let quality = p.setup.cantilever.quality;
+    let mut sim = p.simulation_driven(omega, excitation / quality);
+    sim.cpl.a0 = separation_m / p.setup.contact.separation_scale_m();
+    phase.tau = 0.0;
+    let (c, _) = force.march(&sim, phase, 1, &mut Ignore)?;
+    let c = c.expect("one period marched");
+    phase.tau = 0.0;
+    let (a, lag) = (c.amplitude(), c.phase());
+    if !(a.is_finite() && lag.is_finite() && a > 0.0) {
+        return Err(Error::NotApplicable(
+            "the loops lost the cantilever (no amplitude left to lock on): their gains are \
+             too high for it"
+                .into(),
+        ));
+    }
+    // The lock detector: a lag outside (0°, 180°) is a drive on the wrong side of the
+    // resonance by more than the phase detector can tell, and what the loop then reads
+    // is no frequency of the cantilever's.
+    if !(lag > 0.0 && lag < std::f64::consts::PI) {
+        return Err(Error::NotApplicable(format!(
+            "the PLL lost lock in period {number} (the motion lagged the drive by {:.1}° at \
+             Ω = {omega:.5}, centre {:.5})",
+            lag.to_degrees(),
+            pll.centre
+        )));
+    }
+    let sample = FmSample {
+        separation_m,
+        frequency_ratio: omega,
+        excitation_ratio: excitation,
+        amplitude: a,
+        phase_deg: lag.to_degrees(),
+    };
+    *drive = FmDrive {
+        omega: pll.update(lag),
+        excitation: amplitude.update(a),
+    };
+    if !(drive.omega > 0.5 && drive.omega < 2.0 && drive.excitation > 0.0 && drive.excitation < 1e3)
+    {
+        return Err(Error::NotApplicable(format!(
+            "the loops ran away (Ω = {:.4}, F/F₀ = {:.4}): their gains make them unstable on \
+             this cantilever",
+            drive.omega, drive.excitation
+        )));
+    }
+    Ok(sample)
 }

@@ -12,6 +12,7 @@
 pub mod average;
 pub mod feedback;
 pub mod fm;
+pub mod fm_scan;
 pub mod force_curve;
 pub mod lockin;
 pub mod modal;

@@ -52,6 +52,10 @@ pub struct Repeats {
     gaps: [f64; WINDOW],
     /// Gaps recorded since the stretch began.
     seen: usize,
+    /// For a loop that rings ([`Repeats::within_blocks`]): the block's length, the
+    /// largest gap of the block under way and of the two blocks before (the last
+    /// first).
+    blocks: Option<(usize, f64, [f64; 2])>,
     /// Periods marched.
     pub marched: u64,
     /// Periods taken as repeats.
@@ -70,12 +74,30 @@ impl Repeats {
         Self::skipping(Some(tolerance))
     }
 
+    /// Periods skipped where the state is within `tolerance` of the fixed point of a
+    /// loop that may ring (approach its fixed point in damped oscillations of up to
+    /// `block` periods, as FM's loops do): the gap's largest value over successive
+    /// blocks of `block` periods must shrink, by ratios no larger than ρ over the last
+    /// three blocks (two ratios: a fast mode that died in the first block does not pass
+    /// for the slow one's rate), and the state then lies within M·block·ρ/(1 − ρ) of the
+    /// fixed point (M the last block's largest gap). Over
+    /// a window shorter than its ringing a gap shrinks near each turn of the oscillation
+    /// however far the loop is from its fixed point, which [`Repeats::within`] would take
+    /// for convergence.
+    pub fn within_blocks(tolerance: f64, block: usize) -> Self {
+        Self {
+            blocks: Some((block.max(1), 0.0, [0.0; 2])),
+            ..Self::skipping(Some(tolerance))
+        }
+    }
+
     fn skipping(tolerance: Option<f64>) -> Self {
         Self {
             tolerance,
             last: Vec::new(),
             gaps: [0.0; WINDOW],
             seen: 0,
+            blocks: None,
             marched: 0,
             skipped: 0,
         }
@@ -90,6 +112,9 @@ impl Repeats {
     pub fn restart(&mut self) {
         self.last.clear();
         self.seen = 0;
+        if let Some((_, current, before)) = &mut self.blocks {
+            (*current, *before) = (0.0, [0.0; 2]);
+        }
     }
 
     /// Record the state after a marched period of a loop that repeats every `cycle`
@@ -116,8 +141,24 @@ impl Repeats {
             .zip(&before)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
-        self.gaps[self.seen % WINDOW] = gap;
         self.seen += 1;
+        if let Some((block, current, before)) = &mut self.blocks {
+            *current = current.max(gap);
+            if self.seen % *block != 0 {
+                return false;
+            }
+            let (now, [last, first]) = (*current, *before);
+            (*current, *before) = (0.0, [now, last]);
+            if now == 0.0 {
+                return true;
+            }
+            if self.seen < 3 * *block {
+                return false;
+            }
+            let rho = (now / last).max(last / first);
+            return rho < 1.0 && now * *block as f64 * rho / (1.0 - rho) <= tolerance;
+        }
+        self.gaps[(self.seen - 1) % WINDOW] = gap;
         if self.seen < WINDOW {
             return false;
         }
@@ -192,6 +233,23 @@ mod tests {
         assert!(r.settled(Some(&state(0.5f64.powi(200))), 1));
         r.restart();
         assert!(!r.settled(Some(&state(0.5f64.powi(201))), 1));
+    }
+
+    #[test]
+    fn a_ringing_loop_settles_only_once_its_oscillation_has_died_down() {
+        // x_j = r^j cos(2πj/400), r = 0.995: the distance from the fixed point 0 is at
+        // most r^j. Near each turn of the oscillation the gap shrinks over 32 periods
+        // however far out the loop is; the window's bound is fooled there, the blocks'
+        // is not.
+        let x = |j: i32| 0.995f64.powi(j) * (2.0 * std::f64::consts::PI * j as f64 / 400.0).cos();
+        let tolerance = 1e-6;
+        let first = |mut r: Repeats| (0..20_000).find(|&j| r.settled(Some(&state(x(j))), 1));
+        let window = first(Repeats::within(tolerance)).expect("settles");
+        assert!(0.995f64.powi(window) > 10.0 * tolerance, "{window}");
+        let blocks = first(Repeats::within_blocks(tolerance, 800)).expect("settles");
+        assert!(0.995f64.powi(blocks) <= tolerance, "{blocks}");
+        // And not much later than it must: within two blocks of r^j = 1e-6.
+        assert!(blocks < 2757 + 1600, "{blocks}");
     }
 
     #[test]

@@ -91,8 +91,25 @@ pub fn line(
     line_probe(&mut probe, regions, shape, loop_, start_z_m, progress)
 }
 
+/// The first of `total` periods of `step` (m) each whose start lies past region
+/// `under` of `regions`: the next region's first, or `total` after the last region.
+pub(super) fn stretch_end(regions: &[Region], under: usize, (step, total): (f64, usize)) -> usize {
+    if under + 1 >= regions.len() {
+        return total;
+    }
+    let until_m = regions[under].until_m;
+    let mut g = ((until_m / step).ceil().max(0.0) as usize).min(total);
+    while g > 0 && step * (g - 1) as f64 >= until_m {
+        g -= 1;
+    }
+    while g < total && step * (g as f64) < until_m {
+        g += 1;
+    }
+    g
+}
+
 /// Refuse a layout without regions or naming a material beyond `materials`.
-fn check_regions(regions: &[Region], materials: usize) -> Result<()> {
+pub(super) fn check_regions(regions: &[Region], materials: usize) -> Result<()> {
     if regions.is_empty() || regions.iter().any(|r| r.material >= materials) {
         return Err(Error::NotApplicable(
             "a scanned sample needs regions, each naming one of its materials".into(),
@@ -128,17 +145,6 @@ pub fn line_probe<P: Probe>(
     let cycle = probe.cycle();
     let step = length_m / (pixels * periods_per_pixel) as f64;
     let total = pixels * periods_per_pixel;
-    // The first period whose start lies at or past `until_m` (the next region's first).
-    let first_past = |until_m: f64| {
-        let mut g = ((until_m / step).ceil().max(0.0) as usize).min(total);
-        while g > 0 && step * (g - 1) as f64 >= until_m {
-            g -= 1;
-        }
-        while g < total && step * (g as f64) < until_m {
-            g += 1;
-        }
-        g
-    };
     // The region under the tip: x only grows, so the index only moves on.
     let mut under = 0;
     let mut z = start_z_m;
@@ -174,11 +180,7 @@ pub fn line_probe<P: Probe>(
             recent.push((read, error));
             if probe.repeats_itself(repeats, [z / a0, error]) && recent.len() == cycle {
                 // Whole cycles up to the next region (or the line's end) repeat this one.
-                let end = if under + 1 < regions.len() {
-                    first_past(region.until_m)
-                } else {
-                    total
-                };
+                let end = stretch_end(regions, under, (step, total));
                 repeat_until = g + 1 + (end - g - 1) / cycle * cycle;
                 replayed = 0;
             }

@@ -120,14 +120,24 @@ pub fn run(args: MapArgs) -> Result<()> {
         args.steps,
     )?;
     let moduli = sweep::log_grid("modulus", args.modulus_from, args.modulus_to, args.steps)?;
+    if args.qnm.mode == super::qnm::Mode::Fm {
+        return Err(Error::NotApplicable(
+            "map --mode fm: FM is imaged with `tapsim scan --mode fm`; `tapsim fm` gives \
+             the settled FM state of one material"
+                .into(),
+        ));
+    }
     if let Some(q) = args.qnm.resolve()? {
-        super::qnm::refuse_in_peakforce(&[
-            ("--setpoint", args.setpoint.is_some()),
-            ("--amplitude-setpoint", args.amplitude_setpoint.is_some()),
-            ("--branch", args.branch.is_some()),
-            ("--temperature", args.noise.temperature.is_some()),
-            ("--modes", args.modes.modes.is_some()),
-        ])?;
+        super::qnm::refuse_in_mode(
+            "peakforce",
+            &[
+                ("--setpoint", args.setpoint.is_some()),
+                ("--amplitude-setpoint", args.amplitude_setpoint.is_some()),
+                ("--branch", args.branch.is_some()),
+                ("--temperature", args.noise.temperature.is_some()),
+                ("--modes", args.modes.modes.is_some()),
+            ],
+        )?;
         return super::qnm::map(
             &q,
             (&setup, &numerics),

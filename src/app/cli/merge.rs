@@ -71,7 +71,12 @@ pub fn run(args: MergeArgs) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let merged = part::merge(parts)?;
     let (files, _) = super::image::ImageFiles::among(&args.out)?;
-    if files.any() && !matches!(merged.job, Job::Scan { .. } | Job::QnmScan { .. }) {
+    if files.any()
+        && !matches!(
+            merged.job,
+            Job::Scan { .. } | Job::QnmScan { .. } | Job::FmScan { .. }
+        )
+    {
         return Err(files.no_image());
     }
     match &merged.job {
@@ -102,6 +107,18 @@ pub fn run(args: MergeArgs) -> Result<()> {
             &args.out,
             (law, *peak_force_n),
             (work_of_adhesion_j_m2, modulus_pa),
+            &merged.records,
+        ),
+        Job::FmScan {
+            lines,
+            pixels,
+            frequency_shift_hz,
+            image,
+            ..
+        } => super::fm_scan::emit_scan(
+            &args.output,
+            &args.out,
+            ((*lines, *pixels, *frequency_shift_hz), image.as_ref()),
             &merged.records,
         ),
         Job::QnmScan {

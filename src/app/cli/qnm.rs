@@ -5,7 +5,6 @@ use super::peakforce::{DEFAULT_PEAK_FORCE_N, FitWindowArgs, ModulationArgs};
 use crate::analysis::qnm_map::{QnmCell, map_cells};
 use crate::analysis::sweep::Shard;
 use crate::app::config::{force, number};
-use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::app::report::heatmap::HeatMap;
 use crate::app::report::part::{self, Job};
 use crate::app::report::records::typed;
@@ -14,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::instrument::peakforce::{Modulation, PeakForceFeedback, check_setpoint};
 use crate::instrument::peakforce_scan::{QnmPixel, Scanner};
 use crate::instrument::qnm::Analysis;
-use crate::instrument::scan::{Region, mirrored};
+use crate::instrument::scan::Region;
 use crate::physics::params::ELECTRONVOLT_J;
 use clap::Args;
 
@@ -27,15 +26,21 @@ pub enum Mode {
     /// Off-resonance tapping (PeakForce-type): the peak force of each modulation cycle
     /// held at a setpoint, the QNM channels read from each pixel's force curve.
     Peakforce,
+    /// Frequency modulation (scan only): the cantilever self-excited at its shifted
+    /// resonance, the frequency shift held at a setpoint, the dissipation read from the
+    /// excitation.
+    Fm,
 }
 
 /// The imaging mode and, for off-resonance tapping, its flags.
 #[derive(Debug, Args)]
 #[command(next_help_heading = "Off-resonance tapping (--mode peakforce)")]
 pub(super) struct QnmArgs {
-    /// The imaging mode: tapping (the amplitude held at a setpoint; the default) or
+    /// The imaging mode: tapping (the amplitude held at a setpoint; the default),
     /// peakforce (off-resonance tapping: the peak force held at --peak-force; the maps
-    /// are the QNM channels — adhesion, dissipation, DMT modulus, deformation).
+    /// are the QNM channels — adhesion, dissipation, DMT modulus, deformation) or fm
+    /// (scan only: the frequency shift held at --frequency-shift; topography, Δf and
+    /// dissipation).
     #[arg(long, value_enum, ignore_case = true, default_value_t = Mode::Tapping)]
     pub(super) mode: Mode,
     /// The peak-force setpoint [N; default 5nN].
@@ -74,7 +79,7 @@ impl QnmArgs {
     /// Off-resonance tapping's settings, if the mode is peakforce; else a refusal of
     /// its flags.
     pub(super) fn resolve(&self) -> Result<Option<Qnm>> {
-        if self.mode == Mode::Tapping {
+        if self.mode != Mode::Peakforce {
             let given = [
                 ("--peak-force", self.peak_force.is_some()),
                 (
@@ -115,12 +120,16 @@ impl QnmArgs {
     }
 }
 
-/// Refuse, in peakforce mode, a flag of the tapping loop that was given.
-pub(super) fn refuse_in_peakforce(given: &[(&str, bool)]) -> Result<()> {
+/// Refuse, in `mode` (peakforce or fm), a flag of the tapping loop that was given.
+pub(super) fn refuse_in_mode(mode: &str, given: &[(&str, bool)]) -> Result<()> {
+    let holds = if mode == "fm" {
+        "the frequency shift (--frequency-shift)"
+    } else {
+        "the peak force (--peak-force)"
+    };
     match given.iter().find(|g| g.1) {
         Some((flag, _)) => Err(Error::NotApplicable(format!(
-            "{flag} is tapping's (the amplitude loop); --mode peakforce holds the peak force \
-             (--peak-force)"
+            "{flag} is tapping's (the amplitude loop); --mode {mode} holds {holds}"
         ))),
         None => Ok(()),
     }
@@ -245,14 +254,15 @@ fn map_heat_maps(title: &str, works: &[f64], moduli: &[f64], cells: &[QnmCell]) 
     ]
 }
 
-/// A pixel of a QNM scan with its direction and line.
-#[derive(serde::Serialize, serde::Deserialize)]
-struct Row {
-    direction: String,
-    line: usize,
-    y_m: f64,
-    #[serde(flatten)]
-    pixel: QnmPixel,
+type Row = super::scan_lines::Row<QnmPixel>;
+
+impl super::scan_lines::Located for QnmPixel {
+    fn x_m(&self) -> f64 {
+        self.x_m
+    }
+    fn x_m_mut(&mut self) -> &mut f64 {
+        &mut self.x_m
+    }
 }
 
 /// The most modulation cycles one QNM scan marches (every line, both directions), before
@@ -299,44 +309,20 @@ pub(super) fn scan(
         gain: q.gain,
     };
     let bar = out.progress("scan", mine.len() * (pixels * directions + 1));
-    let scanned: Vec<Vec<Row>> = {
-        use rayon::prelude::*;
-        crate::analysis::sweep::thread_pool(threads)?.install(|| {
-            mine.par_iter()
-                .map(|&j| {
-                    let (y_m, regions) = &lines[j];
-                    crate::interrupt::check()?;
-                    let mut s = Scanner::new(prepared, &q.modulation, q.analysis, loop_, numerics)?;
-                    if exact {
-                        s = s.exact();
-                    }
-                    let first = regions[0];
-                    s.engage(first.material, first.height_m, q.modulation.amplitude_m)?;
-                    bar.inc(1);
-                    let shape = (length_m, pixels, per_pixel);
-                    let tag = |direction: &'static str, pixels: Vec<QnmPixel>| {
-                        pixels.into_iter().map(move |pixel| Row {
-                            direction: direction.into(),
-                            line: j,
-                            y_m: *y_m,
-                            pixel,
-                        })
-                    };
-                    let trace = s.line(regions, shape, |_| bar.inc(1))?;
-                    let mut rows: Vec<Row> = tag("trace", trace).collect();
-                    if retrace {
-                        let back = mirrored(regions, length_m);
-                        let mut pixels = s.line(&back, shape, |_| bar.inc(1))?;
-                        for p in &mut pixels {
-                            p.x_m = length_m - p.x_m;
-                        }
-                        rows.extend(tag("retrace", pixels));
-                    }
-                    Ok(rows)
-                })
-                .collect::<Result<Vec<_>>>()
-        })?
-    };
+    let scanned = super::scan_lines::trace_and_retrace(
+        (&mine, lines, length_m),
+        (threads, retrace, &bar),
+        |regions| {
+            let mut s = Scanner::new(prepared, &q.modulation, q.analysis, loop_, numerics)?;
+            if exact {
+                s = s.exact();
+            }
+            let first = regions[0];
+            s.engage(first.material, first.height_m, q.modulation.amplitude_m)?;
+            Ok(s)
+        },
+        |s, regions, done| s.line(regions, (length_m, pixels, per_pixel), |_| done()),
+    )?;
     bar.finish_and_clear();
     if let Some(shard) = shard {
         return split.write(
@@ -509,20 +495,21 @@ fn draw(
     rows: &[Row],
     path: &std::path::Path,
 ) -> Result<()> {
-    if lines > 1 {
-        let caption = format!("peak force {} nN", setpoint_n * 1e9);
-        crate::app::report::plot::render_side_by_side(&images(rows, lines, pixels, &caption), path)
-    } else {
-        let caption = format!("off-resonance tapping at {} nN", setpoint_n * 1e9);
-        crate::app::report::plot::render_stack(&profiles(rows, &caption), path)
-    }
+    super::scan_lines::draw(
+        (lines, pixels),
+        rows,
+        &CHANNELS,
+        (
+            &format!("off-resonance tapping at {} nN", setpoint_n * 1e9),
+            &format!("peak force {} nN", setpoint_n * 1e9),
+            "no DMT fit",
+        ),
+        path,
+    )
 }
 
-/// What a QNM plot shows of a pixel.
-type Pick = fn(&QnmPixel) -> Option<f64>;
-
 /// The channels plotted: name, label, value.
-const CHANNELS: [(&str, &str, Pick); 4] = [
+const CHANNELS: [super::scan_lines::Channel<QnmPixel>; 4] = [
     ("topography", "z piezo height (nm)", |p| {
         Some(p.topography_m * 1e9)
     }),
@@ -534,57 +521,3 @@ const CHANNELS: [(&str, &str, Pick); 4] = [
         p.dmt_modulus_pa.map(|e| e * 1e-9)
     }),
 ];
-
-/// One line's channels along x, trace and retrace.
-fn profiles(rows: &[Row], caption: &str) -> Vec<Chart> {
-    CHANNELS
-        .iter()
-        .map(|&(name, label, pick)| {
-            let series: Vec<Series> = [("trace", Style::Line, 1), ("retrace", Style::Dashed, 2)]
-                .into_iter()
-                .filter_map(|(dir, style, color)| {
-                    let points: Vec<(f64, f64)> = rows
-                        .iter()
-                        .filter(|r| r.direction == dir)
-                        .filter_map(|r| Some((r.pixel.x_m * 1e9, pick(&r.pixel)?)))
-                        .collect();
-                    (!points.is_empty()).then(|| Series::new(dir, points, style, color))
-                })
-                .collect();
-            Chart {
-                name: name.replace(' ', "_"),
-                title: format!("{name}, {caption}"),
-                x: Axis::linear("position along the line x (nm)", "x_nm"),
-                y: Axis::linear(label, name),
-                legend: Corner::quietest(&series),
-                series,
-                labels: vec![],
-            }
-        })
-        .collect()
-}
-
-/// Heat maps of the trace's channels over the image.
-fn images(rows: &[Row], lines: usize, pixels: usize, caption: &str) -> Vec<HeatMap> {
-    let trace: Vec<&Row> = rows.iter().filter(|r| r.direction == "trace").collect();
-    let x: Vec<f64> = trace
-        .iter()
-        .take(pixels)
-        .map(|r| r.pixel.x_m * 1e9)
-        .collect();
-    let y: Vec<f64> = trace.iter().step_by(pixels).map(|r| r.y_m * 1e9).collect();
-    CHANNELS
-        .iter()
-        .map(|&(name, label, pick)| {
-            HeatMap::image(
-                (format!("{name}, {caption} (trace)"), label, "no DMT fit"),
-                (x.clone(), y.clone()),
-                trace
-                    .chunks(pixels)
-                    .take(lines)
-                    .map(|line| line.iter().map(|r| pick(&r.pixel)).collect())
-                    .collect(),
-            )
-        })
-        .collect()
-}

@@ -72,6 +72,19 @@ use serde_json::value::RawValue;
 /// one; the channels agree within 1e-6, tested). Sharded and merged as tapping images
 /// are; no thermal noise.
 ///
+/// FM imaging (--mode fm): the cantilever self-excited at its shifted resonance (the
+/// phase-locked loop and amplitude controller of `tapsim fm`, running every drive
+/// period), the z feedback moving the piezo to hold --frequency-shift (-200 Hz), each
+/// line engaged on the settled FM state over its first region; per pixel the
+/// topography, the frequency shift and its error, the excitation F/F₀ and the energy
+/// per cycle the dissipation channel reads from it (JSON/CSV keys frequency_shift_hz,
+/// error_hz, excitation_ratio, dissipation_j, amplitude_ratio), drawn as topography,
+/// Δf and dissipation. Every material must hold the setpoint on the attractive side of
+/// its Δf(z) (`tapsim fm` shows the curves); a step up that carries the tip past the
+/// turning point of Δf(z) is refused (the loop would run the tip in). Repeats are taken
+/// as in tapping (--exact marches every period; within 0.3 µHz, tested). Sharded and
+/// merged as tapping images are; no thermal noise.
+///
 /// Output: a table, --json (a record per pixel: direction, line, y_m, x_m,
 /// topography_m, amplitude_ratio, error, phase_deg), --csv, --plot (one line: topography
 /// and phase profiles, trace and retrace; an image: heat maps of the trace).
@@ -152,6 +165,8 @@ pub struct ScanArgs {
     #[command(flatten)]
     qnm: super::qnm::QnmArgs,
     #[command(flatten)]
+    fm: super::fm_scan::FmScanArgs,
+    #[command(flatten)]
     pub(super) images: super::image::ImageFiles,
 }
 
@@ -175,6 +190,16 @@ const MAX_NOISY_PERIODS: f64 = 3e7;
 
 /// The loop's engagement over the first region, in drive periods.
 const ENGAGE_PERIODS: usize = 10_000;
+
+/// What of the sample determines a scan's results, for a part file's configuration.
+fn sample_config(sample: &Sample) -> serde_json::Value {
+    serde_json::to_value((
+        &sample.materials,
+        &sample.layout,
+        (sample.length_m, sample.width_m),
+    ))
+    .expect("a sample serialises")
+}
 
 /// Run the subcommand.
 pub fn run(args: ScanArgs) -> Result<()> {
@@ -245,17 +270,44 @@ pub fn run(args: ScanArgs) -> Result<()> {
             (y, sample.layout.line_at(y, sample.length_m))
         })
         .collect();
+    if let Some(fm) = args.fm.resolve(args.qnm.mode)? {
+        super::qnm::refuse_in_mode(
+            "fm",
+            &[
+                ("--temperature", args.temperature.is_some()),
+                ("--modes", set.is_some()),
+            ],
+        )?;
+        return super::fm_scan::scan(
+            &fm,
+            (&sample.materials, &prepared),
+            &numerics,
+            &lines,
+            (sample.length_m, args.pixels, args.line_rate),
+            (args.threads, !args.no_retrace, args.exact),
+            (&args.out, &args.split, sample_config(&sample)),
+            (
+                &args.images,
+                super::image::meta(
+                    "frequency modulation (FM)",
+                    first_setup,
+                    &args.sample,
+                    (args.lines, args.pixels, args.line_rate),
+                    format!("frequency shift {} Hz", fm.setpoint_hz()),
+                    "z feedback on the frequency shift (integral)",
+                ),
+                (sample.length_m, sample.width_m),
+            ),
+        );
+    }
     if let Some(q) = args.qnm.resolve()? {
-        super::qnm::refuse_in_peakforce(&[
-            ("--temperature", args.temperature.is_some()),
-            ("--modes", set.is_some()),
-        ])?;
-        let config = serde_json::to_value((
-            &sample.materials,
-            &sample.layout,
-            (sample.length_m, sample.width_m),
-        ))
-        .expect("a sample serialises");
+        super::qnm::refuse_in_mode(
+            "peakforce",
+            &[
+                ("--temperature", args.temperature.is_some()),
+                ("--modes", set.is_some()),
+            ],
+        )?;
         return super::qnm::scan(
             &q,
             &prepared,
@@ -263,7 +315,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
             &lines,
             (sample.length_m, args.pixels, args.line_rate),
             (args.threads, !args.no_retrace, args.exact),
-            (&args.out, &args.split, config),
+            (&args.out, &args.split, sample_config(&sample)),
             (
                 &args.images,
                 super::image::meta(

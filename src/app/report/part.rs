@@ -92,6 +92,20 @@ pub enum Job {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         image: Option<ImageInfo>,
     },
+    /// `tapsim scan --mode fm --lines N`: one record per pixel, each line an item.
+    FmScan {
+        /// Lines of the image.
+        lines: usize,
+        /// Pixels a line.
+        pixels: usize,
+        /// Whether each line is scanned back too.
+        retrace: bool,
+        /// The frequency-shift setpoint in Hz.
+        frequency_shift_hz: f64,
+        /// What an image file needs beyond the records.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        image: Option<ImageInfo>,
+    },
     /// `tapsim scan --lines N`: one record per pixel, each line an item.
     Scan {
         /// Lines of the image.
@@ -133,7 +147,9 @@ impl Job {
                 ..
             } => work_of_adhesion_j_m2.len().saturating_mul(modulus_pa.len()),
             Job::Batch { cases } => *cases,
-            Job::Scan { lines, .. } | Job::QnmScan { lines, .. } => *lines,
+            Job::Scan { lines, .. } | Job::QnmScan { lines, .. } | Job::FmScan { lines, .. } => {
+                *lines
+            }
         }
     }
 
@@ -194,6 +210,20 @@ impl Job {
                 ..
             } => {
                 peak_force(*peak_force_n)?;
+                Self::image(name, *lines, *pixels)
+            }
+            Job::FmScan {
+                lines,
+                pixels,
+                frequency_shift_hz,
+                ..
+            } => {
+                if !(frequency_shift_hz.is_finite() && *frequency_shift_hz != 0.0) {
+                    return Err(refuse(
+                        "frequency_shift_hz",
+                        "is not a frequency-shift setpoint (finite, not zero)".into(),
+                    ));
+                }
                 Self::image(name, *lines, *pixels)
             }
             Job::Scan {
@@ -266,7 +296,7 @@ impl Job {
         match self {
             Job::Map { .. } | Job::QnmMap { .. } => "cell",
             Job::Batch { .. } => "case",
-            Job::Scan { .. } | Job::QnmScan { .. } => "line",
+            Job::Scan { .. } | Job::QnmScan { .. } | Job::FmScan { .. } => "line",
         }
     }
 
@@ -280,6 +310,9 @@ impl Job {
                 pixels, retrace, ..
             }
             | Job::QnmScan {
+                pixels, retrace, ..
+            }
+            | Job::FmScan {
                 pixels, retrace, ..
             } => Some(pixels * if *retrace { 2 } else { 1 }),
         }
@@ -577,7 +610,7 @@ fn check(name: &str, p: &Part) -> Result<Shard> {
                 }
             }
         }
-        Job::Scan { .. } | Job::QnmScan { .. } => {
+        Job::Scan { .. } | Job::QnmScan { .. } | Job::FmScan { .. } => {
             for (&k, item) in p.items.iter().zip(&p.records) {
                 #[derive(Deserialize)]
                 struct On {
