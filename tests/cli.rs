@@ -651,6 +651,7 @@ fn approach_normalize_adds_each_mechanisms_share_of_its_largest() {
 }
 
 #[test]
+#[ignore = "slow (every figure and table of results/ regenerated, about 35 s in release): run with cargo test --release -- --ignored cli::"]
 fn reproduce_regenerates_every_file_its_readme_lists() {
     let dir = scratch("reproduce");
     let out = succeeds_with_cache(

@@ -446,6 +446,7 @@ fn hostile_tap_and_approach_command_lines() {
 }
 
 #[test]
+#[ignore = "slow (some hundred hostile sweep command lines, about 25 s in release): run with cargo test --release -- --ignored hostile::"]
 fn hostile_sweep_command_lines() {
     let dir = scratch("sweeps");
     let lines = prop_oneof![
