@@ -832,3 +832,52 @@ fn a_pll_off_the_resonance_locks_or_says_it_lost_lock() {
     let far = march(1e-2).unwrap_err().to_string();
     assert!(far.contains("lost lock") && far.contains("centre"), "{far}");
 }
+
+#[test]
+fn fm_under_the_thermal_force_reads_the_settled_state_in_the_cold_and_albrechts_noise_when_free() {
+    use common::column;
+    // Far from the sample (22 nm) and on the hybrid contact (19 nm).
+    let head = [
+        "fm", "--from", "22nm", "--to", "19nm", "--points", "2", "--json", "-q",
+    ];
+    let cold = common::json_of(&head, &["--temperature", "0.001K"]);
+    let (df, df_cold, se_cold) = (
+        column(&cold, "frequency_shift_hz"),
+        column(&cold, "thermal_frequency_shift_hz"),
+        column(&cold, "thermal_frequency_shift_std_err_hz"),
+    );
+    let (e, e_cold) = (
+        column(&cold, "e_ts_from_excitation_j"),
+        column(&cold, "thermal_e_ts_j"),
+    );
+    // The limit: the loops marched in time hold what Newton's method settles.
+    for i in 0..2 {
+        eprintln!(
+            "0.001 K: Δf {} vs {} (± {}), E_ts {:e} vs {:e}",
+            df_cold[i], df[i], se_cold[i], e_cold[i], e[i]
+        );
+        assert!((df_cold[i] - df[i]).abs() < 1e-3 && se_cold[i] < 1e-3);
+        assert!((e_cold[i] - e[i]).abs() < 1e-5 * e[1]);
+    }
+    // Free at 300 K: the mean shift is none within its error, and the error is the
+    // frequency noise Albrecht et al. (1991) give for one record's averaging time
+    // (B = f₀/(2N), N = 2 500 periods), over √8 records: 8 records spread their
+    // standard error by ±25 % (χ² of 7), hence the band.
+    let warm = common::json_of(&head, &["--temperature", "300K"]);
+    let (m, se) = (
+        column(&warm, "thermal_frequency_shift_hz")[0],
+        column(&warm, "thermal_frequency_shift_std_err_hz")[0],
+    );
+    let (f0, k, a, q, kt) = (300e3, 40.0, 20e-9, 400.0, 1.380649e-23 * 300.0);
+    let b = f0 / (2.0 * 2500.0);
+    let albrecht = (f0 * kt * b / (PI * k * a * a * q)).sqrt() / 8f64.sqrt();
+    eprintln!("300 K, free: Δf {m} ± {se} Hz; Albrecht's over 8 records {albrecht}");
+    assert!(m.abs() < 4.0 * se);
+    assert!(
+        se > 0.45 * albrecht && se < 1.6 * albrecht,
+        "{se} vs {albrecht}"
+    );
+    // Each point draws its own noise.
+    let seeds = warm["thermal_seed"].as_array().unwrap();
+    assert_ne!(seeds[0], seeds[1]);
+}

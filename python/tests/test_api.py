@@ -172,6 +172,13 @@ def test_scan_in_peakforce_mode_returns_the_qnm_channels_per_pixel():
         tapsim.scan(peak_force="3nN")
 
 
+def test_fm_under_the_thermal_force_adds_the_averaged_channels():
+    r = tapsim.fm(setpoint="-200Hz", temperature="300K")
+    # The average over the thermal motion lies within a few of its errors of the state.
+    assert abs(r.thermal_frequency_shift_hz - r.frequency_shift_hz) < 5 * r.thermal_frequency_shift_std_err_hz
+    assert r.thermal_e_ts_std_err_j > 0
+
+
 def test_scan_in_fm_mode_returns_the_topography_shift_and_dissipation_as_an_image():
     lines, pixels = 2, 4
     r = tapsim.scan(mode="fm", lines=lines, pixels=pixels)

@@ -30,8 +30,7 @@ use crate::dynamics::observed::{Recorder, TrajectorySample};
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::dynamics::shooting::eigenvalues;
 use crate::error::{Error, Result};
-use crate::instrument::fm::FmDrive;
-use crate::instrument::fm_scan::Engagement;
+use crate::instrument::fm::{Engagement, FmDrive};
 use crate::physics::law::{AnyLaw, ForceLaw};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -72,6 +71,20 @@ pub struct FmState {
     /// Where the next point of an approach starts.
     #[serde(skip)]
     pub next: FmGuess,
+}
+
+impl FmState {
+    /// The state as the instrument's loops take it up.
+    pub fn engagement(&self) -> Engagement {
+        Engagement {
+            phase: self.next.phase,
+            drive: FmDrive {
+                omega: self.frequency_ratio,
+                excitation: self.excitation_ratio,
+            },
+            separation_m: self.separation_m,
+        }
+    }
 }
 
 /// `p`'s experiment driven at Ω with the excitation ratio `excitation` (F/F₀, the
@@ -470,15 +483,5 @@ pub fn engagement(
     };
     let next = settle(&nearer, numerics, &state.next)?;
     let slope = (state.frequency_shift_hz - next.frequency_shift_hz) / dz;
-    Ok((
-        Engagement {
-            phase: state.next.phase,
-            drive: FmDrive {
-                omega: state.frequency_ratio,
-                excitation: state.excitation_ratio,
-            },
-            separation_m: state.separation_m,
-        },
-        slope,
-    ))
+    Ok((state.engagement(), slope))
 }

@@ -17,7 +17,8 @@ use crate::dynamics::march::Phase;
 use crate::dynamics::numeric::Ignore;
 use crate::dynamics::setup::Prepared;
 use crate::error::{Error, Result};
-use crate::instrument::thermal::ThermalForce;
+use crate::instrument::average::{AVERAGE_RECORDS, AverageRequest, settling_periods};
+use crate::instrument::thermal::{STEPS_PER_PERIOD, ThermalForce, intensity_hat};
 use serde::Serialize;
 
 /// A PI loop: output = centre + K_p·e + K_i·Σe, e the error each period.
@@ -175,6 +176,123 @@ impl FmSample {
     pub fn dissipation_read(&self) -> f64 {
         self.excitation_ratio - self.frequency_ratio
     }
+}
+
+/// Where the loops are engaged: a settled FM state (the one
+/// [`crate::analysis::fm::settle`] finds), taken up without a bump.
+#[derive(Debug, Clone, Copy)]
+pub struct Engagement {
+    /// The lever's state at a drive period's start.
+    pub phase: Phase,
+    /// The drive frequency Ω and excitation F/F₀ the loops hold there.
+    pub drive: FmDrive,
+    /// The rest separation z_c there, m (a scan's piezo sits at z_c plus the surface
+    /// height).
+    pub separation_m: f64,
+}
+
+/// What the FM channels read under the thermal force, averaged: means over
+/// [`AVERAGE_RECORDS`] independent records and their standard errors from the records'
+/// spread.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FmAverage {
+    /// Temperature, K.
+    pub temperature_k: f64,
+    /// Drive periods averaged (after settling), over all records.
+    pub periods: usize,
+    /// Independent records (each its own settling and stream).
+    pub records: usize,
+    /// The mean frequency shift, Hz.
+    pub frequency_shift_hz: f64,
+    /// Its standard error, Hz.
+    pub frequency_shift_std_err_hz: f64,
+    /// The mean excitation over its free value, F/F₀.
+    pub excitation_ratio: f64,
+    /// Its standard error.
+    pub excitation_ratio_std_err: f64,
+    /// The mean energy per cycle the dissipation channel reads, (πkA²/Q)(F/F₀ − Ω), J.
+    pub e_ts_from_excitation_j: f64,
+    /// Its standard error, J.
+    pub e_ts_std_err_j: f64,
+    /// The seed whose streams the records drew.
+    pub seed: u64,
+}
+
+/// The FM channels of `p`'s cantilever under the thermal force at the request's
+/// temperature, the loops (tuned to its Q: [`PhaseLockedLoop::for_quality`],
+/// [`AmplitudeController::for_quality`]) engaged on the settled state `at` at `p`'s
+/// rest separation: [`AVERAGE_RECORDS`] records (streams 0, 1, … of the seed, marched in
+/// parallel: the same result on any thread count), each ten decay times (10 Q/π
+/// periods) of settling under the force and then its share of the periods; each record's
+/// mean Δf, F/F₀ and dissipation read; their means and standard errors. At 0 K every
+/// record holds the settled state.
+pub fn thermal_average(
+    p: &Prepared,
+    at: &Engagement,
+    request: &AverageRequest,
+) -> Result<FmAverage> {
+    use rayon::prelude::*;
+    let c = p.setup.cantilever;
+    request.check(c.quality)?;
+    let per_record = request.periods / AVERAGE_RECORDS;
+    let intensity = intensity_hat(
+        request.temperature_k,
+        c.stiffness_n_m,
+        c.quality,
+        c.free_amplitude_m,
+    );
+    let settle = settling_periods(c.quality);
+    let loss_unit_j =
+        std::f64::consts::PI * c.stiffness_n_m * c.free_amplitude_m.powi(2) / c.quality;
+    let records: Vec<[f64; 3]> = (0..AVERAGE_RECORDS)
+        .into_par_iter()
+        .map(|stream| -> Result<[f64; 3]> {
+            let mut force =
+                ThermalForce::new(intensity, STEPS_PER_PERIOD, request.seed, stream as u64)?;
+            let (mut pll, mut agc) = (
+                PhaseLockedLoop::for_quality(c.quality)?,
+                AmplitudeController::for_quality(c.quality)?,
+            );
+            pll.hold(at.drive.omega);
+            agc.hold(at.drive.excitation);
+            let (mut phase, mut drive) = (at.phase, at.drive);
+            let mut loops: Loops = (&mut pll, &mut agc, &mut force);
+            let mut sum = [0.0; 3];
+            for i in 0..settle + per_record {
+                let s = period(
+                    p,
+                    &mut phase,
+                    &mut loops,
+                    &mut drive,
+                    (p.setup.separation_m, i + 1),
+                )?;
+                if i >= settle {
+                    sum[0] += (s.frequency_ratio - 1.0) * c.resonance_hz;
+                    sum[1] += s.excitation_ratio;
+                    sum[2] += s.dissipation_read() * loss_unit_j;
+                }
+            }
+            Ok(sum.map(|v| v / per_record as f64))
+        })
+        .collect::<Result<_>>()?;
+    let n = records.len() as f64;
+    let stat = |i: usize| {
+        let (m, var) = crate::numeric::mean_and_variance(records.iter().map(|b| b[i]));
+        (m, (var / n).sqrt())
+    };
+    let ((df, df_se), (x, x_se), (e, e_se)) = (stat(0), stat(1), stat(2));
+    Ok(FmAverage {
+        temperature_k: request.temperature_k,
+        periods: per_record * AVERAGE_RECORDS,
+        records: AVERAGE_RECORDS,
+        frequency_shift_hz: df,
+        frequency_shift_std_err_hz: df_se,
+        excitation_ratio: x,
+        excitation_ratio_std_err: x_se,
+        e_ts_from_excitation_j: e,
+        e_ts_std_err_j: e_se,
+        seed: request.seed,
+    })
 }
 
 /// The loops and the thermal force they run under ([`ThermalForce::none`] for none).

@@ -16,7 +16,7 @@
 //! the periods up to the next region are the last one's repeats ([`FmScanner::exact`]
 //! marches every one).
 
-use super::fm::{AmplitudeController, FmDrive, Loops, PhaseLockedLoop, period};
+use super::fm::{AmplitudeController, Engagement, FmDrive, Loops, PhaseLockedLoop, period};
 use super::repeats::{DEFAULT_TOLERANCE, LoopState, Repeats, STATE_LEN};
 use super::scan::{Region, check_regions, stretch_end};
 use super::thermal::ThermalForce;
@@ -100,17 +100,6 @@ impl ShiftFeedback {
     pub fn integral_gain_m_per_hz_s(&self, drive_hz: f64) -> f64 {
         self.gain_m_per_hz * drive_hz
     }
-}
-
-/// Where the loops are engaged: a settled FM state over the first region.
-#[derive(Debug, Clone, Copy)]
-pub struct Engagement {
-    /// The lever's state at a drive period's start.
-    pub phase: Phase,
-    /// The drive frequency Ω and excitation F/F₀ the loops hold there.
-    pub drive: FmDrive,
-    /// The rest separation z_c there, m (the piezo sits at z_c plus the surface height).
-    pub separation_m: f64,
 }
 
 /// The FM loops and the z feedback marching over a sample's materials.

@@ -229,11 +229,7 @@ impl<'a> Scanner<'a> {
         (length_m, pixels, cycles_per_pixel): (f64, usize, usize),
         mut progress: impl FnMut(usize),
     ) -> Result<Vec<QnmPixel>> {
-        if regions.is_empty() || regions.iter().any(|r| r.material >= self.materials.len()) {
-            return Err(Error::NotApplicable(
-                "a scanned sample needs regions, each naming one of its materials".into(),
-            ));
-        }
+        super::scan::check_regions(regions, self.materials.len())?;
         if pixels == 0 || cycles_per_pixel == 0 {
             return Err(Error::NotApplicable(
                 "a scan line needs at least one pixel of at least one cycle".into(),

@@ -6,7 +6,10 @@ use crate::analysis::fm::{FmPoint, approach, at_shift};
 use crate::app::config::TapInputs;
 use crate::app::report::chart::{Axis, Chart, Corner, Series, Style};
 use crate::dynamics::setup::significant;
+use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::Result;
+use crate::instrument::average::AverageRequest;
+use crate::instrument::fm::{FmAverage, thermal_average};
 use crate::physics::params::ELECTRONVOLT_J;
 use clap::Args;
 
@@ -58,6 +61,19 @@ pub struct FmArgs {
     /// Points of the approach [default 40].
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..=10_000))]
     points: Option<u32>,
+    /// Temperature [K; off unless given]: each settled point read again with the loops
+    /// running in time under the thermal force of the cantilever's damping
+    /// (S_F = 4k_BT·k/(ω₀Q)): the mean Δf and E_ts from the excitation, with standard
+    /// errors from eight independent records (JSON/CSV thermal_*).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::app::config::temperature,
+          help_heading = "Thermal noise")]
+    temperature: Option<f64>,
+    /// Drive periods of each thermal average: eight records of an eighth each, after
+    /// ten decay times of settling; each point draws noise of its own (a seed derived
+    /// from its place along the curve).
+    #[arg(hide_short_help = true, long, default_value_t = super::DEFAULT_THERMAL_PERIODS,
+          help_heading = "Thermal noise")]
+    thermal_periods: usize,
     #[command(flatten)]
     pub(super) out: SweepOutput,
 }
@@ -90,12 +106,77 @@ struct Row {
     loop_loss_j: Option<f64>,
     grazing: Option<bool>,
     note: Option<String>,
+    /// Under --temperature: the channels averaged under the thermal force.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    thermal: Option<Thermal>,
+}
+
+/// The thermal averages of a point, as written.
+#[derive(serde::Serialize)]
+struct Thermal {
+    thermal_frequency_shift_hz: f64,
+    thermal_frequency_shift_std_err_hz: f64,
+    thermal_excitation_ratio: f64,
+    thermal_e_ts_j: f64,
+    thermal_e_ts_std_err_j: f64,
+    thermal_seed: u64,
+}
+
+impl Thermal {
+    fn of(a: &FmAverage) -> Self {
+        Self {
+            thermal_frequency_shift_hz: a.frequency_shift_hz,
+            thermal_frequency_shift_std_err_hz: a.frequency_shift_std_err_hz,
+            thermal_excitation_ratio: a.excitation_ratio,
+            thermal_e_ts_j: a.e_ts_from_excitation_j,
+            thermal_e_ts_std_err_j: a.e_ts_std_err_j,
+            thermal_seed: a.seed,
+        }
+    }
+}
+
+/// The thermal average of each settled point of `points` of `setup` at `temperature`
+/// (none where a point has no state), each with a seed of its own.
+fn thermal_averages(
+    (setup, numerics): (&TapSetup, &Numerics),
+    points: &[FmPoint],
+    (temperature_k, periods): (f64, usize),
+    quiet: bool,
+) -> Result<Vec<Option<FmAverage>>> {
+    let request = AverageRequest {
+        temperature_k,
+        periods,
+        seed: 1,
+    };
+    request.check(setup.cantilever.quality)?;
+    let bar = Progress::counted("fm: thermal averages", points.len(), quiet);
+    let out = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let Some(state) = &p.state else {
+                bar.inc(1);
+                return Ok(None);
+            };
+            let at = TapSetup {
+                separation_m: state.separation_m,
+                ..setup.clone()
+            };
+            let prepared = Prepared::new(&at, numerics)?;
+            let average = thermal_average(&prepared, &state.engagement(), &request.at(&[i as u64]));
+            bar.inc(1);
+            average.map(Some)
+        })
+        .collect();
+    bar.finish_and_clear();
+    out
 }
 
 impl Row {
-    fn of(p: &FmPoint) -> Self {
+    fn of(p: &FmPoint, thermal: Option<&FmAverage>) -> Self {
         let s = p.state.as_ref();
         Self {
+            thermal: thermal.map(Thermal::of),
             separation_m: p.separation_m,
             frequency_shift_hz: s.map(|s| s.frequency_shift_hz),
             frequency_ratio: s.map(|s| s.frequency_ratio),
@@ -129,11 +210,23 @@ pub fn run(args: FmArgs) -> Result<()> {
         let state = at_shift(setup, &start.numerics, shift_hz, (from, to), n - 1);
         busy.finish_and_clear();
         let state = state?;
-        let row = Row::of(&FmPoint {
+        let point = FmPoint {
             separation_m: state.separation_m,
             state: Some(state),
             note: None,
-        });
+        };
+        let thermal = match args.temperature {
+            Some(t) => thermal_averages(
+                (setup, &start.numerics),
+                std::slice::from_ref(&point),
+                (t, args.thermal_periods),
+                args.out.quiet,
+            )?
+            .pop()
+            .flatten(),
+            None => None,
+        };
+        let row = Row::of(&point, thermal.as_ref());
         args.out.write_files(std::slice::from_ref(&row), Vec::new)?;
         if args.out.json {
             outln!("{}", crate::app::report::records::document(&row)?);
@@ -152,12 +245,29 @@ pub fn run(args: FmArgs) -> Result<()> {
             row.peak_force_n.unwrap_or(f64::NAN) * 1e9 + 0.0,
             grazing_mark(row.grazing, "; ")
         );
+        if let Some(a) = &thermal {
+            outln!("{}", thermal_line(a));
+        }
         return Ok(());
     }
     let progress = Progress::counted("fm", n, args.out.quiet);
     let points = approach(setup, &start.numerics, &separations, || progress.inc(1));
     progress.finish_and_clear();
-    let rows: Vec<Row> = points?.iter().map(Row::of).collect();
+    let points = points?;
+    let thermal = match args.temperature {
+        Some(t) => thermal_averages(
+            (setup, &start.numerics),
+            &points,
+            (t, args.thermal_periods),
+            args.out.quiet,
+        )?,
+        None => vec![None; points.len()],
+    };
+    let rows: Vec<Row> = points
+        .iter()
+        .zip(&thermal)
+        .map(|(p, a)| Row::of(p, a.as_ref()))
+        .collect();
     let amplitude_m = setup.cantilever.free_amplitude_m;
     let law = setup.law.to_string();
     args.out
@@ -199,14 +309,22 @@ pub fn run(args: FmArgs) -> Result<()> {
             r.peak_force_n,
         ) {
             (Some(df), Some(x), Some(e), Some(min), Some(peak)) => outln!(
-                "{:>9.4}  {:>11.4}  {:>12.9}  {:>10.4}  {:>10.4}  {:>10.4}{}",
+                "{:>9.4}  {:>11.4}  {:>12.9}  {:>10.4}  {:>10.4}  {:>10.4}{}{}",
                 r.separation_m * 1e9,
                 df + 0.0,
                 x,
                 e + 0.0,
                 min * 1e9 + 0.0,
                 peak * 1e9 + 0.0,
-                grazing_mark(r.grazing, "  ")
+                grazing_mark(r.grazing, "  "),
+                r.thermal.as_ref().map_or(String::new(), |t| format!(
+                    "  at {} K: Δf {:.4} ± {:.4} Hz, E_ts {:.4} ± {:.4} eV",
+                    significant(args.temperature.unwrap_or(0.0)),
+                    t.thermal_frequency_shift_hz,
+                    t.thermal_frequency_shift_std_err_hz,
+                    t.thermal_e_ts_j / ELECTRONVOLT_J,
+                    t.thermal_e_ts_std_err_j / ELECTRONVOLT_J
+                ))
             ),
             _ => outln!(
                 "{:>9.4}  {}",
@@ -216,6 +334,23 @@ pub fn run(args: FmArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A thermal average in a line.
+fn thermal_line(a: &FmAverage) -> String {
+    format!(
+        "at {} K, the loops running under the thermal force ({} periods in {} records): Δf \
+         {:.4} ± {:.4} Hz, F/F₀ {:.9} ± {:.1e}, E_ts from the excitation {:.4} ± {:.4} eV",
+        significant(a.temperature_k),
+        a.periods,
+        a.records,
+        a.frequency_shift_hz,
+        a.frequency_shift_std_err_hz,
+        a.excitation_ratio,
+        a.excitation_ratio_std_err,
+        a.e_ts_from_excitation_j / ELECTRONVOLT_J,
+        a.e_ts_std_err_j / ELECTRONVOLT_J
+    )
 }
 
 /// Δf and E_ts against z_c.

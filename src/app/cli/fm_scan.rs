@@ -7,10 +7,10 @@ use crate::analysis::fm::engagement;
 use crate::analysis::sweep::Shard;
 use crate::app::config::{frequency, time};
 use crate::app::report::part::{self, Job};
-use crate::app::report::records::typed;
 use crate::dynamics::setup::{Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
-use crate::instrument::fm_scan::{Engagement, FmPixel, FmScanner, ShiftFeedback};
+use crate::instrument::fm::Engagement;
+use crate::instrument::fm_scan::{FmPixel, FmScanner, ShiftFeedback};
 use crate::instrument::scan::Region;
 use crate::physics::params::ELECTRONVOLT_J;
 use clap::Args;
@@ -329,24 +329,13 @@ pub(super) fn emit_scan<T: serde::Serialize>(
     (shape, image): ((usize, usize, f64), Option<&part::ImageInfo>),
     records: &[T],
 ) -> Result<()> {
-    let rows: Vec<Row<FmPixel>> = typed(records, "FM")?;
-    let (files, extra) = super::image::ImageFiles::among(extra)?;
-    if files.any() && image.is_none() {
-        return Err(files.no_image());
-    }
-    out.emit(
-        ("scan", &extra),
+    super::scan_lines::emit_scan(
+        (out, extra),
+        ("FM", image),
         records,
-        || crate::app::report::records::columns_json(records),
-        Some(&|path| draw(shape, &rows, path)),
-    )?;
-    match image {
-        Some(image) if files.any() => files.write(
-            &image_channels(&rows, (shape.0, shape.1), image.size_m),
-            &image.meta,
-        ),
-        _ => Ok(()),
-    }
+        |rows, path| draw(shape, rows, path),
+        |rows, size_m| image_channels(rows, (shape.0, shape.1), size_m),
+    )
 }
 
 /// The channels plotted: name, label, value.

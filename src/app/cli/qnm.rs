@@ -468,24 +468,13 @@ pub(super) fn emit_scan<T: serde::Serialize>(
     (shape, image): ((usize, usize, f64), Option<&part::ImageInfo>),
     records: &[T],
 ) -> Result<()> {
-    let rows: Vec<Row> = typed(records, "QNM")?;
-    let (files, extra) = super::image::ImageFiles::among(extra)?;
-    if files.any() && image.is_none() {
-        return Err(files.no_image());
-    }
-    out.emit(
-        ("scan", &extra),
+    super::scan_lines::emit_scan(
+        (out, extra),
+        ("QNM", image),
         records,
-        || crate::app::report::records::columns_json(records),
-        Some(&|path| draw(shape, &rows, path)),
-    )?;
-    match image {
-        Some(image) if files.any() => files.write(
-            &image_channels(&rows, (shape.0, shape.1), image.size_m),
-            &image.meta,
-        ),
-        _ => Ok(()),
-    }
+        |rows, path| draw(shape, rows, path),
+        |rows, size_m| image_channels(rows, (shape.0, shape.1), size_m),
+    )
 }
 
 /// The plot of a QNM scan of (lines, pixels) at the peak force setpoint: profiles of

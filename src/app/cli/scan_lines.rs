@@ -162,3 +162,31 @@ pub(super) fn draw<P: Located>(
         crate::app::report::plot::render_stack(&profiles(rows, channels, line_caption), path)
     }
 }
+
+/// Write a whole scan's outputs from its records (`tapsim merge` writes a sharded
+/// image's through this): the CSV, JSON and plot (`draw`) as `out` and `extra` ask, and
+/// the Gwyddion files among `extra` from the channels `channels` gives for the `image`
+/// the parts carry (refused without one). `kind` names the rows in a message.
+pub(super) fn emit_scan<T: serde::Serialize, P: serde::de::DeserializeOwned>(
+    (out, extra): (&super::SweepOutput, &[std::path::PathBuf]),
+    (kind, image): (&str, Option<&crate::app::report::part::ImageInfo>),
+    records: &[T],
+    draw: impl Fn(&[Row<P>], &std::path::Path) -> Result<()>,
+    channels: impl Fn(&[Row<P>], (f64, f64)) -> Vec<crate::app::report::gwyddion::Channel>,
+) -> Result<()> {
+    let rows: Vec<Row<P>> = crate::app::report::records::typed(records, kind)?;
+    let (files, extra) = super::image::ImageFiles::among(extra)?;
+    if files.any() && image.is_none() {
+        return Err(files.no_image());
+    }
+    out.emit(
+        ("scan", &extra),
+        records,
+        || crate::app::report::records::columns_json(records),
+        Some(&|path| draw(&rows, path)),
+    )?;
+    match image {
+        Some(image) if files.any() => files.write(&channels(&rows, image.size_m), &image.meta),
+        _ => Ok(()),
+    }
+}
