@@ -9,8 +9,7 @@ use common::column;
 
 use tapsim::analysis::fm::{at_shift, engagement};
 use tapsim::config::TapInputs;
-use tapsim::dynamics::setup::{Numerics, Prepared};
-use tapsim::instrument::MARCH_RTOL;
+use tapsim::dynamics::setup::Numerics;
 use tapsim::instrument::fm_scan::{FmPixel, FmScanner, ShiftFeedback};
 use tapsim::instrument::scan::Region;
 use tapsim::sample::{BLEND, Sample};
@@ -21,17 +20,7 @@ const SETPOINT_HZ: f64 = -200.0;
 /// of 2 344 periods (4 lines/s at 300 kHz), engaged on A; and the scanner's periods
 /// (marched, skipped).
 fn blend_trace(exact: bool) -> (Vec<FmPixel>, (u64, u64)) {
-    let sample = Sample::from_toml(BLEND, &TapInputs::default()).unwrap();
-    let march = Numerics {
-        rtol: MARCH_RTOL,
-        atol: 1e-2 * MARCH_RTOL,
-        ..Numerics::default()
-    };
-    let prepared: Vec<Prepared> = sample
-        .materials
-        .iter()
-        .map(|(_, s)| Prepared::new(s, &march).unwrap())
-        .collect();
+    let (sample, prepared) = common::blend();
     let a = &sample.materials[0].1;
     let range = (24e-9, 8e-9);
     let (at, slope) = engagement(a, &Numerics::default(), SETPOINT_HZ, range, 40).unwrap();

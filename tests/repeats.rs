@@ -6,15 +6,12 @@
 use crate::common;
 use common::column;
 
-use tapsim::config::TapInputs;
-use tapsim::dynamics::setup::{Numerics, Prepared};
-use tapsim::instrument::MARCH_RTOL;
+use tapsim::dynamics::setup::Prepared;
 use tapsim::instrument::feedback::PiController;
 use tapsim::instrument::lockin::LockIn;
 use tapsim::instrument::repeats::{DEFAULT_TOLERANCE, Repeats};
 use tapsim::instrument::scan::{Pixel, Region, row};
 use tapsim::instrument::thermal::ThermalForce;
-use tapsim::sample::{BLEND, Sample};
 
 /// `scan` with `args`, and with `--exact`: every pixel's topography within 1 pm and
 /// phase within 1e-3°. Returns both documents.
@@ -128,22 +125,6 @@ fn the_step_scanned_fast_overshoots_and_loses_the_sample_as_exactly() {
     );
 }
 
-/// The blend's materials at the instrument's tolerance.
-fn blend() -> (Sample, Vec<Prepared>) {
-    let sample = Sample::from_toml(BLEND, &TapInputs::default()).unwrap();
-    let numerics = Numerics {
-        rtol: MARCH_RTOL,
-        atol: 1e-2 * MARCH_RTOL,
-        ..Numerics::default()
-    };
-    let prepared = sample
-        .materials
-        .iter()
-        .map(|(_, s)| Prepared::new(s, &numerics).unwrap())
-        .collect();
-    (sample, prepared)
-}
-
 /// One trace over `regions` of the blend's materials at `setpoint` with `repeats`:
 /// `pixels` of `per_pixel` periods after 3 000 periods of engaging.
 fn trace(
@@ -173,7 +154,7 @@ fn trace(
 
 #[test]
 fn a_loop_that_settles_skips_and_one_on_a_long_lock_marches_every_period() {
-    let (sample, prepared) = blend();
+    let (sample, prepared) = common::blend();
     let regions = sample.layout.line_at(0.5 * sample.width_m, sample.length_m);
     // At 0.8 the loop settles on each polymer: most periods of a slow line are repeats.
     let mut repeats = Repeats::within(DEFAULT_TOLERANCE);

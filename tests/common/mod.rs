@@ -379,3 +379,26 @@ pub fn tour() -> Vec<Vec<String>> {
     commands.extend(tour_block("docs/src/reference/cli-tour.md", "# CLI tour"));
     commands
 }
+
+/// The blend's materials at the instrument's tolerance.
+pub fn blend() -> (
+    tapsim::sample::Sample,
+    Vec<tapsim::dynamics::setup::Prepared>,
+) {
+    let sample = tapsim::sample::Sample::from_toml(
+        tapsim::sample::BLEND,
+        &tapsim::config::TapInputs::default(),
+    )
+    .unwrap();
+    let numerics = tapsim::dynamics::setup::Numerics {
+        rtol: tapsim::instrument::MARCH_RTOL,
+        atol: 1e-2 * tapsim::instrument::MARCH_RTOL,
+        ..tapsim::dynamics::setup::Numerics::default()
+    };
+    let prepared = sample
+        .materials
+        .iter()
+        .map(|(_, s)| tapsim::dynamics::setup::Prepared::new(s, &numerics).unwrap())
+        .collect();
+    (sample, prepared)
+}
