@@ -22,6 +22,7 @@
 //! The loops as they run in time, with their gains, are [`crate::instrument::fm`]; they
 //! lock onto the state found here.
 
+use crate::analysis::reconstruct::Inversion;
 use crate::dynamics::march::{CycleIntegrals, Phase, Simulation};
 use crate::dynamics::motion::{Motion, StdErr, SteadyState};
 use crate::dynamics::numeric::Ignore;
@@ -339,13 +340,18 @@ pub fn approach(
 }
 
 /// The force at each closest distance D an FM approach's orbits reach, from their
-/// frequency shifts: the Sader–Jarvis inversion (Sader & Jarvis, APL 84, 1801, 2004;
-/// [`crate::analysis::reconstruct::sader_jarvis`]) of the shift the first harmonic's
-/// balance gives, Ω_eff = (Ω² − 1)/2 = −⟨F_ts q₁⟩/(kA²) (to first order Δf/f₀), at the
-/// constant amplitude A; D is each orbit's least separation. `states` in any order of
-/// z_c, each a distinct D; returns (D in m, F in N, repulsive positive) by increasing D,
-/// the force beyond the farthest point taken as zero.
-pub fn sader_jarvis(setup: &TapSetup, states: &[FmState]) -> Result<Vec<(f64, f64)>> {
+/// frequency shifts: `inversion` (the Sader–Jarvis formula, Sader & Jarvis, APL 84,
+/// 1801, 2004, or the first-order relation inverted exactly, Giessibl, APL 78, 123,
+/// 2001; [`Inversion`]) of the shift the first harmonic's balance gives,
+/// Ω_eff = (Ω² − 1)/2 = −⟨F_ts q₁⟩/(kA²) (to first order Δf/f₀), at the constant
+/// amplitude A; D is each orbit's least separation. `states` in any order of z_c, each
+/// a distinct D; returns (D in m, F in N, repulsive positive) by increasing D, the
+/// force beyond the farthest point taken as zero.
+pub fn force_from_shift(
+    setup: &TapSetup,
+    states: &[FmState],
+    inversion: Inversion,
+) -> Result<Vec<(f64, f64)>> {
     let mut points: Vec<(f64, f64)> = states
         .iter()
         .map(|s| {
@@ -362,12 +368,7 @@ pub fn sader_jarvis(setup: &TapSetup, states: &[FmState]) -> Result<Vec<(f64, f6
     let closest: Vec<f64> = points.iter().map(|p| p.0).collect();
     let shift: Vec<f64> = points.iter().map(|p| p.1).collect();
     let amplitude = vec![setup.cantilever.free_amplitude_m; points.len()];
-    let force = crate::analysis::reconstruct::sader_jarvis(
-        setup.cantilever.stiffness_n_m,
-        &closest,
-        &amplitude,
-        &shift,
-    );
+    let force = inversion.force(setup.cantilever.stiffness_n_m, &closest, &amplitude, &shift);
     Ok(closest.into_iter().zip(force).collect())
 }
 

@@ -3,7 +3,8 @@
 
 use super::curve_data::{Columns, read_curve};
 use crate::analysis::reconstruct::{
-    AmCurve, FmCurve, Probe, Reconstruction, law_branches_hat, reconstruct, reconstruct_fm,
+    AmCurve, FmCurve, Inversion, Probe, Reconstruction, law_branches_hat, reconstruct,
+    reconstruct_fm,
 };
 use crate::app::config::TapInputs;
 use crate::app::report::display::fixed;
@@ -25,7 +26,8 @@ use std::path::PathBuf;
 /// component in phase with the motion — the frequency shift an FM measurement would
 /// read — and the energy dissipated (Cleveland et al. 1998). The first is inverted by
 /// the Sader–Jarvis formula with each distance's own amplitude, so the amplitude may
-/// change along the curve as it does in AM. No law is assumed: for measured curves give
+/// change along the curve as it does in AM (--inversion first-order: the relation
+/// inverted exactly, for forces that bend sharply; sample those finely either way). No law is assumed: for measured curves give
 /// the cantilever (--stiffness, --quality, --free-amplitude, --resonance,
 /// --drive-frequency); with --with-law the setup's law is listed and drawn beside, for
 /// curves it simulated:
@@ -69,6 +71,11 @@ pub struct ReconstructArgs {
     /// excitation at a held amplitude (fm).
     #[arg(long, value_enum, default_value_t = Mode::Am)]
     mode: Mode,
+    /// How the shifts become a force: the Sader–Jarvis formula, or the first-order
+    /// relation inverted exactly (Giessibl's matrix method, force linear between the
+    /// points), which stays exact where the force bends sharply.
+    #[arg(long, value_enum, default_value_t = InversionArg::SaderJarvis)]
+    inversion: InversionArg,
     /// List and draw the setup's law at each D: its force on the way in (approach) and
     /// on the way out (retract), for curves it simulated.
     #[arg(long)]
@@ -105,6 +112,24 @@ enum Mode {
     Am,
     /// Frequency modulation: frequency shift and excitation at a held amplitude.
     Fm,
+}
+
+/// The inversion, as the command line names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum InversionArg {
+    /// Sader & Jarvis, APL 84, 1801 (2004).
+    SaderJarvis,
+    /// The first-order relation inverted exactly (Giessibl, APL 78, 123, 2001).
+    FirstOrder,
+}
+
+impl From<InversionArg> for Inversion {
+    fn from(a: InversionArg) -> Self {
+        match a {
+            InversionArg::SaderJarvis => Self::SaderJarvis,
+            InversionArg::FirstOrder => Self::FirstOrder,
+        }
+    }
 }
 
 /// One row of the output: the reconstruction, and the law's forces where asked for.
@@ -184,6 +209,7 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
                     phase_deg,
                     mean_deflection_m,
                 },
+                args.inversion.into(),
             )?
         }
         Mode::Fm => {
@@ -206,6 +232,7 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
                     amplitude_m,
                     mean_deflection_m,
                 },
+                args.inversion.into(),
             )?
         }
     };
@@ -303,6 +330,7 @@ pub fn run(args: ReconstructArgs) -> Result<()> {
     }
     if args.json {
         let mut v = crate::app::report::records::columns_json(&rows)?;
+        v["inversion"] = serde_json::json!(r.inversion);
         v["far_end_shift_ratio"] = r.far_end_shift_ratio.into();
         v["notes"] = notes.clone().into();
         outln!("{}", crate::app::report::records::document(&v)?);
@@ -334,7 +362,11 @@ fn text(
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "force reconstruction (Sader–Jarvis on the in-phase force, {}) from {} points",
+        "force reconstruction ({} on the in-phase force, {}) from {} points",
+        match r.inversion {
+            Inversion::SaderJarvis => "Sader–Jarvis",
+            Inversion::FirstOrder => "first-order inverse",
+        },
         if fm_resonance.is_some() {
             "FM: amplitude held"
         } else {
