@@ -74,6 +74,7 @@ fn fitting(parameters: Vec<Parameter>, max_curves: usize) -> FitOptions {
         estimate_sigma: false,
         max_curves,
         search: Search::Local,
+        keep_grazing: false,
     }
 }
 

@@ -411,3 +411,100 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A curve as an instrument writes it, without a `grazing` column: issue 43's
+/// branch-jumping curve (E* 0.8 GPa, Δγ 0.07 J/m², 40 points from 24 to 8 nm), whose
+/// first touching point grazes the jump-in. Fitted from 0.6 GPa and 0.1 J/m², the fit
+/// finds that point grazing at its own best parameters, leaves it out (`left_out`, the
+/// row `tapsim approach` flagged, and a note naming where), runs again without it and
+/// ends on the truth to 1e-6; `--keep-grazing` fits all 40.
+#[test]
+fn a_point_grazing_at_the_fitted_parameters_is_left_out() {
+    let dir = scratch("fit-left-out");
+    let full = dir.join("full.csv");
+    let out = tapsim(&[
+        "approach",
+        "--modulus",
+        "0.8GPa",
+        "--work-of-adhesion",
+        "0.07J/m^2",
+        "--from",
+        "24nm",
+        "--to",
+        "8nm",
+        "--points",
+        "40",
+        "--no-retract",
+        "--csv",
+        full.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(out.status.success());
+    let mut reader = csv::Reader::from_path(&full).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    let at = headers.iter().position(|h| h == "grazing").unwrap();
+    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    let flagged: Vec<f64> = (0..rows.len())
+        .filter(|&i| &rows[i][at] == "true")
+        .map(|i| i as f64)
+        .collect();
+    assert_eq!(flagged.len(), 1, "{flagged:?}");
+    let bare = dir.join("bare.csv");
+    let mut writer = csv::Writer::from_path(&bare).unwrap();
+    let others = |r: &csv::StringRecord| {
+        r.iter()
+            .enumerate()
+            .filter(|(i, _)| *i != at)
+            .map(|(_, v)| v.to_string())
+            .collect::<Vec<_>>()
+    };
+    writer.write_record(others(&headers)).unwrap();
+    for r in &rows {
+        writer.write_record(others(r)).unwrap();
+    }
+    writer.flush().unwrap();
+    let start = [
+        "fit",
+        bare.to_str().unwrap(),
+        "--fit",
+        "modulus,work-of-adhesion",
+        "--modulus",
+        "0.6GPa",
+        "--work-of-adhesion",
+        "0.1J/m^2",
+    ];
+    let v = json(&[&start[..], &["--json", "--quiet"]].concat());
+    assert_eq!(common::column(&v, "left_out"), flagged);
+    assert_eq!(
+        num(&v, "degrees_of_freedom"),
+        (2 * (rows.len() - 1) - 2) as f64
+    );
+    assert_eq!(v["converged"], true);
+    for (i, truth) in [0.8e9, 0.07].into_iter().enumerate() {
+        let f = v["parameters"][i]["value"].as_f64().unwrap();
+        assert!((f / truth - 1.0).abs() < 1e-6, "{f}");
+    }
+    let text =
+        String::from_utf8_lossy(&tapsim(&[&start[..], &["--quiet"]].concat()).stdout).into_owned();
+    let z = rows[flagged[0] as usize][headers.iter().position(|h| h == "separation_m").unwrap()]
+        .parse::<f64>()
+        .unwrap();
+    assert!(
+        text.contains("1 point(s) whose state at the fitted parameters grazes")
+            && text.contains(&format!("(at {:.3} nm)", z * 1e9)),
+        "{text}"
+    );
+    let kept = json(
+        &[
+            &start[..],
+            &["--keep-grazing", "--max-curves", "3", "--json", "--quiet"],
+        ]
+        .concat(),
+    );
+    assert!(common::column(&kept, "left_out").is_empty());
+    assert_eq!(
+        num(&kept, "degrees_of_freedom"),
+        (2 * rows.len() - 2) as f64
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

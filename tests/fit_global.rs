@@ -314,16 +314,16 @@ fn a_profile_survives_a_trial_outside_the_law() {
 
 /// Coverage on the branch-jumping curve: over 100 noisy replicas of the issue's curve
 /// (E* 0.8 GPa, Δγ 0.07 J/m², 40 points, 0.02 nm and 0.05°), fitted from near the
-/// truth, every fit converges and E*'s 68 % interval holds the truth in 68 ± 7 % of
-/// them (a binomial's standard deviation at 100 replicas is 4.7 %; measured: 67, pulls
-/// +0.25 ± 1.12). Δγ's does NOT yet: 58 of 100, its pulls +0.28 ± 2.02 with tails to
-/// −11 and +5.5 — the curve's first touching point grazes the jump-in (the onset is a
-/// switch the linearised intervals do not see), and Δγ sets the jump-in distance. It is
-/// printed, not asserted, until intervals carry the spread of such points (issue 43,
-/// item 5).
+/// truth, every fit converges and both 68 % intervals hold the truth in 68 ± 7 % of them
+/// (a binomial's standard deviation at 100 replicas is 4.7 %; measured: E* 66, pulls
+/// +0.07 ± 0.97; Δγ 72, pulls +0.14 ± 1.03). The curve's first touching point grazes
+/// the jump-in: every fit leaves it out (its state at the fitted parameters is one draw
+/// among coexisting ones, a step in Δγ the linearised intervals cannot see). With it
+/// kept, Δγ's interval held the truth in 58 of 100, its pulls +0.28 ± 2.02 with tails to
+/// −11 and +5.5.
 #[test]
 #[ignore = "slow (100 fits, about two minutes in release on two cores): run with cargo test --release -- --ignored fit_global::"]
-fn the_modulus_intervals_cover_the_branch_jumping_truth_in_68_percent_of_replicas() {
+fn the_intervals_cover_the_branch_jumping_truth_in_68_percent_of_replicas() {
     use rayon::prelude::*;
     let (e, w) = (0.8e9, 0.07);
     let truth = issue_setup(e, w);
@@ -342,6 +342,8 @@ fn the_modulus_intervals_cover_the_branch_jumping_truth_in_68_percent_of_replica
             let data = measured(&truth, &z, 1000 + seed);
             let r = fit(&start, &numerics(), &data, &options, |_| {}).unwrap();
             assert!(r.converged, "seed {seed}: {}", r.termination);
+            // The first touching point (the ninth) and no other.
+            assert_eq!(r.left_out, [8], "seed {seed}");
             let inside = |k: usize, t: f64| {
                 let [lo, hi] = r.parameters[k].interval_68.unwrap();
                 lo <= t && t <= hi
@@ -362,8 +364,6 @@ fn the_modulus_intervals_cover_the_branch_jumping_truth_in_68_percent_of_replica
         eprintln!(
             "{name}: the 68 % interval holds the truth in {n} of 100 replicas; pulls {mean:+.3} ± {sd:.3}"
         );
-        if k == 0 {
-            assert!((61..=75).contains(&n), "{name}: {n} of 100");
-        }
+        assert!((61..=75).contains(&n), "{name}: {n} of 100");
     }
 }

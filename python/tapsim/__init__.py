@@ -590,7 +590,9 @@ def fit(data: Any = None, setup: Optional[Setup] = None, /, **kwargs: Any) -> Re
     (value, std_err, interval_68, interval_95, identifiable), ``identifiability``
     (singular_values, condition_number, correlations, notes), chi_square,
     ``converged``, ``diagnosis`` (describes_data, reasons, worst_points), the
-    ``minima`` found, the fitted curve; ``profile=True`` adds ``profiles``.
+    ``minima`` found, the fitted curve, ``left_out`` (the points left out because
+    they graze a switch at the fitted parameters; ``keep_grazing=True`` keeps them);
+    ``profile=True`` adds ``profiles``.
     ``law=["hybrid", "jkr"]`` fits each law: ``laws`` (one report per law) and
     ``comparison`` (ranking by AIC and BIC, ``verdict`` in words)."""
     return _run_on_data("fit", data, setup, kwargs)

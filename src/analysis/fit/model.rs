@@ -494,12 +494,53 @@ impl Measured {
                     j.amplitude_m.extend(c.amplitude_m);
                     j.phase_deg.extend(c.phase_deg);
                     j.well_defined.extend(c.well_defined);
+                    j.grazing.extend(c.grazing);
                     j.amplitude2_m.extend(c.amplitude2_m);
                     j.phase2_deg.extend(c.phase2_deg);
                 }
             }
         }
         joined.ok_or_else(|| Error::NotApplicable("no approach to simulate".into()))
+    }
+
+    /// The data without the points `left_out` (indices, increasing): an approach that
+    /// began at a point left out begins at its next point; one left empty is gone.
+    pub fn without(&self, left_out: &[usize]) -> Measured {
+        let n = self.len();
+        let kept: Vec<usize> = (0..n)
+            .filter(|i| left_out.binary_search(i).is_err())
+            .collect();
+        let pick = |v: &Vec<f64>| kept.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+        let pick_opt = |v: &Option<Vec<f64>>| v.as_ref().map(pick);
+        let mut segments: Vec<usize> = self
+            .segments
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &start)| {
+                let end = self.segments.get(k + 1).copied().unwrap_or(n);
+                let first = kept.iter().position(|&i| i >= start)?;
+                (kept[first] < end).then_some(first)
+            })
+            .collect();
+        segments.dedup();
+        Measured {
+            position_m: if self.position_m.is_empty() {
+                Vec::new()
+            } else {
+                pick(&self.position_m)
+            },
+            setpoint_ratio: pick_opt(&self.setpoint_ratio),
+            segments,
+            amplitude_m: pick_opt(&self.amplitude_m),
+            phase_deg: pick_opt(&self.phase_deg),
+            sigma_amplitude_m: self.sigma_amplitude_m,
+            sigma_phase_deg: self.sigma_phase_deg,
+            second_mode: self.second_mode.as_ref().map(|m| SecondMode {
+                amplitude_m: pick_opt(&m.amplitude_m),
+                phase_deg: pick_opt(&m.phase_deg),
+                ..m.clone()
+            }),
+        }
     }
 
     /// The names of the channels measured, in the residuals' order.
@@ -593,6 +634,11 @@ pub struct Curve {
     /// Whether each point is a stable period-1 orbit that does not graze a switch (else
     /// its values are averages over motion that perturbations can change).
     pub well_defined: Vec<bool>,
+    /// Whether each point grazes a switch of the law: a turning point closer to it than
+    /// the thermal motion, so which of the coexisting states an instrument reads there
+    /// is set by perturbations (empty where not known: the several-mode curve).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub grazing: Vec<bool>,
     /// The second mode's amplitudes, m (empty without one).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub amplitude2_m: Vec<f64>,
@@ -637,6 +683,7 @@ pub fn curve_while(
             .iter()
             .map(|p| p.observables.regime == "period-1" && !p.observables.grazing)
             .collect(),
+        grazing: points.iter().map(|p| p.observables.grazing).collect(),
         amplitude2_m: Vec::new(),
         phase2_deg: Vec::new(),
     })
@@ -658,6 +705,7 @@ pub fn at_setpoints(
         amplitude_m: Vec::with_capacity(ratios.len()),
         phase_deg: Vec::with_capacity(ratios.len()),
         well_defined: Vec::with_capacity(ratios.len()),
+        grazing: Vec::with_capacity(ratios.len()),
         amplitude2_m: Vec::new(),
         phase2_deg: Vec::new(),
     };
@@ -673,6 +721,7 @@ pub fn at_setpoints(
         c.amplitude_m.push(s.observables.amplitude_m);
         c.phase_deg.push(s.observables.phase_deg);
         c.well_defined.push(!s.observables.grazing);
+        c.grazing.push(s.observables.grazing);
     }
     Ok(c)
 }
@@ -748,6 +797,7 @@ pub fn modal_curve(
         amplitude_m: Vec::with_capacity(points.len()),
         phase_deg: Vec::with_capacity(points.len()),
         well_defined: Vec::with_capacity(points.len()),
+        grazing: Vec::new(),
         amplitude2_m: Vec::with_capacity(points.len()),
         phase2_deg: Vec::with_capacity(points.len()),
     };

@@ -51,21 +51,30 @@ pub struct LawComparison {
 }
 
 /// Rank the fits `fits` (law name, its report) of one data set.
+/// Where the fits left out points that graze a switch ([`FitReport::left_out`]), they
+/// are compared over the points none of them left out.
 pub fn compare(fits: &[(String, &FitReport)]) -> LawComparison {
+    let mut union: Vec<usize> = fits
+        .iter()
+        .flat_map(|(_, r)| r.left_out.iter().copied())
+        .collect();
+    union.sort_unstable();
+    union.dedup();
     let mut ranking: Vec<LawScore> = fits
         .iter()
         .map(|(law, r)| {
-            let n = r.residuals.len() as f64;
+            let (chi_square, count) = common_chi_square(r, &union);
+            let n = count as f64;
             let k = r.parameters.len() as f64;
             let m2ll = if r.sigma_estimated {
-                n * (r.chi_square.max(f64::MIN_POSITIVE) / n).ln()
+                n * (chi_square.max(f64::MIN_POSITIVE) / n).ln()
             } else {
-                r.chi_square
+                chi_square
             };
             LawScore {
                 law: law.clone(),
                 parameters: r.parameters.len(),
-                chi_square: r.chi_square,
+                chi_square,
                 minus_two_log_likelihood: m2ll,
                 aic: m2ll + 2.0 * k,
                 bic: m2ll + k * n.ln(),
@@ -84,12 +93,40 @@ pub fn compare(fits: &[(String, &FitReport)]) -> LawComparison {
     for s in &mut ranking {
         s.akaike_weight = (-s.delta_aic / 2.0).exp() / total;
     }
-    let (verdict, decided) = verdict(&ranking);
+    let (mut verdict, decided) = verdict(&ranking);
+    if !union.is_empty() {
+        verdict.push_str(&format!(
+            " (compared without the {} points a fit left out as grazing a switch)",
+            union.len()
+        ));
+    }
     LawComparison {
         ranking,
         verdict,
         decided,
     }
+}
+
+/// χ² of `r` over the data's points not in `left_out` (indices, increasing; a superset
+/// of the report's own), and the residuals counted.
+fn common_chi_square(r: &FitReport, left_out: &[usize]) -> (f64, usize) {
+    let kept_n = r.fitted.phase_deg.len().max(1);
+    let total = kept_n + r.left_out.len();
+    let kept: Vec<usize> = (0..total)
+        .filter(|i| r.left_out.binary_search(i).is_err())
+        .collect();
+    let mut sum = 0.0;
+    let mut count = 0;
+    for (k, x) in r.residuals.iter().enumerate() {
+        if kept
+            .get(k % kept_n)
+            .is_some_and(|i| left_out.binary_search(i).is_err())
+        {
+            sum += x * x;
+            count += 1;
+        }
+    }
+    (sum, count)
 }
 
 /// The verdict on a ranking, and whether it decides.

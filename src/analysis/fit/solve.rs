@@ -40,6 +40,11 @@ pub struct FitOptions {
     pub max_curves: usize,
     /// How the minimum is looked for.
     pub search: Search,
+    /// Fit the points whose state at the fitted parameters grazes a switch too. By
+    /// default they are left out (and the fit is run again without them): such a
+    /// point's state is one draw among coexisting states, its value a step in the
+    /// parameters that the intervals cannot see.
+    pub keep_grazing: bool,
 }
 
 impl FitOptions {
@@ -53,6 +58,7 @@ impl FitOptions {
             estimate_sigma: false,
             max_curves: 400,
             search: Search::default(),
+            keep_grazing: false,
         }
     }
 }
@@ -120,6 +126,10 @@ pub struct FitReport {
     pub fitted: Curve,
     /// Weighted residuals (model − measured)/σ, amplitudes first.
     pub residuals: Vec<f64>,
+    /// The data's points (indices) left out because their state at the fitted
+    /// parameters grazes a switch ([`FitOptions::keep_grazing`]); `fitted` and
+    /// `residuals` are over the others.
+    pub left_out: Vec<usize>,
 }
 
 /// Refuse options that cannot fit `data`.
@@ -191,7 +201,7 @@ pub fn fit(
     options: &FitOptions,
     progress: impl Fn(&Progress) + Sync,
 ) -> Result<FitReport> {
-    let data = data.clone().validated()?;
+    let mut data = data.clone().validated()?;
     check(&data, options)?;
     let params = &options.parameters;
     let starts: Vec<f64> = params
@@ -201,7 +211,7 @@ pub fn fit(
     let tracker = Tracker::new(&progress);
     // Each point on the branch the data show while searching; the approach as it goes
     // (jumping where the model jumps) for the verdict.
-    let split = data.split_at_branch_jump();
+    let mut split = data.split_at_branch_jump();
     let working = split.as_ref().unwrap_or(&data);
     let candidates = search::starts(
         setup,
@@ -212,8 +222,8 @@ pub fn fit(
         &options.search,
         &tracker,
     );
-    let m = data.channels() * data.len();
-    let dof = m - params.len();
+    let mut m = data.channels() * data.len();
+    let mut dof = m - params.len();
     // Levenberg–Marquardt from each start; every run's end kept.
     let mut runs: Vec<LocalRun> = Vec::new();
     let mut first_error = None;
@@ -264,6 +274,49 @@ pub fn fit(
     }
     runs.sort_by(|a, b| a.chi_square().total_cmp(&b.chi_square()));
     let mut best = runs.remove(0);
+    // A local run from a point already found, on `working` data.
+    let run_from = |setup: &TapSetup, nuisance: Nuisance, working: &Measured| {
+        local::run(
+            setup,
+            nuisance,
+            numerics,
+            working,
+            params,
+            options.max_curves,
+            &tracker,
+        )
+    };
+    // Points whose state at the best parameters grazes a switch: left out, and the fit
+    // run again from there without them (the other runs' ends re-read on those data).
+    // More than a quarter of the curve grazing is not a few draws to set aside but a
+    // curve of mode locks (or a minimum far from the data's): kept, and said.
+    let grazing: Vec<usize> = (0..best.curve.grazing.len())
+        .filter(|&i| best.curve.grazing[i])
+        .collect();
+    let too_many = 4 * grazing.len() > data.len()
+        || data.channels() * (data.len() - grazing.len()) <= params.len();
+    let left_out = if options.keep_grazing || too_many {
+        Vec::new()
+    } else {
+        grazing.clone()
+    };
+    if !left_out.is_empty() {
+        data = data.without(&left_out);
+        split = data.split_at_branch_jump();
+        m = data.channels() * data.len();
+        dof = m - params.len();
+        let working = split.as_ref().unwrap_or(&data);
+        tracker.stage(Stage::Local { index: 1, of: 1 }, per_run, params.len());
+        best = run_from(&best.setup, best.nuisance, working)?;
+        for r in &mut runs {
+            if let Ok(c) = working.simulate(&r.setup, numerics, &r.nuisance) {
+                r.residuals = DVector::from_vec(working.residuals(&c));
+                r.curve = c;
+            }
+            tracker.curve(None);
+        }
+    }
+    let working = split.as_ref().unwrap_or(&data);
     // Is the end a minimum? Try the Gauss–Newton step from it: where it lowers χ² by
     // more than the variance factor the optimiser stalled (a step refused at a kink,
     // say) — go on from there, twice at most; where it does not (the prediction met a
@@ -293,15 +346,7 @@ pub fn fit(
             break (gained, stalled, jacobian);
         }
         continuations += 1;
-        best = local::run(
-            &s,
-            n,
-            numerics,
-            working,
-            params,
-            options.max_curves,
-            &tracker,
-        )?;
+        best = run_from(&s, n, working)?;
     };
     let minima = distinct_minima(std::iter::once(&best).chain(&runs), params, dof);
     let best = &best;
@@ -339,6 +384,15 @@ pub fn fit(
     };
     let (estimates, mut identifiability) =
         assess(params, &jacobian, variance_factor, &best.values, &starts);
+    if too_many && !options.keep_grazing {
+        identifiability.notes.push(format!(
+            "{} of the {} points graze a switch of the law at the fitted parameters: too \
+             many to leave out, so they are fitted, and the intervals do not carry the \
+             steps their states make as the parameters move",
+            grazing.len(),
+            data.len()
+        ));
+    }
     if options.estimate_sigma && resolved {
         identifiability.notes.push(format!(
             "the residuals are at the simulation's own precision (χ²/dof = {reduced:.1e}): \
@@ -379,6 +433,7 @@ pub fn fit(
         curves: tracker.curves(),
         fitted,
         residuals: residual_list,
+        left_out,
     })
 }
 

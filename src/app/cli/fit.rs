@@ -78,10 +78,11 @@ pub struct FitArgs {
     /// [m/V, e.g. 50nm]; fit `sensitivity` if you doubt it.
     #[arg(long, value_parser = length)]
     invols: Option<f64>,
-    /// Fit the rows a `grazing` column flags too. By default they are left out (with a
-    /// note): where a curve tapsim simulated grazes a switch of the law, its value is one
-    /// draw among coexisting mode locks that perturbations below the thermal motion
-    /// pick, which a fitted curve cannot match point for point.
+    /// Fit the rows a `grazing` column flags too, and the points whose state at the
+    /// fitted parameters grazes a switch. By default both are left out (with a note):
+    /// where a curve grazes a switch of the law, its value is one draw among coexisting
+    /// mode locks that perturbations below the thermal motion pick, which a fitted
+    /// curve cannot match point for point.
     #[arg(long)]
     keep_grazing: bool,
     /// The amplitude's standard deviation [m]. With --sigma-phase: the weights, taken as
@@ -333,6 +334,8 @@ pub fn run(args: FitArgs) -> Result<()> {
         .and_then(|b| fits.iter().position(|(n, _, _)| *n == b.law))
         .unwrap_or(0);
     let (law, setup, report) = &fits[best];
+    // The points the fit took (without those it left out as grazing).
+    let fitted_data = data.without(&report.left_out);
     let mut profiles = Vec::new();
     if args.profile {
         for (p, e) in options.parameters.iter().zip(&report.parameters) {
@@ -340,7 +343,7 @@ pub fn run(args: FitArgs) -> Result<()> {
                 continue;
             }
             let reporter = Reporter::new(&format!("profiling {}", p.key()), args.quiet);
-            let done = profile(setup, &numerics, &data, &options, report, *p, |q| {
+            let done = profile(setup, &numerics, &fitted_data, &options, report, *p, |q| {
                 reporter.report(q)
             });
             reporter.finish();
@@ -351,7 +354,8 @@ pub fn run(args: FitArgs) -> Result<()> {
         crate::app::report::output::write_bytes(
             path,
             &crate::app::report::records::records_csv(&crate::app::report::fit::rows(
-                report, &data,
+                report,
+                &fitted_data,
             ))?,
         )?;
     }
@@ -360,7 +364,7 @@ pub fn run(args: FitArgs) -> Result<()> {
             .data
             .file_name()
             .map_or("data".into(), |n| n.to_string_lossy().into_owned());
-        let mut charts = crate::app::report::fit::charts(report, &data, &source, law);
+        let mut charts = crate::app::report::fit::charts(report, &fitted_data, &source, law);
         charts.extend(profiles.iter().map(crate::app::report::fit::profile_chart));
         crate::app::report::plot::render_stack(&charts, path)?;
     }
@@ -388,7 +392,27 @@ pub fn run(args: FitArgs) -> Result<()> {
             if i > 0 {
                 outln!("");
             }
-            out!("{}", fit_text::report(r, name, &data));
+            out!("{}", fit_text::report(r, name, &data.without(&r.left_out)));
+            if !r.left_out.is_empty() {
+                let at: Vec<String> = r
+                    .left_out
+                    .iter()
+                    .filter_map(|&i| data.position_m.get(i))
+                    .map(|z| format!("{:.3}", z * 1e9))
+                    .collect();
+                outln!(
+                    "note: left out, and the fit run again without them: {} point(s) whose \
+                     state at the fitted parameters grazes a switch of the law (one draw \
+                     among coexisting states, a step the intervals cannot see){}; \
+                     --keep-grazing fits them too",
+                    r.left_out.len(),
+                    if at.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" (at {} nm)", at.join(", "))
+                    }
+                );
+            }
         }
         out!("{}", fit_text::profiles(report, &profiles));
         if let Some(c) = &comparison {
@@ -529,6 +553,7 @@ fn options(args: &FitArgs, data: &Measured) -> FitOptions {
         },
         estimate_sigma: !sigmas_given(args),
         max_curves: args.max_curves,
+        keep_grazing: args.keep_grazing,
         search: match args.search {
             SearchKind::Local => Search::Local,
             SearchKind::Global => Search::Global {
