@@ -463,3 +463,22 @@ def test_a_bimodal_scan_gives_each_pixels_higher_modes_as_2d_columns(cli):
     for key in ("amplitude_ratio", "phase_deg"):
         assert r.modes[key][:, 0].tolist() == [row[0][key] for row in expected["modes"]]
     assert r.phase_deg.tolist() == expected["phase_deg"]
+
+
+def test_fit_leaves_out_a_point_grazing_at_the_fitted_parameters(tmp_path):
+    # The branch-jumping curve as arrays (no grazing column, as an instrument writes
+    # it): the point tapsim's approach flags as grazing the jump-in is the one the fit
+    # leaves out at its own best parameters; keep_grazing=True fits it too.
+    path = tmp_path / "curve.csv"
+    tapsim.approach(**{"from": "24nm"}, to="8nm", points=40, no_retract=True,
+                    modulus="0.8GPa", work_of_adhesion="0.07J/m^2", csv=str(path))
+    table = np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding=None)
+    flagged = [i for i, g in enumerate(table["grazing"]) if str(g).lower() == "true"]
+    assert len(flagged) == 1
+    arrays = dict(z=table["separation_m"], amplitude=table["amplitude_m"], phase=table["phase_deg"])
+    flags = dict(fit="modulus,work-of-adhesion", modulus="0.6GPa", work_of_adhesion="0.1J/m^2")
+    r = tapsim.fit(**arrays, **flags)
+    assert r.left_out == flagged
+    assert abs(r.parameters[1]["value"] / 0.07 - 1) < 1e-6
+    kept = tapsim.fit(**arrays, **flags, keep_grazing=True, max_curves=3)
+    assert kept.left_out == []
