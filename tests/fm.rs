@@ -674,7 +674,11 @@ fn sader_jarvis_recovers_the_dmt_force_from_an_fm_approach() {
 /// lags leaves the drive off resonance, and the amplitude controller makes up the
 /// amplitude with excitation. With the default gains it stays below 1 % of the free
 /// damping all along (measured 0.17 %, the harmonics' real share included); with a PLL a
-/// hundred times slower it reads some 45 %.
+/// hundred times slower it reads some 45 %. An amplitude controller a hundred times
+/// slower does not (0.15 %): on a conservative sample the drive stays at resonance, so
+/// the amplitude holds at the free excitation and there is nothing for its lag to add —
+/// the lag that reads as loss is the PLL's (issue 48 names the amplitude controller; on
+/// this approach it is not the culprit).
 #[test]
 fn slow_loops_read_a_dissipation_that_is_not_there() {
     use tapsim::dynamics::setup::Prepared;
@@ -689,9 +693,8 @@ fn slow_loops_read_a_dissipation_that_is_not_there() {
     let z: Vec<f64> = (0..n)
         .map(|i| 21e-9 - 4e-9 * i as f64 / (n - 1) as f64)
         .collect();
-    let apparent = |mut pll: PhaseLockedLoop| {
+    let apparent = |mut pll: PhaseLockedLoop, mut agc: AmplitudeController| {
         let mut phase = p.simulation().free_steady_start();
-        let mut agc = AmplitudeController::for_quality(q).unwrap();
         let samples = run_along(
             &p,
             &mut phase,
@@ -706,11 +709,23 @@ fn slow_loops_read_a_dissipation_that_is_not_there() {
             .map(|x| x.dissipation_read().abs())
             .fold(0.0f64, f64::max)
     };
-    let default = apparent(PhaseLockedLoop::for_quality(q).unwrap());
-    let slow = apparent(PhaseLockedLoop::new(0.01 / q, 0.08 / (q * q)).unwrap());
-    eprintln!("apparent dissipation: default gains {default:.2e}, slow {slow:.2e} of the free");
+    let (pll, agc) = (
+        || PhaseLockedLoop::for_quality(q).unwrap(),
+        || AmplitudeController::for_quality(q).unwrap(),
+    );
+    let default = apparent(pll(), agc());
+    let slow = apparent(
+        PhaseLockedLoop::new(0.01 / q, 0.08 / (q * q)).unwrap(),
+        agc(),
+    );
+    let slow_agc = apparent(pll(), AmplitudeController::new(0.02, 0.16 / q).unwrap());
+    eprintln!(
+        "apparent dissipation: default gains {default:.2e}, slow PLL {slow:.2e}, slow \
+         amplitude controller {slow_agc:.2e} of the free"
+    );
     assert!(default < 0.01, "{default}");
     assert!(slow > 0.01, "{slow}");
+    assert!(slow_agc < 0.01, "{slow_agc}");
 }
 
 /// The state at a frequency-shift setpoint: on the hybrid defaults −300 Hz is first met on
