@@ -340,6 +340,18 @@ fn several_laws_are_refused_outside_fit() {
     );
 }
 
+/// The CSV `tapsim approach` wrote at `path`: its header, its rows, and where its
+/// `grazing` column is.
+fn with_grazing_column(
+    path: &std::path::Path,
+) -> (csv::StringRecord, Vec<csv::StringRecord>, usize) {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    let at = headers.iter().position(|h| h == "grazing").unwrap();
+    let rows = reader.records().map(|r| r.unwrap()).collect();
+    (headers, rows, at)
+}
+
 /// The curve a new user fits first — `tapsim approach --csv` on the defaults, from 24 nm
 /// in, crossing the onset of contact — holds points that graze a switch of the law (mode
 /// locks one draw among several): the fit leaves out the rows the file flags (counted
@@ -361,10 +373,7 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
         "--quiet",
     ]);
     assert!(out.status.success());
-    let mut reader = csv::Reader::from_path(csv).unwrap();
-    let headers = reader.headers().unwrap().clone();
-    let at = headers.iter().position(|h| h == "grazing").unwrap();
-    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    let (_, rows, at) = with_grazing_column(csv.as_ref());
     let grazing = rows.iter().filter(|r| &r[at] == "true").count();
     assert!(grazing >= 1 && grazing < rows.len() / 2, "{grazing}");
     let start = [
@@ -440,10 +449,7 @@ fn a_point_grazing_at_the_fitted_parameters_is_left_out() {
         "--quiet",
     ]);
     assert!(out.status.success());
-    let mut reader = csv::Reader::from_path(&full).unwrap();
-    let headers = reader.headers().unwrap().clone();
-    let at = headers.iter().position(|h| h == "grazing").unwrap();
-    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    let (headers, rows, at) = with_grazing_column(&full);
     let flagged: Vec<f64> = (0..rows.len())
         .filter(|&i| &rows[i][at] == "true")
         .map(|i| i as f64)

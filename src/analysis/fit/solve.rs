@@ -293,12 +293,13 @@ pub fn fit(
     let grazing: Vec<usize> = (0..best.curve.grazing.len())
         .filter(|&i| best.curve.grazing[i])
         .collect();
-    let too_many = 4 * grazing.len() > data.len()
-        || data.channels() * (data.len() - grazing.len()) <= params.len();
+    let grazing_count = grazing.len();
+    let too_many = 4 * grazing_count > data.len()
+        || data.channels() * (data.len() - grazing_count) <= params.len();
     let left_out = if options.keep_grazing || too_many {
         Vec::new()
     } else {
-        grazing.clone()
+        grazing
     };
     if !left_out.is_empty() {
         data = data.without(&left_out);
@@ -389,7 +390,7 @@ pub fn fit(
             "{} of the {} points graze a switch of the law at the fitted parameters: too \
              many to leave out, so they are fitted, and the intervals do not carry the \
              steps their states make as the parameters move",
-            grazing.len(),
+            grazing_count,
             data.len()
         ));
     }
