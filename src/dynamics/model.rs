@@ -468,7 +468,11 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
     let (s, c) = (y[Part::DriveSin], y[Part::DriveCos]);
     let (drive, x_b) = osc.drive_from(tau, c);
     let alpha = cpl.alpha_hat(x, x_b);
-    let elastic = law.t_hat(alpha, branch);
+    let (elastic, slope) = if has_tangent(N) {
+        law.t_and_slope_hat(alpha, branch)
+    } else {
+        (law.t_hat(alpha, branch), 0.0)
+    };
     let mut state = None;
     let dissipative = if law.is_rate_dependent() {
         let at = ContactState {
@@ -486,7 +490,7 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
     if has_tangent(N) {
         let (d_alpha, d_rate) = state.map_or((0.0, 0.0), |at| law.dissipative_slopes_hat(&at));
         let k = -cpl.f_scale * cpl.a1;
-        let stiffness = k * (law.slope_hat(alpha, branch) + d_alpha);
+        let stiffness = k * (slope + d_alpha);
         let damping = k * d_rate;
         let d = section_dim(N);
         let first = phi_index(N);

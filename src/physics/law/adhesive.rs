@@ -293,6 +293,14 @@ impl ForceLaw for AdhesiveLaw {
             (_, Some(a)) => a.slope_hat(alpha_hat),
         }
     }
+    #[inline]
+    fn t_and_slope_hat(&self, alpha_hat: f64, branch: Branch) -> (f64, f64) {
+        match (branch, &self.approach) {
+            (Branch::Contact, _) => self.contact.t_and_slope_hat(alpha_hat),
+            (_, None) => (0.0, 0.0),
+            (_, Some(a)) => a.t_and_slope_hat(alpha_hat),
+        }
+    }
     fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         match (branch, &self.approach) {
             (Branch::Contact, _) => self.contact.work_hat(alpha_hat),

@@ -153,6 +153,24 @@ impl FoldBranch {
         self.slope_outside(alpha_hat, d)
     }
 
+    /// [`FoldBranch::t_hat`] and [`FoldBranch::slope_hat`] at once: one square root and
+    /// one look-up.
+    #[inline]
+    pub fn t_and_slope_hat(&self, alpha_hat: f64) -> (f64, f64) {
+        let d = self.sign * (alpha_hat - self.fold_alpha_hat);
+        if d >= 0.0 {
+            let u = d.sqrt();
+            if u <= self.u_max {
+                let (t, slope_u) = self.table.eval_and_slope(u);
+                return (t, slope_u * self.sign / (2.0 * u.max(FOLD_SLOPE_FLOOR_U)));
+            }
+        }
+        (
+            self.t_hat_outside(alpha_hat, d),
+            self.slope_outside(alpha_hat, d),
+        )
+    }
+
     /// The slope past the fold (the reflected force has the mirrored slope) or beyond
     /// the table (the far field's derivative).
     #[cold]
@@ -276,6 +294,13 @@ mod tests {
         }
         for &alpha in &[-20.0, -3.9, -2.0, 0.0, 1.0, 1.5, 1.7, 3.0] {
             check(&contact, alpha);
+            // The pair from one look-up is the two evaluations, to the bit.
+            let both = contact.t_and_slope_hat(alpha);
+            assert_eq!(both, (contact.t_hat(alpha), contact.slope_hat(alpha)));
+        }
+        for &alpha in &[0.2, 0.9, 1.0, 1.3, 5.0, 10.5, 40.0] {
+            let both = approach.t_and_slope_hat(alpha);
+            assert_eq!(both, (approach.t_hat(alpha), approach.slope_hat(alpha)));
         }
     }
 }

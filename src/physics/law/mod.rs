@@ -26,6 +26,10 @@ macro_rules! elastic_part_from_inside {
         fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
             self.elastic_law().slope_hat(alpha_hat, branch)
         }
+        #[inline]
+        fn t_and_slope_hat(&self, alpha_hat: f64, branch: Branch) -> (f64, f64) {
+            self.elastic_law().t_and_slope_hat(alpha_hat, branch)
+        }
         fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
             self.elastic_law().work_hat(alpha_hat, branch)
         }
@@ -64,6 +68,10 @@ macro_rules! forward_to_inner {
         #[inline(never)]
         fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
             self.0.slope_hat(alpha_hat, branch)
+        }
+        #[inline(never)]
+        fn t_and_slope_hat(&self, alpha_hat: f64, branch: Branch) -> (f64, f64) {
+            self.0.t_and_slope_hat(alpha_hat, branch)
         }
         fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
             self.0.work_hat(alpha_hat, branch)
@@ -251,6 +259,15 @@ pub trait ForceLaw: Send + Sync {
     /// Slope dT̂/dα̂ on `branch`, for the variational equations of the one-period map.
     /// Finite everywhere (where T̂ has a square-root fold, capped very near it).
     fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64;
+    /// T̂ and dT̂/dα̂ together (what the variational equations need at every stage); a
+    /// tabulated law finds its interval once for both.
+    #[inline]
+    fn t_and_slope_hat(&self, alpha_hat: f64, branch: Branch) -> (f64, f64) {
+        (
+            self.t_hat(alpha_hat, branch),
+            self.slope_hat(alpha_hat, branch),
+        )
+    }
     /// Work function of a branch: an antiderivative Φ with dΦ/dα̂ = T̂(α̂, branch), so the
     /// work done along a branch between two separations is a difference of Φ (each branch
     /// is conservative; the loss comes from switching).
@@ -516,6 +533,10 @@ impl ForceLaw for AnyLaw {
     #[inline]
     fn slope_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         dispatch!(self, l => l.slope_hat(alpha_hat, branch))
+    }
+    #[inline]
+    fn t_and_slope_hat(&self, alpha_hat: f64, branch: Branch) -> (f64, f64) {
+        dispatch!(self, l => l.t_and_slope_hat(alpha_hat, branch))
     }
     fn work_hat(&self, alpha_hat: f64, branch: Branch) -> f64 {
         dispatch!(self, l => l.work_hat(alpha_hat, branch))

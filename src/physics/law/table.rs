@@ -88,6 +88,17 @@ impl UniformTable {
         y0 + t * (m0 + t * (3.0 * d - 2.0 * m0 - m1 + t * (m0 + m1 - 2.0 * d)))
     }
 
+    /// [`UniformTable::eval`] and [`UniformTable::slope`] from one look-up.
+    #[inline]
+    pub fn eval_and_slope(&self, x: f64) -> (f64, f64) {
+        let (t, y0, m0, m1, d) = self.interval(x);
+        let (c2, c3) = (3.0 * d - 2.0 * m0 - m1, m0 + m1 - 2.0 * d);
+        (
+            y0 + t * (m0 + t * (c2 + t * c3)),
+            (m0 + t * (2.0 * c2 + 3.0 * t * c3)) * self.inv_dx,
+        )
+    }
+
     /// Slope of the interpolant at `x` (the derivative of [`UniformTable::eval`]).
     #[inline]
     pub fn slope(&self, x: f64) -> f64 {
