@@ -514,3 +514,42 @@ fn a_point_grazing_at_the_fitted_parameters_is_left_out() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 43's new user: the 100-point CSV `tapsim approach --points 100 --csv` writes
+/// (noise-free), fitted with `tapsim fit FILE --modulus 1GPa --work-of-adhesion
+/// 0.2J/m^2` and nothing else (the global stage, σ estimated). The first local run that
+/// reaches the data's own precision ends the search: one run, no continuation from a
+/// "stalled" end (a Gauss–Newton step at round-off gains round-off), and the truth to
+/// 1e-6. Before, the residuals' round-off pattern failed the runs test, so two more
+/// local runs and two continuations followed: 290 curves in 41 s instead of 139 in 3 s.
+#[test]
+fn a_fit_that_resolves_the_data_searches_no_further() {
+    let dir = scratch("fit-resolved");
+    let csv = dir.join("approach.csv");
+    let csv = csv.to_str().unwrap();
+    let out = tapsim(&["approach", "--points", "100", "-q", "--csv", csv]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v = json(&[
+        "fit",
+        csv,
+        "--modulus",
+        "1GPa",
+        "--work-of-adhesion",
+        "0.2J/m^2",
+        "--json",
+    ]);
+    let params = v["parameters"].as_array().unwrap();
+    let truth = 1.0 / ((1.0 - 0.28f64.powi(2)) / 169e9 + (1.0 - 0.4f64.powi(2)) / 0.5e9);
+    assert!((num(&params[0], "value") / truth - 1.0).abs() < 1e-6, "{v}");
+    assert!((num(&params[1], "value") / 0.1 - 1.0).abs() < 1e-6, "{v}");
+    assert_eq!(v["converged"], true);
+    let minima = v["minima"].as_array().unwrap();
+    let runs: u64 = minima.iter().map(|m| m["runs"].as_u64().unwrap()).sum();
+    assert_eq!(runs, 1, "{minima:?}");
+    let curves = v["curves"].as_u64().unwrap();
+    assert!(curves < 200, "{curves} curves");
+}

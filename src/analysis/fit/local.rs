@@ -39,6 +39,8 @@ pub(crate) struct LocalRun {
     /// Why the optimiser stopped, and whether that was one of its convergence tests.
     pub termination: String,
     pub lm_converged: bool,
+    /// Whether it stopped because its budget of curves ran out (it may go on).
+    pub out_of_budget: bool,
 }
 
 impl LocalRun {
@@ -134,6 +136,7 @@ pub(crate) fn run(
         residuals,
         termination: termination_words(&termination),
         lm_converged: termination.was_successful(),
+        out_of_budget: matches!(termination, TerminationReason::LostPatience),
     })
 }
 
