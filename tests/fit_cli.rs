@@ -4,6 +4,16 @@
 use crate::common;
 use common::{json, num, refused, scratch, tapsim};
 
+/// `tapsim approach ARGS -q --csv CSV`, which must succeed.
+fn approach_csv(csv: &str, args: &[&str]) {
+    let out = tapsim(&[&["approach"], args, &["-q", "--csv", csv]].concat());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// An approach curve `tapsim approach` writes (noise-free, the hybrid defaults) is read
 /// as it is and fitted back from a start 35 % and 20 % off: E* = 593.31 MPa and
 /// Δγ = 0.1 J/m² to 1e-6; without standard deviations given and no noise to estimate
@@ -13,23 +23,17 @@ fn an_approach_curve_is_fitted_back() {
     let dir = scratch("fit-roundtrip");
     let csv = dir.join("curve.csv");
     let csv = csv.to_str().unwrap();
-    let out = tapsim(&[
-        "approach",
-        "--from",
-        "18.5nm",
-        "--to",
-        "8nm",
-        "--points",
-        "12",
-        "--no-retract",
-        "-q",
-        "--csv",
+    approach_csv(
         csv,
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        &[
+            "--from",
+            "18.5nm",
+            "--to",
+            "8nm",
+            "--points",
+            "12",
+            "--no-retract",
+        ],
     );
     let v = json(&[
         "fit",
@@ -212,20 +216,10 @@ fn approaches_joined_by_a_segment_column_are_fitted_together() {
     for (label, from, to) in [("far", "18.5nm", "8nm"), ("near", "8nm", "2nm")] {
         let csv = dir.join(format!("{label}.csv"));
         let csv = csv.to_str().unwrap();
-        let out = tapsim(&[
-            "approach",
-            "--from",
-            from,
-            "--to",
-            to,
-            "--points",
-            "10",
-            "--no-retract",
-            "-q",
-            "--csv",
+        approach_csv(
             csv,
-        ]);
-        assert!(out.status.success());
+            &["--from", from, "--to", to, "--points", "10", "--no-retract"],
+        );
         let mut r = csv::Reader::from_path(csv).unwrap();
         let h = r.headers().unwrap().clone();
         let col = |name: &str| h.iter().position(|x| x == name).unwrap();
@@ -266,25 +260,19 @@ fn approaches_joined_by_a_segment_column_are_fitted_together() {
 fn phases_at_setpoints_are_fitted() {
     let dir = scratch("fit-setpoints");
     let sweep = dir.join("sweep.csv");
-    let out = tapsim(&[
-        "approach",
-        "--sweep",
-        "setpoint",
-        "--from",
-        "0.75",
-        "--to",
-        "0.55",
-        "--points",
-        "5",
-        "--no-retract",
-        "-q",
-        "--csv",
+    approach_csv(
         sweep.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        &[
+            "--sweep",
+            "setpoint",
+            "--from",
+            "0.75",
+            "--to",
+            "0.55",
+            "--points",
+            "5",
+            "--no-retract",
+        ],
     );
     let mut r = csv::Reader::from_path(&sweep).unwrap();
     let h = r.headers().unwrap().clone();
@@ -363,16 +351,7 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
     let dir = scratch("fit-grazing");
     let csv = dir.join("approach.csv");
     let csv = csv.to_str().unwrap();
-    let out = tapsim(&[
-        "approach",
-        "--points",
-        "40",
-        "--no-retract",
-        "--csv",
-        csv,
-        "--quiet",
-    ]);
-    assert!(out.status.success());
+    approach_csv(csv, &["--points", "40", "--no-retract"]);
     let (_, rows, at) = with_grazing_column(csv.as_ref());
     let grazing = rows.iter().filter(|r| &r[at] == "true").count();
     assert!(grazing >= 1 && grazing < rows.len() / 2, "{grazing}");
@@ -431,24 +410,22 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
 fn a_point_grazing_at_the_fitted_parameters_is_left_out() {
     let dir = scratch("fit-left-out");
     let full = dir.join("full.csv");
-    let out = tapsim(&[
-        "approach",
-        "--modulus",
-        "0.8GPa",
-        "--work-of-adhesion",
-        "0.07J/m^2",
-        "--from",
-        "24nm",
-        "--to",
-        "8nm",
-        "--points",
-        "40",
-        "--no-retract",
-        "--csv",
+    approach_csv(
         full.to_str().unwrap(),
-        "--quiet",
-    ]);
-    assert!(out.status.success());
+        &[
+            "--modulus",
+            "0.8GPa",
+            "--work-of-adhesion",
+            "0.07J/m^2",
+            "--from",
+            "24nm",
+            "--to",
+            "8nm",
+            "--points",
+            "40",
+            "--no-retract",
+        ],
+    );
     let (headers, rows, at) = with_grazing_column(&full);
     let flagged: Vec<f64> = (0..rows.len())
         .filter(|&i| &rows[i][at] == "true")
@@ -527,12 +504,7 @@ fn a_fit_that_resolves_the_data_searches_no_further() {
     let dir = scratch("fit-resolved");
     let csv = dir.join("approach.csv");
     let csv = csv.to_str().unwrap();
-    let out = tapsim(&["approach", "--points", "100", "-q", "--csv", csv]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    approach_csv(csv, &["--points", "100"]);
     let v = json(&[
         "fit",
         csv,
