@@ -23,6 +23,21 @@ pub enum Stage {
         /// Starts in all.
         of: usize,
     },
+    /// A run cut short at its first share of the budget going on (`index` of `of`
+    /// such runs, the lowest χ² first), none of the starts having ended on a minimum
+    /// that describes the data.
+    Continue {
+        /// Which cut run.
+        index: usize,
+        /// Cut runs in all.
+        of: usize,
+    },
+    /// Levenberg–Marquardt again from the best minimum, without the points grazing a
+    /// switch there.
+    WithoutGrazing {
+        /// Points left out.
+        left_out: usize,
+    },
     /// The Jacobian and statistics at the best minimum.
     Assess,
     /// A profile: a parameter held at values about its estimate.

@@ -292,7 +292,7 @@ pub fn fit(
         cut.sort_by(|&a, &b| runs[a].chi_square().total_cmp(&runs[b].chi_square()));
         for (n, &k) in cut.iter().enumerate() {
             tracker.stage(
-                Stage::Local {
+                Stage::Continue {
                     index: n + 1,
                     of: cut.len(),
                 },
@@ -360,7 +360,13 @@ pub fn fit(
         m = data.channels() * data.len();
         dof = m - params.len();
         let working = split.as_ref().unwrap_or(&data);
-        tracker.stage(Stage::Local { index: 1, of: 1 }, per_run, params.len());
+        tracker.stage(
+            Stage::WithoutGrazing {
+                left_out: left_out.len(),
+            },
+            per_run,
+            params.len(),
+        );
         best = run_from(&best.setup, best.nuisance, working)?;
         for r in &mut runs {
             if let Ok(c) = working.simulate(&r.setup, numerics, &r.nuisance) {

@@ -234,6 +234,10 @@ impl Reporter {
         let stage = match p.stage {
             Stage::Design { done, total } => format!("global stage, design point {done}/{total}"),
             Stage::Local { index, of } => format!("local run {index}/{of}"),
+            Stage::Continue { index, of } => format!("continuing cut run {index}/{of}"),
+            Stage::WithoutGrazing { left_out } => {
+                format!("again without the {left_out} grazing point(s)")
+            }
             Stage::Assess => "the Jacobian at the best minimum".into(),
             Stage::Profile => "profile".into(),
         };
