@@ -82,6 +82,10 @@ pub struct Minimum {
     pub runs: usize,
     /// Why the optimiser stopped (the first run that ended there).
     pub termination: String,
+    /// Whether every run that ended there was cut short by its budget (a run left at
+    /// its first share once another start had found a minimum describing the data):
+    /// where it stopped, not a minimum.
+    pub cut_short: bool,
 }
 
 /// The standard deviations the residuals imply, per channel (where they are estimated).
@@ -259,6 +263,16 @@ pub fn fit(
         );
         r.lm_converged && d.describes_data && r.chi_square().is_finite()
     };
+    // A local run from `setup` and `nuisance` on at most `budget` curves; a run that
+    // fails keeps its error (the first one is said if no run succeeds).
+    let attempt =
+        |setup: &TapSetup, nuisance: Nuisance, budget: usize, first_error: &mut Option<Error>| {
+            local::run(setup, nuisance, numerics, working, params, budget, &tracker)
+                .map_err(|e| {
+                    first_error.get_or_insert(e);
+                })
+                .ok()
+        };
     let mut found = false;
     for (i, c) in candidates.iter().enumerate() {
         tracker.stage(
@@ -269,21 +283,14 @@ pub fn fit(
             per_run,
             (candidates.len() - i - 1) * per_run + params.len(),
         );
-        match local::run(
-            &c.setup, c.nuisance, numerics, working, params, share, &tracker,
-        ) {
-            Ok(r) => {
-                // A minimum that describes the data ends the search (later starts are
-                // worse by the screening): it is the answer, and no other can fit
-                // better than the noise.
-                found = judge(&r);
-                runs.push(r);
-                if found {
-                    break;
-                }
-            }
-            Err(e) => {
-                first_error.get_or_insert(e);
+        if let Some(r) = attempt(&c.setup, c.nuisance, share, &mut first_error) {
+            // A minimum that describes the data ends the search (later starts are
+            // worse by the screening): it is the answer, and no other can fit better
+            // than the noise.
+            found = judge(&r);
+            runs.push(r);
+            if found {
+                break;
             }
         }
     }
@@ -299,25 +306,13 @@ pub fn fit(
                 per_run,
                 (cut.len() - n - 1) * per_run + params.len(),
             );
-            let r = &runs[k];
-            match local::run(
-                &r.setup,
-                r.nuisance,
-                numerics,
-                working,
-                params,
-                options.max_curves - share,
-                &tracker,
-            ) {
-                Ok(r) => {
-                    let fine = judge(&r);
-                    runs[k] = r;
-                    if fine {
-                        break;
-                    }
-                }
-                Err(e) => {
-                    first_error.get_or_insert(e);
+            let budget = options.max_curves - share;
+            let (setup, nuisance) = (runs[k].setup.clone(), runs[k].nuisance);
+            if let Some(r) = attempt(&setup, nuisance, budget, &mut first_error) {
+                let fine = judge(&r);
+                runs[k] = r;
+                if fine {
+                    break;
                 }
             }
         }
@@ -438,7 +433,14 @@ pub fn fit(
         };
     }
     let stalled = stalled && !resolved;
+    // Points whose state at the best parameters is not a stable period-1 orbit clear of
+    // the law's switches (mode locks, grazing touches) step as the parameters move:
+    // past a quarter of the curve the linearised intervals would claim a precision the
+    // fit does not have.
+    let unsettled = fitted.well_defined.iter().filter(|w| !**w).count();
+    let locked = 4 * unsettled > data.len();
     let variance_factor = match (diagnosis.describes_data, options.estimate_sigma, resolved) {
+        _ if locked => None,
         (false, _, _) => None,
         (true, false, _) => Some(1.0),
         (true, true, false) => Some(reduced),
@@ -446,13 +448,18 @@ pub fn fit(
     };
     let (estimates, mut identifiability) =
         assess(params, &jacobian, variance_factor, &best.values, &starts);
-    if too_many && !options.keep_grazing {
+    if locked {
         identifiability.notes.push(format!(
-            "{} of the {} points graze a switch of the law at the fitted parameters: too \
-             many to leave out, so they are fitted, and the intervals do not carry the \
-             steps their states make as the parameters move",
-            grazing_count,
-            data.len()
+            "{unsettled} of the {} points are mode locks or graze a switch of the law at \
+             the fitted parameters ({grazing_count} grazing{}): their values step as the \
+             parameters move, which linearised intervals cannot see, so none are given; \
+             other values may fit these data as well (compare fits from other starts)",
+            data.len(),
+            if too_many && !options.keep_grazing {
+                ", too many to leave out"
+            } else {
+                ""
+            }
         ));
     }
     if options.estimate_sigma && resolved {
@@ -526,7 +533,10 @@ fn distinct_minima<'a>(
                 .all(|(p, (&a, &b))| p.coordinate_gap(a, b) < SAME_MINIMUM)
         });
         match same {
-            Some(m) => m.runs += 1,
+            Some(m) => {
+                m.runs += 1;
+                m.cut_short &= r.out_of_budget;
+            }
             None => {
                 let chi = r.chi_square();
                 out.push(Minimum {
@@ -535,6 +545,7 @@ fn distinct_minima<'a>(
                     reduced_chi_square: chi / dof as f64,
                     runs: 1,
                     termination: r.termination.clone(),
+                    cut_short: r.out_of_budget,
                 });
             }
         }
@@ -715,4 +726,37 @@ pub fn profile(
         interval_95: [crossing(1.96, -1.0), crossing(1.96, 1.0)],
         unavailable,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::setup::default_setup;
+
+    fn run_at(values: [f64; 2], out_of_budget: bool) -> LocalRun {
+        LocalRun {
+            setup: default_setup(),
+            nuisance: Nuisance::offset(0.0),
+            values: values.to_vec(),
+            curve: Curve::default(),
+            residuals: DVector::from_vec(vec![3.0, 4.0]),
+            termination: String::new(),
+            lm_converged: !out_of_budget,
+            out_of_budget,
+        }
+    }
+
+    /// A run cut short by its budget is listed as such, unless a run that converged
+    /// ended at the same point (then it is a minimum, whichever came first).
+    #[test]
+    fn a_run_cut_short_is_no_minimum_unless_another_converged_there() {
+        let params = [Parameter::Modulus, Parameter::WorkOfAdhesion];
+        let (a, b) = ([0.8e9, 0.07], [1.34e9, 0.116]);
+        let runs = [run_at(a, true), run_at(a, false), run_at(b, true)];
+        let minima = distinct_minima(runs.iter(), &params, 10);
+        assert_eq!(minima.len(), 2);
+        assert_eq!((minima[0].runs, minima[0].cut_short), (2, false));
+        assert_eq!((minima[1].runs, minima[1].cut_short), (1, true));
+        assert_eq!(minima[1].reduced_chi_square, 2.5);
+    }
 }

@@ -217,11 +217,16 @@ pub fn report(r: &FitReport, law: &str, data: &Measured) -> String {
                 .collect();
             let _ = writeln!(
                 s,
-                "  χ²/dof {:>12.4}: {} ({} run{})",
+                "  χ²/dof {:>12.4}: {} ({} run{}{})",
                 m.reduced_chi_square,
                 values.join(", "),
                 m.runs,
-                if m.runs == 1 { "" } else { "s" }
+                if m.runs == 1 { "" } else { "s" },
+                if m.cut_short {
+                    ", cut short: its run stopped before it converged"
+                } else {
+                    ""
+                }
             );
         }
     }
