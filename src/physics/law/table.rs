@@ -83,12 +83,11 @@ impl UniformTable {
     /// Interpolated value; outside the grid the end cubic is extrapolated.
     #[inline]
     pub fn eval(&self, x: f64) -> f64 {
-        let (t, y0, m0, m1, d) = self.interval(x);
-        // Hermite basis in Horner form.
-        y0 + t * (m0 + t * (3.0 * d - 2.0 * m0 - m1 + t * (m0 + m1 - 2.0 * d)))
+        self.eval_and_slope(x).0
     }
 
-    /// [`UniformTable::eval`] and [`UniformTable::slope`] from one look-up.
+    /// [`UniformTable::eval`] and [`UniformTable::slope`] from one look-up: the Hermite
+    /// cubic in Horner form and its derivative.
     #[inline]
     pub fn eval_and_slope(&self, x: f64) -> (f64, f64) {
         let (t, y0, m0, m1, d) = self.interval(x);
@@ -102,8 +101,7 @@ impl UniformTable {
     /// Slope of the interpolant at `x` (the derivative of [`UniformTable::eval`]).
     #[inline]
     pub fn slope(&self, x: f64) -> f64 {
-        let (t, _, m0, m1, d) = self.interval(x);
-        (m0 + t * (2.0 * (3.0 * d - 2.0 * m0 - m1) + 3.0 * t * (m0 + m1 - 2.0 * d))) * self.inv_dx
+        self.eval_and_slope(x).1
     }
 }
 
