@@ -4,6 +4,12 @@
 use crate::common;
 use common::{json, num, refused, scratch, tapsim};
 
+/// The built-in E*, written out: 1/E* = (1 − ν_tip²)/E_tip + (1 − ν²)/E, silicon on
+/// the built-in polymer.
+fn built_in_modulus() -> f64 {
+    1.0 / ((1.0 - 0.28f64.powi(2)) / 169e9 + (1.0 - 0.4f64.powi(2)) / 0.5e9)
+}
+
 /// `tapsim approach ARGS -q --csv CSV`, which must succeed.
 fn approach_csv(csv: &str, args: &[&str]) {
     let out = tapsim(&[&["approach"], args, &["-q", "--csv", csv]].concat());
@@ -49,7 +55,7 @@ fn an_approach_curve_is_fitted_back() {
         "--json",
     ]);
     let params = v["parameters"].as_array().unwrap();
-    let truth = 1.0 / ((1.0 - 0.28f64.powi(2)) / 169e9 + (1.0 - 0.4f64.powi(2)) / 0.5e9);
+    let truth = built_in_modulus();
     assert!((num(&params[0], "value") / truth - 1.0).abs() < 1e-6);
     assert!((num(&params[1], "value") / 0.1 - 1.0).abs() < 1e-6);
     assert!(num(&params[2], "value").abs() < 1e-15);
@@ -372,8 +378,7 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
         (2 * (rows.len() - grazing) - 2) as f64
     );
     assert_eq!(v["converged"], true);
-    // 1/E* = (1 − ν_tip²)/E_tip + (1 − ν²)/E: silicon on the built-in polymer.
-    let modulus = 1.0 / ((1.0 - 0.28f64.powi(2)) / 169e9 + (1.0 - 0.4f64.powi(2)) / 0.5e9);
+    let modulus = built_in_modulus();
     let fitted = |i: usize| v["parameters"][i]["value"].as_f64().unwrap();
     assert!((fitted(0) / modulus - 1.0).abs() < 1e-5, "{}", fitted(0));
     assert!((fitted(1) / 0.1 - 1.0).abs() < 1e-5, "{}", fitted(1));
@@ -522,7 +527,7 @@ fn a_fit_that_resolves_the_data_searches_no_further() {
         "--json",
     ]);
     let params = v["parameters"].as_array().unwrap();
-    let truth = 1.0 / ((1.0 - 0.28f64.powi(2)) / 169e9 + (1.0 - 0.4f64.powi(2)) / 0.5e9);
+    let truth = built_in_modulus();
     assert!((num(&params[0], "value") / truth - 1.0).abs() < 1e-6, "{v}");
     assert!((num(&params[1], "value") / 0.1 - 1.0).abs() < 1e-6, "{v}");
     assert_eq!(v["converged"], true);
