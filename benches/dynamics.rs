@@ -486,6 +486,7 @@ fn noisy_curve(
         ),
         sigma_amplitude_m: 0.02e-9,
         sigma_phase_deg: 0.05,
+        thermal: None,
     }
 }
 

@@ -68,6 +68,7 @@ fn noisy(truth: &TapSetup, positions: &[f64], seed: u64) -> (tapsim::fit::model:
         ),
         sigma_amplitude_m: SIGMA_A_M,
         sigma_phase_deg: SIGMA_PHI_DEG,
+        thermal: None,
     };
     (c, data)
 }
@@ -217,6 +218,7 @@ fn a_curve_over_both_branches_is_fitted_back_within_one_percent_from_three_start
         phase_deg: None,
         sigma_amplitude_m: SIGMA_A_M,
         sigma_phase_deg: SIGMA_PHI_DEG,
+        thermal: None,
     };
     let c = data
         .simulate(&truth, &numerics(), &Nuisance::offset(OFFSET_M))
@@ -302,6 +304,7 @@ fn a_parameter_the_data_do_not_see_is_given_no_value() {
         phase_deg: Some(c.phase_deg),
         sigma_amplitude_m: SIGMA_A_M,
         sigma_phase_deg: SIGMA_PHI_DEG,
+        thermal: None,
     };
     let r = fit(&truth, &numerics(), &data, &options(0.0), |_| {}).unwrap();
     for p in &r.parameters {
@@ -345,6 +348,7 @@ fn a_viscosity_the_tip_never_indents_is_given_no_value() {
             phase_deg: None,
             sigma_amplitude_m: SIGMA_A_M,
             sigma_phase_deg: SIGMA_PHI_DEG,
+            thermal: None,
         };
         let c = data
             .simulate(&truth, &numerics(), &Nuisance::offset(0.0))
@@ -409,6 +413,7 @@ fn phases_at_setpoints_fix_the_loss_not_modulus_and_adhesion_apart() {
         phase_deg: Some(c.phase_deg),
         sigma_amplitude_m: SIGMA_A_M,
         sigma_phase_deg: SIGMA_PHI_DEG,
+        thermal: None,
     };
     let opts = |parameters: Vec<Parameter>| fitting(parameters, 100);
     let mut start = truth.clone();
@@ -482,6 +487,7 @@ fn nuisance_parameters_are_fitted_and_the_stiffness_symmetry_is_found() {
         phase_deg: Some([cf.phase_deg, cn.phase_deg].concat()),
         sigma_amplitude_m: SIGMA_A_M,
         sigma_phase_deg: SIGMA_PHI_DEG,
+        thermal: None,
     };
     let mut start = truth.clone();
     start.cantilever.free_amplitude_m = 20e-9 * s;
@@ -575,6 +581,7 @@ fn a_second_mode_lifts_the_trade_off_between_modulus_and_adhesion() {
             sigma_amplitude_m: SIGMA_A_M,
             sigma_phase_deg: SIGMA_PHI_DEG,
         }),
+        thermal: None,
     };
     let opts = fitting(
         vec![
@@ -729,6 +736,7 @@ fn a_degeneracy_on_the_repulsive_branch_is_flagged_and_the_attractive_branch_lif
             phase_deg: None,
             sigma_amplitude_m: SIGMA_A_M,
             sigma_phase_deg: SIGMA_PHI_DEG,
+            thermal: None,
         };
         let c = data
             .simulate(&truth, &numerics(), &Nuisance::offset(0.0))
@@ -791,4 +799,64 @@ fn a_curve_of_mode_locks_gets_no_intervals() {
     }
     let notes = r.identifiability.notes.join(" ");
     assert!(notes.contains("mode locks or graze"), "{notes}");
+}
+
+/// Issue 43: the same curve of long mode locks read at 300 K, each lock the thermal
+/// average an instrument reads (the data's noise seed 99 and 0.02 nm, 0.05° on top; the
+/// model's seed 1), fitted with the temperature from the truth: every point is kept and
+/// nine are averages, yet no intervals are given and the fit says why — the averages'
+/// noise moves with the parameters and ripples χ². (A fit of these data from 5 % off
+/// ended at +9 % in E* and Δγ with χ²/dof 1.4, intervals 5 σ from the truth.)
+#[test]
+#[ignore = "slow (a fit of thermal averages, about a minute in release): run with cargo test --release -- --ignored fit::"]
+fn a_curve_of_thermal_averages_gets_no_intervals() {
+    use tapsim::instrument::average::AverageRequest;
+    let mut truth = default_setup();
+    truth.law.kind = tapsim::law::LawKind::Jkr;
+    let z: Vec<f64> = span(24e-9, 8e-9, 12).iter().map(|z| z - OFFSET_M).collect();
+    let at = |seed| AverageRequest {
+        temperature_k: 300.0,
+        periods: 800,
+        seed,
+    };
+    let read = tapsim::fit::model::curve_while(
+        &truth,
+        &numerics(),
+        &z,
+        OFFSET_M,
+        Some(&at(99)),
+        |_, _, _| true,
+    )
+    .unwrap();
+    let averaged = read.averaged.iter().filter(|a| **a).count();
+    assert!(4 * averaged > z.len(), "{:?}", read.averaged);
+    let (_, mut data) = noisy(&truth, &z, 5);
+    let (clean, _) = noisy(&truth, &z, 5);
+    for (i, (a, p)) in data
+        .amplitude_m
+        .iter_mut()
+        .flatten()
+        .zip(data.phase_deg.iter_mut().flatten())
+        .enumerate()
+    {
+        *a += read.amplitude_m[i] - clean.amplitude_m[i];
+        *p += read.phase_deg[i] - clean.phase_deg[i];
+    }
+    data.thermal = Some(at(1));
+    let options = FitOptions {
+        start: Nuisance::offset(OFFSET_M),
+        ..fitting(vec![Parameter::Modulus, Parameter::WorkOfAdhesion], 12)
+    };
+    let r = fit(&truth, &numerics(), &data, &options, |_| {}).unwrap();
+    assert!(r.left_out.is_empty(), "{:?}", r.left_out);
+    assert!(4 * r.fitted.averaged.iter().filter(|a| **a).count() > z.len());
+    assert!(r.fitted.well_defined.iter().all(|w| *w));
+    for p in &r.parameters {
+        assert!(
+            p.std_err.is_none() && p.interval_68.is_none() && p.interval_95.is_none(),
+            "{p:?}"
+        );
+    }
+    let notes = r.identifiability.notes.join(" ");
+    assert!(notes.contains("thermal averages"), "{notes}");
 }

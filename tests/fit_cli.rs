@@ -205,6 +205,29 @@ fn bad_data_are_refused_with_why() {
     );
     refused(&["fit", &second], "simulate the modes too (--modes 2)");
     refused(
+        &["fit", &second, "--modes", "2", "--temperature", "300K"],
+        "thermal averages are simulated for one mode",
+    );
+    let setpoints = write(
+        "setpoints.csv",
+        "setpoint,phase_deg\n0.9,100\n0.8,105\n0.7,110\n",
+    );
+    refused(
+        &["fit", &setpoints, "--temperature", "300K"],
+        "a temperature averages the points of an approach curve",
+    );
+    refused(
+        &[
+            "fit",
+            &good,
+            "--temperature",
+            "300K",
+            "--thermal-periods",
+            "10",
+        ],
+        "a thermal average spans 800",
+    );
+    refused(
         &["fit", &good, "--fit", "viscosity"],
         "needs a viscous sample to start from",
     );
@@ -402,6 +425,49 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
         num(&kept, "degrees_of_freedom"),
         (2 * rows.len() - 2) as f64
     );
+    // Read at a temperature, the flagged rows are fitted as thermal averages: none left
+    // out, each averaged (at the truth, where the file flagged them), marked so in the
+    // rows --csv writes.
+    let rows_csv = dir.join("rows.csv");
+    let warm = json(&[
+        "fit",
+        csv,
+        "--fit",
+        "modulus,work-of-adhesion",
+        "--search",
+        "local",
+        "--max-curves",
+        "3",
+        "--temperature",
+        "300K",
+        "--thermal-periods",
+        "800",
+        "--csv",
+        rows_csv.to_str().unwrap(),
+        "--json",
+        "--quiet",
+    ]);
+    assert_eq!(num(&warm, "grazing_points_left_out"), 0.0);
+    let averaged: Vec<bool> = warm["fitted"]["averaged"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_bool().unwrap())
+        .collect();
+    let flagged: Vec<bool> = rows.iter().map(|r| &r[at] == "true").collect();
+    assert_eq!(averaged, flagged);
+    let mut reader = csv::Reader::from_path(&rows_csv).unwrap();
+    let col = reader
+        .headers()
+        .unwrap()
+        .iter()
+        .position(|h| h == "thermal_average")
+        .unwrap();
+    let written: Vec<bool> = reader
+        .records()
+        .map(|r| &r.unwrap()[col] == "true")
+        .collect();
+    assert_eq!(written, flagged);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

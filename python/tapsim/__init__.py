@@ -591,7 +591,8 @@ def fit(data: Any = None, setup: Optional[Setup] = None, /, **kwargs: Any) -> Re
     (singular_values, condition_number, correlations, notes), chi_square,
     ``converged``, ``diagnosis`` (describes_data, reasons, worst_points), the
     ``minima`` found, the fitted curve, ``left_out`` (the points left out because
-    they graze a switch at the fitted parameters; ``keep_grazing=True`` keeps them);
+    they graze a switch at the fitted parameters; ``keep_grazing=True`` keeps them;
+    ``temperature="300K"`` fits them as the thermal averages an instrument reads);
     ``profile=True`` adds ``profiles``.
     ``law=["hybrid", "jkr"]`` fits each law: ``laws`` (one report per law) and
     ``comparison`` (ranking by AIC and BIC, ``verdict`` in words)."""

@@ -127,16 +127,17 @@ pub fn approach_curve_at(
     })
 }
 
-/// [`approach_curve`] that stops after the first point `keep` (given its index and the
-/// point) refuses: the points up to and including that one. A fit screening a
+/// [`approach_curve_at`] that stops after the first point `keep` (given its index and
+/// the point) refuses: the points up to and including that one. A fit screening a
 /// parameter set stops a curve once it is out of the running.
 pub fn approach_curve_while(
     setup: &TapSetup,
     numerics: &Numerics,
     ramp: &[(f64, Direction)],
+    thermal: Option<&AverageRequest>,
     keep: impl FnMut(usize, &SweepPoint) -> bool,
 ) -> Result<Vec<SweepPoint>> {
-    sweep_points(setup, numerics, ramp, None, keep)
+    sweep_points(setup, numerics, ramp, thermal, keep)
 }
 
 /// The sweep behind [`approach_curve_at`] and [`approach_curve_while`].

@@ -135,7 +135,8 @@ pub fn diagnose(
     let mut runs = Vec::new();
     let mut worst: Vec<WorstPoint> = Vec::new();
     let channels = data.channel_values(fitted);
-    for (c, (name, (measured, simulated, _))) in names.iter().zip(&channels).enumerate() {
+    for (c, (name, channel)) in names.iter().zip(&channels).enumerate() {
+        let (measured, simulated) = (channel.measured, channel.simulated);
         let r = &residuals[c * n..(c + 1) * n];
         if data.setpoint_ratio.is_none() {
             if let Some(t) = runs_test(name, r) {

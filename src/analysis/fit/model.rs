@@ -1,10 +1,11 @@
 //! The forward model of a fit: the parameters it may adjust, the measured curve, and the
 //! approach curve a parameter set gives at the measured piezo positions.
 
-use crate::analysis::sweep::{Direction, MAX_SWEEP_POINTS, approach_curve_while};
+use crate::analysis::sweep::{Direction, MAX_SWEEP_POINTS, SweepPoint, approach_curve_while};
 use crate::dynamics::modes::ModeSet;
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
+use crate::instrument::average::{AverageRequest, ThermalAverage};
 use serde::Serialize;
 
 /// A parameter a fit may adjust (the others stay as the setup gives them).
@@ -279,6 +280,14 @@ pub struct Measured {
     pub sigma_phase_deg: f64,
     /// The second eigenmode's channels, read with the first (bimodal AFM).
     pub second_mode: Option<SecondMode>,
+    /// The temperature the data were read at (and the periods a simulated average
+    /// spans, and the seed of its noise): each point an instrument reads only as a
+    /// thermal average — its state grazes a switch or is not a stable period-1 orbit
+    /// ([`crate::instrument::average::reads_as_average`]), typically the onset of
+    /// contact — is simulated as that average, its standard errors added to the data's
+    /// standard deviations in quadrature. None: every point is its deterministic state
+    /// (and a grazing one is left out of the fit unless kept).
+    pub thermal: Option<AverageRequest>,
 }
 
 /// What a second eigenmode read at each point (bimodal AFM: the first mode's amplitude
@@ -358,6 +367,13 @@ impl Measured {
         }
         if let Some(m) = &self.second_mode {
             m.check(n)?;
+            if self.thermal.is_some() {
+                return Err(Error::NotApplicable(
+                    "thermal averages are simulated for one mode: fit several-mode data \
+                     without a temperature"
+                        .into(),
+                ));
+            }
         }
         Ok(self)
     }
@@ -374,6 +390,14 @@ impl Measured {
         if !self.position_m.is_empty() {
             return Err(Error::NotApplicable(
                 "give positions or setpoints, not both".into(),
+            ));
+        }
+        if self.thermal.is_some() {
+            return Err(Error::NotApplicable(
+                "at a setpoint the feedback holds a stable period-1 state, which is read as \
+                 it is: a temperature averages the points of an approach curve that graze \
+                 a switch or are not period-1"
+                    .into(),
             ));
         }
         if self.second_mode.is_some() {
@@ -456,7 +480,12 @@ impl Measured {
             }
         }
         let mut c = data.simulate_true(&true_setup, numerics, nuisance)?;
-        for a in c.amplitude_m.iter_mut().chain(&mut c.amplitude2_m) {
+        for a in c
+            .amplitude_m
+            .iter_mut()
+            .chain(&mut c.amplitude2_m)
+            .chain(&mut c.amplitude_std_err_m)
+        {
             *a *= s;
         }
         Ok(c)
@@ -485,7 +514,22 @@ impl Measured {
             let positions = &self.position_m[start..end];
             let c = match &self.second_mode {
                 Some(m) => modal_curve(setup, numerics, &m.modes, positions, offset_m)?,
-                None => curve(setup, numerics, positions, offset_m)?,
+                None => {
+                    // Each approach's points their own noise (the first's as a lone
+                    // curve's).
+                    let thermal = self.thermal.map(|t| match k {
+                        0 => t,
+                        _ => t.at(&[k as u64]),
+                    });
+                    curve_while(
+                        setup,
+                        numerics,
+                        positions,
+                        offset_m,
+                        thermal.as_ref(),
+                        |_, _, _| true,
+                    )?
+                }
             };
             match joined.as_mut() {
                 None => joined = Some(c),
@@ -495,6 +539,9 @@ impl Measured {
                     j.phase_deg.extend(c.phase_deg);
                     j.well_defined.extend(c.well_defined);
                     j.grazing.extend(c.grazing);
+                    j.averaged.extend(c.averaged);
+                    j.amplitude_std_err_m.extend(c.amplitude_std_err_m);
+                    j.phase_std_err_deg.extend(c.phase_std_err_deg);
                     j.amplitude2_m.extend(c.amplitude2_m);
                     j.phase2_deg.extend(c.phase2_deg);
                 }
@@ -540,6 +587,7 @@ impl Measured {
                 phase_deg: pick_opt(&m.phase_deg),
                 ..m.clone()
             }),
+            thermal: self.thermal,
         }
     }
 
@@ -560,35 +608,45 @@ impl Measured {
         .collect()
     }
 
-    /// Each channel measured, the simulated values it is compared with in `curve`, and
-    /// its standard deviation: amplitude, phase, then the second mode's.
-    pub fn channel_values<'a>(&'a self, curve: &'a Curve) -> Vec<(&'a [f64], &'a [f64], f64)> {
+    /// Each channel measured, the simulated values it is compared with in `curve`, its
+    /// standard deviation, and the simulated values' standard errors (empty where every
+    /// value is deterministic): amplitude, phase, then the second mode's.
+    pub fn channel_values<'a>(&'a self, curve: &'a Curve) -> Vec<Channel<'a>> {
         let second = self.second_mode.as_ref();
         [
             (
                 self.amplitude_m.as_deref(),
-                &curve.amplitude_m,
+                curve.amplitude_m.as_slice(),
                 self.sigma_amplitude_m,
+                curve.amplitude_std_err_m.as_slice(),
             ),
             (
                 self.phase_deg.as_deref(),
-                &curve.phase_deg,
+                curve.phase_deg.as_slice(),
                 self.sigma_phase_deg,
+                curve.phase_std_err_deg.as_slice(),
             ),
             (
                 second.and_then(|m| m.amplitude_m.as_deref()),
-                &curve.amplitude2_m,
+                curve.amplitude2_m.as_slice(),
                 second.map_or(0.0, |m| m.sigma_amplitude_m),
+                &[],
             ),
             (
                 second.and_then(|m| m.phase_deg.as_deref()),
-                &curve.phase2_deg,
+                curve.phase2_deg.as_slice(),
                 second.map_or(0.0, |m| m.sigma_phase_deg),
+                &[],
             ),
         ]
         .into_iter()
-        .filter_map(|(measured, simulated, sigma)| {
-            measured.map(|m| (m, simulated.as_slice(), sigma))
+        .filter_map(|(measured, simulated, sigma, std_err)| {
+            measured.map(|measured| Channel {
+                measured,
+                simulated,
+                sigma,
+                std_err,
+            })
         })
         .collect()
     }
@@ -611,13 +669,30 @@ impl Measured {
     pub fn residuals(&self, curve: &Curve) -> Vec<f64> {
         self.channel_values(curve)
             .into_iter()
-            .flat_map(|(measured, simulated, sigma)| {
-                measured
-                    .iter()
-                    .zip(simulated)
-                    .map(move |(m, s)| (s - m) / sigma)
-            })
+            .flat_map(|c| (0..c.measured.len()).map(move |i| c.residual(i)))
             .collect()
+    }
+}
+
+/// One channel of measured data beside its simulation ([`Measured::channel_values`]).
+pub struct Channel<'a> {
+    /// The values measured.
+    pub measured: &'a [f64],
+    /// The values simulated.
+    pub simulated: &'a [f64],
+    /// The standard deviation of a measured value.
+    pub sigma: f64,
+    /// The standard error of each simulated value (a thermal average's; empty where
+    /// every value is deterministic).
+    pub std_err: &'a [f64],
+}
+
+impl Channel<'_> {
+    /// The weighted residual of point `i`: (simulated − measured) over the measured
+    /// value's standard deviation and the simulated one's standard error in quadrature.
+    pub fn residual(&self, i: usize) -> f64 {
+        let e = self.std_err.get(i).copied().unwrap_or(0.0);
+        (self.simulated[i] - self.measured[i]) / self.sigma.hypot(e)
     }
 }
 
@@ -639,6 +714,17 @@ pub struct Curve {
     /// is set by perturbations (empty where not known: the several-mode curve).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub grazing: Vec<bool>,
+    /// Whether each point is a thermal average ([`Measured::thermal`]; empty without a
+    /// temperature).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub averaged: Vec<bool>,
+    /// The standard errors of the amplitudes, m: those of the thermal averages, 0 at
+    /// the deterministic points (empty without a temperature).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub amplitude_std_err_m: Vec<f64>,
+    /// The standard errors of the phases, degrees, likewise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub phase_std_err_deg: Vec<f64>,
     /// The second mode's amplitudes, m (empty without one).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub amplitude2_m: Vec<f64>,
@@ -656,34 +742,70 @@ pub fn curve(
     position_m: &[f64],
     offset_m: f64,
 ) -> Result<Curve> {
-    curve_while(setup, numerics, position_m, offset_m, |_, _, _| true)
+    curve_while(setup, numerics, position_m, offset_m, None, |_, _, _| true)
 }
 
-/// [`curve`] that stops after the first point `keep` (given its index, amplitude in m
-/// and phase in degrees) refuses: the points up to and including it.
+/// [`curve`] read at a temperature where `thermal` is given: each point an instrument
+/// reads only as a thermal average ([`crate::instrument::average::reads_as_average`])
+/// is that average ([`crate::analysis::sweep::approach_curve_at`]: the approach itself
+/// goes on from the deterministic state), with its standard errors, and neither grazes
+/// nor is ill-defined any more — an average is what the instrument reads there; the
+/// `keep` of [`curve_while`] that stops after the first point it refuses (given its
+/// index and the amplitude in m and phase in degrees read there): the points up to and
+/// including it.
 pub fn curve_while(
     setup: &TapSetup,
     numerics: &Numerics,
     position_m: &[f64],
     offset_m: f64,
+    thermal: Option<&AverageRequest>,
     mut keep: impl FnMut(usize, f64, f64) -> bool,
 ) -> Result<Curve> {
     let ramp: Vec<(f64, Direction)> = position_m
         .iter()
         .map(|z| (z + offset_m, Direction::Approach))
         .collect();
-    let points = approach_curve_while(setup, numerics, &ramp, |i, p| {
-        keep(i, p.observables.amplitude_m, p.observables.phase_deg)
+    let a0 = setup.cantilever.free_amplitude_m;
+    // What the instrument reads at a point: the average where there is one.
+    let read = |p: &SweepPoint| match p.thermal_average {
+        Some(t) => (t.amplitude_ratio * a0, t.phase_deg),
+        None => (p.observables.amplitude_m, p.observables.phase_deg),
+    };
+    let points = approach_curve_while(setup, numerics, &ramp, thermal, |i, p| {
+        let (a, phi) = read(p);
+        keep(i, a, phi)
     })?;
+    let averaged: Vec<bool> = points.iter().map(|p| p.thermal_average.is_some()).collect();
+    let std_err = |f: &dyn Fn(&ThermalAverage) -> f64| -> Vec<f64> {
+        match thermal {
+            Some(_) => points
+                .iter()
+                .map(|p| p.thermal_average.as_ref().map_or(0.0, f))
+                .collect(),
+            None => Vec::new(),
+        }
+    };
     Ok(Curve {
         separation_m: ramp.iter().take(points.len()).map(|r| r.0).collect(),
-        amplitude_m: points.iter().map(|p| p.observables.amplitude_m).collect(),
-        phase_deg: points.iter().map(|p| p.observables.phase_deg).collect(),
+        amplitude_m: points.iter().map(|p| read(p).0).collect(),
+        phase_deg: points.iter().map(|p| read(p).1).collect(),
         well_defined: points
             .iter()
-            .map(|p| p.observables.regime == "period-1" && !p.observables.grazing)
+            .zip(&averaged)
+            .map(|(p, &avg)| avg || (p.observables.regime == "period-1" && !p.observables.grazing))
             .collect(),
-        grazing: points.iter().map(|p| p.observables.grazing).collect(),
+        grazing: points
+            .iter()
+            .zip(&averaged)
+            .map(|(p, &avg)| p.observables.grazing && !avg)
+            .collect(),
+        amplitude_std_err_m: std_err(&|t| t.amplitude_ratio_std_err * a0),
+        phase_std_err_deg: std_err(&|t| t.phase_std_err_deg),
+        averaged: if thermal.is_some() {
+            averaged
+        } else {
+            Vec::new()
+        },
         amplitude2_m: Vec::new(),
         phase2_deg: Vec::new(),
     })
@@ -706,6 +828,9 @@ pub fn at_setpoints(
         phase_deg: Vec::with_capacity(ratios.len()),
         well_defined: Vec::with_capacity(ratios.len()),
         grazing: Vec::with_capacity(ratios.len()),
+        averaged: Vec::new(),
+        amplitude_std_err_m: Vec::new(),
+        phase_std_err_deg: Vec::new(),
         amplitude2_m: Vec::new(),
         phase2_deg: Vec::new(),
     };
@@ -798,6 +923,9 @@ pub fn modal_curve(
         phase_deg: Vec::with_capacity(points.len()),
         well_defined: Vec::with_capacity(points.len()),
         grazing: Vec::new(),
+        averaged: Vec::new(),
+        amplitude_std_err_m: Vec::new(),
+        phase_std_err_deg: Vec::new(),
         amplitude2_m: Vec::with_capacity(points.len()),
         phase2_deg: Vec::with_capacity(points.len()),
     };

@@ -261,11 +261,19 @@ fn screen_plain(
             (10.0 * data.sigma_amplitude_m).max(5e-3 * a0)
         };
         let mut first = None;
-        let Ok(head) = curve_while(&setup, numerics, z, nuisance.offset_m, |_, a, p| {
-            let v = if phase { p } else { a };
-            let f = *first.get_or_insert(v);
-            (v - f).abs() <= threshold
-        }) else {
+        let thermal = data.thermal.as_ref();
+        let Ok(head) = curve_while(
+            &setup,
+            numerics,
+            z,
+            nuisance.offset_m,
+            thermal,
+            |_, a, p| {
+                let v = if phase { p } else { a };
+                let f = *first.get_or_insert(v);
+                (v - f).abs() <= threshold
+            },
+        ) else {
             return fail(nuisance);
         };
         tracker.curve(None);
@@ -295,6 +303,7 @@ fn screen_plain(
             numerics,
             &data.position_m[start..stop],
             nuisance.offset_m,
+            data.thermal.as_ref(),
             |i, a, p| {
                 let i = start + i;
                 if let Some(m) = &data.amplitude_m {

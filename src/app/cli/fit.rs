@@ -8,6 +8,7 @@ use crate::analysis::fit::{
 };
 use crate::app::config::{TapInputs, length, number};
 use crate::error::{Error, Result};
+use crate::instrument::average::AverageRequest;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -82,9 +83,24 @@ pub struct FitArgs {
     /// fitted parameters grazes a switch. By default both are left out (with a note):
     /// where a curve grazes a switch of the law, its value is one draw among coexisting
     /// mode locks that perturbations below the thermal motion pick, which a fitted
-    /// curve cannot match point for point.
+    /// curve cannot match point for point. With --temperature such points are fitted
+    /// as the thermal averages an instrument reads instead.
     #[arg(long)]
     keep_grazing: bool,
+    /// The temperature the data were read at [K; off unless given, 300K is room
+    /// temperature]: each point whose state grazes a switch or is not a stable
+    /// period-1 orbit (the onset of contact, a mode lock) is simulated as the average
+    /// over the thermal motion an instrument reads there (`tapsim approach
+    /// --temperature`), its standard error added to the data's — such points are fitted,
+    /// not left out. Costs a thermal average for each such point of every simulated
+    /// curve.
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::app::config::temperature, help_heading = "Thermal noise")]
+    temperature: Option<f64>,
+    /// Drive periods of each thermal average (eight records, each after ten decay times
+    /// of settling; their spread gives the standard errors). Each point draws its own
+    /// noise, the same for every parameter set (seed 1, from the point's place).
+    #[arg(hide_short_help = true, long, default_value_t = DEFAULT_FIT_THERMAL_PERIODS, help_heading = "Thermal noise")]
+    thermal_periods: usize,
     /// The amplitude's standard deviation [m]. With --sigma-phase: the weights, taken as
     /// given. Without either: 0.02 nm and 0.05° relative weights, the scale estimated
     /// from the residuals (χ²/dof; the noise they imply is reported).
@@ -148,6 +164,12 @@ pub struct FitArgs {
     #[arg(long, short = 'q', help_heading = "Output")]
     pub(super) quiet: bool,
 }
+
+/// Drive periods of each thermal average a fit simulates (--thermal-periods): a tenth
+/// of a single average's default, since a fit simulates each averaged point on every
+/// curve it tries (the settling, ten decay times a record, costs more: 10 200 periods
+/// on the built-in lever).
+const DEFAULT_FIT_THERMAL_PERIODS: usize = 2_000;
 
 /// How the fit looks for its minimum, on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -462,7 +484,7 @@ fn measured(
         &super::curve_data::Reading {
             phase: args.phase_convention,
             invols_m_per_v: args.invols,
-            skip_grazing: !args.keep_grazing,
+            skip_grazing: !args.keep_grazing && args.temperature.is_none(),
         },
     )?;
     if amplitude_m.is_none() && phase_deg.is_none() {
@@ -521,6 +543,11 @@ fn measured(
         phase_deg,
         sigma_amplitude_m: args.sigma_amplitude.unwrap_or(0.02e-9),
         sigma_phase_deg: args.sigma_phase.unwrap_or(0.05),
+        thermal: args.temperature.map(|temperature_k| AverageRequest {
+            temperature_k,
+            periods: args.thermal_periods,
+            seed: 1,
+        }),
     };
     Ok((data, grazing_left_out))
 }

@@ -61,6 +61,21 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
         series,
         labels: Vec::new(),
     };
+    // The fitted points read as thermal averages, marked on the fitted line.
+    let averaged_name = data.thermal.map(|t| {
+        format!(
+            "fitted: thermal average at {} K (grazing or not period-1)",
+            t.temperature_k
+        )
+    });
+    let averaged = |ys: &[f64]| -> Option<Series> {
+        let points: Vec<(f64, f64)> = (0..n)
+            .filter(|&i| r.fitted.averaged.get(i) == Some(&true))
+            .map(|i| (z[i], ys[i]))
+            .collect();
+        let name = averaged_name.as_deref()?;
+        (!points.is_empty()).then(|| Series::new(name, points, Style::Triangles, 1))
+    };
     let mut out = Vec::new();
     let fitted_name = format!("fitted ({law} law)");
     if let Some(a) = &data.amplitude_m {
@@ -70,10 +85,19 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
             "amplitude",
             "amplitude: measured and fitted".into(),
             Axis::linear("amplitude A (nm)", "amplitude_nm"),
-            vec![
-                Series::new(&measured_name, marks(&measured), Style::Markers, 0),
-                Series::new(&fitted_name, line(&fitted), Style::Line, 1),
-            ],
+            [
+                Some(Series::new(
+                    &measured_name,
+                    marks(&measured),
+                    Style::Markers,
+                    0,
+                )),
+                Some(Series::new(&fitted_name, line(&fitted), Style::Line, 1)),
+                averaged(&fitted),
+            ]
+            .into_iter()
+            .flatten()
+            .collect(),
         ));
     }
     if let Some(p) = &data.phase_deg {
@@ -81,10 +105,19 @@ pub fn charts(r: &FitReport, data: &Measured, source: &str, law: &str) -> Vec<Ch
             "phase",
             "phase: measured and fitted".into(),
             Axis::linear("phase lag φ (deg)", "phase_deg"),
-            vec![
-                Series::new(&measured_name, marks(p), Style::Markers, 0),
-                Series::new(&fitted_name, line(&r.fitted.phase_deg), Style::Line, 1),
-            ],
+            [
+                Some(Series::new(&measured_name, marks(p), Style::Markers, 0)),
+                Some(Series::new(
+                    &fitted_name,
+                    line(&r.fitted.phase_deg),
+                    Style::Line,
+                    1,
+                )),
+                averaged(&r.fitted.phase_deg),
+            ]
+            .into_iter()
+            .flatten()
+            .collect(),
         ));
     }
     if let Some(m) = &data.second_mode {
@@ -195,8 +228,16 @@ pub struct Row {
     /// Its fitted phase, degrees.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fitted_phase2_deg: Option<f64>,
-    /// Whether the fitted state is a stable period-1 orbit clear of the law's switches.
+    /// Whether the fitted state is a stable period-1 orbit clear of the law's switches
+    /// (or a thermal average, which is what the instrument reads there).
     pub well_defined: bool,
+    /// With a temperature: whether the fitted value is the thermal average (the state
+    /// grazes a switch or is not period-1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thermal_average: Option<bool>,
+    /// Its phase's standard error, degrees (0 where not averaged).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fitted_phase_std_err_deg: Option<f64>,
 }
 
 /// The data beside the fit, point by point.
@@ -232,6 +273,8 @@ pub fn rows(r: &FitReport, data: &Measured) -> Vec<Row> {
                 .map(|p| p[i]),
             fitted_phase2_deg: r.fitted.phase2_deg.get(i).copied(),
             well_defined: r.fitted.well_defined[i],
+            thermal_average: r.fitted.averaged.get(i).copied(),
+            fitted_phase_std_err_deg: r.fitted.phase_std_err_deg.get(i).copied(),
         })
         .collect()
 }

@@ -256,6 +256,15 @@ pub fn report(r: &FitReport, law: &str, data: &Measured) -> String {
     for note in &id.notes {
         let _ = writeln!(s, "note: {note}");
     }
+    let averaged = r.fitted.averaged.iter().filter(|a| **a).count();
+    if averaged > 0 {
+        let _ = writeln!(
+            s,
+            "note: {averaged} of the fitted curve's points graze a switch or are not \
+             period-1 there, and are read as the average over the thermal motion (as an \
+             instrument reads them), their standard errors added to the data's"
+        );
+    }
     if r.fitted.well_defined.iter().any(|w| !w) {
         let _ = writeln!(
             s,
