@@ -248,31 +248,35 @@ pub fn fit(
     } else {
         options.max_curves
     };
-    // Whether a local run ended on a minimum that describes the data (residuals at
+    // Whether a curve with these weighted residuals describes the data (residuals at
     // the simulation's precision do, whatever pattern their round-off makes).
-    let judge = |r: &LocalRun| {
-        if r.lm_converged && r.chi_square() / dof as f64 <= RESOLVED_CHI_SQUARE {
-            return true;
-        }
-        let d = diagnose(
-            working,
-            &r.curve,
-            r.residuals.as_slice(),
-            dof,
-            options.estimate_sigma,
-        );
-        r.lm_converged && d.describes_data && r.chi_square().is_finite()
+    let describes = |c: &Curve, r: &[f64]| {
+        let reduced = r.iter().map(|v| v * v).sum::<f64>() / dof as f64;
+        reduced <= RESOLVED_CHI_SQUARE
+            || diagnose(working, c, r, dof, options.estimate_sigma).describes_data
     };
-    // A local run from `setup` and `nuisance` on at most `budget` curves; a run that
+    // Whether a local run ended on a minimum that describes the data.
+    let judge = |r: &LocalRun| {
+        r.lm_converged && r.chi_square().is_finite() && describes(&r.curve, r.residuals.as_slice())
+    };
+    // A local run from `setup` and `nuisance` on at most `budget` curves (in the first
+    // pass over several starts, cut where it crawls far from the data); a run that
     // fails keeps its error (the first one is said if no run succeeds).
-    let attempt =
-        |setup: &TapSetup, nuisance: Nuisance, budget: usize, first_error: &mut Option<Error>| {
-            local::run(setup, nuisance, numerics, working, params, budget, &tracker)
-                .map_err(|e| {
-                    first_error.get_or_insert(e);
-                })
-                .ok()
+    let attempt = |setup: &TapSetup,
+                   nuisance: Nuisance,
+                   budget: usize,
+                   cut_crawling: bool,
+                   first_error: &mut Option<Error>| {
+        let budget = local::Budget {
+            max_curves: budget,
+            describes: cut_crawling.then_some(&describes as local::Describes),
         };
+        local::run(setup, nuisance, numerics, working, params, budget, &tracker)
+            .map_err(|e| {
+                first_error.get_or_insert(e);
+            })
+            .ok()
+    };
     let mut found = false;
     for (i, c) in candidates.iter().enumerate() {
         tracker.stage(
@@ -283,7 +287,8 @@ pub fn fit(
             per_run,
             (candidates.len() - i - 1) * per_run + params.len(),
         );
-        if let Some(r) = attempt(&c.setup, c.nuisance, share, &mut first_error) {
+        let several = candidates.len() > 1;
+        if let Some(r) = attempt(&c.setup, c.nuisance, share, several, &mut first_error) {
             // A minimum that describes the data ends the search (later starts are
             // worse by the screening): it is the answer, and no other can fit better
             // than the noise.
@@ -308,7 +313,7 @@ pub fn fit(
             );
             let budget = options.max_curves - share;
             let (setup, nuisance) = (runs[k].setup.clone(), runs[k].nuisance);
-            if let Some(r) = attempt(&setup, nuisance, budget, &mut first_error) {
+            if let Some(r) = attempt(&setup, nuisance, budget, false, &mut first_error) {
                 let fine = judge(&r);
                 runs[k] = r;
                 if fine {
@@ -330,7 +335,7 @@ pub fn fit(
             numerics,
             working,
             params,
-            options.max_curves,
+            local::Budget::curves(options.max_curves),
             &tracker,
         )
     };
@@ -689,7 +694,15 @@ pub fn profile(
             tracker.curve(Some(chi));
             return Ok((chi, (s, n)));
         }
-        let r = local::run(&s, n, numerics, data, &others, options.max_curves, &tracker)?;
+        let r = local::run(
+            &s,
+            n,
+            numerics,
+            data,
+            &others,
+            local::Budget::curves(options.max_curves),
+            &tracker,
+        )?;
         Ok((r.chi_square(), (r.setup, r.nuisance)))
     };
     let step = |i: f64| {
