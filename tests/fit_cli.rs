@@ -603,3 +603,85 @@ fn a_fit_that_resolves_the_data_searches_no_further() {
     let curves = v["curves"].as_u64().unwrap();
     assert!(curves < 200, "{curves} curves");
 }
+
+/// The round trip at a temperature: `tapsim approach --temperature 300K --csv` writes
+/// each grazing point's thermal average beside its deterministic state, and `tapsim
+/// fit --temperature 300K` reads the average there (what an instrument reads). With
+/// the same periods each point draws the same noise in both (seed 1, its place along
+/// the curve), so the branch-jumping curve comes back from 2 % off to 1e-4,
+/// every row kept and the averaged ones marked; read without the temperature, the
+/// deterministic columns and the grazing rows left out, as before.
+#[test]
+fn a_curve_written_at_a_temperature_is_fitted_back_at_it() {
+    let dir = scratch("fit-warm-roundtrip");
+    let csv = dir.join("warm.csv");
+    let csv = csv.to_str().unwrap();
+    let thermal = ["--temperature", "300K", "--thermal-periods", "800"];
+    approach_csv(
+        csv,
+        &[
+            &[
+                "--modulus",
+                "0.8GPa",
+                "--work-of-adhesion",
+                "0.07J/m^2",
+                "--from",
+                "24nm",
+                "--to",
+                "8nm",
+                "--points",
+                "40",
+                "--no-retract",
+            ][..],
+            &thermal,
+        ]
+        .concat(),
+    );
+    let (headers, rows, at) = with_grazing_column(csv.as_ref());
+    let phase_col = headers
+        .iter()
+        .position(|h| h == "thermal_average_phase_deg")
+        .unwrap();
+    let averaged: Vec<bool> = rows.iter().map(|r| !r[phase_col].is_empty()).collect();
+    let flagged: Vec<bool> = rows.iter().map(|r| &r[at] == "true").collect();
+    assert!(averaged.contains(&true));
+    assert_eq!(averaged, flagged);
+    let fit = [
+        "fit",
+        csv,
+        "--fit",
+        "modulus,work-of-adhesion",
+        "--search",
+        "local",
+        "--modulus",
+        "0.816GPa",
+        "--work-of-adhesion",
+        "0.0714J/m^2",
+        "--json",
+        "--quiet",
+    ];
+    let v = json(&[&fit[..], &thermal].concat());
+    assert_eq!(num(&v, "grazing_points_left_out"), 0.0);
+    let marked: Vec<bool> = v["fitted"]["averaged"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_bool().unwrap())
+        .collect();
+    assert_eq!(marked, averaged);
+    let fitted = |v: &serde_json::Value, i: usize| v["parameters"][i]["value"].as_f64().unwrap();
+    assert!(
+        (fitted(&v, 0) / 0.8e9 - 1.0).abs() < 1e-4,
+        "{}",
+        fitted(&v, 0)
+    );
+    assert!(
+        (fitted(&v, 1) / 0.07 - 1.0).abs() < 1e-4,
+        "{}",
+        fitted(&v, 1)
+    );
+    let cold = json(&fit);
+    let left_out = flagged.iter().filter(|f| **f).count();
+    assert_eq!(num(&cold, "grazing_points_left_out"), left_out as f64);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -44,6 +44,11 @@ pub struct Reading {
     /// turning point passes a switch of the law closer than the thermal motion: one
     /// draw among coexisting mode locks, which no fit can match point for point).
     pub skip_grazing: bool,
+    /// Read a row's amplitude and phase from its `thermal_average_amplitude_ratio` and
+    /// `thermal_average_phase_deg` where those are filled (`tapsim approach
+    /// --temperature` averages there: what an instrument reads), its deterministic
+    /// columns elsewhere.
+    pub thermal_averages: bool,
 }
 
 /// What a column holds.
@@ -65,6 +70,8 @@ enum Kind {
     Grazing,
     FrequencyShift,
     Excitation,
+    ThermalAmplitudeRatio,
+    ThermalPhase,
 }
 
 /// A column's kind and the factor that makes its values SI, by the header's name.
@@ -98,6 +105,8 @@ fn column_kind(name: &str) -> Option<(Kind, f64)> {
         "grazing" => Some((Kind::Grazing, 1.0)),
         "frequency_shift_hz" | "df_hz" => Some((Kind::FrequencyShift, 1.0)),
         "excitation_ratio" => Some((Kind::Excitation, 1.0)),
+        "thermal_average_amplitude_ratio" => Some((Kind::ThermalAmplitudeRatio, 1.0)),
+        "thermal_average_phase_deg" => Some((Kind::ThermalPhase, 1.0)),
         _ => None,
     }
 }
@@ -242,6 +251,14 @@ pub fn read_curve(
         (None, None) => None,
     };
     let phase2 = at.get(&Kind::Phase2).copied();
+    // Where a row holds a thermal average, that (the amplitude's as a ratio of A₀).
+    let averaged = |kind: Kind, scale: f64| {
+        at.get(&kind)
+            .filter(|_| reading.thermal_averages)
+            .map(|&(i, _)| (i, scale))
+    };
+    let averaged_amp = averaged(Kind::ThermalAmplitudeRatio, cantilever.free_amplitude_m);
+    let averaged_phase = averaged(Kind::ThermalPhase, 1.0);
     let direction_col = at.get(&Kind::Direction).map(|&(i, _)| i);
     let segment = at.get(&Kind::Segment).map(|&(i, _)| i);
     let grazing = at
@@ -319,10 +336,16 @@ pub fn read_curve(
                 " m",
             )?
         });
+        // A thermal average's column where the row fills it, else `plain`.
+        let or_averaged = |plain: (usize, f64), averaged: Option<(usize, f64)>| {
+            averaged
+                .filter(|&(i, _)| record.get(i).is_some_and(|v| !v.trim().is_empty()))
+                .unwrap_or(plain)
+        };
         let amplitude = (0.0, 10.0 * a0);
         if let Some(c) = amp {
             a.push(within(
-                value(c, "amplitude")?,
+                value(or_averaged(c, averaged_amp), "amplitude")?,
                 amplitude,
                 "amplitude",
                 " m",
@@ -330,6 +353,7 @@ pub fn read_curve(
         }
         let degrees = (-MAX_PHASE_DEG, MAX_PHASE_DEG);
         if let Some(c) = phase {
+            let c = or_averaged(c, averaged_phase);
             let lag = reading.phase.lag_deg(value(c, "phase")?);
             p.push(within(lag, degrees, "phase", "°")?);
         }

@@ -92,8 +92,10 @@ pub struct FitArgs {
     /// period-1 orbit (the onset of contact, a mode lock) is simulated as the average
     /// over the thermal motion an instrument reads there (`tapsim approach
     /// --temperature`), its standard error added to the data's — such points are fitted,
-    /// not left out. Costs a thermal average for each such point of every simulated
-    /// curve.
+    /// not left out; a row's thermal_average_amplitude_ratio and
+    /// thermal_average_phase_deg, where filled (that command's CSV), are read as its
+    /// amplitude and phase. Costs a thermal average for each such point of every
+    /// simulated curve.
     #[arg(long, allow_hyphen_values = true, value_parser = crate::app::config::temperature, help_heading = "Thermal noise")]
     temperature: Option<f64>,
     /// Drive periods of each thermal average (eight records, each after ten decay times
@@ -485,6 +487,7 @@ fn measured(
             phase: args.phase_convention,
             invols_m_per_v: args.invols,
             skip_grazing: !args.keep_grazing && args.temperature.is_none(),
+            thermal_averages: args.temperature.is_some(),
         },
     )?;
     if amplitude_m.is_none() && phase_deg.is_none() {
