@@ -770,6 +770,19 @@ fn a_degeneracy_on_the_repulsive_branch_is_flagged_and_the_attractive_branch_lif
     assert_eq!((c_rep.round(), c_both.round()), (1125.0, 11.0));
 }
 
+/// Assert that `r` gives no standard error or interval for any parameter, and that a
+/// note says why (holding `why`).
+fn gives_no_intervals_because(r: &tapsim::fit::FitReport, why: &str) {
+    for p in &r.parameters {
+        assert!(
+            p.std_err.is_none() && p.interval_68.is_none() && p.interval_95.is_none(),
+            "{p:?}"
+        );
+    }
+    let notes = r.identifiability.notes.join(" ");
+    assert!(notes.contains(why), "{notes}");
+}
+
 /// Issue 43: a curve of long mode locks (JKR on the defaults' approach from 24 to 8 nm,
 /// 12 points, nine of them mode locks or grazing touches), fitted with the law that made
 /// it from the truth: the fit gives no intervals and says why. Their values step as the
@@ -791,14 +804,7 @@ fn a_curve_of_mode_locks_gets_no_intervals() {
     // (The data are described: without the locks' account the intervals would be
     // given.)
     assert!(r.diagnosis.describes_data, "{:?}", r.diagnosis.reasons);
-    for p in &r.parameters {
-        assert!(
-            p.std_err.is_none() && p.interval_68.is_none() && p.interval_95.is_none(),
-            "{p:?}"
-        );
-    }
-    let notes = r.identifiability.notes.join(" ");
-    assert!(notes.contains("mode locks or graze"), "{notes}");
+    gives_no_intervals_because(&r, "mode locks or graze");
 }
 
 /// Issue 43: the same curve of long mode locks read at 300 K, each lock the thermal
@@ -830,8 +836,7 @@ fn a_curve_of_thermal_averages_gets_no_intervals() {
     .unwrap();
     let averaged = read.averaged.iter().filter(|a| **a).count();
     assert!(4 * averaged > z.len(), "{:?}", read.averaged);
-    let (_, mut data) = noisy(&truth, &z, 5);
-    let (clean, _) = noisy(&truth, &z, 5);
+    let (clean, mut data) = noisy(&truth, &z, 5);
     for (i, (a, p)) in data
         .amplitude_m
         .iter_mut()
@@ -851,12 +856,5 @@ fn a_curve_of_thermal_averages_gets_no_intervals() {
     assert!(r.left_out.is_empty(), "{:?}", r.left_out);
     assert!(4 * r.fitted.averaged.iter().filter(|a| **a).count() > z.len());
     assert!(r.fitted.well_defined.iter().all(|w| *w));
-    for p in &r.parameters {
-        assert!(
-            p.std_err.is_none() && p.interval_68.is_none() && p.interval_95.is_none(),
-            "{p:?}"
-        );
-    }
-    let notes = r.identifiability.notes.join(" ");
-    assert!(notes.contains("thermal averages"), "{notes}");
+    gives_no_intervals_because(&r, "thermal averages");
 }

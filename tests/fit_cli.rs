@@ -10,6 +10,22 @@ fn built_in_modulus() -> f64 {
     1.0 / ((1.0 - 0.28f64.powi(2)) / 169e9 + (1.0 - 0.4f64.powi(2)) / 0.5e9)
 }
 
+/// Issue 43's branch-jumping curve as `tapsim approach` makes it: E* 0.8 GPa, Δγ
+/// 0.07 J/m², 40 points from 24 to 8 nm, approach only.
+const ISSUE_CURVE: [&str; 11] = [
+    "--modulus",
+    "0.8GPa",
+    "--work-of-adhesion",
+    "0.07J/m^2",
+    "--from",
+    "24nm",
+    "--to",
+    "8nm",
+    "--points",
+    "40",
+    "--no-retract",
+];
+
 /// `tapsim approach ARGS -q --csv CSV`, which must succeed.
 fn approach_csv(csv: &str, args: &[&str]) {
     let out = tapsim(&[&["approach"], args, &["-q", "--csv", csv]].concat());
@@ -438,22 +454,7 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
 fn a_point_grazing_at_the_fitted_parameters_is_left_out() {
     let dir = scratch("fit-left-out");
     let full = dir.join("full.csv");
-    approach_csv(
-        full.to_str().unwrap(),
-        &[
-            "--modulus",
-            "0.8GPa",
-            "--work-of-adhesion",
-            "0.07J/m^2",
-            "--from",
-            "24nm",
-            "--to",
-            "8nm",
-            "--points",
-            "40",
-            "--no-retract",
-        ],
-    );
+    approach_csv(full.to_str().unwrap(), &ISSUE_CURVE);
     let (headers, rows, at) = with_grazing_column(&full);
     let flagged: Vec<f64> = (0..rows.len())
         .filter(|&i| &rows[i][at] == "true")
@@ -576,26 +577,7 @@ fn a_curve_written_at_a_temperature_is_fitted_back_at_it() {
     let csv = dir.join("warm.csv");
     let csv = csv.to_str().unwrap();
     let thermal = ["--temperature", "300K", "--thermal-periods", "800"];
-    approach_csv(
-        csv,
-        &[
-            &[
-                "--modulus",
-                "0.8GPa",
-                "--work-of-adhesion",
-                "0.07J/m^2",
-                "--from",
-                "24nm",
-                "--to",
-                "8nm",
-                "--points",
-                "40",
-                "--no-retract",
-            ][..],
-            &thermal,
-        ]
-        .concat(),
-    );
+    approach_csv(csv, &[&ISSUE_CURVE[..], &thermal].concat());
     let (headers, rows, at) = with_grazing_column(csv.as_ref());
     let phase_col = headers
         .iter()

@@ -363,26 +363,26 @@ impl Problem<'_> {
             shifted[col] += h;
             let mut r = self.evaluate(&shifted)?;
             let mut step = h;
-            let simulated = r.norm() < UNSIMULATED * 0.5;
-            let crosses = simulated
-                && self
-                    .last_curve()
-                    .is_some_and(|c| crosses_switch(&sides, &side(&shifted, &c)));
-            if !simulated || crosses {
+            // Whether a point changes branch at `at` (whose residuals `r` the curve last
+            // evaluated gave); None where the curve could not be simulated.
+            let crossing = |r: &DVector<f64>, at: &DVector<f64>| {
+                (r.norm() < UNSIMULATED * 0.5).then(|| {
+                    self.last_curve()
+                        .is_some_and(|c| crosses_switch(&sides, &side(at, &c)))
+                })
+            };
+            let forward = crossing(&r, &shifted);
+            if forward != Some(false) {
                 // The law's range ends within the step, or a point changes branch:
-                // difference backward.
+                // difference backward where that is simulated and, for a crossing,
+                // crosses nothing.
                 let mut back = x.clone();
                 back[col] -= h;
                 let rb = self.evaluate(&back)?;
-                let usable = rb.norm() < UNSIMULATED * 0.5
-                    && self
-                        .last_curve()
-                        .is_some_and(|c| !crosses_switch(&sides, &side(&back, &c)));
-                if usable || !simulated {
-                    if rb.norm() >= UNSIMULATED * 0.5 {
-                        return None;
-                    }
-                    (r, step) = (rb, -h);
+                match (forward, crossing(&rb, &back)) {
+                    (None, None) => return None,
+                    (None, Some(_)) | (Some(true), Some(false)) => (r, step) = (rb, -h),
+                    _ => {}
                 }
             }
             j.set_column(col, &((r - r0) / step));
