@@ -14,6 +14,7 @@ mod capture;
 pub mod continuation;
 mod dopri5;
 pub mod free;
+pub mod free_steps;
 pub mod gradient;
 pub mod grazing;
 pub mod harmonic_balance;

@@ -10,13 +10,16 @@
 //! sinc²(πfΔ), so the free ⟨x²⟩ falls short of equipartition by about (πf₀Δ)²/3
 //! (8e-4 at n = 64 and f = f₀; [`free_variance_hat`] gives it exactly). Within a step
 //! the force is a constant the marcher integrates exactly (closed-form free flight,
-//! located switches: [`crate::dynamics::march::Simulation::advance`]).
+//! located switches: [`crate::dynamics::march::Simulation::advance`]); a step of free
+//! flight that cannot meet the contact or turn is taken from one precomputed transition
+//! ([`crate::dynamics::free_steps`]; [`ThermalForce::exact`] locates every step).
 //!
 //! The forces are drawn from a ChaCha8 stream of a seed: the same seed and stream give
 //! the same bytes on any machine and thread count.
 
 use super::spectrum::{Calibration, Psd, Welch, calibrate};
 use crate::dynamics::free::FreeFlight;
+use crate::dynamics::free_steps::FreeSteps;
 use crate::dynamics::grazing::BOLTZMANN_J_K;
 use crate::dynamics::march::{CycleIntegrals, Phase, Simulation};
 use crate::dynamics::model::{Drive, Oscillator};
@@ -61,6 +64,9 @@ pub struct ThermalForce {
     steps_per_period: usize,
     /// The random stream.
     rng: ChaCha8Rng,
+    /// Whether every step is marched as [`Simulation::advance`] marches it, none taken
+    /// from [`FreeSteps`]' precomputed transition.
+    exact: bool,
 }
 
 impl ThermalForce {
@@ -89,7 +95,19 @@ impl ThermalForce {
             intensity_hat,
             steps_per_period,
             rng,
+            exact: false,
         })
+    }
+
+    /// This force with every step marched as [`Simulation::advance`] marches it (the
+    /// reference: by default a step in free flight that cannot meet the contact or turn
+    /// is taken from [`FreeSteps`]' precomputed transition, the same motion to
+    /// round-off, its observer reading the step's Hermite interpolant).
+    pub fn exact(self) -> Self {
+        Self {
+            exact: true,
+            ..self
+        }
     }
 
     /// No force at all (D̂ = 0): a march under it is [`Simulation::march`]'s, bit for
@@ -116,7 +134,9 @@ impl ThermalForce {
 
     /// March `periods` drive periods of `sim` from `phase` under this force, every step
     /// shown to `observer` (as [`Simulation::march`]); each period is cut into the
-    /// force's steps, each integrated with its force held ([`Simulation::advance`]).
+    /// force's steps, each integrated with its force held ([`Simulation::advance`], or
+    /// [`FreeSteps`] where the step is free flight that cannot meet the contact or
+    /// turn).
     /// Returns the integrals over the whole march and the work the thermal force did,
     /// Σ ξ_j·(x_{j+1} − x_j) (units of kL²). With D̂ = 0 the march is
     /// [`Simulation::march`]'s, bit for bit.
@@ -138,28 +158,41 @@ impl ThermalForce {
         }
         let period = sim.osc.period();
         let step = period / self.steps_per_period as f64;
+        let free_steps = (!self.exact).then(|| FreeSteps::new(sim, step)).flatten();
         let mut total: Option<CycleIntegrals> = None;
         let mut work = 0.0;
         for _ in 0..periods {
             sim.rewind(phase);
             let end = phase.tau + period;
             let mut this: Option<CycleIntegrals> = None;
+            // The drive's phasor at each step's start (for the steps taken in closed
+            // form), turned on step by step from the period's start.
+            let mut phasor = (sim.osc.omega * phase.tau).sin_cos();
             for j in 0..self.steps_per_period {
                 let force = self.draw(step);
-                let held = Simulation {
-                    osc: Oscillator {
-                        bias: force,
-                        ..sim.osc
-                    },
-                    ..*sim
-                };
-                let span = if j + 1 == self.steps_per_period {
-                    end - phase.tau
-                } else {
-                    step
-                };
+                let last = j + 1 == self.steps_per_period;
+                let span = if last { end - phase.tau } else { step };
                 let x0 = phase.x;
-                let part = held.advance(phase, span, observer)?;
+                let fast = match &free_steps {
+                    Some(steps) if !last => steps.advance(phase, phasor, force, observer)?,
+                    _ => None,
+                };
+                let part = match fast {
+                    Some(part) => part,
+                    None => {
+                        let held = Simulation {
+                            osc: Oscillator {
+                                bias: force,
+                                ..sim.osc
+                            },
+                            ..*sim
+                        };
+                        held.advance(phase, span, observer)?
+                    }
+                };
+                if let Some(steps) = &free_steps {
+                    phasor = steps.turned(phasor);
+                }
                 work += force * (phase.x - x0);
                 this = Some(this.map_or(part, |t| t.then(&part)));
             }

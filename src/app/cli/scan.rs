@@ -145,7 +145,10 @@ pub struct ScanArgs {
     /// it approached it), the periods up to the next change are taken as repeats of the
     /// last: images agree with --exact to far below 1 pm and 1e-3° (tested), many times
     /// faster. Motion that does not repeat each period (near the onset of contact, a
-    /// second mode) and a thermal force are always marched.
+    /// second mode) and a thermal force are always marched; under a thermal force
+    /// --exact also locates every force step of free flight against the contact
+    /// instead of taking the steps that cannot meet it from one precomputed transition
+    /// (the same motion to round-off, tested).
     #[arg(long)]
     exact: bool,
     /// Temperature [K; default none]: the cantilever shaken by the thermal force of its
@@ -430,6 +433,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
                     }
                     let force =
                         ThermalForce::new(intensity, STEPS_PER_PERIOD, args.seed, j as u64)?;
+                    let force = if args.exact { force.exact() } else { force };
                     row(
                         &prepared,
                         &lines[j].1,
