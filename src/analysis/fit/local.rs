@@ -122,28 +122,16 @@ pub(crate) fn run(
     budget: Budget,
     tracker: &Tracker,
 ) -> crate::error::Result<LocalRun> {
-    let Budget {
-        max_curves,
-        describes,
-    } = budget;
+    let max_curves = budget.max_curves;
     let starts: Vec<f64> = params.iter().map(|p| p.value(setup, &nuisance)).collect();
-    let problem = Problem {
-        setup,
-        base: nuisance,
+    let problem = Problem::new(
+        (setup, nuisance, &starts),
         numerics,
         data,
         params,
-        starts: &starts,
-        x: DVector::zeros(params.len()),
-        curves: Cell::new(0),
-        max_curves,
-        failure: RefCell::new(None),
-        describes,
-        chi_squares: RefCell::new(Vec::new()),
-        crawled: Cell::new(false),
-        cache: RefCell::new(None),
+        budget,
         tracker,
-    };
+    );
     let (problem, report) = LevenbergMarquardt::new()
         .with_patience(max_curves.div_ceil(params.len() + 1).max(1))
         .minimize(problem);
@@ -204,23 +192,14 @@ pub(crate) fn jacobian(
     tracker: &Tracker,
 ) -> crate::error::Result<DMatrix<f64>> {
     let starts = run.values.clone();
-    let problem = Problem {
-        setup: &run.setup,
-        base: run.nuisance,
+    let problem = Problem::new(
+        (&run.setup, run.nuisance, &starts),
         numerics,
         data,
         params,
-        starts: &starts,
-        x: DVector::zeros(params.len()),
-        curves: Cell::new(0),
-        max_curves: usize::MAX / 2,
-        failure: RefCell::new(None),
-        describes: None,
-        chi_squares: RefCell::new(Vec::new()),
-        crawled: Cell::new(false),
-        cache: RefCell::new(None),
+        Budget::curves(usize::MAX / 2),
         tracker,
-    };
+    );
     let j = problem.jacobian_at(&problem.x, &run.residuals, &run.curve);
     if let Some(e) = problem.failure.borrow_mut().take() {
         return Err(e);
@@ -283,7 +262,37 @@ struct Problem<'a> {
     tracker: &'a Tracker<'a>,
 }
 
-impl Problem<'_> {
+impl<'a> Problem<'a> {
+    /// The problem of fitting `params` to `data` from `start` (the setup, the nuisance
+    /// values and the fitted parameters' values there: the origin of the coordinates),
+    /// within `budget`.
+    fn new(
+        (setup, base, starts): (&'a TapSetup, Nuisance, &'a [f64]),
+        numerics: &'a Numerics,
+        data: &'a Measured,
+        params: &'a [Parameter],
+        budget: Budget<'a>,
+        tracker: &'a Tracker<'a>,
+    ) -> Self {
+        Self {
+            setup,
+            base,
+            numerics,
+            data,
+            params,
+            starts,
+            x: DVector::zeros(params.len()),
+            curves: Cell::new(0),
+            max_curves: budget.max_curves,
+            failure: RefCell::new(None),
+            describes: budget.describes,
+            chi_squares: RefCell::new(Vec::new()),
+            crawled: Cell::new(false),
+            cache: RefCell::new(None),
+            tracker,
+        }
+    }
+
     /// The setup and the nuisance values at coordinates `x`.
     fn physical(&self, x: &DVector<f64>) -> (TapSetup, Nuisance) {
         at_coordinates(self.setup, self.base, self.params, self.starts, x)
@@ -509,23 +518,14 @@ mod tests {
         let tracker = Tracker::new(&report);
         let params = [Parameter::Modulus];
         let starts = [lo];
-        let problem = Problem {
-            setup: &setup,
-            base: Nuisance::offset(0.0),
-            numerics: &numerics,
-            data: &data,
-            params: &params,
-            starts: &starts,
-            x: DVector::zeros(1),
-            curves: Cell::new(0),
-            max_curves: 100,
-            failure: RefCell::new(None),
-            describes: None,
-            chi_squares: RefCell::new(Vec::new()),
-            crawled: Cell::new(false),
-            cache: RefCell::new(None),
-            tracker: &tracker,
-        };
+        let problem = Problem::new(
+            (&setup, Nuisance::offset(0.0), &starts),
+            &numerics,
+            &data,
+            &params,
+            Budget::curves(100),
+            &tracker,
+        );
         let x = DVector::zeros(1);
         let r0 = problem.evaluate(&x).unwrap();
         let j = problem.jacobian_at(&x, &r0, &c).unwrap();
