@@ -9,7 +9,7 @@
 //! Φ(Δ) and the weights ∫₀^Δ Φ₀ₖ(s)(cos Ωs, sin Ωs) ds computed once, a step costs a
 //! 2 × 2 product, a rotation of the drive's phasor (sin Ωτ, cos Ωτ) by ΩΔ and a few
 //! products for the Fourier projections and the energies (the same closed forms as
-//! [`FreeFlight::advance`]) — no sine, cosine or exponential. The motion is the
+//! `FreeFlight`'s own advance) — no sine, cosine or exponential. The motion is the
 //! closed form's to round-off.
 //!
 //! A step is taken here only where nothing happens inside it that the march must
