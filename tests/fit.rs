@@ -831,7 +831,7 @@ fn a_curve_of_thermal_averages_gets_no_intervals() {
         &z,
         OFFSET_M,
         Some(&at(99)),
-        |_, _, _| true,
+        |_, _| true,
     )
     .unwrap();
     let averaged = read.averaged.iter().filter(|a| **a).count();

@@ -5,7 +5,7 @@ use crate::analysis::sweep::{Direction, MAX_SWEEP_POINTS, SweepPoint, approach_c
 use crate::dynamics::modes::ModeSet;
 use crate::dynamics::setup::{Numerics, TapSetup};
 use crate::error::{Error, Result};
-use crate::instrument::average::{AverageRequest, ThermalAverage};
+use crate::instrument::average::AverageRequest;
 use serde::Serialize;
 
 /// A parameter a fit may adjust (the others stay as the setup gives them).
@@ -514,22 +514,14 @@ impl Measured {
             let positions = &self.position_m[start..end];
             let c = match &self.second_mode {
                 Some(m) => modal_curve(setup, numerics, &m.modes, positions, offset_m)?,
-                None => {
-                    // Each approach's points their own noise (the first's as a lone
-                    // curve's).
-                    let thermal = self.thermal.map(|t| match k {
-                        0 => t,
-                        _ => t.at(&[k as u64]),
-                    });
-                    curve_while(
-                        setup,
-                        numerics,
-                        positions,
-                        offset_m,
-                        thermal.as_ref(),
-                        |_, _, _| true,
-                    )?
-                }
+                None => curve_while(
+                    setup,
+                    numerics,
+                    positions,
+                    offset_m,
+                    self.segment_thermal(k).as_ref(),
+                    |_, _| true,
+                )?,
             };
             match joined.as_mut() {
                 None => joined = Some(c),
@@ -659,6 +651,15 @@ impl Measured {
         usize::from(self.amplitude_m.is_some()) + usize::from(self.phase_deg.is_some()) + second
     }
 
+    /// The thermal averaging of approach `k` (its segment): each approach's points
+    /// draw noise of their own, the first's as a lone curve's.
+    pub fn segment_thermal(&self, k: usize) -> Option<AverageRequest> {
+        self.thermal.map(|t| match k {
+            0 => t,
+            _ => t.at(&[k as u64]),
+        })
+    }
+
     /// χ² of `curve`: the sum of its weighted residuals' squares.
     pub fn chi_square(&self, curve: &Curve) -> f64 {
         self.residuals(curve).iter().map(|r| r * r).sum()
@@ -692,7 +693,7 @@ impl Channel<'_> {
     /// value's standard deviation and the simulated one's standard error in quadrature.
     pub fn residual(&self, i: usize) -> f64 {
         let e = self.std_err.get(i).copied().unwrap_or(0.0);
-        (self.simulated[i] - self.measured[i]) / self.sigma.hypot(e)
+        weighted_residual(self.simulated[i], self.measured[i], self.sigma, e)
     }
 }
 
@@ -742,7 +743,29 @@ pub fn curve(
     position_m: &[f64],
     offset_m: f64,
 ) -> Result<Curve> {
-    curve_while(setup, numerics, position_m, offset_m, None, |_, _, _| true)
+    curve_while(setup, numerics, position_m, offset_m, None, |_, _| true)
+}
+
+/// What an instrument reads at one point of a simulated curve: the state's amplitude
+/// and phase, or the thermal average's with its standard errors (zero for a
+/// deterministic state).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reading {
+    /// Amplitude, m.
+    pub amplitude_m: f64,
+    /// Phase, degrees.
+    pub phase_deg: f64,
+    /// The amplitude's standard error, m.
+    pub amplitude_std_err_m: f64,
+    /// The phase's standard error, degrees.
+    pub phase_std_err_deg: f64,
+}
+
+/// The weighted residual (simulated − measured)/√(σ² + se²) of a measured value of
+/// standard deviation `sigma` against a simulated one of standard error `std_err`
+/// (independent errors add in quadrature).
+pub fn weighted_residual(simulated: f64, measured: f64, sigma: f64, std_err: f64) -> f64 {
+    (simulated - measured) / sigma.hypot(std_err)
 }
 
 /// [`curve`] read at a temperature where `thermal` is given: each point an instrument
@@ -751,15 +774,14 @@ pub fn curve(
 /// goes on from the deterministic state), with its standard errors, and neither grazes
 /// nor is ill-defined any more — an average is what the instrument reads there; the
 /// `keep` of [`curve_while`] that stops after the first point it refuses (given its
-/// index and the amplitude in m and phase in degrees read there): the points up to and
-/// including it.
+/// index and what is read there): the points up to and including it.
 pub fn curve_while(
     setup: &TapSetup,
     numerics: &Numerics,
     position_m: &[f64],
     offset_m: f64,
     thermal: Option<&AverageRequest>,
-    mut keep: impl FnMut(usize, f64, f64) -> bool,
+    mut keep: impl FnMut(usize, &Reading) -> bool,
 ) -> Result<Curve> {
     let ramp: Vec<(f64, Direction)> = position_m
         .iter()
@@ -768,27 +790,31 @@ pub fn curve_while(
     let a0 = setup.cantilever.free_amplitude_m;
     // What the instrument reads at a point: the average where there is one.
     let read = |p: &SweepPoint| match p.thermal_average {
-        Some(t) => (t.amplitude_ratio * a0, t.phase_deg),
-        None => (p.observables.amplitude_m, p.observables.phase_deg),
+        Some(t) => Reading {
+            amplitude_m: t.amplitude_ratio * a0,
+            phase_deg: t.phase_deg,
+            amplitude_std_err_m: t.amplitude_ratio_std_err * a0,
+            phase_std_err_deg: t.phase_std_err_deg,
+        },
+        None => Reading {
+            amplitude_m: p.observables.amplitude_m,
+            phase_deg: p.observables.phase_deg,
+            amplitude_std_err_m: 0.0,
+            phase_std_err_deg: 0.0,
+        },
     };
-    let points = approach_curve_while(setup, numerics, &ramp, thermal, |i, p| {
-        let (a, phi) = read(p);
-        keep(i, a, phi)
-    })?;
+    let points = approach_curve_while(setup, numerics, &ramp, thermal, |i, p| keep(i, &read(p)))?;
     let averaged: Vec<bool> = points.iter().map(|p| p.thermal_average.is_some()).collect();
-    let std_err = |f: &dyn Fn(&ThermalAverage) -> f64| -> Vec<f64> {
+    let std_err = |f: &dyn Fn(&Reading) -> f64| -> Vec<f64> {
         match thermal {
-            Some(_) => points
-                .iter()
-                .map(|p| p.thermal_average.as_ref().map_or(0.0, f))
-                .collect(),
+            Some(_) => points.iter().map(|p| f(&read(p))).collect(),
             None => Vec::new(),
         }
     };
     Ok(Curve {
         separation_m: ramp.iter().take(points.len()).map(|r| r.0).collect(),
-        amplitude_m: points.iter().map(|p| read(p).0).collect(),
-        phase_deg: points.iter().map(|p| read(p).1).collect(),
+        amplitude_m: points.iter().map(|p| read(p).amplitude_m).collect(),
+        phase_deg: points.iter().map(|p| read(p).phase_deg).collect(),
         well_defined: points
             .iter()
             .zip(&averaged)
@@ -799,8 +825,8 @@ pub fn curve_while(
             .zip(&averaged)
             .map(|(p, &avg)| p.observables.grazing && !avg)
             .collect(),
-        amplitude_std_err_m: std_err(&|t| t.amplitude_ratio_std_err * a0),
-        phase_std_err_deg: std_err(&|t| t.phase_std_err_deg),
+        amplitude_std_err_m: std_err(&|r| r.amplitude_std_err_m),
+        phase_std_err_deg: std_err(&|r| r.phase_std_err_deg),
         averaged: if thermal.is_some() {
             averaged
         } else {

@@ -12,7 +12,7 @@
 //! fixes it to a fraction of the points' spacing before any optimiser runs.
 
 use super::features::{Features, first_end, onset};
-use super::model::{Curve, Measured, Nuisance, Parameter, curve_while};
+use super::model::{Curve, Measured, Nuisance, Parameter, curve_while, weighted_residual};
 use super::progress::{Stage, Tracker};
 use crate::dynamics::setup::{Numerics, TapSetup};
 use rayon::prelude::*;
@@ -262,18 +262,11 @@ fn screen_plain(
         };
         let mut first = None;
         let thermal = data.thermal.as_ref();
-        let Ok(head) = curve_while(
-            &setup,
-            numerics,
-            z,
-            nuisance.offset_m,
-            thermal,
-            |_, a, p| {
-                let v = if phase { p } else { a };
-                let f = *first.get_or_insert(v);
-                (v - f).abs() <= threshold
-            },
-        ) else {
+        let Ok(head) = curve_while(&setup, numerics, z, nuisance.offset_m, thermal, |_, r| {
+            let v = if phase { r.phase_deg } else { r.amplitude_m };
+            let f = *first.get_or_insert(v);
+            (v - f).abs() <= threshold
+        }) else {
             return fail(nuisance);
         };
         tracker.curve(None);
@@ -303,14 +296,26 @@ fn screen_plain(
             numerics,
             &data.position_m[start..stop],
             nuisance.offset_m,
-            data.thermal.as_ref(),
-            |i, a, p| {
+            data.segment_thermal(k).as_ref(),
+            |i, r| {
                 let i = start + i;
                 if let Some(m) = &data.amplitude_m {
-                    chi += ((a - m[i]) / data.sigma_amplitude_m).powi(2);
+                    chi += weighted_residual(
+                        r.amplitude_m,
+                        m[i],
+                        data.sigma_amplitude_m,
+                        r.amplitude_std_err_m,
+                    )
+                    .powi(2);
                 }
                 if let Some(m) = &data.phase_deg {
-                    chi += ((p + nuisance.phase_offset_deg - m[i]) / data.sigma_phase_deg).powi(2);
+                    chi += weighted_residual(
+                        r.phase_deg + nuisance.phase_offset_deg,
+                        m[i],
+                        data.sigma_phase_deg,
+                        r.phase_std_err_deg,
+                    )
+                    .powi(2);
                 }
                 chi <= bound
             },
@@ -432,4 +437,86 @@ pub(crate) fn starts(
         });
     }
     chosen
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::setup::default_setup;
+    use crate::instrument::average::AverageRequest;
+
+    /// The screen's χ², summed as the curve comes, is the χ² the local stage minimises
+    /// ([`Measured::chi_square`] of [`Measured::simulate`]) on two approaches read at
+    /// 300 K through the onset of contact, where points are thermal averages: each
+    /// approach's own noise, each average's standard error beside σ.
+    #[test]
+    fn the_screen_sums_the_chi_square_the_fit_minimises() {
+        let setup = default_setup();
+        let numerics = Numerics::default();
+        let z: Vec<f64> = [24.0, 20.2, 19.5, 21.0, 20.0, 19.5]
+            .iter()
+            .map(|z| z * 1e-9)
+            .collect();
+        let mut data = Measured {
+            position_m: z.clone(),
+            setpoint_ratio: None,
+            segments: vec![0, 3],
+            amplitude_m: None,
+            phase_deg: None,
+            sigma_amplitude_m: 0.02e-9,
+            sigma_phase_deg: 0.05,
+            second_mode: None,
+            thermal: Some(AverageRequest {
+                temperature_k: 300.0,
+                periods: 800,
+                seed: 3,
+            }),
+        };
+        let nuisance = Nuisance::offset(0.0);
+        let model = data.simulate(&setup, &numerics, &nuisance).unwrap();
+        assert!(
+            model.averaged.iter().filter(|a| **a).count() >= 2
+                && model.amplitude_std_err_m.iter().any(|e| *e > 0.0),
+            "the onset is read as thermal averages: {:?}",
+            model.averaged
+        );
+        // Measured values a little off the model's, so that every residual counts.
+        data.amplitude_m = Some(
+            model
+                .amplitude_m
+                .iter()
+                .enumerate()
+                .map(|(i, a)| a + (i as f64 - 2.5) * 0.01e-9)
+                .collect(),
+        );
+        data.phase_deg = Some(
+            model
+                .phase_deg
+                .iter()
+                .enumerate()
+                .map(|(i, p)| p + (2.0 - i as f64) * 0.03)
+                .collect(),
+        );
+        let expected = data.chi_square(&model);
+        let report = |_: &crate::analysis::fit::Progress| {};
+        let tracker = Tracker::new(&report);
+        let wanted = Features {
+            jump: None,
+            onset_m: None,
+        };
+        let screened = screen_plain(
+            &data,
+            &numerics,
+            &[Parameter::Modulus],
+            &wanted,
+            (setup.clone(), nuisance),
+            f64::INFINITY,
+            &tracker,
+        );
+        assert!(
+            (screened.chi_square - expected).abs() <= 1e-9 * expected,
+            "screen {} against the fit's {expected}",
+            screened.chi_square
+        );
+    }
 }
