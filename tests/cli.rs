@@ -1,7 +1,7 @@
 //! The `tapsim` command line, run as a user would.
 
 use crate::common;
-use common::{cells, json, num, scratch, tapsim};
+use common::{cells, json, json_of, num, scratch, tapsim};
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -1891,4 +1891,50 @@ fn version_completions_man_pages_and_help_come_from_the_definitions() {
         &["man", "--out", dir.join("missing").to_str().unwrap()],
         "existing directory",
     );
+}
+
+/// Where Lee & Radok's integral, run through unloading, pulls the tip beyond what the
+/// elastic law under the sample can (an outside check's case: Hertz, E* 1 → 3 GPa,
+/// τ_r = 100 ns at z_c = 12 nm pulls to −5.72 nN; a non-adhesive contact cannot pull),
+/// `tap` says so, with the pull its JSON reports; against DMT's own pull-off −2πRΔγ
+/// (12.566 nN at R = 20 nm, Δγ = 0.1 J/m²) likewise; the elastic sample gets no such note.
+#[test]
+fn tap_says_where_the_relaxing_sample_pulls_the_tip() {
+    let case = |law: &'static str, relaxing: bool| {
+        let mut a = vec![
+            "tap",
+            "--law",
+            law,
+            "--modulus",
+            "1GPa",
+            "--separation",
+            "12nm",
+        ];
+        if relaxing {
+            a.extend(["--unrelaxed-modulus", "3GPa", "--relaxation-time", "100ns"]);
+        }
+        a
+    };
+    let note = "note: the relaxing sample pulls the tip to";
+    for (law, own_n) in [
+        ("hertz", 0.0),
+        ("dmt", -2.0 * std::f64::consts::PI * 20e-9 * 0.1),
+    ] {
+        let args = case(law, true);
+        let pull = num(&json_of(&args, &["--json"]), "peak_attractive_force_n");
+        assert!(pull < own_n - 1e-12, "{law}: {pull:e} against {own_n:e}");
+        let text = String::from_utf8(succeeds(&args).stdout).unwrap();
+        let said = format!("{note} {:.4} nN", pull * 1e9);
+        assert!(text.contains(&said), "{law}: {said:?} not in\n{text}");
+        let own = match own_n {
+            0.0 => "0 nN".to_string(),
+            f => format!("{:.4} nN", f * 1e9),
+        };
+        assert!(
+            text.contains(&format!("own most tensile force ({own})")),
+            "{text}"
+        );
+        let elastic = String::from_utf8(succeeds(&case(law, false)).stdout).unwrap();
+        assert!(!elastic.contains(note), "{law}: {elastic}");
+    }
 }
