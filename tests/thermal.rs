@@ -6,7 +6,7 @@ use crate::common;
 
 use tapsim::dynamics::free::FreeFlight;
 use tapsim::dynamics::grazing::{BOLTZMANN_J_K, ROOM_TEMPERATURE_K};
-use tapsim::dynamics::march::Simulation;
+use tapsim::dynamics::march::{Phase, Simulation};
 use tapsim::dynamics::model::{Coupling, Drive, Oscillator, X};
 use tapsim::dynamics::numeric::{StepEnd, StepObserver, Tolerances};
 use tapsim::dynamics::setup::{Numerics, Prepared, default_setup};
@@ -14,6 +14,28 @@ use tapsim::instrument::thermal::{
     FreeThermal, STEPS_PER_PERIOD, ThermalForce, free_variance_hat, intensity_hat,
 };
 use tapsim::law::{Branch, NoForce};
+
+/// The defaults (at rest separation `z_c` where given) settled over `periods`
+/// noise-free periods, and the thermal force's D̂ at 300 K on their lever.
+fn settled_at_room_temperature(z_c: Option<f64>, periods: usize) -> (Prepared, Phase, f64) {
+    let mut setup = default_setup();
+    if let Some(z_c) = z_c {
+        setup.separation_m = z_c;
+    }
+    let p = Prepared::new(&setup, &Numerics::default()).unwrap();
+    let mut phase = p.simulation().free_steady_start();
+    p.simulation()
+        .march(&mut phase, periods, &mut tapsim::dynamics::numeric::Ignore)
+        .unwrap();
+    let c = &p.setup.cantilever;
+    let d = intensity_hat(
+        ROOM_TEMPERATURE_K,
+        c.stiffness_n_m,
+        c.quality,
+        c.free_amplitude_m,
+    );
+    (p, phase, d)
+}
 
 /// The mean of `x²` and its standard error from the means of 50 batches (each far longer
 /// than the motion's correlation time when the record is).
@@ -139,11 +161,8 @@ fn the_noisy_marcher_moves_the_free_cantilever_as_the_step_recursion_does() {
 #[test]
 fn free_steps_from_the_precomputed_transition_march_as_the_exact_march_does() {
     use tapsim::instrument::lockin::LockIn;
-    let p = Prepared::new(&default_setup(), &Numerics::default()).unwrap();
+    let (p, mut settled, d_room) = settled_at_room_temperature(None, 200);
     let sim = p.simulation();
-    let mut settled = sim.free_steady_start();
-    sim.march(&mut settled, 200, &mut tapsim::dynamics::numeric::Ignore)
-        .unwrap();
     // Off the lock-in's sampling grid (at τ = 0 the force steps would end where it
     // samples, and the interpolants would be read only at their ends).
     sim.advance(
@@ -152,9 +171,9 @@ fn free_steps_from_the_precomputed_transition_march_as_the_exact_march_does() {
         &mut tapsim::dynamics::numeric::Ignore,
     )
     .unwrap();
-    let c = &p.setup.cantilever;
-    for temperature in [ROOM_TEMPERATURE_K, 100.0 * ROOM_TEMPERATURE_K] {
-        let d = intensity_hat(temperature, c.stiffness_n_m, c.quality, c.free_amplitude_m);
+    for hotter in [1.0, 100.0] {
+        // D̂ grows as the temperature.
+        let (d, temperature) = (hotter * d_room, hotter * ROOM_TEMPERATURE_K);
         for seed in 1..=3 {
             let run = |exact: bool| {
                 let force = ThermalForce::new(d, STEPS_PER_PERIOD, seed, 0).unwrap();
@@ -223,20 +242,8 @@ fn free_steps_from_the_precomputed_transition_march_as_the_exact_march_does() {
 #[test]
 fn at_the_grazing_onset_the_fast_steps_touch_when_the_located_ones_do() {
     for z_c in [19.5e-9, 20.2e-9] {
-        let mut setup = default_setup();
-        setup.separation_m = z_c;
-        let p = Prepared::new(&setup, &Numerics::default()).unwrap();
+        let (p, start, d) = settled_at_room_temperature(Some(z_c), 3000);
         let sim = p.simulation();
-        let mut start = sim.free_steady_start();
-        sim.march(&mut start, 3000, &mut tapsim::dynamics::numeric::Ignore)
-            .unwrap();
-        let c = &p.setup.cantilever;
-        let d = intensity_hat(
-            ROOM_TEMPERATURE_K,
-            c.stiffness_n_m,
-            c.quality,
-            c.free_amplitude_m,
-        );
         let run = |exact: bool| {
             let force = ThermalForce::new(d, STEPS_PER_PERIOD, 5, 0).unwrap();
             let mut force = if exact { force.exact() } else { force };
@@ -296,18 +303,8 @@ fn streams_are_reproducible_and_zero_temperature_is_noise_free() {
 /// free flight and contact alike.
 #[test]
 fn a_noisy_tapping_march_balances_its_energy() {
-    let p = Prepared::new(&default_setup(), &Numerics::default()).unwrap();
+    let (p, mut phase, d) = settled_at_room_temperature(None, 200);
     let sim = p.simulation();
-    let mut phase = sim.free_steady_start();
-    sim.march(&mut phase, 200, &mut tapsim::dynamics::numeric::Ignore)
-        .unwrap();
-    let c = &p.setup.cantilever;
-    let d = intensity_hat(
-        ROOM_TEMPERATURE_K,
-        c.stiffness_n_m,
-        c.quality,
-        c.free_amplitude_m,
-    );
     let mut force = ThermalForce::new(d, STEPS_PER_PERIOD, 11, 0).unwrap();
     let (total, work) = force
         .march(&sim, &mut phase, 20, &mut tapsim::dynamics::numeric::Ignore)
