@@ -373,16 +373,30 @@ fn several_laws_are_refused_outside_fit() {
     );
 }
 
-/// The CSV `tapsim approach` wrote at `path`: its header, its rows, and where its
-/// `grazing` column is.
-fn with_grazing_column(
-    path: &std::path::Path,
-) -> (csv::StringRecord, Vec<csv::StringRecord>, usize) {
-    let mut reader = csv::Reader::from_path(path).unwrap();
-    let headers = reader.headers().unwrap().clone();
-    let at = headers.iter().position(|h| h == "grazing").unwrap();
-    let rows = reader.records().map(|r| r.unwrap()).collect();
-    (headers, rows, at)
+/// A CSV tapsim wrote: its header and its rows.
+struct Table {
+    headers: csv::StringRecord,
+    rows: Vec<csv::StringRecord>,
+}
+
+impl Table {
+    fn read(path: &std::path::Path) -> Self {
+        let mut reader = csv::Reader::from_path(path).unwrap();
+        let headers = reader.headers().unwrap().clone();
+        let rows = reader.records().map(|r| r.unwrap()).collect();
+        Self { headers, rows }
+    }
+
+    /// Where column `name` is.
+    fn at(&self, name: &str) -> usize {
+        self.headers.iter().position(|h| h == name).unwrap()
+    }
+
+    /// The cells of column `name`, row by row.
+    fn column(&self, name: &str) -> Vec<&str> {
+        let at = self.at(name);
+        self.rows.iter().map(|r| &r[at]).collect()
+    }
 }
 
 /// The curve a new user fits first — `tapsim approach --csv` on the defaults, from 24 nm
@@ -397,9 +411,14 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
     let csv = dir.join("approach.csv");
     let csv = csv.to_str().unwrap();
     approach_csv(csv, &["--points", "40", "--no-retract"]);
-    let (_, rows, at) = with_grazing_column(csv.as_ref());
-    let grazing = rows.iter().filter(|r| &r[at] == "true").count();
-    assert!(grazing >= 1 && grazing < rows.len() / 2, "{grazing}");
+    let table = Table::read(csv.as_ref());
+    let rows = table.rows.len();
+    let grazing = table
+        .column("grazing")
+        .iter()
+        .filter(|g| **g == "true")
+        .count();
+    assert!(grazing >= 1 && grazing < rows / 2, "{grazing}");
     let start = [
         "fit",
         csv,
@@ -414,7 +433,7 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
     assert_eq!(num(&v, "grazing_points_left_out"), grazing as f64);
     assert_eq!(
         num(&v, "degrees_of_freedom"),
-        (2 * (rows.len() - grazing) - 2) as f64
+        (2 * (rows - grazing) - 2) as f64
     );
     assert_eq!(v["converged"], true);
     let modulus = built_in_modulus();
@@ -437,10 +456,7 @@ fn the_rows_a_curve_flags_as_grazing_are_left_out_of_the_fit() {
         .concat(),
     );
     assert_eq!(num(&kept, "grazing_points_left_out"), 0.0);
-    assert_eq!(
-        num(&kept, "degrees_of_freedom"),
-        (2 * rows.len() - 2) as f64
-    );
+    assert_eq!(num(&kept, "degrees_of_freedom"), (2 * rows - 2) as f64);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -455,7 +471,8 @@ fn a_point_grazing_at_the_fitted_parameters_is_left_out() {
     let dir = scratch("fit-left-out");
     let full = dir.join("full.csv");
     approach_csv(full.to_str().unwrap(), &ISSUE_CURVE);
-    let (headers, rows, at) = with_grazing_column(&full);
+    let table = Table::read(&full);
+    let (headers, rows, at) = (&table.headers, &table.rows, table.at("grazing"));
     let flagged: Vec<f64> = (0..rows.len())
         .filter(|&i| &rows[i][at] == "true")
         .map(|i| i as f64)
@@ -470,8 +487,8 @@ fn a_point_grazing_at_the_fitted_parameters_is_left_out() {
             .map(|(_, v)| v.to_string())
             .collect::<Vec<_>>()
     };
-    writer.write_record(others(&headers)).unwrap();
-    for r in &rows {
+    writer.write_record(others(headers)).unwrap();
+    for r in rows {
         writer.write_record(others(r)).unwrap();
     }
     writer.flush().unwrap();
@@ -505,7 +522,7 @@ fn a_point_grazing_at_the_fitted_parameters_is_left_out() {
             .any(|l| l.starts_with("fitting: again without the 1 grazing point(s), ")),
         "{log}"
     );
-    let z = rows[flagged[0] as usize][headers.iter().position(|h| h == "separation_m").unwrap()]
+    let z = rows[flagged[0] as usize][table.at("separation_m")]
         .parse::<f64>()
         .unwrap();
     assert!(
@@ -578,13 +595,17 @@ fn a_curve_written_at_a_temperature_is_fitted_back_at_it() {
     let csv = csv.to_str().unwrap();
     let thermal = ["--temperature", "300K", "--thermal-periods", "800"];
     approach_csv(csv, &[&ISSUE_CURVE[..], &thermal].concat());
-    let (headers, rows, at) = with_grazing_column(csv.as_ref());
-    let phase_col = headers
+    let table = Table::read(csv.as_ref());
+    let averaged: Vec<bool> = table
+        .column("thermal_average_phase_deg")
         .iter()
-        .position(|h| h == "thermal_average_phase_deg")
-        .unwrap();
-    let averaged: Vec<bool> = rows.iter().map(|r| !r[phase_col].is_empty()).collect();
-    let flagged: Vec<bool> = rows.iter().map(|r| &r[at] == "true").collect();
+        .map(|p| !p.is_empty())
+        .collect();
+    let flagged: Vec<bool> = table
+        .column("grazing")
+        .iter()
+        .map(|g| *g == "true")
+        .collect();
     assert!(averaged.contains(&true));
     assert_eq!(averaged, flagged);
     let fit = [
@@ -605,16 +626,10 @@ fn a_curve_written_at_a_temperature_is_fitted_back_at_it() {
     let rows_at = ["--csv", rows_csv.to_str().unwrap()];
     let v = json(&[&fit[..], &thermal, &rows_at].concat());
     assert_eq!(num(&v, "grazing_points_left_out"), 0.0);
-    let mut reader = csv::Reader::from_path(&rows_csv).unwrap();
-    let col = reader
-        .headers()
-        .unwrap()
+    let written: Vec<bool> = Table::read(&rows_csv)
+        .column("thermal_average")
         .iter()
-        .position(|h| h == "thermal_average")
-        .unwrap();
-    let written: Vec<bool> = reader
-        .records()
-        .map(|r| &r.unwrap()[col] == "true")
+        .map(|a| *a == "true")
         .collect();
     assert_eq!(written, averaged);
     let marked: Vec<bool> = v["fitted"]["averaged"]

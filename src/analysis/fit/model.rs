@@ -805,16 +805,17 @@ pub fn curve_while(
     };
     let points = approach_curve_while(setup, numerics, &ramp, thermal, |i, p| keep(i, &read(p)))?;
     let averaged: Vec<bool> = points.iter().map(|p| p.thermal_average.is_some()).collect();
-    let std_err = |f: &dyn Fn(&Reading) -> f64| -> Vec<f64> {
-        match thermal {
-            Some(_) => points.iter().map(|p| f(&read(p))).collect(),
-            None => Vec::new(),
-        }
+    let readings: Vec<Reading> = points.iter().map(read).collect();
+    let pick = |f: fn(&Reading) -> f64| readings.iter().map(f).collect::<Vec<f64>>();
+    // Standard errors only where a temperature is given.
+    let std_err = |f: fn(&Reading) -> f64| match thermal {
+        Some(_) => pick(f),
+        None => Vec::new(),
     };
     Ok(Curve {
         separation_m: ramp.iter().take(points.len()).map(|r| r.0).collect(),
-        amplitude_m: points.iter().map(|p| read(p).amplitude_m).collect(),
-        phase_deg: points.iter().map(|p| read(p).phase_deg).collect(),
+        amplitude_m: pick(|r| r.amplitude_m),
+        phase_deg: pick(|r| r.phase_deg),
         well_defined: points
             .iter()
             .zip(&averaged)
@@ -825,8 +826,8 @@ pub fn curve_while(
             .zip(&averaged)
             .map(|(p, &avg)| p.observables.grazing && !avg)
             .collect(),
-        amplitude_std_err_m: std_err(&|r| r.amplitude_std_err_m),
-        phase_std_err_deg: std_err(&|r| r.phase_std_err_deg),
+        amplitude_std_err_m: std_err(|r| r.amplitude_std_err_m),
+        phase_std_err_deg: std_err(|r| r.phase_std_err_deg),
         averaged: if thermal.is_some() {
             averaged
         } else {
