@@ -501,8 +501,24 @@ mod tests {
                 lo = mid;
             }
         }
-        setup.contact.modulus_pa = lo;
-        let c = super::super::model::curve(&setup, &numerics, &z, 0.0).unwrap();
+        // Right at the switch the point that switches can be in transit between the
+        // branches (not a stable period-1 orbit, its value jumping within a step): step
+        // back from there, half a step at a time, while the forward step still crosses.
+        let s_hi = side(hi);
+        let switching: Vec<usize> = (0..z.len()).filter(|&i| s_lo[i] * s_hi[i] < 0).collect();
+        let mut c;
+        loop {
+            setup.contact.modulus_pa = lo;
+            c = super::super::model::curve(&setup, &numerics, &z, 0.0).unwrap();
+            if switching.iter().all(|&i| c.well_defined[i]) {
+                break;
+            }
+            lo *= (-0.5 * LOG_STEP).exp();
+            assert!(
+                hi / lo - 1.0 < 0.9 * LOG_STEP,
+                "in transit below {hi}: {switching:?}"
+            );
+        }
         let data = Measured {
             position_m: z.clone(),
             setpoint_ratio: None,
