@@ -153,15 +153,12 @@ fn an_approach_curve_is_fitted_back() {
         rows.to_str().unwrap(),
     ]);
     assert!(out.status.success());
-    let mut r = csv::Reader::from_path(&rows).unwrap();
-    let h = r.headers().unwrap().clone();
-    let col = |name: &str| h.iter().position(|x| x == name).unwrap();
-    let records: Vec<csv::StringRecord> = r.records().map(|r| r.unwrap()).collect();
-    assert_eq!(records.len(), 12);
+    let table = Table::read(&rows);
+    assert_eq!(table.rows.len(), 12);
     let fitted_phase = v["fitted"]["phase_deg"].as_array().unwrap();
     let residuals = v["residuals"].as_array().unwrap();
-    for (i, row) in records.iter().enumerate() {
-        let cell = |name: &str| row[col(name)].parse::<f64>().unwrap();
+    for (i, row) in table.rows.iter().enumerate() {
+        let cell = |name: &str| row[table.at(name)].parse::<f64>().unwrap();
         let same = |a: f64, b: &serde_json::Value| (a / b.as_f64().unwrap() - 1.0).abs() < 1e-9;
         assert!(same(cell("fitted_phase_deg"), &fitted_phase[i]));
         // (fitted − measured)/σ, σ the default weights 0.02 nm and 0.05°.
@@ -175,7 +172,7 @@ fn an_approach_curve_is_fitted_back() {
             residuals[i]
         );
         assert!(same(rp, &residuals[12 + i]) || rp == 0.0);
-        assert_eq!(&row[col("well_defined")], "true");
+        assert_eq!(&row[table.at("well_defined")], "true");
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
@@ -265,12 +262,10 @@ fn approaches_joined_by_a_segment_column_are_fitted_together() {
             csv,
             &["--from", from, "--to", to, "--points", "10", "--no-retract"],
         );
-        let mut r = csv::Reader::from_path(csv).unwrap();
-        let h = r.headers().unwrap().clone();
-        let col = |name: &str| h.iter().position(|x| x == name).unwrap();
+        let table = Table::read(csv.as_ref());
+        let col = |name: &str| table.at(name);
         let (z, a, p) = (col("separation_m"), col("amplitude_m"), col("phase_deg"));
-        for row in r.records() {
-            let row = row.unwrap();
+        for row in &table.rows {
             joined.push_str(&format!("{label},{},{},{}\n", &row[z], &row[a], &row[p]));
         }
     }
@@ -319,13 +314,10 @@ fn phases_at_setpoints_are_fitted() {
             "--no-retract",
         ],
     );
-    let mut r = csv::Reader::from_path(&sweep).unwrap();
-    let h = r.headers().unwrap().clone();
-    let col = |name: &str| h.iter().position(|x| x == name).unwrap();
-    let (a, p) = (col("amplitude_ratio"), col("phase_deg"));
+    let table = Table::read(&sweep);
+    let (a, p) = (table.at("amplitude_ratio"), table.at("phase_deg"));
     let mut text = String::from("setpoint,phase_deg\n");
-    for row in r.records() {
-        let row = row.unwrap();
+    for row in &table.rows {
         text.push_str(&format!("{},{}\n", &row[a], &row[p]));
     }
     let data = dir.join("phase_vs_setpoint.csv");

@@ -491,12 +491,13 @@ mod tests {
         };
         // Bisect in E* for where the curve's branches change, to well within a step.
         let (mut lo, mut hi) = (0.4e9, 1.5e9);
-        let (s_lo, s_hi) = (side(lo), side(hi));
+        let (s_lo, mut s_hi) = (side(lo), side(hi));
         assert!(crosses_switch(&s_lo, &s_hi), "{s_lo:?} {s_hi:?}");
         while hi / lo - 1.0 > 0.2 * LOG_STEP {
             let mid = (lo * hi).sqrt();
-            if crosses_switch(&s_lo, &side(mid)) {
-                hi = mid;
+            let s_mid = side(mid);
+            if crosses_switch(&s_lo, &s_mid) {
+                (hi, s_hi) = (mid, s_mid);
             } else {
                 lo = mid;
             }
@@ -504,7 +505,6 @@ mod tests {
         // Right at the switch the point that switches can be in transit between the
         // branches (not a stable period-1 orbit, its value jumping within a step): step
         // back from there, half a step at a time, while the forward step still crosses.
-        let s_hi = side(hi);
         let switching: Vec<usize> = (0..z.len()).filter(|&i| s_lo[i] * s_hi[i] < 0).collect();
         let mut c;
         loop {
