@@ -5,7 +5,9 @@
 //! - [`hybrid`]: the hybrid hysteresis loss, eq. (18);
 //! - [`spring`]: a support of finite stiffness, eqs. (22)–(27);
 //! - [`length_scale`]: the adhesive length scale, eqs. (19)–(21);
-//! - [`lj`]: the full Lennard-Jones numerical solution (§3.1).
+//! - [`lj`]: the full Lennard-Jones numerical solution (§3.1);
+//! - [`viscoelastic`]: a sphere on a relaxing (standard-linear-solid) half-space,
+//!   unloading included (Ting 1966; not in the paper).
 //!
 //! May import: the foundation and [`crate::physics::params`]. Pure: the Lennard-Jones
 //! cache on disk is the application's, handed in as a source.
@@ -16,3 +18,4 @@ pub mod length_scale;
 pub mod lj;
 pub mod semi_rigid;
 pub mod spring;
+pub mod viscoelastic;

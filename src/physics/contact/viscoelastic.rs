@@ -1,0 +1,507 @@
+//! A rigid sphere on a standard-linear-solid half-space, unloading included: the
+//! receding contact of Ting (J. Appl. Mech. 33, 845, 1966), computed by the method of
+//! dimensionality reduction (Popov & Heß, *Method of Dimensionality Reduction in Contact
+//! Mechanics and Friction*, Springer 2015, ch. 6; exact for a viscoelastic half-space
+//! under an axisymmetric indenter, unloading included: Argatov & Popov, ZAMM 96, 956,
+//! 2016).
+//!
+//! Lee & Radok's hereditary Hertz integral (what [`crate::physics::law::StandardLinearSolid`]
+//! runs) holds while the contact grows. Once it shrinks, the force depends on the
+//! history only up to the instant t₁ when the contact last had today's radius, and t₁
+//! is where ∫_{t₁}^{t} E(t − s) dδ(s) = 0 (Ting). A non-adhesive contact then never
+//! pulls, and it ends before the indentation returns to zero: the surface, slower than
+//! the tip, has not come back yet.
+//!
+//! The reduction maps the half-space onto a row of independent elements at ξ ≥ 0,
+//! pressed by the profile ξ² (the sphere's x²/(2R) transformed). In the contact's units
+//! (indentation δ̂ = −α̂, the [`crate::physics::law`] scales; ξ̂ in √(length unit · R))
+//! each element is a standard linear solid: a spring E_∞ in parallel with a Maxwell arm
+//! (spring r·E_∞, r = (E₀ − E_∞)/E_∞, relaxation time τ̂_r) whose extension is v̂. Its
+//! surface moves with the tip where the tip is below its free position, and freely
+//! otherwise:
+//!
+//!   û = max(δ̂ − ξ̂², κ v̂),  κ = r/(1 + r),   dv̂/dτ = (û − v̂)/τ̂_r,
+//!   q̂ = (1 + r)û − r v̂ ≥ 0,   F̂ = 2∫₀^∞ q̂ dξ̂
+//!
+//! (F̂ compressive positive, the Hertz force (4/3)δ̂^{3/2} for an elastic E_∞). An
+//! element touches exactly where its force would be positive, (1 + r)(δ̂ − ξ̂²) − r v̂ > 0,
+//! and there its two equations of motion agree, so v̂ is smooth across a touch. A free
+//! element creeps back with the retardation time (1 + r)τ̂_r: the surface remembers the
+//! last contact until it has.
+//!
+//! Limits: τ̂_r → 0 the Hertz contact on E_∞, τ̂_r → ∞ on E₀ = (1 + r)E_∞.
+//!
+//! Discretisation: nodes ξ̂_j = j·h carry v̂_j = c_j − p_j ξ̂_j², split so that both
+//! elastic limits are exact between nodes (p = c = 0 as τ̂_r → ∞; p = 1, c = δ̂ in
+//! contact as τ̂_r → 0). Inside the contact p and c are interpolated linearly in each
+//! cell, where q̂ is then a cubic, integrated exactly; in the cell the contact's edge
+//! crosses they are extrapolated from the touching side and the edge is located by
+//! Newton. In time each element is advanced exactly for an indentation linear over a
+//! step, its touches located. Checked (tests below) against Ting's formulas evaluated
+//! on their own for a loading–unloading history: second order in h, 1.3e-6 of the peak
+//! force at 400 cells; the elastic limits within 1e-7 at 50.
+
+use crate::error::{Error, Result, positive};
+use crate::numeric::{bracketed_root, newton_bracketed};
+
+/// Two-point Gauss–Legendre abscissae on [0, 1] (exact for cubics).
+const GAUSS_2: [f64; 2] = [0.211_324_865_405_187_1, 0.788_675_134_594_812_9];
+
+/// A sphere on a standard-linear-solid half-space, with the surface's memory.
+#[derive(Debug, Clone)]
+pub struct RelaxingHalfSpace {
+    /// r = (E₀ − E_∞)/E_∞.
+    modulus_ratio: f64,
+    /// τ̂_r.
+    relaxation_hat: f64,
+    /// Node spacing h in ξ̂.
+    spacing: f64,
+    /// p_j (the Maxwell extension v̂_j = c_j − p_j ξ̂_j²).
+    p: Vec<f64>,
+    /// c_j.
+    c: Vec<f64>,
+}
+
+/// The state of one element: its Maxwell extension split as v̂ = c − pξ̂².
+#[derive(Debug, Clone, Copy)]
+struct Element {
+    p: f64,
+    c: f64,
+}
+
+impl RelaxingHalfSpace {
+    /// A relaxed, flat surface: modulus ratio r = (E₀ − E_∞)/E_∞ (> 0), relaxation time
+    /// τ̂_r (> 0), for indentations up to `max_indentation_hat` (the nodes reach
+    /// ξ̂ = √δ̂_max), with `nodes` cells across that reach.
+    pub fn new(
+        modulus_ratio: f64,
+        relaxation_hat: f64,
+        max_indentation_hat: f64,
+        nodes: usize,
+    ) -> Result<Self> {
+        positive("modulus ratio", modulus_ratio)?;
+        positive("relaxation time", relaxation_hat)?;
+        positive("largest indentation", max_indentation_hat)?;
+        if !(2..=1_000_000).contains(&nodes) {
+            return Err(Error::InvalidParameter {
+                name: "nodes",
+                value: nodes as f64,
+                reason: "between 2 and 10⁶",
+            });
+        }
+        // One cell of margin: an edge in the last cell still has a node past it.
+        let spacing = max_indentation_hat.sqrt() / nodes as f64;
+        Ok(Self {
+            modulus_ratio,
+            relaxation_hat,
+            spacing,
+            p: vec![0.0; nodes + 2],
+            c: vec![0.0; nodes + 2],
+        })
+    }
+
+    /// The largest indentation the nodes reach.
+    pub fn reach_hat(&self) -> f64 {
+        let x = self.spacing * (self.p.len() - 2) as f64;
+        x * x
+    }
+
+    fn xi(&self, j: usize) -> f64 {
+        self.spacing * j as f64
+    }
+
+    /// Advance the surface by `duration_hat` while the indentation goes linearly from
+    /// `from_hat` to `to_hat` (each element exactly; where it touches or lets go within
+    /// the step, the instant is located). Refused past [`RelaxingHalfSpace::reach_hat`].
+    pub fn advance(&mut self, from_hat: f64, to_hat: f64, duration_hat: f64) -> Result<()> {
+        if !(from_hat.is_finite() && to_hat.is_finite() && duration_hat >= 0.0) {
+            return Err(Error::Numerical(format!(
+                "relaxing half-space: a step from δ̂ = {from_hat} to {to_hat} over {duration_hat}"
+            )));
+        }
+        if from_hat.max(to_hat) > self.reach_hat() {
+            return Err(Error::NotApplicable(format!(
+                "relaxing half-space: indentation {:.6} beyond the nodes' reach {:.6}",
+                from_hat.max(to_hat),
+                self.reach_hat()
+            )));
+        }
+        if duration_hat == 0.0 {
+            return Ok(());
+        }
+        let step = Step {
+            d0: from_hat,
+            slope: (to_hat - from_hat) / duration_hat,
+            tau: self.relaxation_hat,
+            kappa: self.modulus_ratio / (1.0 + self.modulus_ratio),
+            creep: (1.0 + self.modulus_ratio) * self.relaxation_hat,
+        };
+        let (decay, creep_decay) = (
+            (-duration_hat / step.tau).exp(),
+            (-duration_hat / step.creep).exp(),
+        );
+        for j in 0..self.p.len() {
+            let xi2 = self.xi(j).powi(2);
+            let e = Element {
+                p: self.p[j],
+                c: self.c[j],
+            };
+            let next = step.advance(e, xi2, duration_hat, (decay, creep_decay))?;
+            self.p[j] = next.p;
+            self.c[j] = next.c;
+        }
+        Ok(())
+    }
+
+    /// The force F̂ (compressive positive; (4/3)δ̂^{3/2} for the relaxed elastic
+    /// contact) at indentation `indentation_hat`, on the surface as it is now.
+    pub fn force_hat(&self, indentation_hat: f64) -> f64 {
+        let total: f64 = (0..self.p.len() - 1)
+            .filter_map(|j| {
+                let (a, b, line) = self.touching_part(j, indentation_hat)?;
+                let q = self.line_force(line, indentation_hat);
+                let len = b - a;
+                Some(
+                    0.5 * len
+                        * GAUSS_2
+                            .iter()
+                            .map(|g| q(a + g * len).0.max(0.0))
+                            .sum::<f64>(),
+                )
+            })
+            .sum();
+        2.0 * total
+    }
+
+    /// The contact radius ξ̂ (= a/√(R·length unit)): the outermost point where the
+    /// elements' force is positive at `indentation_hat`, 0 out of contact.
+    pub fn contact_radius_hat(&self, indentation_hat: f64) -> f64 {
+        (0..self.p.len() - 1)
+            .rev()
+            .find_map(|j| self.touching_part(j, indentation_hat))
+            .map_or(0.0, |(_, b, _)| b)
+    }
+
+    /// The element force density q̂(ξ̂) = (1 + r)(δ̂ − ξ̂²) − r(c − pξ̂²) with p and c on
+    /// the line through nodes k and k + 1 (a cubic in ξ̂), and its derivative.
+    fn line_force(&self, k: usize, indentation_hat: f64) -> impl Fn(f64) -> (f64, f64) + '_ {
+        let (r, h, xk) = (self.modulus_ratio, self.spacing, self.xi(k));
+        let (dp, dc) = (
+            (self.p[k + 1] - self.p[k]) / h,
+            (self.c[k + 1] - self.c[k]) / h,
+        );
+        move |x: f64| {
+            let p = self.p[k] + (x - xk) * dp;
+            let c = self.c[k] + (x - xk) * dc;
+            (
+                (1.0 + r) * (indentation_hat - x * x) - r * (c - p * x * x),
+                -2.0 * (1.0 + r) * x - r * (dc - dp * x * x - 2.0 * p * x),
+            )
+        }
+    }
+
+    /// The part of cell j where q̂ > 0, and the node whose line gives q̂ there. Within the contact p and c are
+    /// interpolated between the cell's nodes; in a cell the contact's edge crosses
+    /// they are extrapolated from the touching side (the elements in contact vary
+    /// smoothly up to the edge; across it they do not), and the edge is located by
+    /// Newton. `None` where no element of the cell touches.
+    fn touching_part(&self, j: usize, indentation_hat: f64) -> Option<(f64, f64, usize)> {
+        let (x0, x1) = (self.xi(j), self.xi(j + 1));
+        let last = self.p.len() - 2;
+        let at_node = |k: usize| self.line_force(k.min(last), indentation_hat)(self.xi(k)).0;
+        let (in0, in1) = (at_node(j) > 0.0, at_node(j + 1) > 0.0);
+        let (line, a, b) = match (in0, in1) {
+            (true, true) => (j, x0, x1),
+            (false, false) => return None,
+            (true, false) => {
+                let line = j.saturating_sub(1);
+                let q = self.line_force(line, indentation_hat);
+                (line, x0, newton_bracketed(&q, x0, x1, 1e-15 * self.spacing))
+            }
+            (false, true) => {
+                let line = (j + 1).min(last);
+                let q = self.line_force(line, indentation_hat);
+                (line, newton_bracketed(&q, x0, x1, 1e-15 * self.spacing), x1)
+            }
+        };
+        Some((a, b, line))
+    }
+
+    /// The free surface's depth under the axis, κv̂(0) (positive below the undeformed
+    /// level): where the tip next touches.
+    pub fn surface_depth_hat(&self) -> f64 {
+        self.modulus_ratio / (1.0 + self.modulus_ratio) * self.c[0]
+    }
+}
+
+/// One step of an indentation linear in time, δ̂(s) = d0 + slope·s.
+struct Step {
+    d0: f64,
+    slope: f64,
+    tau: f64,
+    kappa: f64,
+    creep: f64,
+}
+
+impl Step {
+    /// The element's gap at time s: δ̂(s) − ξ̂² − κv̂, positive where it touches (its
+    /// force (1 + r)(δ̂ − ξ̂²) − r v̂ is then positive).
+    fn gap(&self, e: Element, xi2: f64, s: f64) -> f64 {
+        self.d0 + self.slope * s - xi2 - self.kappa * (e.c - e.p * xi2)
+    }
+
+    /// The element at time `from + s` of one that is `e` at time `from`: touching
+    /// throughout (dv̂/dτ = (δ̂ − ξ̂² − v̂)/τ̂_r, split as dp/dτ = (1 − p)/τ̂_r and
+    /// dc/dτ = (δ̂ − c)/τ̂_r, `decay` = e^{−s/τ̂_r}) or free throughout
+    /// (dv̂/dτ = −v̂/((1 + r)τ̂_r), `decay` = e^{−s/((1 + r)τ̂_r)}).
+    fn evolve(&self, e: Element, from: f64, s: f64, touching: bool, decay: f64) -> Element {
+        if touching {
+            // c(s) = c₀e^{−x} + δ̂(from)(1 − e^{−x}) + slope·s·φ(x), x = s/τ̂_r,
+            // φ(x) = 1 − (1 − e^{−x})/x: no cancellation at large τ̂_r.
+            let x = s / self.tau;
+            let m = 1.0 - decay;
+            let phi = if x < 1e-2 {
+                x * (0.5 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x / 120.0)))
+            } else {
+                1.0 - m / x
+            };
+            Element {
+                p: e.p * decay + m,
+                c: e.c * decay + (self.d0 + self.slope * from) * m + self.slope * s * phi,
+            }
+        } else {
+            Element {
+                p: e.p * decay,
+                c: e.c * decay,
+            }
+        }
+    }
+
+    fn evolve_for(&self, e: Element, from: f64, s: f64, touching: bool) -> Element {
+        let time = if touching { self.tau } else { self.creep };
+        self.evolve(e, from, s, touching, (-s / time).exp())
+    }
+
+    /// The element after `duration`, in the mode it starts in, switched where its gap
+    /// changes sign (at most a few times a step). `decays` are the whole step's.
+    fn advance(
+        &self,
+        mut e: Element,
+        xi2: f64,
+        duration: f64,
+        decays: (f64, f64),
+    ) -> Result<Element> {
+        // At a touch the two modes' rates agree; which one follows is the sign of the
+        // gap's rate there (the tip's against the free surface's creep).
+        let rising = |e: Element| self.slope + self.kappa * (e.c - e.p * xi2) / self.creep > 0.0;
+        let g0 = self.gap(e, xi2, 0.0);
+        let mut touching = g0 > 0.0 || (g0 == 0.0 && rising(e));
+        let mut start = 0.0;
+        for switches in 0..8 {
+            let end = if start == 0.0 {
+                let decay = if touching { decays.0 } else { decays.1 };
+                self.evolve(e, 0.0, duration, touching, decay)
+            } else {
+                self.evolve_for(e, start, duration - start, touching)
+            };
+            let g1 = self.gap(end, xi2, duration);
+            if g1 == 0.0 || (g1 > 0.0) == touching || switches == 7 {
+                return Ok(end);
+            }
+            // The switch: where the gap along this mode's solution changes sign (at the
+            // start it has this mode's sign, whatever round-off says after a switch).
+            let sign = if touching { 1.0 } else { -1.0 };
+            let at = bracketed_root(
+                "relaxing half-space: an element's touch",
+                |s| {
+                    if s <= start {
+                        sign * f64::MIN_POSITIVE
+                    } else {
+                        self.gap(self.evolve_for(e, start, s - start, touching), xi2, s)
+                    }
+                },
+                start,
+                duration,
+                1e-14,
+            )?;
+            e = self.evolve_for(e, start, at - start, touching);
+            start = at;
+            touching = rising(e);
+        }
+        unreachable!("the loop returns on its last pass")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ting's (1966) solution for the indentation δ̂ = t on [0, 1], 2 − t on [1, 2]
+    /// (relaxation modulus E(t)/E_∞ = 1 + r e^{−t/τ̂}), from his formulas and nothing of
+    /// the element model: t₁ from ∫_{t₁}^{t} E(t − s) dδ̂(s) = 0 in closed form (root by
+    /// bisection), the force F̂ = ∫₀^{t₁} E(t − s) d((4/3)δ̂^{3/2}) by Simpson's rule in
+    /// w = √s. Returns (F̂, t₁).
+    fn ting_triangle(r: f64, tau: f64, t: f64) -> (f64, f64) {
+        let t1 = if t <= 1.0 {
+            t
+        } else {
+            let h = |t1: f64| {
+                (1.0 - t1) + r * tau * ((-(t - 1.0) / tau).exp() - (-(t - t1) / tau).exp())
+                    - (t - 1.0)
+                    - r * tau * (1.0 - (-(t - 1.0) / tau).exp())
+            };
+            if h(0.0) <= 0.0 {
+                return (0.0, 0.0);
+            }
+            let (mut lo, mut hi) = (0.0, 1.0);
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if h(mid) > 0.0 { lo = mid } else { hi = mid }
+            }
+            0.5 * (lo + hi)
+        };
+        let top = t1.sqrt();
+        let f = |w: f64| 4.0 * w * w * r * (-(t - w * w) / tau).exp();
+        let panels = 4000;
+        let dw = top / panels as f64;
+        let simpson: f64 = (0..panels)
+            .map(|i| {
+                let a = i as f64 * dw;
+                dw / 6.0 * (f(a) + 4.0 * f(a + 0.5 * dw) + f(a + dw))
+            })
+            .sum();
+        (4.0 / 3.0 * t1.powf(1.5) + simpson, t1)
+    }
+
+    /// The element model over the same history, sampled every `every` of its steps.
+    fn elements_triangle(r: f64, tau: f64, nodes: usize, times: &[f64]) -> Vec<(f64, f64)> {
+        let mut s = RelaxingHalfSpace::new(r, tau, 1.0, nodes).unwrap();
+        let dt = 1e-3;
+        let depth = |t: f64| if t <= 1.0 { t } else { (2.0 - t).max(0.0) };
+        let mut out = Vec::new();
+        let mut t = 0.0;
+        for &at in times {
+            while t < at - 1e-12 {
+                let next = (t + dt).min(at);
+                s.advance(depth(t), depth(next), next - t).unwrap();
+                t = next;
+            }
+            out.push((s.force_hat(depth(t)), s.contact_radius_hat(depth(t))));
+        }
+        out
+    }
+
+    #[test]
+    fn the_element_model_is_tings_receding_contact() {
+        // Loading over 1, unloading over 1, relaxation time 0.3: the contact recedes
+        // through the unloading and ends before the indentation is back at zero.
+        let (r, tau) = (2.0, 0.3);
+        let times: Vec<f64> = (1..=38).map(|i| 0.05 * i as f64).collect();
+        let ting: Vec<(f64, f64)> = times.iter().map(|&t| ting_triangle(r, tau, t)).collect();
+        let peak = ting[19].0;
+        let mut worst = [0.0f64; 2];
+        for (k, nodes) in [200, 400].into_iter().enumerate() {
+            let model = elements_triangle(r, tau, nodes, &times);
+            let spacing = 1.0 / nodes as f64;
+            for ((&t, &(f, radius)), &(f_ting, t1)) in times.iter().zip(&model).zip(&ting) {
+                worst[k] = worst[k].max((f - f_ting).abs() / peak);
+                // In contact exactly where Ting's is (t₁ > 0), and never pulling.
+                assert_eq!(f > 0.0, t1 > 0.0, "t = {t}: F̂ {f} against Ting's {f_ting}");
+                // The contact radius is the one the contact had at t₁ (â² = δ̂(t₁) = t₁).
+                // (within 0.020 and 0.011 of a spacing at 200 and 400 nodes: second order)
+                assert!(
+                    (radius - t1.sqrt()).abs() <= 0.03 * spacing,
+                    "t = {t}: â {radius} against {}",
+                    t1.sqrt()
+                );
+            }
+        }
+        // Lee & Radok's integral through the unloading would pull here: Ting's does not,
+        // and the contact ends before the tip is back at the surface's level.
+        let lee_radok_at = |t: f64| {
+            let mut sum = 0.0;
+            let n = 20000;
+            for i in 0..n {
+                let s = (i as f64 + 0.5) * t / n as f64;
+                let rate = if s < 1.0 {
+                    2.0 * s.sqrt()
+                } else {
+                    -2.0 * (2.0 - s).sqrt()
+                };
+                sum += (1.0 + r * (-(t - s) / tau).exp()) * rate * t / n as f64;
+            }
+            sum
+        };
+        assert!(lee_radok_at(1.8) < -0.05 * peak, "{}", lee_radok_at(1.8));
+        let end = ting.iter().position(|&(f, _)| f == 0.0).unwrap();
+        assert!(times[end] < 1.7, "the contact ends at {}", times[end]);
+        // Second order in the node spacing, and within 1.5e-6 of the peak force at 400.
+        assert!(
+            worst[1] < 1.5e-6 && (3.5..4.5).contains(&(worst[0] / worst[1])),
+            "{worst:?}"
+        );
+    }
+
+    /// δ̂(t) = 0.5 − 0.8 cos(2πt): two contacts a period, loading and unloading.
+    fn tapping(s: &mut RelaxingHalfSpace, periods: usize, steps: usize) -> Vec<(f64, f64)> {
+        let depth = |t: f64| 0.5 - 0.8 * (2.0 * std::f64::consts::PI * t).cos();
+        let mut out = Vec::new();
+        let dt = 1.0 / steps as f64;
+        for i in 0..periods * steps {
+            let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
+            let (d0, d1) = (depth(t0).max(-1.0), depth(t1).max(-1.0));
+            s.advance(d0, d1, dt).unwrap();
+            out.push((d1, s.force_hat(d1)));
+        }
+        out
+    }
+
+    #[test]
+    fn fast_and_slow_relaxation_are_the_elastic_contacts() {
+        // τ̂_r → 0: Hertz on E_∞; τ̂_r → ∞: Hertz on E₀ = 3E_∞, through two periods
+        // of touching and letting go, exact between the nodes (50 cells).
+        let hertz = |d: f64| 4.0 / 3.0 * d.max(0.0).powf(1.5);
+        for (tau, modulus) in [(1e-9, 1.0), (1e9, 3.0)] {
+            // (measured 1.7e-8 and 2.7e-9: the lag τ̂_r·dδ̂/dτ and its converse)
+            let mut s = RelaxingHalfSpace::new(2.0, tau, 1.69, 50).unwrap();
+            for (d, f) in tapping(&mut s, 2, 500) {
+                assert!(
+                    (f - modulus * hertz(d)).abs() < 1e-7,
+                    "τ̂ {tau}: δ̂ {d} F̂ {f}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_free_surface_creeps_back_with_the_retardation_time() {
+        // After a contact the surface under the axis is still depressed; free, it comes
+        // back as e^{−t/((1 + r)τ̂_r)} (an SLS under no load creeps with its retardation
+        // time τ_r E₀/E_∞).
+        let (r, tau) = (2.0, 0.3);
+        let mut s = RelaxingHalfSpace::new(r, tau, 1.0, 100).unwrap();
+        s.advance(0.0, 1.0, 1.0).unwrap();
+        s.advance(1.0, -1.0, 2.0).unwrap();
+        let (depth, later) = (s.surface_depth_hat(), {
+            s.advance(-1.0, -1.0, 0.5).unwrap();
+            s.surface_depth_hat()
+        });
+        assert!(depth > 0.0 && s.force_hat(-1.0) == 0.0, "{depth}");
+        let expected = depth * (-0.5 / ((1.0 + r) * tau)).exp();
+        assert!(
+            (later - expected).abs() < 1e-12 * depth,
+            "{later} against {expected}"
+        );
+    }
+
+    #[test]
+    fn bad_input_is_refused() {
+        assert!(RelaxingHalfSpace::new(0.0, 1.0, 1.0, 10).is_err());
+        assert!(RelaxingHalfSpace::new(1.0, f64::NAN, 1.0, 10).is_err());
+        assert!(RelaxingHalfSpace::new(1.0, 1.0, 1.0, 1).is_err());
+        let mut s = RelaxingHalfSpace::new(1.0, 1.0, 1.0, 10).unwrap();
+        assert!(s.advance(0.0, 1.1, 1.0).is_err());
+        assert!(s.advance(0.0, f64::INFINITY, 1.0).is_err());
+        assert!(s.advance(0.0, 0.5, -1.0).is_err());
+    }
+}
