@@ -1,9 +1,11 @@
 //! A rigid sphere on a standard-linear-solid half-space, unloading included: the
 //! receding contact of Ting (J. Appl. Mech. 33, 845, 1966), computed by the method of
 //! dimensionality reduction (Popov & Heß, *Method of Dimensionality Reduction in Contact
-//! Mechanics and Friction*, Springer 2015, ch. 6; exact for a viscoelastic half-space
-//! under an axisymmetric indenter, unloading included: Argatov & Popov, ZAMM 96, 956,
-//! 2016).
+//! Mechanics and Friction*, Springer 2015; for viscoelastic media Popov, Willert & Heß,
+//! Facta Universitatis Mech. Eng. 16, 99, 2018; Ting's rebound reproduced: Argatov &
+//! Popov, ZAMM 96, 956, 2016). Ting's case, a touch of a relaxed surface, is checked
+//! here against his formulas; a touch of a surface that has not recovered from the last
+//! one rests on the reduction's claim for arbitrary histories, not checked here.
 //!
 //! Lee & Radok's hereditary Hertz integral (what [`crate::physics::law::StandardLinearSolid`]
 //! runs) holds while the contact grows. Once it shrinks, the force depends on the
