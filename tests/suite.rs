@@ -36,6 +36,7 @@ mod peakforce;
 mod readback;
 mod reconstruct;
 mod reconstruct_cli;
+mod relaxing;
 mod repeats;
 mod semi_rigid;
 mod setpoint;
