@@ -62,6 +62,11 @@ pub struct RelaxingHalfSpace {
     p: Vec<f64>,
     /// c_j.
     c: Vec<f64>,
+    /// The integrator step's start ([`RelaxingHalfSpace::begin_step`]): δ̂_n, dδ̂/dτ
+    /// there, ŷ_n.
+    step_start: (f64, f64, f64),
+    /// Whether each element touched at the step's start.
+    touching: Vec<bool>,
 }
 
 /// The state of one element: its Maxwell extension split as v̂ = c − pξ̂².
@@ -99,6 +104,8 @@ impl RelaxingHalfSpace {
             spacing,
             p: vec![0.0; nodes + 2],
             c: vec![0.0; nodes + 2],
+            step_start: (0.0, 0.0, 0.0),
+            touching: vec![false; nodes + 2],
         })
     }
 
@@ -155,13 +162,212 @@ impl RelaxingHalfSpace {
         Ok(())
     }
 
+    /// Open an integrator's step at indentation δ̂_n (rising at `rate_hat`), where the Maxwell mean the
+    /// integrator carries is ŷ_n (dŷ/dτ = (δ̂ − ŷ)/τ̂_r while the tip may touch): the
+    /// elements as they are now are the step's start. Within the step an element that
+    /// touches throughout has the Maxwell extension
+    ///
+    ///   c = c_n e^{−Δ/τ̂_r} + ŷ − ŷ_n e^{−Δ/τ̂_r},  p = 1 − (1 − p_n)e^{−Δ/τ̂_r}
+    ///
+    /// exactly, whatever the path of δ̂ (ŷ carries it), and one that stays free creeps
+    /// in closed form; one that touches or lets go within the step is switched where
+    /// its gap vanishes (cubic in time over the step, from its values and rates at
+    /// both ends).
+    ///
+    /// Refused at an indentation beyond [`RelaxingHalfSpace::reach_hat`] (a step's
+    /// points must stay within it too: the elements past it are not there).
+    pub fn begin_step(&mut self, indentation_hat: f64, rate_hat: f64, mean_hat: f64) -> Result<()> {
+        if !(indentation_hat.is_finite() && rate_hat.is_finite() && mean_hat.is_finite()) {
+            return Err(Error::Numerical(format!(
+                "relaxing half-space: a step from δ̂ = {indentation_hat}, rate {rate_hat}, mean {mean_hat}"
+            )));
+        }
+        if indentation_hat > self.reach_hat() {
+            return Err(Error::NotApplicable(format!(
+                "relaxing half-space: indentation {indentation_hat:.6} beyond the nodes' reach {:.6}",
+                self.reach_hat()
+            )));
+        }
+        self.step_start = (indentation_hat, rate_hat, mean_hat);
+        for j in 0..self.p.len() {
+            self.touching[j] = self.gap(j, self.stored(j), indentation_hat) > 0.0;
+        }
+        Ok(())
+    }
+
+    /// The force F̂ at `elapsed_hat` into the step opened by
+    /// [`RelaxingHalfSpace::begin_step`], where the indentation is `indentation_hat`
+    /// (rising at `rate_hat`) and the Maxwell mean `mean_hat` (the surface is not
+    /// changed).
+    pub fn force_in_step_hat(
+        &self,
+        indentation_hat: f64,
+        rate_hat: f64,
+        mean_hat: f64,
+        elapsed_hat: f64,
+    ) -> f64 {
+        let decays = self.decays(elapsed_hat);
+        let now = (indentation_hat, rate_hat, mean_hat);
+        self.force_of(indentation_hat, &|j| {
+            self.in_step(j, now, elapsed_hat, decays)
+        })
+    }
+
+    /// Close the step opened by [`RelaxingHalfSpace::begin_step`] at `elapsed_hat`,
+    /// indentation `indentation_hat` (rising at `rate_hat`) and Maxwell mean
+    /// `mean_hat`: the elements become what [`RelaxingHalfSpace::force_in_step_hat`]
+    /// saw there.
+    pub fn end_step(
+        &mut self,
+        indentation_hat: f64,
+        rate_hat: f64,
+        mean_hat: f64,
+        elapsed_hat: f64,
+    ) {
+        let decays = self.decays(elapsed_hat);
+        let now = (indentation_hat, rate_hat, mean_hat);
+        for j in 0..self.p.len() {
+            let e = self.in_step(j, now, elapsed_hat, decays);
+            self.p[j] = e.p;
+            self.c[j] = e.c;
+        }
+    }
+
+    /// e^{−Δ/τ̂_r} and e^{−Δ/((1 + r)τ̂_r)}.
+    fn decays(&self, elapsed_hat: f64) -> (f64, f64) {
+        (
+            (-elapsed_hat / self.relaxation_hat).exp(),
+            (-elapsed_hat / ((1.0 + self.modulus_ratio) * self.relaxation_hat)).exp(),
+        )
+    }
+
+    /// Element j's gap δ̂ − ξ̂² − κv̂ (positive where it touches).
+    fn gap(&self, j: usize, e: Element, indentation_hat: f64) -> f64 {
+        let xi2 = self.xi(j).powi(2);
+        let kappa = self.modulus_ratio / (1.0 + self.modulus_ratio);
+        indentation_hat - xi2 - kappa * (e.c - e.p * xi2)
+    }
+
+    /// Element j at `elapsed` into the step (see [`RelaxingHalfSpace::begin_step`]).
+    fn in_step(
+        &self,
+        j: usize,
+        (indentation, rate, mean): (f64, f64, f64),
+        elapsed: f64,
+        (decay, creep_decay): (f64, f64),
+    ) -> Element {
+        let (d_n, rate_n, y_n) = self.step_start;
+        let start = self.stored(j);
+        let tau = self.relaxation_hat;
+        let creep_time = (1.0 + self.modulus_ratio) * tau;
+        // Touching from a state `e` with the mean at `from`: the exact solution.
+        let touching = |e: Element, decay: f64, from: f64| Element {
+            p: 1.0 - (1.0 - e.p) * decay,
+            c: e.c * decay + mean - from * decay,
+        };
+        let creeping = |e: Element, decay: f64| Element {
+            p: e.p * decay,
+            c: e.c * decay,
+        };
+        // ŷ at a fraction of the step: cubic Hermite with dŷ/dτ = (δ̂ − ŷ)/τ̂_r at both
+        // ends (fourth order, where a linear interpolation would leave the surface's
+        // memory a second-order error).
+        let mean_at = |s: f64| {
+            let (r0, r1) = (
+                (d_n - y_n) / tau * elapsed,
+                (indentation - mean) / tau * elapsed,
+            );
+            let (s2, s3) = (s * s, s * s * s);
+            (2.0 * s3 - 3.0 * s2 + 1.0) * y_n
+                + (s3 - 2.0 * s2 + s) * r0
+                + (3.0 * s2 - 2.0 * s3) * mean
+                + (s3 - s2) * r1
+        };
+        let (e, touched) = if self.touching[j] {
+            (touching(start, decay, y_n), true)
+        } else {
+            (creeping(start, creep_decay), false)
+        };
+        let g = self.gap(j, e, indentation);
+        if g == 0.0 || (g > 0.0) == touched {
+            return e;
+        }
+        // Switched within the step, where the gap vanished: cubic in time from its
+        // values and rates at both ends (the instant fourth order, and the state more:
+        // the two motions' rates are equal at a switch).
+        let xi2 = self.xi(j).powi(2);
+        let kappa = self.modulus_ratio / (1.0 + self.modulus_ratio);
+        let v_rate = |e: Element, d: f64| {
+            let v = e.c - e.p * xi2;
+            if touched {
+                (d - xi2 - v) / tau
+            } else {
+                -v / creep_time
+            }
+        };
+        let g_n = self.gap(j, start, d_n);
+        let (r0, r1) = (
+            (rate_n - kappa * v_rate(start, d_n)) * elapsed,
+            (rate - kappa * v_rate(e, indentation)) * elapsed,
+        );
+        let hermite = |s: f64| {
+            let (s2, s3) = (s * s, s * s * s);
+            (
+                (2.0 * s3 - 3.0 * s2 + 1.0) * g_n
+                    + (s3 - 2.0 * s2 + s) * r0
+                    + (3.0 * s2 - 2.0 * s3) * g
+                    + (s3 - s2) * r1,
+                (6.0 * s2 - 6.0 * s) * g_n
+                    + (3.0 * s2 - 4.0 * s + 1.0) * r0
+                    + (6.0 * s - 6.0 * s2) * g
+                    + (3.0 * s2 - 2.0 * s) * r1,
+            )
+        };
+        let frac = newton_bracketed(hermite, 0.0, 1.0, 1e-14);
+        let at = frac * elapsed;
+        let rest = elapsed - at;
+        if touched {
+            let here = mean_at(frac);
+            let at_switch = Element {
+                p: 1.0 - (1.0 - start.p) * (-at / tau).exp(),
+                c: start.c * (-at / tau).exp() + here - y_n * (-at / tau).exp(),
+            };
+            creeping(at_switch, (-rest / creep_time).exp())
+        } else {
+            let at_switch = creeping(start, (-at / creep_time).exp());
+            touching(at_switch, (-rest / tau).exp(), mean_at(frac))
+        }
+    }
+
     /// The force F̂ (compressive positive; (4/3)δ̂^{3/2} for the relaxed elastic
     /// contact) at indentation `indentation_hat`, on the surface as it is now.
     pub fn force_hat(&self, indentation_hat: f64) -> f64 {
+        self.force_of(indentation_hat, &|j| self.stored(j))
+    }
+
+    /// The contact radius ξ̂ (= a/√(R·length unit)): the outermost point where the
+    /// elements' force is positive at `indentation_hat`, 0 out of contact.
+    pub fn contact_radius_hat(&self, indentation_hat: f64) -> f64 {
+        let node = |j| self.stored(j);
+        (0..self.p.len() - 1)
+            .rev()
+            .find_map(|j| self.touching_part(j, indentation_hat, &node))
+            .map_or(0.0, |(_, b, _)| b)
+    }
+
+    fn stored(&self, j: usize) -> Element {
+        Element {
+            p: self.p[j],
+            c: self.c[j],
+        }
+    }
+
+    /// F̂ = 2∫q̂ dξ̂ with the elements `node(j)`.
+    fn force_of(&self, indentation_hat: f64, node: &impl Fn(usize) -> Element) -> f64 {
         let total: f64 = (0..self.p.len() - 1)
             .filter_map(|j| {
-                let (a, b, line) = self.touching_part(j, indentation_hat)?;
-                let q = self.line_force(line, indentation_hat);
+                let (a, b, line) = self.touching_part(j, indentation_hat, node)?;
+                let q = self.line_force(line, indentation_hat, node);
                 let len = b - a;
                 Some(
                     0.5 * len
@@ -175,26 +381,20 @@ impl RelaxingHalfSpace {
         2.0 * total
     }
 
-    /// The contact radius ξ̂ (= a/√(R·length unit)): the outermost point where the
-    /// elements' force is positive at `indentation_hat`, 0 out of contact.
-    pub fn contact_radius_hat(&self, indentation_hat: f64) -> f64 {
-        (0..self.p.len() - 1)
-            .rev()
-            .find_map(|j| self.touching_part(j, indentation_hat))
-            .map_or(0.0, |(_, b, _)| b)
-    }
-
     /// The element force density q̂(ξ̂) = (1 + r)(δ̂ − ξ̂²) − r(c − pξ̂²) with p and c on
     /// the line through nodes k and k + 1 (a cubic in ξ̂), and its derivative.
-    fn line_force(&self, k: usize, indentation_hat: f64) -> impl Fn(f64) -> (f64, f64) + '_ {
+    fn line_force<N: Fn(usize) -> Element>(
+        &self,
+        k: usize,
+        indentation_hat: f64,
+        node: &N,
+    ) -> impl Fn(f64) -> (f64, f64) + use<N> {
         let (r, h, xk) = (self.modulus_ratio, self.spacing, self.xi(k));
-        let (dp, dc) = (
-            (self.p[k + 1] - self.p[k]) / h,
-            (self.c[k + 1] - self.c[k]) / h,
-        );
+        let (e0, e1) = (node(k), node(k + 1));
+        let (dp, dc) = ((e1.p - e0.p) / h, (e1.c - e0.c) / h);
         move |x: f64| {
-            let p = self.p[k] + (x - xk) * dp;
-            let c = self.c[k] + (x - xk) * dc;
+            let p = e0.p + (x - xk) * dp;
+            let c = e0.c + (x - xk) * dc;
             (
                 (1.0 + r) * (indentation_hat - x * x) - r * (c - p * x * x),
                 -2.0 * (1.0 + r) * x - r * (dc - dp * x * x - 2.0 * p * x),
@@ -202,27 +402,36 @@ impl RelaxingHalfSpace {
         }
     }
 
-    /// The part of cell j where q̂ > 0, and the node whose line gives q̂ there. Within the contact p and c are
-    /// interpolated between the cell's nodes; in a cell the contact's edge crosses
-    /// they are extrapolated from the touching side (the elements in contact vary
-    /// smoothly up to the edge; across it they do not), and the edge is located by
-    /// Newton. `None` where no element of the cell touches.
-    fn touching_part(&self, j: usize, indentation_hat: f64) -> Option<(f64, f64, usize)> {
+    /// The part of cell j where q̂ > 0, and the node whose line gives q̂ there. Within
+    /// the contact p and c are interpolated between the cell's nodes; in a cell the
+    /// contact's edge crosses they are extrapolated from the touching side (the
+    /// elements in contact vary smoothly up to the edge; across it they do not), and
+    /// the edge is located by Newton. `None` where no element of the cell touches.
+    fn touching_part(
+        &self,
+        j: usize,
+        indentation_hat: f64,
+        node: &impl Fn(usize) -> Element,
+    ) -> Option<(f64, f64, usize)> {
         let (x0, x1) = (self.xi(j), self.xi(j + 1));
         let last = self.p.len() - 2;
-        let at_node = |k: usize| self.line_force(k.min(last), indentation_hat)(self.xi(k)).0;
+        let r = self.modulus_ratio;
+        let at_node = |k: usize| {
+            let (e, x) = (node(k), self.xi(k));
+            (1.0 + r) * (indentation_hat - x * x) - r * (e.c - e.p * x * x)
+        };
         let (in0, in1) = (at_node(j) > 0.0, at_node(j + 1) > 0.0);
         let (line, a, b) = match (in0, in1) {
             (true, true) => (j, x0, x1),
             (false, false) => return None,
             (true, false) => {
                 let line = j.saturating_sub(1);
-                let q = self.line_force(line, indentation_hat);
+                let q = self.line_force(line, indentation_hat, node);
                 (line, x0, newton_bracketed(&q, x0, x1, 1e-15 * self.spacing))
             }
             (false, true) => {
                 let line = (j + 1).min(last);
-                let q = self.line_force(line, indentation_hat);
+                let q = self.line_force(line, indentation_hat, node);
                 (line, newton_bracketed(&q, x0, x1, 1e-15 * self.spacing), x1)
             }
         };
@@ -496,6 +705,59 @@ mod tests {
         );
     }
 
+    /// An integrator's steps through two taps: at each step's middle and end,
+    /// [`RelaxingHalfSpace::force_in_step_hat`] (ŷ exact) against the elements
+    /// advanced in fine steps. Returns the largest difference over the peak force.
+    fn stepped_error(tau: f64, step: f64) -> f64 {
+        let w = 2.0 * std::f64::consts::PI;
+        let depth = |t: f64| 0.5 - 0.8 * (w * t).cos();
+        let rate = |t: f64| 0.8 * w * (w * t).sin();
+        // The periodic solution of dŷ/dτ = (δ̂ − ŷ)/τ̂_r.
+        let mean = |t: f64| {
+            0.5 - 0.8 * ((w * t).cos() + w * tau * (w * t).sin()) / (1.0 + (w * tau).powi(2))
+        };
+        let mut fine = RelaxingHalfSpace::new(2.0, tau, 1.69, 60).unwrap();
+        let mut stepped = fine.clone();
+        let fine_steps = 200;
+        let mut advance_fine = |from: f64, to: f64| {
+            let dt = (to - from) / fine_steps as f64;
+            for i in 0..fine_steps {
+                let (a, b) = (from + i as f64 * dt, from + (i + 1) as f64 * dt);
+                fine.advance(depth(a), depth(b), dt).unwrap();
+            }
+            fine.force_hat(depth(to))
+        };
+        let (mut worst, mut peak) = (0.0f64, 0.0f64);
+        let steps = (2.0 / step).round() as usize;
+        for k in 0..steps {
+            let t = k as f64 * step;
+            stepped.begin_step(depth(t), rate(t), mean(t)).unwrap();
+            for (at, done) in [(t + 0.5 * step, false), (t + step, true)] {
+                let reference = advance_fine(if done { t + 0.5 * step } else { t }, at);
+                let f = stepped.force_in_step_hat(depth(at), rate(at), mean(at), at - t);
+                worst = worst.max((f - reference).abs());
+                peak = peak.max(reference);
+            }
+            stepped.end_step(depth(t + step), rate(t + step), mean(t + step), step);
+        }
+        worst / peak
+    }
+
+    #[test]
+    fn a_step_sees_the_force_its_elements_would_have() {
+        // Relaxation fast, near the contact time, slow against the period (the surface
+        // then remembers the last tap): fourth order or better in the step, 1e-9 of
+        // the peak at 200 steps a period (measured: 1.1e-7 to 3.5e-8 at 50 steps,
+        // 4e-10 to 9e-10 at 200).
+        for tau in [0.01, 0.05, 0.3] {
+            let (coarse, fine) = (stepped_error(tau, 0.02), stepped_error(tau, 0.005));
+            assert!(
+                fine < 2e-9 && coarse > 30.0 * fine,
+                "τ̂ {tau}: {coarse:e} → {fine:e}"
+            );
+        }
+    }
+
     #[test]
     fn bad_input_is_refused() {
         assert!(RelaxingHalfSpace::new(0.0, 1.0, 1.0, 10).is_err());
@@ -505,5 +767,7 @@ mod tests {
         assert!(s.advance(0.0, 1.1, 1.0).is_err());
         assert!(s.advance(0.0, f64::INFINITY, 1.0).is_err());
         assert!(s.advance(0.0, 0.5, -1.0).is_err());
+        assert!(s.begin_step(1.1, 0.0, 0.0).is_err());
+        assert!(s.begin_step(0.5, f64::NAN, 0.0).is_err());
     }
 }
