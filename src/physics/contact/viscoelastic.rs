@@ -79,33 +79,33 @@ struct Element {
 impl RelaxingHalfSpace {
     /// A relaxed, flat surface: modulus ratio r = (E₀ − E_∞)/E_∞ (> 0), relaxation time
     /// τ̂_r (> 0), for indentations up to `max_indentation_hat` (the nodes reach
-    /// ξ̂ = √δ̂_max), with `nodes` cells across that reach.
+    /// ξ̂ = √δ̂_max), with `cells` cells across that reach.
     pub fn new(
         modulus_ratio: f64,
         relaxation_hat: f64,
         max_indentation_hat: f64,
-        nodes: usize,
+        cells: usize,
     ) -> Result<Self> {
         positive("modulus ratio", modulus_ratio)?;
         positive("relaxation time", relaxation_hat)?;
         positive("largest indentation", max_indentation_hat)?;
-        if !(2..=1_000_000).contains(&nodes) {
+        if !(2..=1_000_000).contains(&cells) {
             return Err(Error::InvalidParameter {
-                name: "nodes",
-                value: nodes as f64,
+                name: "cells",
+                value: cells as f64,
                 reason: "between 2 and 10⁶",
             });
         }
         // One cell of margin: an edge in the last cell still has a node past it.
-        let spacing = max_indentation_hat.sqrt() / nodes as f64;
+        let spacing = max_indentation_hat.sqrt() / cells as f64;
         Ok(Self {
             modulus_ratio,
             relaxation_hat,
             spacing,
-            p: vec![0.0; nodes + 2],
-            c: vec![0.0; nodes + 2],
+            p: vec![0.0; cells + 2],
+            c: vec![0.0; cells + 2],
             step_start: (0.0, 0.0, 0.0),
-            touching: vec![false; nodes + 2],
+            touching: vec![false; cells + 2],
         })
     }
 
@@ -123,7 +123,9 @@ impl RelaxingHalfSpace {
     /// `from_hat` to `to_hat` (each element exactly; where it touches or lets go within
     /// the step, the instant is located). Refused past [`RelaxingHalfSpace::reach_hat`].
     pub fn advance(&mut self, from_hat: f64, to_hat: f64, duration_hat: f64) -> Result<()> {
-        if !(from_hat.is_finite() && to_hat.is_finite() && duration_hat >= 0.0) {
+        if !(from_hat.is_finite() && to_hat.is_finite() && duration_hat.is_finite())
+            || duration_hat < 0.0
+        {
             return Err(Error::Numerical(format!(
                 "relaxing half-space: a step from δ̂ = {from_hat} to {to_hat} over {duration_hat}"
             )));
@@ -767,6 +769,7 @@ mod tests {
         assert!(s.advance(0.0, 1.1, 1.0).is_err());
         assert!(s.advance(0.0, f64::INFINITY, 1.0).is_err());
         assert!(s.advance(0.0, 0.5, -1.0).is_err());
+        assert!(s.advance(0.0, 0.5, f64::INFINITY).is_err());
         assert!(s.begin_step(1.1, 0.0, 0.0).is_err());
         assert!(s.begin_step(0.5, f64::NAN, 0.0).is_err());
     }
