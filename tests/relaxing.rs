@@ -43,90 +43,152 @@ struct Orbit {
     most_tensile_n: f64,
 }
 
+/// The lever and sample in the reference's units: time τ = ω₀t, the drive
+/// F₀ cos τ with F₀ = kA₀/Q, the half-space's indentation in nm.
+struct Lever {
+    k: f64,
+    q: f64,
+    a0: f64,
+    zc: f64,
+    radius: f64,
+    e_inf: f64,
+    /// τ̂_r.
+    tau_hat: f64,
+    /// F̂ to newtons.
+    force_unit: f64,
+}
+
+const UNIT_M: f64 = 1e-9;
+
+impl Lever {
+    fn new(tau_s: f64) -> Self {
+        let s = setup(LawKind::Hertz.into());
+        assert_eq!(s.cantilever.drive_frequency_hz, s.cantilever.resonance_hz);
+        Self {
+            k: s.cantilever.stiffness_n_m,
+            q: s.cantilever.quality,
+            a0: s.cantilever.free_amplitude_m,
+            zc: s.separation_m,
+            radius: s.contact.radius_m,
+            e_inf: s.contact.modulus_pa,
+            tau_hat: 2.0 * PI * s.cantilever.resonance_hz * tau_s,
+            force_unit: s.contact.modulus_pa * s.contact.radius_m.sqrt() * UNIT_M.powf(1.5),
+        }
+    }
+
+    /// z'' of the lever at τ under the force f (N).
+    fn acceleration(&self, t: f64, z: f64, v: f64, f: f64) -> f64 {
+        self.a0 / self.q * t.cos() + f / self.k - z - v / self.q
+    }
+
+    /// The indentation δ̂ at deflection z.
+    fn indentation(&self, z: f64) -> f64 {
+        -(self.zc + z) / UNIT_M
+    }
+
+    /// A half-space with 2E_∞ in its Maxwell arm, reaching 2 nm deep.
+    fn surface(&self, cells: usize) -> RelaxingHalfSpace {
+        RelaxingHalfSpace::new(2.0, self.tau_hat, 4.0, cells).unwrap()
+    }
+
+    /// Run `periods` periods of `steps` steps from (τ, z, F) = `start`, `step` taking the
+    /// motion one step and returning the new (τ, z, F); the last period observed once
+    /// its amplitude has settled to 1e-7 from the one before.
+    fn settle(
+        &self,
+        periods: usize,
+        steps: usize,
+        start: (f64, f64, f64),
+        mut step: impl FnMut() -> (f64, f64, f64),
+        what: &str,
+    ) -> Orbit {
+        let (mut t, mut z, mut f) = start;
+        let mut previous = f64::NAN;
+        for period in 0..periods {
+            let (mut x_c, mut x_s, mut work, mut most_tensile) = (0.0, 0.0, 0.0, 0.0f64);
+            for _ in 0..steps {
+                let (t1, z1, f1) = step();
+                let dt = t1 - t;
+                work -= 0.5 * (f + f1) * (z1 - z);
+                x_c += 0.5 * (z * t.cos() + z1 * t1.cos()) * dt / PI;
+                x_s += 0.5 * (z * t.sin() + z1 * t1.sin()) * dt / PI;
+                most_tensile = most_tensile.min(f1);
+                (t, z, f) = (t1, z1, f1);
+            }
+            let amplitude = x_c.hypot(x_s);
+            if period + 1 == periods {
+                assert!(
+                    ((amplitude - previous) / amplitude).abs() < 1e-7,
+                    "{what} has not settled: {amplitude:e} after {previous:e}"
+                );
+                let orbit = Orbit {
+                    amplitude_ratio: amplitude / self.a0,
+                    phase_deg: x_s.atan2(x_c).to_degrees(),
+                    e_ts_ev: work / EV,
+                    most_tensile_n: most_tensile,
+                };
+                eprintln!("{what}: {orbit:?}");
+                return orbit;
+            }
+            previous = amplitude;
+        }
+        unreachable!("the last period returns")
+    }
+}
+
 /// The steady orbit on a sample with unrelaxed modulus 3E* and relaxation time `tau_s`,
-/// by velocity Verlet at `steps` a period for `periods` periods (the last one observed,
-/// after the amplitude has settled to 1e-7 from one period to the next).
+/// by velocity Verlet at `steps` a period for `periods` periods, the sample's state
+/// advanced exactly along each step's straight-line indentation.
 fn reference(tau_s: f64, sample: Sample, steps: usize, periods: usize) -> Orbit {
-    let s = setup(LawKind::Hertz.into());
-    let (k, q) = (s.cantilever.stiffness_n_m, s.cantilever.quality);
-    let (a0, zc) = (s.cantilever.free_amplitude_m, s.separation_m);
-    let (radius, e_inf) = (s.contact.radius_m, s.contact.modulus_pa);
-    let e0 = 3.0 * e_inf;
-    assert_eq!(s.cantilever.drive_frequency_hz, s.cantilever.resonance_hz);
-    // Time in τ = ω₀t; the drive F₀ cos τ with F₀ = kA₀/Q.
-    let tau_hat = 2.0 * PI * s.cantilever.resonance_hz * tau_s;
+    let lever = Lever::new(tau_s);
     let dt = 2.0 * PI / steps as f64;
-    let unit: f64 = 1e-9; // the indentation unit of the half-space
-    let force_unit = e_inf * radius.sqrt() * unit.powf(1.5);
-    let hertz = |d: f64| 4.0 / 3.0 * radius.sqrt() * d.max(0.0).powf(1.5);
-    let mut surface = RelaxingHalfSpace::new(
-        2.0,
-        tau_hat,
-        4.0,
-        match sample {
-            Sample::Ting { cells } => cells,
-            Sample::LeeRadok => 2,
-        },
-    )
-    .unwrap();
+    let hertz = |d: f64| 4.0 / 3.0 * lever.radius.sqrt() * d.max(0.0).powf(1.5);
+    let mut surface = lever.surface(match sample {
+        Sample::Ting { cells } => cells,
+        Sample::LeeRadok => 2,
+    });
     // Lee & Radok's Maxwell arm m (N per unit modulus): dm/dτ = dH/dτ − m/τ̂_r.
     let mut arm = 0.0;
     let force = |surface: &RelaxingHalfSpace, arm: f64, z: f64| {
-        let d = -(zc + z);
+        let d = -(lever.zc + z);
         match sample {
-            Sample::Ting { .. } => force_unit * surface.force_hat(d / unit),
-            Sample::LeeRadok if d > 0.0 => e_inf * hertz(d) + (e0 - e_inf) * arm,
+            Sample::Ting { .. } => lever.force_unit * surface.force_hat(d / UNIT_M),
+            Sample::LeeRadok if d > 0.0 => lever.e_inf * (hertz(d) + 2.0 * arm),
             Sample::LeeRadok => 0.0,
         }
     };
     // Start near the tapping orbit (z = 0, going up at 13 nm a radian).
     let (mut z, mut v, mut t): (f64, f64, f64) = (0.0, 13e-9, 0.0);
     let mut f = force(&surface, arm, z);
-    let mut previous = f64::NAN;
-    let mut orbit = None;
-    for period in 0..periods {
-        let (mut x_c, mut x_s, mut work, mut most_tensile) = (0.0, 0.0, 0.0, 0.0f64);
-        for _ in 0..steps {
-            let half = v + 0.5 * dt * ((a0 / q * t.cos() * k + f) / k - z - v / q);
+    let start = (t, z, f);
+    lever.settle(
+        periods,
+        steps,
+        start,
+        || {
+            let half = v + 0.5 * dt * lever.acceleration(t, z, v, f);
             let z1 = z + dt * half;
-            let (d0, d1) = (-(zc + z), -(zc + z1));
+            let (d0, d1) = (-(lever.zc + z), -(lever.zc + z1));
             match sample {
                 Sample::Ting { .. } => surface
-                    .advance(d0.max(-2e-9) / unit, d1.max(-2e-9) / unit, dt)
+                    .advance(d0.max(-2e-9) / UNIT_M, d1.max(-2e-9) / UNIT_M, dt)
                     .unwrap(),
                 Sample::LeeRadok => {
-                    let decay = (-dt / tau_hat).exp();
-                    arm = arm * decay + (hertz(d1) - hertz(d0)) / dt * tau_hat * (1.0 - decay);
+                    let decay = (-dt / lever.tau_hat).exp();
+                    arm =
+                        arm * decay + (hertz(d1) - hertz(d0)) / dt * lever.tau_hat * (1.0 - decay);
                 }
             }
             let f1 = force(&surface, arm, z1);
             let t1 = t + dt;
-            let v1 =
-                (half + 0.5 * dt * ((a0 / q * t1.cos() * k + f1) / k - z1)) / (1.0 + 0.5 * dt / q);
-            work -= 0.5 * (f + f1) * (z1 - z);
-            x_c += 0.5 * (z * t.cos() + z1 * t1.cos()) * dt / PI;
-            x_s += 0.5 * (z * t.sin() + z1 * t1.sin()) * dt / PI;
-            most_tensile = most_tensile.min(f1);
+            // The damping half-step implicit: the whole step symmetric.
+            let v1 = (half + 0.5 * dt * lever.acceleration(t1, z1, 0.0, f1))
+                / (1.0 + 0.5 * dt / lever.q);
             (z, v, f, t) = (z1, v1, f1, t1);
-        }
-        let amplitude = x_c.hypot(x_s);
-        if period + 1 == periods {
-            assert!(
-                ((amplitude - previous) / amplitude).abs() < 1e-7,
-                "{sample:?} at τ_r = {tau_s:e} s has not settled: {amplitude:e} after {previous:e}"
-            );
-            orbit = Some(Orbit {
-                amplitude_ratio: amplitude / a0,
-                phase_deg: x_s.atan2(x_c).to_degrees(),
-                e_ts_ev: work / EV,
-                most_tensile_n: most_tensile,
-            });
-        }
-        previous = amplitude;
-    }
-    let orbit = orbit.unwrap();
-    eprintln!("{sample:?}, τ_r = {tau_s:e} s: {orbit:?}");
-    orbit
+            (t, z, f)
+        },
+        &format!("{sample:?}, τ_r = {tau_s:e} s"),
+    )
 }
 
 /// The dynamics' Lee–Radok orbit is what an independent lever integration of the same
@@ -218,74 +280,47 @@ fn a_slowly_relaxing_surface_sinks_under_the_mean_tapping_force() {
 /// stages see [`RelaxingHalfSpace::force_in_step_hat`], the Maxwell mean ŷ integrated
 /// with the motion (dŷ/dτ = (δ̂ − ŷ)/τ̂_r), the step closed by `end_step`.
 fn runge_kutta_ting(tau_s: f64, cells: usize, steps: usize, periods: usize) -> Orbit {
-    let s = setup(LawKind::Hertz.into());
-    let (k, q) = (s.cantilever.stiffness_n_m, s.cantilever.quality);
-    let (a0, zc) = (s.cantilever.free_amplitude_m, s.separation_m);
-    let (radius, e_inf) = (s.contact.radius_m, s.contact.modulus_pa);
-    let tau_hat = 2.0 * PI * s.cantilever.resonance_hz * tau_s;
+    let lever = Lever::new(tau_s);
     let dt = 2.0 * PI / steps as f64;
-    let unit: f64 = 1e-9;
-    let force_unit = e_inf * radius.sqrt() * unit.powf(1.5);
-    let mut surface = RelaxingHalfSpace::new(2.0, tau_hat, 4.0, cells).unwrap();
+    let mut surface = lever.surface(cells);
     // (z, z', ŷ) and their rates `elapsed` into the step.
     let rates = |surface: &RelaxingHalfSpace, t: f64, y: [f64; 3], elapsed: f64| {
-        let (d, d_rate) = (-(zc + y[0]) / unit, -y[1] / unit);
-        let f = force_unit * surface.force_in_step_hat(d, d_rate, y[2], elapsed);
+        let (d, d_rate) = (lever.indentation(y[0]), -y[1] / UNIT_M);
+        let f = lever.force_unit * surface.force_in_step_hat(d, d_rate, y[2], elapsed);
         [
             y[1],
-            a0 / q * t.cos() + f / k - y[0] - y[1] / q,
-            (d - y[2]) / tau_hat,
+            lever.acceleration(t, y[0], y[1], f),
+            (d - y[2]) / lever.tau_hat,
         ]
     };
-    let plus =
-        |y: [f64; 3], r: [f64; 3], h: f64| [y[0] + h * r[0], y[1] + h * r[1], y[2] + h * r[2]];
-    let (mut y, mut t): ([f64; 3], f64) = ([0.0, 13e-9, 0.0], 0.0);
+    let plus = |y: [f64; 3], r: [f64; 3], h: f64| std::array::from_fn(|i| y[i] + h * r[i]);
     let force_now = |surface: &RelaxingHalfSpace, y: [f64; 3]| {
-        force_unit * surface.force_hat(-(zc + y[0]) / unit)
+        lever.force_unit * surface.force_hat(lever.indentation(y[0]))
     };
-    let mut f = force_now(&surface, y);
-    let mut previous = f64::NAN;
-    let mut orbit = None;
-    for period in 0..periods {
-        let (mut x_c, mut x_s, mut work, mut most_tensile) = (0.0, 0.0, 0.0, 0.0f64);
-        for _ in 0..steps {
+    let (mut y, mut t): ([f64; 3], f64) = ([0.0, 13e-9, 0.0], 0.0);
+    let start = (t, y[0], force_now(&surface, y));
+    lever.settle(
+        periods,
+        steps,
+        start,
+        || {
+            let rate = -y[1] / UNIT_M;
             surface
-                .begin_step(-(zc + y[0]) / unit, -y[1] / unit, y[2])
+                .begin_step(lever.indentation(y[0]), rate, y[2])
                 .unwrap();
             let k1 = rates(&surface, t, y, 0.0);
             let k2 = rates(&surface, t + 0.5 * dt, plus(y, k1, 0.5 * dt), 0.5 * dt);
             let k3 = rates(&surface, t + 0.5 * dt, plus(y, k2, 0.5 * dt), 0.5 * dt);
             let k4 = rates(&surface, t + dt, plus(y, k3, dt), dt);
-            let y1: [f64; 3] = std::array::from_fn(|i| {
+            y = std::array::from_fn(|i| {
                 y[i] + dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
             });
-            surface.end_step(-(zc + y1[0]) / unit, -y1[1] / unit, y1[2], dt);
-            let f1 = force_now(&surface, y1);
-            let t1 = t + dt;
-            work -= 0.5 * (f + f1) * (y1[0] - y[0]);
-            x_c += 0.5 * (y[0] * t.cos() + y1[0] * t1.cos()) * dt / PI;
-            x_s += 0.5 * (y[0] * t.sin() + y1[0] * t1.sin()) * dt / PI;
-            most_tensile = most_tensile.min(f1);
-            (y, f, t) = (y1, f1, t1);
-        }
-        let amplitude = x_c.hypot(x_s);
-        if period + 1 == periods {
-            assert!(
-                ((amplitude - previous) / amplitude).abs() < 1e-7,
-                "not settled"
-            );
-            orbit = Some(Orbit {
-                amplitude_ratio: amplitude / a0,
-                phase_deg: x_s.atan2(x_c).to_degrees(),
-                e_ts_ev: work / EV,
-                most_tensile_n: most_tensile,
-            });
-        }
-        previous = amplitude;
-    }
-    let orbit = orbit.unwrap();
-    eprintln!("Runge–Kutta on Ting, τ_r = {tau_s:e} s, {steps} steps: {orbit:?}");
-    orbit
+            surface.end_step(lever.indentation(y[0]), -y[1] / UNIT_M, y[2], dt);
+            t += dt;
+            (t, y[0], force_now(&surface, y))
+        },
+        &format!("Runge–Kutta on Ting, τ_r = {tau_s:e} s, {steps} steps"),
+    )
 }
 
 /// Ting's contact driven step by step as the dynamics will drive it (the stages seeing
