@@ -352,3 +352,107 @@ fn tings_contact_driven_step_by_step_settles_on_the_reference_orbit() {
         "{verlet:?}"
     );
 }
+
+/// The slow limit computed without any relaxation: the unrelaxed (E₀) elastic contact
+/// on a frozen reduced surface v̄(ξ̂), iterated to v̄ = ⟨û⟩ over the orbit (each
+/// element's Maxwell arm at its mean displacement, which is where a relaxation slow
+/// against the period leaves it). Its own quadrature (v̄ linear between nodes, the
+/// positive part of the quadratic integrated exactly), its own loop. Returns the
+/// orbit's (A/A₀, φ) and the surface's depth under the axis in nm.
+fn sunk_surface_limit(cells: usize, steps: usize) -> (f64, f64, f64) {
+    let lever = Lever::new(1.0);
+    let (r, kappa) = (2.0, 2.0 / 3.0);
+    let h = 2.0 / cells as f64;
+    let force = |d: f64, v: &[f64]| {
+        let mut total = 0.0;
+        for j in 0..cells {
+            let x0 = j as f64 * h;
+            let dv = (v[j + 1] - v[j]) / h;
+            // q̂ = aξ̂² + bξ̂ + c in the cell, concave.
+            let (a, b, c) = (-(1.0 + r), -r * dv, (1.0 + r) * d - r * (v[j] - dv * x0));
+            let disc = b * b - 4.0 * a * c;
+            if disc > 0.0 {
+                let (r1, r2) = (
+                    (-b + disc.sqrt()) / (2.0 * a),
+                    (-b - disc.sqrt()) / (2.0 * a),
+                );
+                let (lo, hi) = (r1.min(r2).max(x0), r1.max(r2).min(x0 + h));
+                let prim = |x: f64| ((a / 3.0 * x + b / 2.0) * x + c) * x;
+                if hi > lo {
+                    total += prim(hi) - prim(lo);
+                }
+            }
+        }
+        lever.force_unit * 2.0 * total
+    };
+    let dt = 2.0 * PI / steps as f64;
+    let mut surface = vec![0.0; cells + 1];
+    let (mut z, mut v, mut t): (f64, f64, f64) = (0.0, 13e-9, 0.0);
+    let mut orbit = (0.0, 0.0);
+    for _ in 0..60 {
+        let mut mean = vec![0.0; cells + 1];
+        let (mut x_c, mut x_s) = (0.0, 0.0);
+        let mut f = force(lever.indentation(z), &surface);
+        for period in 0..200 {
+            let last = period == 199;
+            for _ in 0..steps {
+                let half = v + 0.5 * dt * lever.acceleration(t, z, v, f);
+                let z1 = z + dt * half;
+                let f1 = force(lever.indentation(z1), &surface);
+                let t1 = t + dt;
+                let v1 = (half + 0.5 * dt * lever.acceleration(t1, z1, 0.0, f1))
+                    / (1.0 + 0.5 * dt / lever.q);
+                if last {
+                    x_c += 0.5 * (z * t.cos() + z1 * t1.cos()) * dt / PI;
+                    x_s += 0.5 * (z * t.sin() + z1 * t1.sin()) * dt / PI;
+                    let d = lever.indentation(z1);
+                    for (j, m) in mean.iter_mut().enumerate() {
+                        let xi2 = (j as f64 * h).powi(2);
+                        *m += (d - xi2).max(kappa * surface[j]) / steps as f64;
+                    }
+                }
+                (z, v, f, t) = (z1, v1, f1, t1);
+            }
+        }
+        let change = mean
+            .iter()
+            .zip(&surface)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        orbit = (x_c.hypot(x_s) / lever.a0, x_s.atan2(x_c).to_degrees());
+        surface = mean;
+        if change < 1e-6 {
+            eprintln!(
+                "sunk surface: A/A₀ {:.7}, φ {:.5}°, depth {:.5} nm",
+                orbit.0,
+                orbit.1,
+                kappa * surface[0]
+            );
+            return (orbit.0, orbit.1, kappa * surface[0]);
+        }
+    }
+    panic!("the sunk surface did not settle: {orbit:?}");
+}
+
+/// The slow limit is the unrelaxed contact on the sunk surface: the relaxing surface at
+/// τ_r = 100 µs settles on the orbit the fixed point finds, up to its own loss, which
+/// falls as 1/τ_r (measured: the fixed point A/A₀ 0.6418741, φ 39.93192°, the surface
+/// 0.1050 nm deep under the axis; at 100 µs 0.6418724 and 39.93895°; the bare unrelaxed
+/// contact 0.638242).
+#[test]
+#[ignore = "release: a fixed point of 200-period marches"]
+fn the_slow_limit_is_the_unrelaxed_contact_on_the_sunk_surface() {
+    let (amplitude_ratio, phase_deg, depth_nm) = sunk_surface_limit(48, 2000);
+    let slow = reference(1e-4, Sample::Ting { cells: 48 }, 2000, 1500);
+    let unrelaxed = elastic(3e9);
+    assert!(
+        (slow.amplitude_ratio - amplitude_ratio).abs() < 2e-5,
+        "{slow:?}"
+    );
+    // The loss (0.048 eV a cycle) lifts φ by about 0.007°.
+    assert!(
+        (0.0..0.015).contains(&(slow.phase_deg - phase_deg)),
+        "{slow:?}"
+    );
+    assert!(amplitude_ratio > 1.003 * unrelaxed.amplitude_ratio && depth_nm > 0.05);
+}
