@@ -76,6 +76,33 @@ struct Element {
     c: f64,
 }
 
+impl Element {
+    /// The element after creeping free (dv̂/dτ = −v̂/((1 + r)τ̂_r)), `decay` the factor
+    /// e^{−s/((1 + r)τ̂_r)} of the time s.
+    fn creep(self, decay: f64) -> Self {
+        Self {
+            p: self.p * decay,
+            c: self.c * decay,
+        }
+    }
+}
+
+/// The cubic Hermite interpolant on [0, 1] with values y₀, y₁ and slopes r₀, r₁ (per
+/// unit of s) at its ends, and its derivative, at s.
+fn hermite(s: f64, (y0, r0): (f64, f64), (y1, r1): (f64, f64)) -> (f64, f64) {
+    let (s2, s3) = (s * s, s * s * s);
+    (
+        (2.0 * s3 - 3.0 * s2 + 1.0) * y0
+            + (s3 - 2.0 * s2 + s) * r0
+            + (3.0 * s2 - 2.0 * s3) * y1
+            + (s3 - s2) * r1,
+        (6.0 * s2 - 6.0 * s) * y0
+            + (3.0 * s2 - 4.0 * s + 1.0) * r0
+            + (6.0 * s - 6.0 * s2) * y1
+            + (3.0 * s2 - 2.0 * s) * r1,
+    )
+}
+
 impl RelaxingHalfSpace {
     /// A relaxed, flat surface: modulus ratio r = (E₀ − E_∞)/E_∞ (> 0), relaxation time
     /// τ̂_r (> 0), for indentations up to `max_indentation_hat` (the nodes reach
@@ -119,6 +146,27 @@ impl RelaxingHalfSpace {
         self.spacing * j as f64
     }
 
+    /// κ = r/(1 + r): the free surface sits at κv̂.
+    fn kappa(&self) -> f64 {
+        self.modulus_ratio / (1.0 + self.modulus_ratio)
+    }
+
+    /// The retardation time (1 + r)τ̂_r a free element creeps back with.
+    fn creep_hat(&self) -> f64 {
+        (1.0 + self.modulus_ratio) * self.relaxation_hat
+    }
+
+    /// Refuse an indentation beyond [`RelaxingHalfSpace::reach_hat`].
+    fn within_reach(&self, indentation_hat: f64) -> Result<()> {
+        if indentation_hat > self.reach_hat() {
+            return Err(Error::NotApplicable(format!(
+                "relaxing half-space: indentation {indentation_hat:.6} beyond the nodes' reach {:.6}",
+                self.reach_hat()
+            )));
+        }
+        Ok(())
+    }
+
     /// Advance the surface by `duration_hat` while the indentation goes linearly from
     /// `from_hat` to `to_hat` (each element exactly; where it touches or lets go within
     /// the step, the instant is located). Refused past [`RelaxingHalfSpace::reach_hat`].
@@ -130,13 +178,7 @@ impl RelaxingHalfSpace {
                 "relaxing half-space: a step from δ̂ = {from_hat} to {to_hat} over {duration_hat}"
             )));
         }
-        if from_hat.max(to_hat) > self.reach_hat() {
-            return Err(Error::NotApplicable(format!(
-                "relaxing half-space: indentation {:.6} beyond the nodes' reach {:.6}",
-                from_hat.max(to_hat),
-                self.reach_hat()
-            )));
-        }
+        self.within_reach(from_hat.max(to_hat))?;
         if duration_hat == 0.0 {
             return Ok(());
         }
@@ -144,8 +186,8 @@ impl RelaxingHalfSpace {
             d0: from_hat,
             slope: (to_hat - from_hat) / duration_hat,
             tau: self.relaxation_hat,
-            kappa: self.modulus_ratio / (1.0 + self.modulus_ratio),
-            creep: (1.0 + self.modulus_ratio) * self.relaxation_hat,
+            kappa: self.kappa(),
+            creep: self.creep_hat(),
         };
         let (decay, creep_decay) = (
             (-duration_hat / step.tau).exp(),
@@ -153,11 +195,7 @@ impl RelaxingHalfSpace {
         );
         for j in 0..self.p.len() {
             let xi2 = self.xi(j).powi(2);
-            let e = Element {
-                p: self.p[j],
-                c: self.c[j],
-            };
-            let next = step.advance(e, xi2, duration_hat, (decay, creep_decay))?;
+            let next = step.advance(self.stored(j), xi2, duration_hat, (decay, creep_decay))?;
             self.p[j] = next.p;
             self.c[j] = next.c;
         }
@@ -184,12 +222,7 @@ impl RelaxingHalfSpace {
                 "relaxing half-space: a step from δ̂ = {indentation_hat}, rate {rate_hat}, mean {mean_hat}"
             )));
         }
-        if indentation_hat > self.reach_hat() {
-            return Err(Error::NotApplicable(format!(
-                "relaxing half-space: indentation {indentation_hat:.6} beyond the nodes' reach {:.6}",
-                self.reach_hat()
-            )));
-        }
+        self.within_reach(indentation_hat)?;
         self.step_start = (indentation_hat, rate_hat, mean_hat);
         for j in 0..self.p.len() {
             self.touching[j] = self.gap(j, self.stored(j), indentation_hat) > 0.0;
@@ -239,15 +272,14 @@ impl RelaxingHalfSpace {
     fn decays(&self, elapsed_hat: f64) -> (f64, f64) {
         (
             (-elapsed_hat / self.relaxation_hat).exp(),
-            (-elapsed_hat / ((1.0 + self.modulus_ratio) * self.relaxation_hat)).exp(),
+            (-elapsed_hat / self.creep_hat()).exp(),
         )
     }
 
     /// Element j's gap δ̂ − ξ̂² − κv̂ (positive where it touches).
     fn gap(&self, j: usize, e: Element, indentation_hat: f64) -> f64 {
         let xi2 = self.xi(j).powi(2);
-        let kappa = self.modulus_ratio / (1.0 + self.modulus_ratio);
-        indentation_hat - xi2 - kappa * (e.c - e.p * xi2)
+        indentation_hat - xi2 - self.kappa() * (e.c - e.p * xi2)
     }
 
     /// Element j at `elapsed` into the step (see [`RelaxingHalfSpace::begin_step`]).
@@ -260,35 +292,16 @@ impl RelaxingHalfSpace {
     ) -> Element {
         let (d_n, rate_n, y_n) = self.step_start;
         let start = self.stored(j);
-        let tau = self.relaxation_hat;
-        let creep_time = (1.0 + self.modulus_ratio) * tau;
-        // Touching from a state `e` with the mean at `from`: the exact solution.
-        let touching = |e: Element, decay: f64, from: f64| Element {
+        let (tau, creep_time) = (self.relaxation_hat, self.creep_hat());
+        // Touching from `e` while the mean goes from `from` to `to`: the exact solution.
+        let touching = |e: Element, decay: f64, from: f64, to: f64| Element {
             p: 1.0 - (1.0 - e.p) * decay,
-            c: e.c * decay + mean - from * decay,
-        };
-        let creeping = |e: Element, decay: f64| Element {
-            p: e.p * decay,
-            c: e.c * decay,
-        };
-        // ŷ at a fraction of the step: cubic Hermite with dŷ/dτ = (δ̂ − ŷ)/τ̂_r at both
-        // ends (fourth order, where a linear interpolation would leave the surface's
-        // memory a second-order error).
-        let mean_at = |s: f64| {
-            let (r0, r1) = (
-                (d_n - y_n) / tau * elapsed,
-                (indentation - mean) / tau * elapsed,
-            );
-            let (s2, s3) = (s * s, s * s * s);
-            (2.0 * s3 - 3.0 * s2 + 1.0) * y_n
-                + (s3 - 2.0 * s2 + s) * r0
-                + (3.0 * s2 - 2.0 * s3) * mean
-                + (s3 - s2) * r1
+            c: e.c * decay + to - from * decay,
         };
         let (e, touched) = if self.touching[j] {
-            (touching(start, decay, y_n), true)
+            (touching(start, decay, y_n, mean), true)
         } else {
-            (creeping(start, creep_decay), false)
+            (start.creep(creep_decay), false)
         };
         let g = self.gap(j, e, indentation);
         if g == 0.0 || (g > 0.0) == touched {
@@ -298,7 +311,6 @@ impl RelaxingHalfSpace {
         // values and rates at both ends (the instant fourth order, and the state more:
         // the two motions' rates are equal at a switch).
         let xi2 = self.xi(j).powi(2);
-        let kappa = self.modulus_ratio / (1.0 + self.modulus_ratio);
         let v_rate = |e: Element, d: f64| {
             let v = e.c - e.p * xi2;
             if touched {
@@ -307,37 +319,34 @@ impl RelaxingHalfSpace {
                 -v / creep_time
             }
         };
-        let g_n = self.gap(j, start, d_n);
-        let (r0, r1) = (
-            (rate_n - kappa * v_rate(start, d_n)) * elapsed,
-            (rate - kappa * v_rate(e, indentation)) * elapsed,
+        let gap_rate =
+            |e: Element, d: f64, rate: f64| (rate - self.kappa() * v_rate(e, d)) * elapsed;
+        let frac = newton_bracketed(
+            |s| {
+                hermite(
+                    s,
+                    (self.gap(j, start, d_n), gap_rate(start, d_n, rate_n)),
+                    (g, gap_rate(e, indentation, rate)),
+                )
+            },
+            0.0,
+            1.0,
+            1e-14,
         );
-        let hermite = |s: f64| {
-            let (s2, s3) = (s * s, s * s * s);
-            (
-                (2.0 * s3 - 3.0 * s2 + 1.0) * g_n
-                    + (s3 - 2.0 * s2 + s) * r0
-                    + (3.0 * s2 - 2.0 * s3) * g
-                    + (s3 - s2) * r1,
-                (6.0 * s2 - 6.0 * s) * g_n
-                    + (3.0 * s2 - 4.0 * s + 1.0) * r0
-                    + (6.0 * s - 6.0 * s2) * g
-                    + (3.0 * s2 - 2.0 * s) * r1,
-            )
-        };
-        let frac = newton_bracketed(hermite, 0.0, 1.0, 1e-14);
-        let at = frac * elapsed;
-        let rest = elapsed - at;
+        // ŷ there: cubic Hermite with dŷ/dτ = (δ̂ − ŷ)/τ̂_r at both ends (fourth order,
+        // where a linear interpolation would leave the surface's memory a second-order
+        // error).
+        let (mean_there, _) = hermite(
+            frac,
+            (y_n, (d_n - y_n) / tau * elapsed),
+            (mean, (indentation - mean) / tau * elapsed),
+        );
+        let (at, rest) = (frac * elapsed, (1.0 - frac) * elapsed);
         if touched {
-            let here = mean_at(frac);
-            let at_switch = Element {
-                p: 1.0 - (1.0 - start.p) * (-at / tau).exp(),
-                c: start.c * (-at / tau).exp() + here - y_n * (-at / tau).exp(),
-            };
-            creeping(at_switch, (-rest / creep_time).exp())
+            touching(start, (-at / tau).exp(), y_n, mean_there).creep((-rest / creep_time).exp())
         } else {
-            let at_switch = creeping(start, (-at / creep_time).exp());
-            touching(at_switch, (-rest / tau).exp(), mean_at(frac))
+            let at_switch = start.creep((-at / creep_time).exp());
+            touching(at_switch, (-rest / tau).exp(), mean_there, mean)
         }
     }
 
@@ -443,7 +452,7 @@ impl RelaxingHalfSpace {
     /// The free surface's depth under the axis, κv̂(0) (positive below the undeformed
     /// level): where the tip next touches.
     pub fn surface_depth_hat(&self) -> f64 {
-        self.modulus_ratio / (1.0 + self.modulus_ratio) * self.c[0]
+        self.kappa() * self.c[0]
     }
 }
 
@@ -483,10 +492,7 @@ impl Step {
                 c: e.c * decay + (self.d0 + self.slope * from) * m + self.slope * s * phi,
             }
         } else {
-            Element {
-                p: e.p * decay,
-                c: e.c * decay,
-            }
+            e.creep(decay)
         }
     }
 
