@@ -238,6 +238,15 @@ fn tings_contact_never_pulls_and_loses_less_than_lee_radoks() {
         ting.e_ts_ev < 0.7 * lee_radok.e_ts_ev,
         "{ting:?} {lee_radok:?}"
     );
+    // The design notes' numbers: about 26 eV against 46, the phase some 3° lower.
+    assert!(
+        (ting.e_ts_ev - 26.0).abs() < 0.5 && (lee_radok.e_ts_ev - 46.0).abs() < 0.5,
+        "{ting:?} {lee_radok:?}"
+    );
+    assert!(
+        (lee_radok.phase_deg - ting.phase_deg - 3.3).abs() < 0.3,
+        "{ting:?} {lee_radok:?}"
+    );
     let fast = reference(1e-11, Sample::Ting { cells: 48 }, 2000, 1500);
     let relaxed = elastic(1e9);
     assert!(
