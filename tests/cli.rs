@@ -1290,9 +1290,11 @@ fn a_relaxing_sample_is_a_law_parameter_checked_against_the_law() {
     ];
     let v = json(&args);
     assert_eq!(v["law"], "hertz+sls");
-    // With a capillary neck too: every channel but the law's own (it has no loop).
+    // With a capillary neck too: every channel but the law's own (it has no loop). (Over
+    // 64 periods: on the sunk surface this neck holds the tip in an attractive state the
+    // march does not settle within its budget; tests/relaxing.rs runs a neck that does.)
     let mut necked = args.to_vec();
-    necked.extend(["--rupture-distance", "2nm"]);
+    necked.extend(["--rupture-distance", "2nm", "--max-cycles", "64"]);
     let n = json(&necked);
     assert_eq!(n["law"], "hertz+capillary+sls");
     assert!(
@@ -1301,12 +1303,14 @@ fn a_relaxing_sample_is_a_law_parameter_checked_against_the_law() {
     );
     assert_eq!(v["e_ts_viscous_j"], v["e_ts_j"]);
     assert!(num(&v, "e_ts_j") > 0.0 && num(&v, "energy_balance_rel") < 1e-6);
-    // Its Floquet multipliers: one per dimension of the section state (x, x', memory).
+    // Its orbit is marched to (the surface remembers every tap): no Floquet multipliers,
+    // stable because the march reached it.
     assert_eq!(
         v["floquet_multipliers"].as_array().map(Vec::len),
-        Some(3),
+        Some(0),
         "{v}"
     );
+    assert_eq!(v["stable"], true);
     a_file_gives_what_the_flags_give(
         "relaxing-config",
         "law = \"hertz\"\nunrelaxed-modulus = \"1.8GPa\"\nrelaxation-time = \"100ns\"\n",
@@ -1893,48 +1897,28 @@ fn version_completions_man_pages_and_help_come_from_the_definitions() {
     );
 }
 
-/// Where Lee & Radok's integral, run through unloading, pulls the tip beyond what the
-/// elastic law under the sample can (an outside check's case: Hertz, E* 1 → 3 GPa,
-/// τ_r = 100 ns at z_c = 12 nm pulls to −5.72 nN; a non-adhesive contact cannot pull),
-/// `tap` says so, with the pull its JSON reports; against DMT's own pull-off −2πRΔγ
-/// (12.566 nN at R = 20 nm, Δγ = 0.1 J/m²) likewise; the elastic sample gets no such note.
+/// A relaxing sample lets go of a withdrawing tip (Ting's receding contact): on an
+/// outside check's case (Hertz, E* 1 → 3 GPa, τ_r = 100 ns at z_c = 12 nm), where Lee &
+/// Radok's integral run through unloading pulled the tip to −5.72 nN, the most tensile
+/// force `tap` reports is none on Hertz: the sample adds no pull of its own.
 #[test]
-fn tap_says_where_the_relaxing_sample_pulls_the_tip() {
-    let case = |law: &'static str, relaxing: bool| {
-        let mut a = vec![
-            "tap",
-            "--law",
-            law,
-            "--modulus",
-            "1GPa",
-            "--separation",
-            "12nm",
-        ];
-        if relaxing {
-            a.extend(["--unrelaxed-modulus", "3GPa", "--relaxation-time", "100ns"]);
-        }
-        a
-    };
-    let note = "note: the relaxing sample pulls the tip to";
-    for (law, own_n) in [
-        ("hertz", 0.0),
-        ("dmt", -2.0 * std::f64::consts::PI * 20e-9 * 0.1),
-    ] {
-        let args = case(law, true);
-        let pull = num(&json_of(&args, &["--json"]), "peak_attractive_force_n");
-        assert!(pull < own_n - 1e-12, "{law}: {pull:e} against {own_n:e}");
-        let text = String::from_utf8(succeeds(&args).stdout).unwrap();
-        let said = format!("{note} {:.4} nN", pull * 1e9);
-        assert!(text.contains(&said), "{law}: {said:?} not in\n{text}");
-        let own = match own_n {
-            0.0 => "0 nN".to_string(),
-            f => format!("{:.4} nN", f * 1e9),
-        };
-        assert!(
-            text.contains(&format!("own most tensile force ({own})")),
-            "{text}"
-        );
-        let elastic = String::from_utf8(succeeds(&case(law, false)).stdout).unwrap();
-        assert!(!elastic.contains(note), "{law}: {elastic}");
-    }
+fn tap_on_a_relaxing_sample_never_pulls() {
+    let args = [
+        "tap",
+        "--law",
+        "hertz",
+        "--modulus",
+        "1GPa",
+        "--separation",
+        "12nm",
+        "--unrelaxed-modulus",
+        "3GPa",
+        "--relaxation-time",
+        "100ns",
+        "--json",
+    ];
+    let json = json_of(&args, &[]);
+    let pull = num(&json, "peak_attractive_force_n");
+    assert!(pull == 0.0, "{pull:e}");
+    assert!(num(&json, "e_ts_viscous_j") > 0.0, "the sample loses");
 }

@@ -580,8 +580,8 @@ fn a_small_viscosity_loses_eta_times_the_elastic_orbits_rate_integral() {
     assert!((decade - 10.0).abs() < 1.0, "{decade}: {ratios:?}");
 }
 
-/// A capillary neck (VEDA's model) on Hertz and DMT, alone, with a viscous sample and
-/// with a relaxing one: every cycle in which the neck forms and breaks loses exactly its
+/// A capillary neck (VEDA's model) on Hertz and DMT, alone and with a viscous sample
+/// (with a relaxing one: tests/relaxing.rs): every cycle in which the neck forms and breaks loses exactly its
 /// closed-form loop 2πRγ cos θ (D₀ − a₀), the channels add up to E_ts, and the energy
 /// balance holds.
 #[test]
@@ -592,11 +592,6 @@ fn a_capillary_neck_loses_its_closed_form_loop_per_touch_on_every_combination() 
         elastic,
         LawSpec {
             viscosity_pa_s: Some(10.0),
-            ..elastic
-        },
-        LawSpec {
-            unrelaxed_modulus_pa: Some(3.0 * contact.modulus_pa),
-            relaxation_time_s: Some(1e-7),
             ..elastic
         },
     ];
@@ -654,116 +649,6 @@ fn a_capillary_neck_loses_its_closed_form_loop_per_touch_on_every_combination() 
             }
         }
     }
-}
-
-/// Hertz (or DMT) on a standard-linear-solid sample with relaxation time τ_r.
-fn relaxing(kind: LawKind, unrelaxed_pa: f64, relaxation_s: f64) -> TapObservables {
-    let law = LawSpec {
-        unrelaxed_modulus_pa: Some(unrelaxed_pa),
-        relaxation_time_s: Some(relaxation_s),
-        ..kind.into()
-    };
-    observe(law, 12.0)
-}
-
-/// A standard linear solid loses nothing in both limits of its relaxation time: for
-/// τ_r → 0 the Maxwell arm relaxes at once (the relaxed law, the contact's own modulus),
-/// for τ_r → ∞ it never does (an elastic law with the unrelaxed modulus). In between the
-/// loss peaks where τ_r is near the contact time; towards either limit it falls in
-/// proportion to τ_r and to 1/τ_r. The loss is all in the viscous channel, and the
-/// energy balance holds.
-#[test]
-fn a_relaxing_sample_is_elastic_in_both_limits_of_its_relaxation_time() {
-    for kind in [LawKind::Hertz, LawKind::Dmt] {
-        let elastic = run(kind, 12.0);
-        let unrelaxed = 3.0 * default_setup().contact.modulus_pa;
-        let taus = [1e-11, 1e-10, 1e-7, 1e-3, 1e-2];
-        let runs: Vec<TapObservables> = taus
-            .iter()
-            .map(|&tau| relaxing(kind, unrelaxed, tau))
-            .collect();
-        for (o, tau) in runs.iter().zip(taus) {
-            let name = format!("{} τ_r = {tau:e} s", o.law);
-            assert!(o.converged && o.period == Some(1), "{name}: {}", o.regime);
-            assert!(o.jumps_in == 1.0, "{name}: touches once a period");
-            assert!(
-                o.energy_balance_rel < 1e-6,
-                "{name}: {:e}",
-                o.energy_balance_rel
-            );
-            let sum = o.e_ts_adhesion_j + o.e_ts_viscous_j + o.e_ts_capillary_j;
-            assert!((sum - o.e_ts_j).abs() <= 1e-12 * o.e_ts_j, "{name}");
-            // (No loop of its own: the adhesion channel is round-off, E_ts − E_viscous.)
-            assert!(o.e_ts_adhesion_j.abs() <= 1e-12 * o.e_drive_j, "{name}");
-            assert!(o.e_ts_j > 0.0, "{name}");
-            eprintln!(
-                "{name}: E_ts {:.4e} eV, A/A0 {:.7}, φ {:.5}°",
-                o.e_ts_ev, o.amplitude_ratio, o.phase_deg
-            );
-        }
-        let e: Vec<f64> = runs.iter().map(|o| o.e_ts_j).collect();
-        // Linear in τ_r at the short end, in 1/τ_r at the long end.
-        assert!((e[0] / e[1] - 0.1).abs() < 0.005, "{kind}: {e:?}");
-        assert!((e[4] / e[3] - 0.1).abs() < 0.005, "{kind}: {e:?}");
-        // Both ends lose a thousandth of the peak or less (on Hertz: DMT settles on its
-        // attractive branch at τ_r = 100 ns, where it barely touches).
-        if kind == LawKind::Hertz {
-            assert!(e[0] < 1e-3 * e[2] && e[4] < 1e-3 * e[2], "{kind}: {e:?}");
-        }
-        // The short end tends to the relaxed (elastic) law, its departure linear in τ_r.
-        let departure = |o: &TapObservables| {
-            (
-                (o.amplitude_ratio - elastic.amplitude_ratio).abs(),
-                (o.phase_deg - elastic.phase_deg).abs(),
-            )
-        };
-        let (near, nearer) = (departure(&runs[1]), departure(&runs[0]));
-        eprintln!("{kind}: departure from the relaxed law {near:?} → {nearer:?}");
-        assert!(
-            nearer.0 < 1e-5 && nearer.0 < 0.15 * near.0,
-            "{kind}: {near:?} {nearer:?}"
-        );
-        assert!(nearer.1 < 0.15 * near.1, "{kind}: {near:?} {nearer:?}");
-    }
-}
-
-/// With its arm's modulus E₀ − E_∞ = η/(2τ_r) and τ_r → 0, the Maxwell arm becomes a
-/// dashpot and the standard linear solid becomes Kelvin–Voigt with viscosity η: the loss,
-/// amplitude and phase converge to the Kelvin–Voigt run's.
-#[test]
-fn a_relaxing_sample_tends_to_kelvin_voigt_as_its_arm_becomes_a_dashpot() {
-    let eta = 10.0;
-    let setup = TapSetup {
-        law: LawSpec {
-            viscosity_pa_s: Some(eta),
-            ..LawKind::Hertz.into()
-        },
-        separation_m: 12e-9,
-        ..default_setup()
-    };
-    let kv = tap(&setup, &Numerics::default(), Observe::default())
-        .unwrap()
-        .observables;
-    let relaxed = setup.contact.modulus_pa;
-    let mut errors = Vec::new();
-    for tau in [1e-9, 1e-10, 1e-11] {
-        let o = relaxing(LawKind::Hertz, relaxed + eta / (2.0 * tau), tau);
-        let error = (o.e_ts_j / kv.e_ts_j - 1.0).abs();
-        eprintln!(
-            "τ_r = {tau:e} s: E_ts/E_ts(KV) − 1 = {:.3e}, ΔA/A0 {:.2e}, Δφ {:.2e}°",
-            o.e_ts_j / kv.e_ts_j - 1.0,
-            o.amplitude_ratio - kv.amplitude_ratio,
-            o.phase_deg - kv.phase_deg
-        );
-        assert!((o.amplitude_ratio - kv.amplitude_ratio).abs() < 1e-5 * (tau / 1e-11).max(1.0));
-        errors.push(error);
-    }
-    // Converging, by more than a decade per decade of τ_r, to within 1e-5.
-    assert!(
-        errors[1] < 0.1 * errors[0] && errors[2] < 0.1 * errors[1],
-        "{errors:?}"
-    );
-    assert!(errors[2] < 1e-5, "{errors:?}");
 }
 
 /// On a hysteretic law (JKR, hybrid, LJ) the neck outlives the contact: it forms at the

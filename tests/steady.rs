@@ -325,12 +325,6 @@ fn the_period_map_derivative_matches_finite_differences_across_switches() {
         viscosity_pa_s: Some(20.0),
         ..kind.into()
     };
-    // And a relaxing sample, whose internal state is part of the section state.
-    let relaxing = |kind: LawKind| tapsim::law::LawSpec {
-        unrelaxed_modulus_pa: Some(2e9),
-        relaxation_time_s: Some(0.3e-6),
-        ..kind.into()
-    };
     for (law, z_nm) in [
         (LawKind::Hybrid.into(), 16.0),
         (LawKind::Jkr.into(), 12.0),
@@ -339,8 +333,6 @@ fn the_period_map_derivative_matches_finite_differences_across_switches() {
         (LawKind::Hertz.into(), 14.0),
         (viscous(LawKind::Hertz), 14.0),
         (viscous(LawKind::Hybrid), 14.0),
-        (relaxing(LawKind::Hertz), 14.0),
-        (relaxing(LawKind::Dmt), 14.0),
     ] {
         let setup = TapSetup {
             law,
@@ -360,7 +352,7 @@ fn the_period_map_derivative_matches_finite_differences_across_switches() {
         assert!(c.jumps_in >= 1, "{law}: the period must touch");
         let dim = sim.section_dim();
         assert_eq!(d.shape(), (dim, dim + 1), "{law}");
-        assert_eq!(dim, if law.relaxing().is_some() { 3 } else { 2 }, "{law}");
+        assert_eq!(dim, 2, "{law}");
         // The map in the section's own units (Simulation::z), q last.
         let z0 = sim.z(&start);
         let map = |dz: &[f64]| {

@@ -178,7 +178,7 @@ fn free_steps_from_the_precomputed_transition_march_as_the_exact_march_does() {
             let run = |exact: bool| {
                 let force = ThermalForce::new(d, STEPS_PER_PERIOD, seed, 0).unwrap();
                 let mut force = if exact { force.exact() } else { force };
-                let mut phase = settled;
+                let mut phase = settled.clone();
                 let mut lockin = LockIn::new(2, 30.0, sim.osc.omega).unwrap();
                 let (total, work) = force.march(&sim, &mut phase, 100, &mut lockin).unwrap();
                 (phase, total.unwrap(), work, lockin.output())
@@ -247,7 +247,7 @@ fn at_the_grazing_onset_the_fast_steps_touch_when_the_located_ones_do() {
         let run = |exact: bool| {
             let force = ThermalForce::new(d, STEPS_PER_PERIOD, 5, 0).unwrap();
             let mut force = if exact { force.exact() } else { force };
-            let mut phase = start;
+            let mut phase = start.clone();
             (0..2000)
                 .map(|_| {
                     let (t, _) = force
@@ -1125,7 +1125,7 @@ fn the_noisy_march_is_as_accurate_as_its_tolerance_says() {
             },
             ..sim
         };
-        let mut phase = start;
+        let mut phase = start.clone();
         let mut force = ThermalForce::new(d, STEPS_PER_PERIOD, 5, 0).unwrap();
         let (total, _) = force
             .march(&at, &mut phase, 200, &mut tapsim::dynamics::numeric::Ignore)

@@ -106,9 +106,9 @@ fn continuation_starts(p: &Prepared, numerics: &Numerics) -> Result<Vec<Phase>> 
         .map(|w| {
             let (a, b) = (&w[0], &w[1]);
             if (a.separation_m - z).abs() < (b.separation_m - z).abs() {
-                a.phase
+                a.phase.clone()
             } else {
-                b.phase
+                b.phase.clone()
             }
         })
         .collect())

@@ -78,7 +78,7 @@ impl FmState {
     /// The state as the instrument's loops take it up.
     pub fn engagement(&self) -> Engagement {
         Engagement {
-            phase: self.next.phase,
+            phase: self.next.phase.clone(),
             drive: FmDrive {
                 omega: self.frequency_ratio,
                 excitation: self.excitation_ratio,
@@ -120,7 +120,7 @@ fn residuals(
         tau: 0.0,
         x: u[0],
         v: u[1],
-        ..*start
+        ..start.clone()
     };
     let c = sim.cycle(&mut phase, &mut Ignore)?;
     phase.tau = 0.0;
@@ -155,7 +155,7 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
         guess.omega,
         guess.excitation.ln(),
     ];
-    let mut start = guess.phase;
+    let mut start = guess.phase.clone();
     let p = Prepared::new(setup, numerics)?;
     let (mut r, mut c, mut end) = residuals(&p, u, &start)?;
     for iteration in 0..MAX_ITERATIONS {
@@ -240,7 +240,7 @@ pub fn settle(setup: &TapSetup, numerics: &Numerics, guess: &FmGuess) -> Result<
 
 /// Where a search for the settled FM state starts: an orbit's state at drive phase 0
 /// and the loops' (Ω, F/F₀).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct FmGuess {
     /// The state (x, x' in units of A, the branch).
     pub phase: Phase,
@@ -281,7 +281,7 @@ pub fn trajectory(
         state.excitation_ratio,
     );
     let mut recorder = Recorder::new(&p.law, p.cpl, p.osc);
-    let mut phase = state.next.phase;
+    let mut phase = state.next.phase.clone();
     p.simulation().cycle(&mut phase, &mut recorder)?;
     Ok(recorder.to_si(&p))
 }
@@ -319,7 +319,7 @@ pub fn approach(
         };
         let point = match settle(&at, numerics, &guess) {
             Ok(s) => {
-                guess = s.next;
+                guess = s.next.clone();
                 FmPoint {
                     separation_m: z,
                     state: Some(s),

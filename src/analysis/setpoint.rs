@@ -224,7 +224,7 @@ fn far_from_the_sample(p: &Prepared) -> Result<BranchRecord> {
 /// The steady state at rest separation `z_m` started from `phase` (left on it).
 fn settled(p: &Prepared, z_m: f64, phase: &mut Phase) -> Result<BranchRecord> {
     let state = p.simulation_at(z_m)?.steady_state(phase, &p.steady)?;
-    Ok(record(z_m, TapObservables::new(p, &state)?, *phase))
+    Ok(record(z_m, TapObservables::new(p, &state)?, phase.clone()))
 }
 
 /// A state found by settling or solving at `separation_m`, as an orbit of a family
@@ -269,7 +269,7 @@ fn hold(
             // A tip pressed in by more than A₀ at rest: no setpoint lies beyond.
             break;
         }
-        let mut phase = here.phase;
+        let mut phase = here.phase.clone();
         let next = settled(p, here.separation_m + step, &mut phase)?;
         let crossed = (next.observables.amplitude_ratio - ratio) * error <= 0.0;
         let before = std::mem::replace(here, next);
@@ -290,7 +290,7 @@ fn hold(
     if held(&a) && held(&b) && other == side {
         if let Some(s) = refine(p, (&a, &b), ratio, side, free)? {
             // Carry on from the state at the setpoint.
-            *here = record(s.separation_m, s.observables.clone(), s.phase);
+            *here = record(s.separation_m, s.observables.clone(), s.phase.clone());
             return Ok(Ok(s));
         }
     }
@@ -648,7 +648,7 @@ fn refine(
         (
             r.separation_m,
             r.observables.amplitude_ratio - ratio,
-            r.phase,
+            r.phase.clone(),
         )
     };
     let (mut lo, mut hi) = (end(a), end(b));
@@ -668,9 +668,9 @@ fn refine(
             0.5 * (z0 + z1)
         };
         let mut phase: Phase = if (z - z0).abs() < (z - z1).abs() {
-            lo.2
+            lo.2.clone()
         } else {
-            hi.2
+            hi.2.clone()
         };
         let sim = p.simulation_at(z)?;
         let state = sim.steady_state(&mut phase, &p.steady)?;
@@ -689,7 +689,7 @@ fn refine(
                     branch: side,
                     separation_m: z,
                     observables: o,
-                    phase,
+                    phase: phase.clone(),
                 },
             ));
         }

@@ -510,7 +510,7 @@ impl BranchRecord {
                 PointKind::PeriodDoubling => BranchPointKind::PeriodDoubling,
             },
             observables: TapObservables::new(p, &state)?,
-            phase: b.phase,
+            phase: b.phase.clone(),
         })
     }
 }
@@ -664,7 +664,7 @@ pub fn orbit_branch_across_gaps(
                     nm(q * a0)
                 ));
                 let last = branch.points.last().expect("a piece has points");
-                phase = last.phase;
+                phase = last.phase.clone();
                 at = q * a0 + toward * max_step_m;
                 segment += 1;
                 if (at - to_m) * toward > 0.0 {

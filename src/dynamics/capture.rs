@@ -75,7 +75,7 @@ impl Candidate {
     ) -> crate::error::Result<Self> {
         let n = state.window.periods as usize;
         let mut points = Vec::with_capacity(n);
-        let mut p = on;
+        let mut p = on.clone();
         points.push((sim.z(&p), p.branch));
         for _ in 1..n {
             sim.cycle(&mut p, &mut super::numeric::Ignore)?;

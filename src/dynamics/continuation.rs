@@ -61,7 +61,7 @@ pub enum PointKind {
 }
 
 /// A point of the period-1 orbit family.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct BranchPoint {
     /// q = z_c/L.
     pub q: f64,
@@ -171,7 +171,7 @@ impl Solved {
     fn point(&self, kind: PointKind) -> BranchPoint {
         BranchPoint {
             q: self.q(),
-            phase: self.phase,
+            phase: self.phase.clone(),
             integrals: self.integrals,
             multipliers: eigenvalues(&self.monodromy()),
             kind,

@@ -436,7 +436,7 @@ mod tests {
                 y[V] = v;
                 crate::dynamics::model::set_phasor(&osc, t, &mut y);
                 let mut dy = State::<BASE>::zeros();
-                rhs(&NoForce, &osc, &cpl, Branch::Free, t, &y, &mut dy);
+                rhs(&NoForce, &osc, &cpl, Branch::Free, t, &y, &mut dy, None);
                 assert!((acc - dy[V]).abs() < 1e-7, "{acc} vs {}", dy[V]);
                 assert!(((xp - xm) / (2.0 * h) - v).abs() < 1e-7);
             }

@@ -260,7 +260,7 @@ mod tests {
             v: -0.9,
             ..Phase::at_rest()
         };
-        let start = phase;
+        let start = phase.clone();
         let part = steps
             .advance(&mut phase, phasor, force, &mut Ignore)
             .unwrap()
@@ -290,8 +290,12 @@ mod tests {
         // jump-in level: both left to the march, the phase untouched.
         let level = steps.level_x;
         for (x, v) in [(0.5, -0.01), (level + 1e-3, -0.5)] {
-            let mut phase = Phase { x, v, ..start };
-            let before = phase;
+            let mut phase = Phase {
+                x,
+                v,
+                ..start.clone()
+            };
+            let before = phase.clone();
             let taken = steps
                 .advance(&mut phase, phasor, force, &mut Ignore)
                 .unwrap();

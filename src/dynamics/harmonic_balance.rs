@@ -36,7 +36,7 @@ const GOLDEN_STEPS: usize = 40;
 const ROOT_RESIDUAL: f64 = 1e-3;
 
 /// A stable root of the first-harmonic balance.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Estimate {
     /// Amplitude Â (units of L).
     pub amplitude: f64,

@@ -16,23 +16,25 @@ use super::grazing::{Margins, SwitchLevels};
 use super::model::{
     BASE, Carried, Coupling, Drive, MEMORY, MEMORY_TANGENT, MODES, Oscillator, RATE, RATE_TANGENT,
     State, TANGENT, V, X, dissipative_work_index, has_tangent, internal, internal_count, phi,
-    phi_column, relax_internal, reset_phi, section_dim, set_internal,
+    phi_column, relax_internal, reset_phi, section_dim, set_internal, surface_view,
 };
 use super::numeric::{
     self, Crossing, Events, StepEnd, StepObserver, Tolerances, hermite, hermite_turn_fraction,
     internal_at,
 };
-use crate::error::Result;
+use super::surface::Surface;
+use crate::error::{Error, Result};
 use crate::physics::law::{Branch, Exits, ForceLaw, Internal, MAX_INTERNAL};
 use nalgebra::{DMatrix, DVector};
+use std::cell::RefCell;
 
 /// The most dimensions a section state has: each mode's x and x', and the law's
 /// internal state.
 pub const MAX_SECTION: usize = 2 * MODES + MAX_INTERNAL;
 
 /// Where the oscillator is: time, deflection, velocity, the law's internal state and
-/// the contact branch.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// the contact branch (and a relaxing sample's surface).
+#[derive(Debug, Clone, PartialEq)]
 pub struct Phase {
     /// τ.
     pub tau: f64,
@@ -51,6 +53,9 @@ pub struct Phase {
     /// [`Simulation::advance`] stopped it (0: none stopped): the integrator's own
     /// proposal, so that cutting a segment into parts costs no smaller steps.
     pub h_carry: f64,
+    /// A relaxing sample's surface as the motion left it ([`super::surface`]; none for
+    /// every other law, and none yet before the first period: a fresh surface then).
+    pub surface: Option<Box<Surface>>,
 }
 
 impl Phase {
@@ -64,6 +69,7 @@ impl Phase {
             branch: Branch::Free,
             h_next: [0.0; Branch::COUNT],
             h_carry: 0.0,
+            surface: None,
         }
     }
 
@@ -87,7 +93,7 @@ impl Phase {
             x: z[0],
             v: z[1],
             internal,
-            ..*self
+            ..self.clone()
         }
     }
 }
@@ -204,6 +210,8 @@ struct Tracker<'a, L: ForceLaw, O: StepObserver> {
     levels: Option<SwitchLevels>,
     /// The grazing margins so far.
     margins: Margins,
+    /// A relaxing sample's surface, open at the start of each step shown.
+    surface: Option<&'a RefCell<Surface>>,
 }
 
 impl<L: ForceLaw, O: StepObserver> Tracker<'_, L, O> {
@@ -244,7 +252,15 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
             );
             lowest = lowest.min(turn.alpha_hat);
             self.turn(branch, turn.alpha_hat);
-            let f = -self.cpl.f_scale * self.law.force_hat(&turn);
+            let force_hat = match self.surface {
+                Some(s) => {
+                    let view = [-turn.alpha_hat, -turn.rate_hat, turn.internal[0]];
+                    let pushed = s.borrow().force_at(tau, view);
+                    self.law.t_hat(turn.alpha_hat, branch) + self.law.surface_t_hat(&turn, pushed)
+                }
+                None => self.law.force_hat(&turn),
+            };
+            let f = -self.cpl.f_scale * force_hat;
             self.max_f = self.max_f.max(f);
             self.min_f = self.min_f.min(f);
         }
@@ -292,6 +308,11 @@ impl<L: ForceLaw> Copy for Simulation<'_, L> {}
 pub(crate) const LOOSEST_RTOL: f64 = 1e-5;
 
 impl<L: ForceLaw> Simulation<'_, L> {
+    /// Whether the law's sample has a surface the march carries ([`super::surface`]).
+    pub fn has_surface(&self) -> bool {
+        Surface::of(self.law, self.cpl.a1).is_some()
+    }
+
     /// Dimension of the section state: x, x' and the law's internal state.
     pub fn section_dim(&self) -> usize {
         2 * MODES + self.law.internal_states().min(MAX_INTERNAL)
@@ -334,6 +355,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             branch: self.branch_at(0.0, x),
             h_next: [0.0; Branch::COUNT],
             h_carry: 0.0,
+            surface: None,
         }
     }
 
@@ -418,6 +440,15 @@ impl<L: ForceLaw> Simulation<'_, L> {
         span: f64,
     ) -> Result<(CycleIntegrals, DMatrix<f64>)> {
         let span = span.min(self.osc.period());
+        if self.has_surface() {
+            return Err(Error::NotApplicable(
+                "the period map's derivative is not computed for a relaxing sample: its \
+                 surface remembers every tap, as many variables as its elements (its steady \
+                 state is found by marching; orbit continuation, shooting and harmonic \
+                 balance do not take it)"
+                    .into(),
+            ));
+        }
         let (integrals, derivative) = if self.law.internal_states() > 0 {
             self.cycle_in::<MEMORY_TANGENT, _>(phase, span, false, &mut numeric::Ignore)
         } else if self.law.is_rate_dependent() {
@@ -528,6 +559,17 @@ impl<L: ForceLaw> Simulation<'_, L> {
         if has_tangent(N) {
             reset_phi(&mut y);
         }
+        // A relaxing sample's surface: as the motion left it, or fresh.
+        let surface = if internal_count(N) > 0 {
+            phase
+                .surface
+                .take()
+                .map(|s| *s)
+                .or_else(|| Surface::of(self.law, self.cpl.a1))
+                .map(RefCell::new)
+        } else {
+            None
+        };
         let mechanical = |y: &State<N>| 0.5 * (y[X] * y[X] + y[V] * y[V]);
         let e0 = mechanical(&y);
         let start = (phase.tau, phase.x, phase.v);
@@ -541,6 +583,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             min_f: f64::INFINITY,
             levels: None,
             margins: Margins::NONE,
+            surface: surface.as_ref(),
         };
         let (mut contact_time, mut jumps_in, mut jumps_out) = (0.0, 0, 0);
         // E_ts = (RΔγ/(kL))/(L/(με)) ∫ T̂ dα̂ in units of kL².
@@ -592,6 +635,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
                 if let Some(rates) = &relaxation {
                     relax_internal(&mut y, rates, stop - tau);
                 }
+                if let Some(surface) = &surface {
+                    let view = surface_view(&self.osc, &self.cpl, stop, &y);
+                    surface
+                        .borrow_mut()
+                        .creep(stop - tau, stop, view, self.osc.period())?;
+                }
                 tracker.free_flight(&flight, tau, stop);
                 tracker.min_alpha = tracker.min_alpha.min(self.cpl.alpha_hat(min_x, 0.0));
                 tau = stop;
@@ -628,6 +677,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     phase.h_next[phase.branch as usize]
                 },
                 &self.tol,
+                surface.as_ref(),
                 &mut tracker,
             )?;
             let alpha_end = alpha_at(end.tau, &end.y);
@@ -694,6 +744,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
             jumps_in,
             jumps_out,
         };
+        phase.surface = surface.map(|s| Box::new(s.into_inner()));
         Ok((integrals, has_tangent(N).then(|| phi(&y))))
     }
 

@@ -31,4 +31,5 @@ mod recurrence;
 pub mod setup;
 pub mod shooting;
 pub mod steady;
+pub mod surface;
 pub mod window;

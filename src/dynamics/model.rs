@@ -8,6 +8,7 @@
 //! with f_ts = −T̂·RΔγ/(kL) and the tip–sample separation α̂ = a₀ + a₁(x + x_b(τ)),
 //! where x_b is the support displacement of a base drive (zero for a force drive).
 
+use super::surface::{Surface, View};
 use crate::physics::law::{Branch, ContactState, ForceLaw, Internal, MAX_INTERNAL};
 use nalgebra::{DMatrix, SVector};
 use std::ops::{Index, IndexMut};
@@ -448,13 +449,34 @@ impl Coupling {
     }
 }
 
+/// What a relaxing sample's surface sees of the tip at τ in state `y`
+/// ([`super::surface::View`]): δ̂ = −α̂, its rate and the Maxwell mean ŷ.
+#[inline]
+pub(crate) fn surface_view<const N: usize>(
+    osc: &Oscillator,
+    cpl: &Coupling,
+    tau: f64,
+    y: &State<N>,
+) -> View {
+    let (x_b, v_b) = osc.base_at(tau);
+    [
+        -cpl.alpha_hat(y[X], x_b),
+        -cpl.a1 * (y[V] + v_b),
+        y[Part::Internal(0)],
+    ]
+}
+
 /// The right-hand side of the equation of motion and of the carried integrals; for a
 /// state with a tangent also of the variational equations δx'' + 2γδx' + δx =
 /// (∂f_ts/∂x)δx + (∂f_ts/∂x')δx' + Σ (∂f_ts/∂s_k)δs_k (+ ∂f_ts/∂q for the q column),
 /// ∂f_ts/∂x = ∂f_ts/∂q = −f_scale·a₁·∂T̂/∂α̂, ∂f_ts/∂x' = −f_scale·a₁·∂T̂/∂(dα̂/dτ) (a
 /// rate-dependent law's), and for a law with internal state s also δs_k' = a₁(∂ṡ_k/∂α̂)
 /// (δx + δq) + a₁(∂ṡ_k/∂α̂')δx' + Σ (∂ṡ_k/∂s_j)δs_j.
+///
+/// A law with a surface ([`ForceLaw::surface`]) takes its rate-dependent force from
+/// `surface`, the step the integrator has open on it.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn rhs<L: ForceLaw, const N: usize>(
     law: &L,
     osc: &Oscillator,
@@ -463,6 +485,7 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
     tau: f64,
     y: &State<N>,
     dy: &mut State<N>,
+    surface: Option<&Surface>,
 ) {
     let (x, v) = (y[X], y[V]);
     let (s, c) = (y[Part::DriveSin], y[Part::DriveCos]);
@@ -482,7 +505,10 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
             internal: internal(y),
         };
         state = Some(at);
-        law.dissipative_t_hat(&at)
+        match surface {
+            Some(s) => law.surface_t_hat(&at, s.force_at(tau, surface_view(osc, cpl, tau, y))),
+            None => law.dissipative_t_hat(&at),
+        }
     } else {
         0.0
     };

@@ -16,13 +16,15 @@ use super::budget;
 use super::dopri5::{self, Settings, StepError, System};
 use super::model::{
     BASE, Coupling, Oscillator, Part, State, V, X, has_tangent, internal_count, rhs, set_phasor,
+    surface_view,
 };
 pub(crate) use super::observer::hermite_turn_fraction;
 pub use super::observer::{Ignore, StepEnd, StepObserver, hermite, internal_at};
+use super::surface::Surface;
 use crate::error::{Error, Result};
 use crate::numeric::bracketed_root;
 use crate::physics::law::{Branch, ForceLaw};
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 /// Tolerances and step limits of the integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -80,6 +82,8 @@ struct Progress<const N: usize> {
     /// The step end from which the switch is close enough to land on (Hénon), the
     /// length of the step that ended there, and the event.
     approach: Option<(StepEnd<N>, f64, Event)>,
+    /// Why the segment stopped short, if the surface refused a step.
+    failed: Option<Error>,
 }
 
 struct Segment<'a, L: ForceLaw, O: StepObserver, const N: usize> {
@@ -93,6 +97,8 @@ struct Segment<'a, L: ForceLaw, O: StepObserver, const N: usize> {
     land: bool,
     /// End of the span.
     tau_end: f64,
+    /// A relaxing sample's surface, with the step it has open ([`super::surface`]).
+    surface: Option<&'a RefCell<Surface>>,
     progress: &'a mut Progress<N>,
     observer: &'a mut O,
 }
@@ -190,7 +196,17 @@ fn approach_rate(
 impl<L: ForceLaw, O: StepObserver, const N: usize> System<N> for Segment<'_, L, O, N> {
     #[inline]
     fn system(&self, tau: f64, y: &State<N>, dy: &mut State<N>) {
-        rhs(self.law, self.osc, self.cpl, self.branch, tau, y, dy);
+        let surface = self.surface.map(RefCell::borrow);
+        rhs(
+            self.law,
+            self.osc,
+            self.cpl,
+            self.branch,
+            tau,
+            y,
+            dy,
+            surface.as_deref(),
+        );
     }
 
     fn solout(&mut self, tau: f64, y: &State<N>, dy: &State<N>) -> bool {
@@ -210,6 +226,16 @@ impl<L: ForceLaw, O: StepObserver, const N: usize> System<N> for Segment<'_, L, 
             return true;
         }
         self.observer.step(&start, &end, self.branch);
+        if let Some(surface) = self.surface {
+            if let Err(e) = surface.borrow_mut().close(
+                tau,
+                surface_view(self.osc, self.cpl, tau, y),
+                self.osc.period(),
+            ) {
+                self.progress.failed = Some(e);
+                return true;
+            }
+        }
         if self.progress.h == 0.0 {
             self.progress.h = end.tau - start.tau;
         }
@@ -276,7 +302,8 @@ impl<L: ForceLaw, const N: usize> System<N> for Approach<'_, L, N> {
     #[inline]
     fn system(&self, w: f64, y: &State<N>, dy: &mut State<N>) {
         let (tau, z) = self.tau_form(w, y);
-        rhs(self.law, self.osc, self.cpl, self.branch, tau, &z, dy);
+        // (Never with a surface: a law with one does not land, see `Span::integrate`.)
+        rhs(self.law, self.osc, self.cpl, self.branch, tau, &z, dy, None);
         let (_, v_b) = self
             .osc
             .base_from(tau, (z[Part::DriveSin], z[Part::DriveCos]));
@@ -293,7 +320,16 @@ impl<L: ForceLaw, const N: usize> System<N> for Approach<'_, L, N> {
     fn solout(&mut self, w: f64, y: &State<N>, _dy: &State<N>) -> bool {
         let (tau, z) = self.tau_form(w, y);
         let mut dz = State::<N>::zeros();
-        rhs(self.law, self.osc, self.cpl, self.branch, tau, &z, &mut dz);
+        rhs(
+            self.law,
+            self.osc,
+            self.cpl,
+            self.branch,
+            tau,
+            &z,
+            &mut dz,
+            None,
+        );
         let landing = &mut *self.landing;
         if landing.len == MAX_LANDING_STEPS {
             landing.failed.set(true);
@@ -466,7 +502,8 @@ fn run<S: System<N>, const N: usize>(
 }
 
 /// Integrate branch `branch` from (`tau0`, `y0`) to `tau_end`, stopping at the first of
-/// its `events` met. `h0` is the first trial step (0 lets the solver choose).
+/// its `events` met. `h0` is the first trial step (0 lets the solver choose). A relaxing
+/// sample's `surface` is driven along (left with a step open at the end).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn integrate<L: ForceLaw, O: StepObserver, const N: usize>(
     law: &L,
@@ -479,6 +516,7 @@ pub(crate) fn integrate<L: ForceLaw, O: StepObserver, const N: usize>(
     tau_end: f64,
     h0: f64,
     tol: &Tolerances,
+    surface: Option<&RefCell<Surface>>,
     observer: &mut O,
 ) -> Result<SegmentEnd<N>> {
     let span = Span {
@@ -490,7 +528,7 @@ pub(crate) fn integrate<L: ForceLaw, O: StepObserver, const N: usize>(
         tau_end,
         tol,
     };
-    span.integrate(tau0, y0, h0, true, observer)
+    span.integrate(tau0, y0, h0, surface, observer)
 }
 
 /// What [`integrate`] works on.
@@ -505,14 +543,28 @@ struct Span<'a, L: ForceLaw> {
 }
 
 impl<L: ForceLaw> Span<'_, L> {
-    /// Integrate from (`tau0`, `y0`); `land`: whether to land on the switch ([`land`])
-    /// once it is within reach, else locate its crossing.
+    /// Integrate from (`tau0`, `y0`), landing on the switch ([`land`]) once it is within
+    /// reach — except with a `surface`, whose steps a landing in another variable would
+    /// not drive: its crossing is located.
     fn integrate<O: StepObserver, const N: usize>(
         &self,
         tau0: f64,
         y0: State<N>,
         h0: f64,
+        surface: Option<&RefCell<Surface>>,
+        observer: &mut O,
+    ) -> Result<SegmentEnd<N>> {
+        self.integrate_landing(tau0, y0, h0, surface.is_none(), surface, observer)
+    }
+
+    /// [`Span::integrate`]; `land_on_switch`: whether to land on the switch.
+    fn integrate_landing<O: StepObserver, const N: usize>(
+        &self,
+        tau0: f64,
+        y0: State<N>,
+        h0: f64,
         land_on_switch: bool,
+        surface: Option<&RefCell<Surface>>,
         observer: &mut O,
     ) -> Result<SegmentEnd<N>> {
         let Self {
@@ -526,13 +578,28 @@ impl<L: ForceLaw> Span<'_, L> {
         } = *self;
         let mut y0 = y0;
         set_phasor(osc, tau0, &mut y0);
+        if let Some(surface) = surface {
+            surface
+                .borrow_mut()
+                .open(tau0, surface_view(osc, cpl, tau0, &y0), osc.period())?;
+        }
         let mut dy0 = State::<N>::zeros();
-        rhs(law, osc, cpl, branch, tau0, &y0, &mut dy0);
+        let open = surface.map(RefCell::borrow);
+        rhs(law, osc, cpl, branch, tau0, &y0, &mut dy0, open.as_deref());
+        drop(open);
         if too_short(tau0, tau_end) {
             // Nothing Dopri5 could step over: advance by one Euler step (error ~ (Δτ)²).
+            let y = y0 + dy0 * (tau_end - tau0);
+            if let Some(surface) = surface {
+                surface.borrow_mut().close(
+                    tau_end,
+                    surface_view(osc, cpl, tau_end, &y),
+                    osc.period(),
+                )?;
+            }
             return Ok(SegmentEnd {
                 tau: tau_end,
-                y: y0 + dy0 * (tau_end - tau0),
+                y,
                 switched: None,
                 h_first: 0.0,
                 h_proposed: 0.0,
@@ -547,6 +614,7 @@ impl<L: ForceLaw> Span<'_, L> {
             hit: None,
             h: 0.0,
             approach: None,
+            failed: None,
         };
         let segment = Segment {
             law,
@@ -556,10 +624,14 @@ impl<L: ForceLaw> Span<'_, L> {
             events,
             land: land_on_switch,
             tau_end,
+            surface,
             progress: &mut progress,
             observer: &mut *observer,
         };
         let h_proposed = run(segment, tau0, tau_end, y0, h0, tol, branch)?;
+        if let Some(e) = progress.failed {
+            return Err(e);
+        }
         if let Some((entry, h, event)) = progress.approach {
             let landed = land(law, osc, cpl, branch, event, entry, tau_end, tol, observer)?;
             let end = match landed {
@@ -573,7 +645,7 @@ impl<L: ForceLaw> Span<'_, L> {
                 // Carry on from where the landing started, locating the crossing.
                 None => SegmentEnd {
                     h_first: progress.h,
-                    ..self.integrate(entry.tau, entry.y, h, false, observer)?
+                    ..self.integrate_landing(entry.tau, entry.y, h, false, surface, observer)?
                 },
             };
             return Ok(end);
@@ -588,10 +660,15 @@ impl<L: ForceLaw> Span<'_, L> {
                 h_proposed,
             });
         };
-        let (tau, y) = self.polish(start, hit_end, t_hit, event)?;
+        // (The surface is still open at the step's start: the polish drives a copy.)
+        let (tau, y, moved) = self.polish(start, hit_end, t_hit, event, surface)?;
         let mut dy = State::<N>::zeros();
-        rhs(law, osc, cpl, branch, tau, &y, &mut dy);
+        rhs(law, osc, cpl, branch, tau, &y, &mut dy, moved.as_ref());
+        // The observer sees the step with the surface open at its start, as every other.
         observer.step(&start, &StepEnd { tau, y, dy }, branch);
+        if let (Some(surface), Some(moved)) = (surface, moved) {
+            *surface.borrow_mut() = moved;
+        }
         Ok(SegmentEnd {
             tau,
             y,
@@ -606,25 +683,36 @@ impl<L: ForceLaw> Span<'_, L> {
     /// switching time polished by Newton steps on the re-integrated state (the Hermite
     /// interpolant is only fourth-order accurate, and the force may be singular at the
     /// switch, as at the JKR fold C).
+    ///
+    /// A relaxing sample's `surface` (open at the step's start) is left as it was; the
+    /// surface driven to the switch is returned.
     fn polish<const N: usize>(
         &self,
         start: StepEnd<N>,
         hit_end: StepEnd<N>,
         t_hit: f64,
         (level, crossing): Event,
-    ) -> Result<(f64, State<N>)> {
+        surface: Option<&RefCell<Surface>>,
+    ) -> Result<(f64, State<N>, Option<Surface>)> {
         let mut t = t_hit;
         let mut y = start.y;
+        let mut moved = None;
         for attempt in 0..4 {
             let mut refine = Progress {
                 last: start,
                 hit: None,
                 h: 0.0,
                 approach: None,
+                failed: None,
             };
+            let copy = surface.map(|s| RefCell::new(s.borrow().clone()));
             if too_short(start.tau, t) {
                 // The switch sits at the very start of the step: interpolate.
                 refine.last.y = interpolate(&start, &hit_end, t);
+                if let Some(copy) = &copy {
+                    let view = surface_view(self.osc, self.cpl, t, &refine.last.y);
+                    copy.borrow_mut().close(t, view, self.osc.period())?;
+                }
             } else if t > start.tau {
                 let mut quiet = Ignore;
                 let again = Segment {
@@ -635,6 +723,7 @@ impl<L: ForceLaw> Span<'_, L> {
                     events: Events::default(),
                     land: false,
                     tau_end: t,
+                    surface: copy.as_ref(),
                     progress: &mut refine,
                     observer: &mut quiet,
                 };
@@ -647,8 +736,12 @@ impl<L: ForceLaw> Span<'_, L> {
                     self.tol,
                     self.branch,
                 )?;
+                if let Some(e) = refine.failed {
+                    return Err(e);
+                }
             }
             y = refine.last.y;
+            moved = copy.map(RefCell::into_inner);
             // Still to go, and its rate of decrease.
             let (gap, rate) = approach_rate(self.osc, self.cpl, (level, crossing), t, y[X], y[V]);
             let next = t + gap / rate;
@@ -662,7 +755,7 @@ impl<L: ForceLaw> Span<'_, L> {
             }
             t = next;
         }
-        Ok((t, y))
+        Ok((t, y, moved))
     }
 }
 
@@ -750,7 +843,7 @@ mod tests {
         };
         let mut y = State::<BASE>::zeros();
         y[V] = v0;
-        span.integrate(0.0, y, 0.0, land_on_switch, &mut Ignore)
+        span.integrate_landing(0.0, y, 0.0, land_on_switch, None, &mut Ignore)
             .expect("integrates")
     }
 

@@ -147,7 +147,9 @@ pub fn tap(setup: &TapSetup, numerics: &Numerics, observe: Observe) -> Result<Ta
         .then(|| attractors(setup, numerics, &Start::list(starts)))
         .transpose()?;
     let (harmonics, mean_force_gradient_n_m) = match state.motion.period() {
-        Some(n) if observe.harmonics => {
+        // (Not on a relaxing sample: its force between the integrator's steps lives in
+        // a surface only the open step knows.)
+        Some(n) if observe.harmonics && !sim.has_surface() => {
             // Both watch the same n periods of the orbit.
             let mut observer = (
                 HarmonicsObserver::new(&p.law, p.cpl, p.osc),

@@ -4,10 +4,11 @@
 
 use super::free::FreeFlight;
 use super::march::CycleIntegrals;
-use super::model::{Coupling, Drive, Oscillator, V, X};
+use super::model::{Carried, Coupling, Drive, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver, hermite, internal_at};
 use super::setup::Prepared;
 use super::steady::{Motion, SteadyState};
+use super::surface::Surface;
 use crate::error::{Error, Result};
 use crate::physics::law::{Branch, ForceLaw, Internal};
 use crate::physics::params::ELECTRONVOLT_J;
@@ -299,7 +300,10 @@ pub type Sample = (f64, f64, f64, f64, f64, Branch);
 
 /// Records the trajectory (dimensionless samples, converted by [`Recorder::to_si`]):
 /// step ends plus points on each step's Hermite interpolant, and closed-form free flight
-/// sampled evenly, as densely as its [`Sampling`] says.
+/// sampled evenly, as densely as its [`Sampling`] says. On a relaxing sample, whose
+/// force lives in a surface only the integrator's open step knows
+/// ([`super::surface`]), at the step ends alone, with the force the integrator found
+/// there.
 pub(crate) struct Recorder<'a, L: ForceLaw> {
     /// The samples recorded.
     pub samples: Vec<Sample>,
@@ -309,6 +313,8 @@ pub(crate) struct Recorder<'a, L: ForceLaw> {
     cpl: Coupling,
     osc: Oscillator,
     sampling: Sampling,
+    /// Whether the law's force comes from a surface (sampled at step ends only).
+    surface: bool,
 }
 
 /// How densely a [`Recorder`] samples.
@@ -352,6 +358,14 @@ pub const MAX_TRAJECTORY_SAMPLES: usize = 200_000;
 
 impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
     fn step<const N: usize>(&mut self, from: &StepEnd<N>, to: &StepEnd<N>, branch: Branch) {
+        if self.surface {
+            for end in &[from, to][self.first(branch, 1)..] {
+                let alpha = self.cpl.alpha_hat(end.y[X], self.osc.base_at(end.tau).0);
+                let f = end.dy[Carried::Force] + 0.0;
+                self.record(end.tau, (end.y[X], end.y[V]), alpha, f, branch);
+            }
+            return;
+        }
         let start = self.first(branch, 1);
         let points = self.sampling.points_per_step;
         for i in start..=points {
@@ -391,6 +405,7 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
             cpl,
             osc,
             sampling,
+            surface: Surface::of(law, cpl.a1).is_some(),
         }
     }
 
@@ -407,16 +422,25 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
     }
 
     fn push(&mut self, tau: f64, (x, v): (f64, f64), internal: Internal, branch: Branch) {
+        let state = self
+            .cpl
+            .contact_state((x, v), self.osc.base_at(tau), branch, internal);
+        // (+ 0.0 turns the −0 of a force-free branch into 0; a surface's law is
+        // force-free in the free flights sampled here.)
+        let f = if self.surface && branch == Branch::Free {
+            0.0
+        } else {
+            -self.cpl.f_scale * self.law.force_hat(&state) + 0.0
+        };
+        self.record(tau, (x, v), state.alpha_hat, f, branch);
+    }
+
+    fn record(&mut self, tau: f64, (x, v): (f64, f64), alpha: f64, f: f64, branch: Branch) {
         if self.samples.len() >= self.sampling.max_samples {
             self.overflowed = true;
             return;
         }
-        let state = self
-            .cpl
-            .contact_state((x, v), self.osc.base_at(tau), branch, internal);
-        // (+ 0.0 turns the −0 of a force-free branch into 0.)
-        let f = -self.cpl.f_scale * self.law.force_hat(&state) + 0.0;
-        self.samples.push((tau, x, v, state.alpha_hat, f, branch));
+        self.samples.push((tau, x, v, alpha, f, branch));
     }
 
     /// The samples in SI units for the prepared experiment `p`.

@@ -8,6 +8,7 @@ use super::march::{CycleIntegrals, MAX_SECTION, Phase, Simulation};
 use super::model::{chain, phi_start};
 pub use super::motion::Multipliers;
 use super::motion::{Motion, StdErr, SteadyOptions, SteadyState};
+use super::numeric::Ignore;
 use crate::error::{Error, Result};
 use crate::physics::law::ForceLaw;
 use nalgebra::{Complex, DMatrix, DVector};
@@ -111,7 +112,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let Some(value) = self.period_map(start, &z, n, spent)? else {
             return Ok(None);
         };
-        let (mut end, mut m) = (value.end, value.monodromy());
+        let mut m = value.monodromy();
+        let mut end = value.end;
         let mut r = self.z(&end) - &z;
         let mut norm = r.amax();
         let mut radius: f64 = 0.2;
@@ -249,7 +251,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         spent: usize,
     ) -> Option<SteadyState> {
         let candidate = pending.iter().find(|c| c.captures(self, phase))?;
-        *phase = candidate.on;
+        *phase = candidate.on.clone();
         Some(SteadyState {
             cycles: spent,
             ..candidate.state
@@ -267,7 +269,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         residual: f64,
         spent: &mut usize,
     ) -> Result<Option<(SteadyState, DMatrix<f64>)>> {
-        let start = *phase;
+        let start = phase.clone();
         let z = self.z(&start);
         let Some(mut pass) = self.period_map(&start, &z, n, spent)? else {
             return Ok(None);
@@ -281,8 +283,8 @@ impl<L: ForceLaw> Simulation<'_, L> {
             };
             pass = shorter;
         }
-        *phase = pass.end;
         let monodromy = pass.monodromy();
+        *phase = pass.end;
         Ok(Some((
             SteadyState {
                 window: pass.integrals,
@@ -296,6 +298,53 @@ impl<L: ForceLaw> Simulation<'_, L> {
             },
             monodromy,
         )))
+    }
+}
+
+impl<L: ForceLaw> Simulation<'_, L> {
+    /// [`Simulation::settle`] for a law with a surface ([`super::surface`]), whose period
+    /// map has no derivative here: the n periods marched (the least period found the
+    /// same way), no multipliers.
+    pub(super) fn settle_marching(
+        &self,
+        phase: &mut Phase,
+        n: usize,
+        residual: f64,
+        spent: &mut usize,
+    ) -> Result<SteadyState> {
+        let z = self.z(phase);
+        let pass =
+            |periods: usize, spent: &mut usize| -> Result<(Phase, CycleIntegrals, Vec<f64>)> {
+                let mut p = phase.clone();
+                let mut integrals: Option<CycleIntegrals> = None;
+                let mut returns = Vec::with_capacity(periods);
+                for _ in 0..periods {
+                    *spent += 1;
+                    self.rewind(&mut p);
+                    let c = self.cycle(&mut p, &mut Ignore)?;
+                    integrals = Some(integrals.map_or(c, |s| s.then(&c)));
+                    returns.push((self.z(&p) - &z).amax());
+                }
+                Ok((p, integrals.expect("n >= 1"), returns))
+            };
+        let (mut end, mut integrals, returns) = pass(n, spent)?;
+        let least = (1..=n)
+            .find(|&m| n % m == 0 && (m == n || returns[m - 1] <= 1e3 * residual.max(1e-12)))
+            .unwrap_or(n);
+        if least < n {
+            (end, integrals, _) = pass(least, spent)?;
+        }
+        *phase = end;
+        Ok(SteadyState {
+            window: integrals,
+            cycles: *spent,
+            converged: true,
+            motion: Motion::Periodic {
+                period: least,
+                multipliers: Multipliers::default(),
+            },
+            std_err: StdErr::default(),
+        })
     }
 }
 

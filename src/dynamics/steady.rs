@@ -16,6 +16,7 @@ pub use super::motion::{
 };
 use super::numeric;
 use super::recurrence::Recurrence;
+use super::surface::Surface;
 use super::window::Window;
 use crate::error::Result;
 use crate::physics::law::ForceLaw;
@@ -42,7 +43,17 @@ impl<L: ForceLaw> Simulation<'_, L> {
     /// says whether the reported averages meet their tolerance.
     /// The search runs on a work budget ([`budget`]): motion too costly to resolve ends
     /// with an error.
+    ///
+    /// A relaxing sample's surface ([`super::surface`]) has as many variables as its
+    /// elements, beyond the period map's derivative: its steady state is only marched
+    /// to, judged by the return distances of (x, x', ŷ) with the surface's own creep
+    /// counted in how fast the motion contracts, and its orbit's Floquet multipliers are
+    /// not computed (the marching reached it: it attracts).
     pub fn steady_state(&self, phase: &mut Phase, opts: &SteadyOptions) -> Result<SteadyState> {
+        let opts = &SteadyOptions {
+            shooting: opts.shooting && !self.has_surface(),
+            ..*opts
+        };
         budget::budgeted(opts.max_steps, || {
             self.steady_state_within_budget(phase, opts)
         })
@@ -87,6 +98,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         // The periods marched while searching are the averaging window's first batches,
         // should the motion prove irregular (a transient at their head is cut there).
         let mut window = Window::new(self.memory_periods(), budget - spent);
+        let creep = Surface::of(self.law, self.cpl.a1).map(|s| s.creep_hat());
         let mut stretch = FIRST_STRETCH;
         while spent < search_budget {
             for _ in 0..stretch.min(search_budget - spent) {
@@ -100,15 +112,24 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     // A state contracting onto the orbit by a factor ρ per n periods
                     // is |Δz|·ρ/(1 − ρ) from it; ρ is at most the free oscillator's
                     // e^{−γnT}, so this return distance puts it within `tolerance`.
+                    // A relaxing sample's surface may be slower: it creeps back with
+                    // its retardation time (in contact its elements relax faster).
                     let within = |n: usize| {
-                        let rho = (-self.osc.gamma * self.osc.period() * n as f64).exp();
+                        let rate = creep.map_or(self.osc.gamma, |c| self.osc.gamma.min(1.0 / c));
+                        let rho = (-rate * self.osc.period() * n as f64).exp();
                         opts.tolerance * (1.0 - rho) / rho
                     };
                     if let Some(n) = ring.repeats(within) {
                         let gap = ring.gap(0, n).unwrap_or(0.0);
-                        let mut on = *phase;
+                        let mut on = phase.clone();
                         // (`None`: the orbit grazes a fold, see `period_map`: march on.)
-                        if let Some((state, _)) = self.settle(&mut on, n, gap, &mut spent)? {
+                        let settled = if self.has_surface() {
+                            Some(self.settle_marching(&mut on, n, gap, &mut spent)?)
+                        } else {
+                            self.settle(&mut on, n, gap, &mut spent)?
+                                .map(|(state, _)| state)
+                        };
+                        if let Some(state) = settled {
                             *phase = on;
                             return Ok(state);
                         }

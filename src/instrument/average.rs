@@ -182,7 +182,7 @@ pub fn thermal_average_from(
         .map(|stream| -> Result<[f64; 4]> {
             let mut force =
                 ThermalForce::new(intensity, STEPS_PER_PERIOD, request.seed, stream as u64)?;
-            let mut phase = *start;
+            let mut phase = start.clone();
             let ignore = &mut crate::dynamics::numeric::Ignore;
             force.march(sim, &mut phase, settle, ignore)?;
             let (mut sum, mut touched) = (None::<CycleIntegrals>, 0usize);

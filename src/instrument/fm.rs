@@ -180,7 +180,7 @@ impl FmSample {
 
 /// Where the loops are engaged: a settled FM state (the one
 /// [`crate::analysis::fm::settle`] finds), taken up without a bump.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Engagement {
     /// The lever's state at a drive period's start.
     pub phase: Phase,
@@ -255,7 +255,7 @@ pub fn thermal_average(
             );
             pll.hold(at.drive.omega);
             agc.hold(at.drive.excitation);
-            let (mut phase, mut drive) = (at.phase, at.drive);
+            let (mut phase, mut drive) = (at.phase.clone(), at.drive);
             let mut loops: Loops = (&mut pll, &mut agc, &mut force);
             let mut sum = [0.0; 3];
             for i in 0..settle + per_record {

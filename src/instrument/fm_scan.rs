@@ -176,7 +176,7 @@ impl<'a> FmScanner<'a> {
     /// `height_m`: the lever there, the PLL and the amplitude controller preloaded to
     /// hold its drive (a bumpless start).
     pub fn engage(&mut self, at: &Engagement, height_m: f64) {
-        self.phase = at.phase;
+        self.phase = at.phase.clone();
         self.drive = at.drive;
         self.pll.hold(at.drive.omega);
         self.agc.hold(at.drive.excitation);

@@ -581,7 +581,7 @@ impl Lever for OneMode<'_> {
                 let chunk = 2.0 * PI;
                 while phase.tau < leg.span - 1e-12 * leg.span {
                     let span = chunk.min(leg.span - phase.tau);
-                    let (before, kept) = (*phase, recorder.samples.len());
+                    let (before, kept) = (phase.clone(), recorder.samples.len());
                     let c = sim.advance(phase, span, &mut recorder)?;
                     if c.max_force < level {
                         add(c, record);
@@ -589,7 +589,7 @@ impl Lever for OneMode<'_> {
                     }
                     recorder.samples.truncate(kept);
                     let hi = first_reach(span, |s| {
-                        let mut trial = before;
+                        let mut trial = before.clone();
                         Ok(sim.advance(&mut trial, s, &mut Ignore)?.max_force >= level)
                     })?;
                     *phase = before;

@@ -100,7 +100,7 @@ pub fn linear_noise<L: ForceLaw>(
     let h = period / parts as f64;
     let d = sim.section_dim();
     let omega = sim.osc.omega;
-    let mut at = *phase;
+    let mut at = phase.clone();
     let tau0 = at.tau;
     // Φ(s_j) and G(s_j) on the grid s_j = j·h.
     let mut phi = vec![DMatrix::<f64>::identity(d, d)];
@@ -266,7 +266,7 @@ pub fn monte_carlo_noise<L: ForceLaw + Sync>(
         .into_par_iter()
         .map(|stream| -> Result<Vec<(f64, f64)>> {
             let mut force = ThermalForce::new(intensity_hat, steps, seed, stream as u64)?;
-            let (mut at, mut lockin) = (*phase, lockin);
+            let (mut at, mut lockin) = (phase.clone(), lockin);
             force.march(sim, &mut at, settle, &mut lockin)?;
             let mut out = Vec::with_capacity(per_stream);
             for _ in 0..per_stream {

@@ -179,7 +179,7 @@ impl<'a> Scanner<'a> {
         // Record where asked, and the first repeating cycle (its channels stand for
         // the repeats).
         let record = record || (self.quiet + 1 >= QUIET_CYCLES && self.channels.is_none());
-        let before = self.phase;
+        let before = self.phase.clone();
         sim.rewind(&mut self.phase);
         let (c, channels) = budgeted(p.steady.max_steps, || {
             if record {

@@ -204,19 +204,6 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
             }
         );
     }
-    if let Some(pull_n) = relaxing_pull_n(setup, o.peak_attractive_force_n) {
-        let _ = writeln!(
-            s,
-            "note: the relaxing sample pulls the tip to {}, beyond the {} law's own most \
-             tensile force ({}): Lee & Radok's hereditary integral runs through unloading as \
-             through loading (Ting's correction for a shrinking contact is not applied), so \
-             the Maxwell arm's force turns tensile as the tip withdraws; a real contact lets \
-             go instead. E_ts and φ above are that model's",
-            nanonewtons(o.peak_attractive_force_n),
-            setup.law.kind,
-            nanonewtons(pull_n)
-        );
-    }
     if o.contact_fraction == 0.0 && o.jumps_in == 0.0 && o.law != "none" {
         let _ = writeln!(
             s,
@@ -243,23 +230,6 @@ pub fn to_text(setup: &TapSetup, run: &TapRun) -> String {
         );
     }
     s
-}
-
-/// The most tensile force the elastic law under a standard-linear-solid sample exerts
-/// (N: Hertz's none, DMT's pull-off −2πRΔγ, Derjaguin, Muller & Toporov 1975), where the
-/// orbit's `peak_attractive_force_n` goes beyond it by more than 0.1 % of it or 1 pN:
-/// the pull of Lee & Radok's integral through unloading. `None` for an elastic sample
-/// or no such pull.
-fn relaxing_pull_n(setup: &TapSetup, peak_attractive_force_n: f64) -> Option<f64> {
-    setup.law.relaxing()?;
-    let c = &setup.contact;
-    let own = match setup.law.kind {
-        crate::law::LawKind::Dmt => {
-            -2.0 * std::f64::consts::PI * c.radius_m * c.work_of_adhesion_j_m2
-        }
-        _ => 0.0,
-    };
-    (peak_attractive_force_n < own - (1e-3 * own.abs()).max(1e-12)).then_some(own)
 }
 
 /// A length in pm to three significant digits (below 0.01 pm in scientific form, from

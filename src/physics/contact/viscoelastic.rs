@@ -46,11 +46,14 @@
 use crate::error::{Error, Result, positive};
 use crate::numeric::{bracketed_root, newton_bracketed};
 
+/// The most nodes whose state within a step is found once per force on the stack.
+const STACK_NODES: usize = 256;
+
 /// Two-point Gauss–Legendre abscissae on [0, 1] (exact for cubics).
 const GAUSS_2: [f64; 2] = [0.211_324_865_405_187_1, 0.788_675_134_594_812_9];
 
 /// A sphere on a standard-linear-solid half-space, with the surface's memory.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RelaxingHalfSpace {
     /// r = (E₀ − E_∞)/E_∞.
     modulus_ratio: f64,
@@ -136,6 +139,59 @@ impl RelaxingHalfSpace {
         })
     }
 
+    /// Cells across the nodes' reach.
+    pub fn cells(&self) -> usize {
+        self.p.len() - 2
+    }
+
+    /// Let every element creep free for `duration_hat` (dv̂/dτ = −v̂/((1 + r)τ̂_r)): the
+    /// surface while the tip is away from it (the caller knows no element touches).
+    pub fn creep(&mut self, duration_hat: f64) {
+        let decay = (-duration_hat.max(0.0) / self.creep_hat()).exp();
+        for j in 0..self.p.len() {
+            let e = self.stored(j).creep(decay);
+            self.p[j] = e.p;
+            self.c[j] = e.c;
+        }
+    }
+
+    /// The same surface on nodes that reach `reach_hat`, as many cells across: p and c
+    /// interpolated linearly from today's nodes, zero past them (no element there has
+    /// been touched; moving to a shorter reach drops what the elements past it hold,
+    /// [`RelaxingHalfSpace::extension_beyond`]). Second order in the old spacing, once.
+    pub fn regrid(&mut self, reach_hat: f64) {
+        let old = (self.spacing, self.p.clone(), self.c.clone());
+        let last = old.1.len() - 1;
+        self.spacing = reach_hat.sqrt() / self.cells() as f64;
+        for j in 0..self.p.len() {
+            let at = self.xi(j) / old.0;
+            let k = at.floor() as usize;
+            let (p, c) = if k >= last {
+                (0.0, 0.0)
+            } else {
+                let w = at - k as f64;
+                (
+                    old.1[k] + w * (old.1[k + 1] - old.1[k]),
+                    old.2[k] + w * (old.2[k + 1] - old.2[k]),
+                )
+            };
+            self.p[j] = p;
+            self.c[j] = c;
+        }
+    }
+
+    /// The largest Maxwell extension |v̂| of the nodes past the indentation `reach_hat`
+    /// (ξ̂² > reach): what moving to that reach would drop.
+    pub fn extension_beyond(&self, reach_hat: f64) -> f64 {
+        (0..self.p.len())
+            .filter(|&j| self.xi(j).powi(2) > reach_hat)
+            .map(|j| {
+                let e = self.stored(j);
+                (e.c - e.p * self.xi(j).powi(2)).abs()
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// The largest indentation the nodes reach.
     pub fn reach_hat(&self) -> f64 {
         let x = self.spacing * (self.p.len() - 2) as f64;
@@ -152,7 +208,7 @@ impl RelaxingHalfSpace {
     }
 
     /// The retardation time (1 + r)τ̂_r a free element creeps back with.
-    fn creep_hat(&self) -> f64 {
+    pub fn creep_hat(&self) -> f64 {
         (1.0 + self.modulus_ratio) * self.relaxation_hat
     }
 
@@ -241,11 +297,25 @@ impl RelaxingHalfSpace {
         mean_hat: f64,
         elapsed_hat: f64,
     ) -> f64 {
+        // A tip above the undeformed level touches no element that did not touch at the
+        // step's start (each element's free surface sits at ξ̂² + κv̂ ≥ 0).
+        if indentation_hat <= 0.0 && !self.touching.iter().any(|&t| t) {
+            return 0.0;
+        }
         let decays = self.decays(elapsed_hat);
         let now = (indentation_hat, rate_hat, mean_hat);
-        self.force_of(indentation_hat, &|j| {
-            self.in_step(j, now, elapsed_hat, decays)
-        })
+        let node = |j| self.in_step(j, now, elapsed_hat, decays);
+        // Each node is read by the cells on both sides and by the lines through it:
+        // found once, on the stack, where the nodes fit there.
+        if self.p.len() <= STACK_NODES {
+            let mut nodes = [Element { p: 0.0, c: 0.0 }; STACK_NODES];
+            for (j, e) in nodes.iter_mut().enumerate().take(self.p.len()) {
+                *e = node(j);
+            }
+            self.force_of(indentation_hat, &|j| nodes[j])
+        } else {
+            self.force_of(indentation_hat, &node)
+        }
     }
 
     /// Close the step opened by [`RelaxingHalfSpace::begin_step`] at `elapsed_hat`,

@@ -117,6 +117,12 @@ macro_rules! forward_to_inner {
         fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
             self.0.internal_slopes_hat(state)
         }
+        fn surface(&self, reach_hat: f64) -> Option<RelaxingHalfSpace> {
+            self.0.surface(reach_hat)
+        }
+        fn surface_t_hat(&self, state: &ContactState, surface_force_hat: f64) -> f64 {
+            self.0.surface_t_hat(state, surface_force_hat)
+        }
     };
 }
 
@@ -160,6 +166,7 @@ pub use table::UniformTable;
 pub use viscous::KelvinVoigt;
 
 use crate::error::Result;
+use crate::physics::contact::viscoelastic::RelaxingHalfSpace;
 use crate::physics::params::Contact;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -339,6 +346,22 @@ pub trait ForceLaw: Send + Sync {
     fn internal_slopes_hat(&self, _state: &ContactState) -> InternalSlopes {
         InternalSlopes::default()
     }
+    /// A fresh surface, relaxed and flat, whose nodes reach the indentation
+    /// `reach_hat`, for a law whose sample remembers its deformation from one contact to
+    /// the next (Ting's receding contact on a relaxing half-space,
+    /// [`StandardLinearSolid`]); `None` (the default) for every other law. The
+    /// integrator carries the surface beside the state, and the rate-dependent force
+    /// comes from it ([`ForceLaw::surface_t_hat`]), not from
+    /// [`ForceLaw::dissipative_t_hat`].
+    fn surface(&self, _reach_hat: f64) -> Option<RelaxingHalfSpace> {
+        None
+    }
+    /// The rate-dependent force T̂_d at `state` of a law with a surface
+    /// ([`ForceLaw::surface`]), where the surface pushes on the tip with F̂
+    /// (`surface_force_hat`, compressive positive, the contact's units).
+    fn surface_t_hat(&self, state: &ContactState, _surface_force_hat: f64) -> f64 {
+        self.dissipative_t_hat(state)
+    }
     /// The whole force T̂ + T̂_d at `state`.
     #[inline]
     fn force_hat(&self, state: &ContactState) -> f64 {
@@ -456,6 +479,12 @@ impl ForceLaw for Rheology {
     }
     fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
         rheology!(self, l => l.internal_slopes_hat(state))
+    }
+    fn surface(&self, reach_hat: f64) -> Option<RelaxingHalfSpace> {
+        rheology!(self, l => l.surface(reach_hat))
+    }
+    fn surface_t_hat(&self, state: &ContactState, surface_force_hat: f64) -> f64 {
+        rheology!(self, l => l.surface_t_hat(state, surface_force_hat))
     }
 }
 
@@ -601,6 +630,16 @@ impl ForceLaw for AnyLaw {
     }
     fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
         dispatch!(self, l => l.dissipative_slopes_hat(state))
+    }
+    fn surface(&self, reach_hat: f64) -> Option<RelaxingHalfSpace> {
+        match self {
+            AnyLaw::Viscous(l) => l.surface(reach_hat),
+            AnyLaw::Dyn(l) => l.surface(reach_hat),
+            _ => None,
+        }
+    }
+    fn surface_t_hat(&self, state: &ContactState, surface_force_hat: f64) -> f64 {
+        dispatch!(self, l => l.surface_t_hat(state, surface_force_hat))
     }
 }
 

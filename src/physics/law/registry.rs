@@ -270,10 +270,11 @@ pub const UNRELAXED_MODULUS: LawParam = LawParam {
     key: "unrelaxed-modulus",
     name: "unrelaxed modulus",
     unit: "Pa",
-    help: "Standard-linear-solid sample on the hertz or dmt law (Lee–Radok's hereditary \
-           Hertz integral with E(t) = E∞ + (E0 − E∞)exp(−t/τ)): its unrelaxed composite \
-           modulus E0, above the contact's modulus E*, which is the relaxed E∞ (e.g. 3GPa; \
-           give the relaxation time too) [Pa; default: none, elastic]",
+    help: "Standard-linear-solid sample on the hertz or dmt law, E(t) = E∞ + (E0 − \
+           E∞)exp(−t/τ), with Ting's receding contact (the surface lags a retreating tip and \
+           never pulls; it creeps back between taps): its unrelaxed composite modulus E0, \
+           above the contact's modulus E*, which is the relaxed E∞ (e.g. 3GPa; give the \
+           relaxation time too) [Pa; default: none, elastic]",
     taken_by: takes_a_relaxing_sample,
     range: (1e5, 1e12, "from soft gels to stiff solids"),
 };
@@ -283,8 +284,9 @@ pub const RELAXATION_TIME: LawParam = LawParam {
     key: "relaxation-time",
     name: "relaxation time",
     unit: "s",
-    help: "Relaxation time τ of the standard-linear-solid sample (e.g. 1us; give the \
-           unrelaxed modulus too) [s; default: none, elastic]",
+    help: "Relaxation time τ of the standard-linear-solid sample (e.g. 100ns; give the \
+           unrelaxed modulus too; from 0.05/ω₀ to a retardation (E0/E∞)τ of 100 lever \
+           periods) [s; default: none, elastic]",
     taken_by: takes_a_relaxing_sample,
     range: (
         1e-12,
