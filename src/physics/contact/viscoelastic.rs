@@ -68,8 +68,10 @@ pub struct RelaxingHalfSpace {
     /// The integrator step's start ([`RelaxingHalfSpace::begin_step`]): δ̂_n, dδ̂/dτ
     /// there, ŷ_n.
     step_start: (f64, f64, f64),
-    /// Whether each element touched at the step's start.
+    /// Whether each element touched at the step's start …
     touching: Vec<bool>,
+    /// … and whether any did.
+    any_touching: bool,
 }
 
 /// The state of one element: its Maxwell extension split as v̂ = c − pξ̂².
@@ -136,6 +138,7 @@ impl RelaxingHalfSpace {
             c: vec![0.0; cells + 2],
             step_start: (0.0, 0.0, 0.0),
             touching: vec![false; cells + 2],
+            any_touching: false,
         })
     }
 
@@ -283,6 +286,7 @@ impl RelaxingHalfSpace {
         for j in 0..self.p.len() {
             self.touching[j] = self.gap(j, self.stored(j), indentation_hat) > 0.0;
         }
+        self.any_touching = self.touching.contains(&true);
         Ok(())
     }
 
@@ -299,7 +303,7 @@ impl RelaxingHalfSpace {
     ) -> f64 {
         // A tip above the undeformed level touches no element that did not touch at the
         // step's start (each element's free surface sits at ξ̂² + κv̂ ≥ 0).
-        if indentation_hat <= 0.0 && !self.touching.iter().any(|&t| t) {
+        if indentation_hat <= 0.0 && !self.any_touching {
             return 0.0;
         }
         let decays = self.decays(elapsed_hat);
