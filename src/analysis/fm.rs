@@ -251,13 +251,14 @@ pub struct FmGuess {
 }
 
 impl FmGuess {
-    /// The free cantilever's orbit at resonance (far from the sample). Refuses a law
-    /// with internal state (a relaxing sample), whose memory the search does not carry.
+    /// The free cantilever's orbit at resonance (far from the sample). Refuses a relaxing
+    /// sample, whose surface's memory the search does not carry.
     pub fn free(setup: &TapSetup, numerics: &Numerics) -> Result<Self> {
         let p = Prepared::new(setup, numerics)?;
-        if p.law.internal_states() > 0 {
+        if p.law.has_surface() {
             return Err(Error::OutOfRange(
-                "FM with a relaxing sample (a law with internal state) is not supported yet".into(),
+                "FM with a relaxing sample (whose surface remembers the last tap) is not supported yet"
+                    .into(),
             ));
         }
         Ok(Self {

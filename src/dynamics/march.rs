@@ -254,7 +254,7 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
             self.turn(branch, turn.alpha_hat);
             let force_hat = match self.surface {
                 Some(s) => {
-                    let view = [-turn.alpha_hat, -turn.rate_hat, turn.internal[0]];
+                    let view = [-turn.alpha_hat, -turn.rate_hat];
                     let pushed = s.borrow().force_at(tau, view);
                     self.law.t_hat(turn.alpha_hat, branch) + self.law.surface_t_hat(&turn, pushed)
                 }
@@ -310,7 +310,7 @@ pub(crate) const LOOSEST_RTOL: f64 = 1e-5;
 impl<L: ForceLaw> Simulation<'_, L> {
     /// Whether the law's sample has a surface the march carries ([`super::surface`]).
     pub fn has_surface(&self) -> bool {
-        Surface::of(self.law, self.cpl.a1).is_some()
+        self.law.has_surface()
     }
 
     /// Dimension of the section state: x, x' and the law's internal state.
@@ -560,16 +560,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
             reset_phi(&mut y);
         }
         // A relaxing sample's surface: as the motion left it, or fresh.
-        let surface = if internal_count(N) > 0 {
-            phase
-                .surface
-                .take()
-                .map(|s| *s)
-                .or_else(|| Surface::of(self.law, self.cpl.a1))
-                .map(RefCell::new)
-        } else {
-            None
-        };
+        let surface = phase
+            .surface
+            .take()
+            .map(|s| *s)
+            .or_else(|| Surface::of(self.law, self.cpl.a1))
+            .map(RefCell::new);
         let mechanical = |y: &State<N>| 0.5 * (y[X] * y[X] + y[V] * y[V]);
         let e0 = mechanical(&y);
         let start = (phase.tau, phase.x, phase.v);

@@ -450,7 +450,7 @@ impl Coupling {
 }
 
 /// What a relaxing sample's surface sees of the tip at τ in state `y`
-/// ([`super::surface::View`]): δ̂ = −α̂, its rate and the Maxwell mean ŷ.
+/// ([`super::surface::View`]): δ̂ = −α̂ and its rate.
 #[inline]
 pub(crate) fn surface_view<const N: usize>(
     osc: &Oscillator,
@@ -459,11 +459,7 @@ pub(crate) fn surface_view<const N: usize>(
     y: &State<N>,
 ) -> View {
     let (x_b, v_b) = osc.base_at(tau);
-    [
-        -cpl.alpha_hat(y[X], x_b),
-        -cpl.a1 * (y[V] + v_b),
-        y[Part::Internal(0)],
-    ]
+    [-cpl.alpha_hat(y[X], x_b), -cpl.a1 * (y[V] + v_b)]
 }
 
 /// The right-hand side of the equation of motion and of the carried integrals; for a

@@ -8,7 +8,6 @@ use super::model::{Carried, Coupling, Drive, Oscillator, V, X};
 use super::numeric::{StepEnd, StepObserver, hermite, internal_at};
 use super::setup::Prepared;
 use super::steady::{Motion, SteadyState};
-use super::surface::Surface;
 use crate::error::{Error, Result};
 use crate::physics::law::{Branch, ForceLaw, Internal};
 use crate::physics::params::ELECTRONVOLT_J;
@@ -405,7 +404,7 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
             cpl,
             osc,
             sampling,
-            surface: Surface::of(law, cpl.a1).is_some(),
+            surface: law.has_surface(),
         }
     }
 

@@ -26,6 +26,11 @@ const FIRST_STRETCH: usize = 32;
 /// Periods the search for an orbit may integrate at most (with shooting).
 const SEARCH_PERIODS: usize = 1000;
 
+/// How close, in units of the integrator's relative tolerance, a marched orbit of a
+/// relaxing sample is settled (the period map's own jitter is some tenths of it a
+/// period).
+const MARCHED_FLOOR: f64 = 100.0;
+
 impl<L: ForceLaw> Simulation<'_, L> {
     /// The steady state reached from `phase` (which is left on it): the attractor the
     /// motion settles on, classified as period-n (n ≤ [`MAX_PERIOD`]) or irregular, with
@@ -46,9 +51,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
     ///
     /// A relaxing sample's surface ([`super::surface`]) has as many variables as its
     /// elements, beyond the period map's derivative: its steady state is only marched
-    /// to, judged by the return distances of (x, x', ŷ) with the surface's own creep
-    /// counted in how fast the motion contracts, and its orbit's Floquet multipliers are
-    /// not computed (the marching reached it: it attracts).
+    /// to, judged by the return distances of (x, x') with the surface's own creep
+    /// counted in how fast the motion contracts, to within 100 times the
+    /// integrator's tolerance (the marched map's own jitter), and its orbit's Floquet
+    /// multipliers are not computed (the marching reached it: it attracts).
     pub fn steady_state(&self, phase: &mut Phase, opts: &SteadyOptions) -> Result<SteadyState> {
         let opts = &SteadyOptions {
             shooting: opts.shooting && !self.has_surface(),
@@ -113,11 +119,20 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     // is |Δz|·ρ/(1 − ρ) from it; ρ is at most the free oscillator's
                     // e^{−γnT}, so this return distance puts it within `tolerance`.
                     // A relaxing sample's surface may be slower: it creeps back with
-                    // its retardation time (in contact its elements relax faster).
+                    // its retardation time (in contact its elements relax faster). Its
+                    // orbit is only ever marched to, and a marched period jitters by
+                    // a fraction of the integrator's tolerance (its steps, adapted to
+                    // the surface's kinks, differ from period to period: measured
+                    // 3e-10 a period at rtol 1e-9, 2e-9 of wander on a Q = 400
+                    // lever), so it is settled to within `MARCHED_FLOOR` rtol.
+                    let target = match creep {
+                        Some(_) => opts.tolerance.max(MARCHED_FLOOR * self.tol.rtol),
+                        None => opts.tolerance,
+                    };
                     let within = |n: usize| {
                         let rate = creep.map_or(self.osc.gamma, |c| self.osc.gamma.min(1.0 / c));
                         let rho = (-rate * self.osc.period() * n as f64).exp();
-                        opts.tolerance * (1.0 - rho) / rho
+                        target * (1.0 - rho) / rho
                     };
                     if let Some(n) = ring.repeats(within) {
                         let gap = ring.gap(0, n).unwrap_or(0.0);

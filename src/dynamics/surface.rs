@@ -20,9 +20,8 @@ use crate::error::Result;
 use crate::physics::contact::viscoelastic::RelaxingHalfSpace;
 use crate::physics::law::ForceLaw;
 
-/// What the surface sees of the tip: the indentation δ̂ = −α̂, its rate dδ̂/dτ and the
-/// Maxwell mean ŷ the integrator carries (the law's internal state).
-pub type View = [f64; 3];
+/// What the surface sees of the tip: the indentation δ̂ = −α̂ and its rate dδ̂/dτ.
+pub type View = [f64; 2];
 
 /// The fraction of the nodes' reach past which a step's start grows it.
 const GROW_AT: f64 = 0.7;
@@ -55,9 +54,6 @@ impl Surface {
     /// A fresh surface for `law` if its sample has one (none for every other law).
     /// `length_hat` is the length unit L in the contact's units (the coupling's a₁).
     pub(crate) fn of<L: ForceLaw>(law: &L, length_hat: f64) -> Option<Self> {
-        if law.internal_states() == 0 {
-            return None;
-        }
         let reach = (FIRST_REACH * length_hat).max(f64::MIN_POSITIVE.sqrt());
         Some(Self {
             half_space: law.surface(reach)?,
@@ -69,7 +65,7 @@ impl Surface {
 
     /// Open a step at τ where the tip is seen as `view` (growing the reach first if the
     /// tip is deep in it; `period`, the drive's, paces the look for shrinking it).
-    pub(crate) fn open(&mut self, tau: f64, [depth, rate, mean]: View, period: f64) -> Result<()> {
+    pub(crate) fn open(&mut self, tau: f64, [depth, rate]: View, period: f64) -> Result<()> {
         let reach = self.half_space.reach_hat();
         self.deepest = self.deepest.max(depth);
         if depth > GROW_AT * reach {
@@ -85,7 +81,7 @@ impl Surface {
             }
             (self.deepest, self.since) = (depth, 0.0);
         }
-        self.half_space.begin_step(depth, rate, mean)?;
+        self.half_space.begin_step(depth, rate)?;
         self.opened_at = tau;
         Ok(())
     }
@@ -93,16 +89,15 @@ impl Surface {
     /// F̂, the surface's push on the tip (compressive positive, the contact's units), at τ
     /// inside the open step where the tip is seen as `view`.
     #[inline]
-    pub(crate) fn force_at(&self, tau: f64, [depth, rate, mean]: View) -> f64 {
+    pub(crate) fn force_at(&self, tau: f64, [depth, rate]: View) -> f64 {
         self.half_space
-            .force_in_step_hat(depth, rate, mean, tau - self.opened_at)
+            .force_in_step_hat(depth, rate, tau - self.opened_at)
     }
 
     /// Close the open step at τ where the tip is seen as `view`, and open the next there.
     pub(crate) fn close(&mut self, tau: f64, view: View, period: f64) -> Result<()> {
-        let [depth, rate, mean] = view;
-        self.half_space
-            .end_step(depth, rate, mean, tau - self.opened_at);
+        let [depth, rate] = view;
+        self.half_space.end_step(depth, rate, tau - self.opened_at);
         self.since += tau - self.opened_at;
         self.open(tau, view, period)
     }

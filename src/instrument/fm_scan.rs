@@ -131,9 +131,10 @@ impl<'a> FmScanner<'a> {
                 "an FM scan needs at least one material".into(),
             ));
         };
-        if materials.iter().any(|p| p.law.internal_states() > 0) {
+        if materials.iter().any(|p| p.law.has_surface()) {
             return Err(Error::OutOfRange(
-                "FM with a relaxing sample (a law with internal state) is not supported yet".into(),
+                "FM with a relaxing sample (whose surface remembers the last tap) is not supported yet"
+                    .into(),
             ));
         }
         let quality = first.setup.cantilever.quality;

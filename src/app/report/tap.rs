@@ -293,21 +293,27 @@ fn attractors_text(s: &mut String, list: &[Attractor], well_defined: Option<bool
 /// The kind of motion, the periods the values are averaged over, and the stability of a
 /// periodic orbit with its largest Floquet multiplier.
 fn motion_text(o: &TapObservables) -> String {
-    let largest = o
-        .floquet_multipliers
-        .iter()
-        .map(|m| m[0].hypot(m[1]))
-        .fold(0.0, f64::max);
+    // (A relaxing sample's orbit is marched to: no multipliers are computed.)
+    let largest = if o.floquet_multipliers.is_empty() {
+        String::new()
+    } else {
+        let largest = o
+            .floquet_multipliers
+            .iter()
+            .map(|m| m[0].hypot(m[1]))
+            .fold(0.0, f64::max);
+        format!(", largest |Floquet multiplier| {largest:.4}")
+    };
     match (o.stable, o.period) {
+        (Some(true), _) if largest.is_empty() => {
+            format!("{} (stable: reached by marching)", o.regime)
+        }
         (Some(stable), _) => format!(
-            "{} ({}, largest |Floquet multiplier| {largest:.4})",
+            "{} ({}{largest})",
             o.regime,
             if stable { "stable" } else { "unstable" }
         ),
-        (None, Some(_)) => format!(
-            "{} (grazing a switch, largest |Floquet multiplier| {largest:.4})",
-            o.regime
-        ),
+        (None, Some(_)) => format!("{} (grazing a switch{largest})", o.regime),
         (None, None) => format!("{}: averages over {} periods", o.regime, o.periods_averaged),
     }
 }

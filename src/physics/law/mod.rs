@@ -356,6 +356,10 @@ pub trait ForceLaw: Send + Sync {
     fn surface(&self, _reach_hat: f64) -> Option<RelaxingHalfSpace> {
         None
     }
+    /// Whether the sample has a surface that remembers ([`ForceLaw::surface`]).
+    fn has_surface(&self) -> bool {
+        self.surface(1.0).is_some()
+    }
     /// The rate-dependent force T̂_d at `state` of a law with a surface
     /// ([`ForceLaw::surface`]), where the surface pushes on the tip with F̂
     /// (`surface_force_hat`, compressive positive, the contact's units).

@@ -285,11 +285,11 @@ pub const RELAXATION_TIME: LawParam = LawParam {
     name: "relaxation time",
     unit: "s",
     help: "Relaxation time τ of the standard-linear-solid sample (e.g. 100ns; give the \
-           unrelaxed modulus too; from 0.05/ω₀ to a retardation (E0/E∞)τ of 100 lever \
+           unrelaxed modulus too; from 1e-8/ω₀ to a retardation (E0/E∞)τ of 100 lever \
            periods) [s; default: none, elastic]",
     taken_by: takes_a_relaxing_sample,
     range: (
-        1e-12,
+        1e-14,
         1.0,
         "a relaxation time far outside the drive period (~µs) leaves the sample elastic",
     ),
