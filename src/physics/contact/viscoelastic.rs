@@ -771,6 +771,34 @@ mod tests {
             worst[1] < 1.5e-6 && (3.5..4.5).contains(&(worst[0] / worst[1])),
             "{worst:?}"
         );
+        // The loss of the cycle, ∮F̂ dδ̂ = ∫₀¹F̂ dt − ∫₁²F̂ dt, the model's at 400 nodes
+        // against Ting's, the same trapezoidal rule on 400 intervals for both (measured
+        // 2.2e-6 apart).
+        let fine: Vec<f64> = (0..=400).map(|i| i as f64 * 0.005).collect();
+        let loss = |force: &[f64]| -> f64 {
+            (0..400)
+                .map(|i| {
+                    let sign = if fine[i] < 1.0 - 1e-12 { 1.0 } else { -1.0 };
+                    sign * 0.5 * (force[i] + force[i + 1]) * 0.005
+                })
+                .sum()
+        };
+        let ting_loss = loss(
+            &fine
+                .iter()
+                .map(|&t| ting_triangle(r, tau, t).0)
+                .collect::<Vec<_>>(),
+        );
+        let model_loss = loss(
+            &elements_triangle(r, tau, 400, &fine)
+                .iter()
+                .map(|&(f, _)| f)
+                .collect::<Vec<_>>(),
+        );
+        assert!(
+            ting_loss > 0.1 * peak && (model_loss / ting_loss - 1.0).abs() < 1e-5,
+            "{model_loss} against Ting's {ting_loss}"
+        );
     }
 
     /// δ̂(t) = 0.5 − 0.8 cos(2πt): two contacts a period, loading and unloading.
