@@ -1,8 +1,8 @@
 //! The period-1 orbit family followed through the rest separation by pseudo-arclength
 //! continuation of the shooting equations.
 //!
-//! Unknowns u = (z, q): the section state at the drive phase (x, x' and a law's
-//! internal state, [`Simulation::z`]) and the rest separation q = z_c/L. The equations
+//! Unknowns u = (z, q): the section state at the drive phase (x and x',
+//! [`Simulation::z`]) and the rest separation q = z_c/L. The equations
 //! P(z; q) − z = 0 have the Jacobian [M − I | ∂P/∂q],
 //! exact from the variational equations ([`Simulation::cycle_with_derivative`]); its null
 //! vector is the branch's tangent, so the family is followed through its folds, stable

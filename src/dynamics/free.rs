@@ -224,8 +224,7 @@ impl FreeFlight {
         y[Carried::CosProjection] += sc;
         y[Carried::SinProjection] += ss;
         if has_tangent(N) {
-            // The rows of x and x', column by column (a law's internal rows are the
-            // caller's: `relax_internal`).
+            // The rows of x and x', column by column.
             let t = self.transition(tau_b - tau_a);
             for col in 0..=section_dim(N) {
                 let at = phi_column(N, col);

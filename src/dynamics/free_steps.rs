@@ -66,7 +66,7 @@ pub struct FreeSteps {
 
 impl FreeSteps {
     /// The steps of `step` (τ) for `sim`; `None` where they do not apply (a law with
-    /// internal or rate-dependent state, a force out of contact, a branch left other
+    /// a rate-dependent force, a force out of contact, a branch left other
     /// than by falling into contact, a base drive or a ramp, overdamping, a step
     /// above a tenth of the free period).
     pub fn new<L: ForceLaw>(sim: &Simulation<'_, L>, step: f64) -> Option<Self> {
@@ -82,7 +82,6 @@ impl FreeSteps {
         };
         let gamma = sim.osc.gamma;
         let applies = sim.law.free_branch_is_force_free()
-            && sim.law.internal_states() == 0
             && !sim.law.is_rate_dependent()
             && step > 0.0
             && step <= MAX_STEP

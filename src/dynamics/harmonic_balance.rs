@@ -14,13 +14,13 @@
 //! from the sample, and, where the attractive and the repulsive regimes coexist, three
 //! (two stable, the middle one a saddle). The walk along the cosine follows the law's
 //! branches (jump-in and jump-out where they fall), so the hysteresis enters f_s. A root
-//! is only an estimate (the tip's motion has harmonics, a law's internal state is taken
-//! as relaxed): each is a start for the exact steady-state search, which decides.
+//! is only an estimate (the tip's motion has harmonics, a relaxing sample's surface is
+//! not in it): each is a start for the exact steady-state search, which decides.
 
 use super::march::{Phase, Simulation};
 use super::model::Drive;
 use crate::numeric::{GAUSS_LEGENDRE_8, bracketed_root};
-use crate::physics::law::{Branch, ContactState, ForceLaw, Internal};
+use crate::physics::law::{Branch, ContactState, ForceLaw};
 use std::f64::consts::PI;
 
 /// Gauss–Legendre panels along a stretch of the cosine on one branch.
@@ -253,7 +253,6 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     alpha_hat: self.cpl.alpha_hat(m + a * c, 0.0),
                     rate_hat: -self.cpl.a1 * a * self.osc.omega * s,
                     branch,
-                    internal: Internal::default(),
                 };
                 let f = -self.cpl.f_scale * self.law.force_hat(&state) * weight * half;
                 sum.mean += f;

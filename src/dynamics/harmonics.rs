@@ -12,7 +12,7 @@
 
 use super::free::FreeFlight;
 use super::model::{Coupling, Oscillator, V, X};
-use super::numeric::{StepEnd, StepObserver, internal_at};
+use super::numeric::{StepEnd, StepObserver};
 use crate::numeric::GAUSS_LEGENDRE_8;
 use crate::physics::law::{Branch, ForceLaw};
 use nalgebra::Complex;
@@ -113,12 +113,9 @@ impl<L: ForceLaw> StepObserver for HarmonicsObserver<'_, L> {
             let (t, w) = (0.5 * (1.0 + x), 0.5 * w);
             let tau = from.tau + t * h;
             let (x, dx_dt) = quintic_hermite(t, start, finish);
-            let state = self.cpl.contact_state(
-                (x, dx_dt / h),
-                self.osc.base_at(tau),
-                branch,
-                internal_at(from, to, tau),
-            );
+            let state = self
+                .cpl
+                .contact_state((x, dx_dt / h), self.osc.base_at(tau), branch);
             let f = -self.cpl.f_scale * self.law.force_hat(&state);
             self.add(tau, w * h, x, f);
         }

@@ -14,26 +14,23 @@ use super::budget;
 use super::free::FreeFlight;
 use super::grazing::{Margins, SwitchLevels};
 use super::model::{
-    BASE, Carried, Coupling, Drive, MEMORY, MEMORY_TANGENT, MODES, Oscillator, RATE, RATE_TANGENT,
-    State, TANGENT, V, X, dissipative_work_index, has_tangent, internal, internal_count, phi,
-    phi_column, relax_internal, reset_phi, section_dim, set_internal, surface_view,
+    BASE, Carried, Coupling, Drive, MODES, Oscillator, RATE, RATE_TANGENT, State, TANGENT, V, X,
+    dissipative_work_index, has_tangent, phi, phi_column, reset_phi, section_dim, surface_view,
 };
 use super::numeric::{
     self, Crossing, Events, StepEnd, StepObserver, Tolerances, hermite, hermite_turn_fraction,
-    internal_at,
 };
 use super::surface::Surface;
 use crate::error::{Error, Result};
-use crate::physics::law::{Branch, Exits, ForceLaw, Internal, MAX_INTERNAL};
+use crate::physics::law::{Branch, Exits, ForceLaw};
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
 
-/// The most dimensions a section state has: each mode's x and x', and the law's
-/// internal state.
-pub const MAX_SECTION: usize = 2 * MODES + MAX_INTERNAL;
+/// The most dimensions a section state has: each mode's x and x'.
+pub const MAX_SECTION: usize = 2 * MODES;
 
-/// Where the oscillator is: time, deflection, velocity, the law's internal state and
-/// the contact branch (and a relaxing sample's surface).
+/// Where the oscillator is: time, deflection, velocity and the contact branch (and a
+/// relaxing sample's surface).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Phase {
     /// τ.
@@ -42,8 +39,6 @@ pub struct Phase {
     pub x: f64,
     /// Velocity x'.
     pub v: f64,
-    /// The law's internal state ([`ForceLaw::internal_states`]; zeros for a law without).
-    pub internal: Internal,
     /// Contact branch.
     pub branch: Branch,
     /// First trial step for the next numerical segment on each branch (free, contact,
@@ -65,7 +60,6 @@ impl Phase {
             tau: 0.0,
             x: 0.0,
             v: 0.0,
-            internal: Internal::default(),
             branch: Branch::Free,
             h_next: [0.0; Branch::COUNT],
             h_carry: 0.0,
@@ -73,26 +67,16 @@ impl Phase {
         }
     }
 
-    /// The section state z of dimension `d`: (x, x'), then the first d − 2 internal
-    /// variables times `scale`.
-    fn section(&self, d: usize, scale: f64) -> DVector<f64> {
-        DVector::from_fn(d, |i, _| match i {
-            0 => self.x,
-            1 => self.v,
-            k => scale * self.internal[k - 2 * MODES],
-        })
+    /// The section state z: (x, x').
+    fn section(&self) -> DVector<f64> {
+        DVector::from_column_slice(&[self.x, self.v])
     }
 
     /// This phase moved to the section state `z` ([`Phase::section`]).
-    fn with_section(&self, z: &DVector<f64>, scale: f64) -> Self {
-        let mut internal = self.internal;
-        for (k, s) in internal.iter_mut().enumerate().take(z.len() - 2 * MODES) {
-            *s = z[2 * MODES + k] / scale;
-        }
+    fn with_section(&self, z: &DVector<f64>) -> Self {
         Self {
             x: z[0],
             v: z[1],
-            internal,
             ..self.clone()
         }
     }
@@ -244,12 +228,9 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
             let t = hermite_turn(a, b, true);
             let tau = a.tau + t * (b.tau - a.tau);
             // (The tip is at rest there; the support may not be.)
-            let turn = self.cpl.contact_state(
-                (hermite(a, b, X, tau), 0.0),
-                self.osc.base_at(tau),
-                branch,
-                internal_at(a, b, tau),
-            );
+            let turn =
+                self.cpl
+                    .contact_state((hermite(a, b, X, tau), 0.0), self.osc.base_at(tau), branch);
             lowest = lowest.min(turn.alpha_hat);
             self.turn(branch, turn.alpha_hat);
             let force_hat = match self.surface {
@@ -313,22 +294,19 @@ impl<L: ForceLaw> Simulation<'_, L> {
         self.law.has_surface()
     }
 
-    /// Dimension of the section state: x, x' and the law's internal state.
+    /// Dimension of the section state: x and x'.
     pub fn section_dim(&self) -> usize {
-        2 * MODES + self.law.internal_states().min(MAX_INTERNAL)
+        2 * MODES
     }
 
-    /// The section state of `phase`: (x, x') and the law's internal variables (forces
-    /// in the contact's units, [`ForceLaw::internal_states`]) as forces in units of kL,
-    /// so that every component is a length in units of L and one norm and tolerance
-    /// serve them all.
+    /// The section state of `phase`: (x, x'), lengths in units of L.
     pub fn z(&self, phase: &Phase) -> DVector<f64> {
-        phase.section(self.section_dim(), self.cpl.f_scale)
+        phase.section()
     }
 
     /// `phase` moved to the section state `z` ([`Simulation::z`]).
     pub fn at_z(&self, phase: &Phase, z: &DVector<f64>) -> Phase {
-        phase.with_section(z, self.cpl.f_scale)
+        phase.with_section(z)
     }
 
     /// The branch a state at rest separation α̂ starts on: in contact if the tip is already
@@ -351,7 +329,6 @@ impl<L: ForceLaw> Simulation<'_, L> {
             tau: 0.0,
             x,
             v,
-            internal: Internal::default(),
             branch: self.branch_at(0.0, x),
             h_next: [0.0; Branch::COUNT],
             h_carry: 0.0,
@@ -392,9 +369,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
         carry: bool,
         observer: &mut O,
     ) -> Result<CycleIntegrals> {
-        Ok(if self.law.internal_states() > 0 {
-            self.cycle_in::<MEMORY, O>(phase, span, carry, observer)?.0
-        } else if self.law.is_rate_dependent() {
+        Ok(if self.law.is_rate_dependent() {
             self.cycle_in::<RATE, O>(phase, span, carry, observer)?.0
         } else {
             self.cycle_in::<BASE, O>(phase, span, carry, observer)?.0
@@ -419,12 +394,11 @@ impl<L: ForceLaw> Simulation<'_, L> {
     }
 
     /// Integrate one drive period from `phase`, updating it, with the derivative of the
-    /// period map, ∂z(τ + T)/∂(z, q)(τ), z the section state ([`Simulation::z`]: x, x'
-    /// and the law's internal state, in its units), q = z_c/L: the variational equations along every segment, the
-    /// free flight's transition matrix in closed form, and at every branch switch the
-    /// saltation matrix: where the force jumps by Δf_ts as α̂ crosses its level, δx'
-    /// gains Δf_ts(δx + δq)/(x' + x_b') (and an internal variable whose rate jumps, its
-    /// jump times the same).
+    /// period map, ∂z(τ + T)/∂(z, q)(τ), z the section state ([`Simulation::z`]: x, x'),
+    /// q = z_c/L: the variational equations along every segment, the free flight's
+    /// transition matrix in closed form, and at every branch switch the saltation
+    /// matrix: where the force jumps by Δf_ts as α̂ crosses its level, δx' gains
+    /// Δf_ts(δx + δq)/(x' + x_b').
     pub fn cycle_with_derivative(
         &self,
         phase: &mut Phase,
@@ -449,26 +423,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     .into(),
             ));
         }
-        let (integrals, derivative) = if self.law.internal_states() > 0 {
-            self.cycle_in::<MEMORY_TANGENT, _>(phase, span, false, &mut numeric::Ignore)
-        } else if self.law.is_rate_dependent() {
+        let (integrals, derivative) = if self.law.is_rate_dependent() {
             self.cycle_in::<RATE_TANGENT, _>(phase, span, false, &mut numeric::Ignore)
         } else {
             self.cycle_in::<TANGENT, _>(phase, span, false, &mut numeric::Ignore)
         }?;
-        let mut derivative = derivative.expect("a tangent layout carries Φ");
-        // In the section's units (`Simulation::z`): internal rows times f_scale, internal
-        // columns divided by it.
-        let d = derivative.nrows();
-        for row in 2 * MODES..d {
-            for col in 0..=d {
-                derivative[(row, col)] *= self.cpl.f_scale;
-                if col < d {
-                    derivative[(col, row)] /= self.cpl.f_scale;
-                }
-            }
-        }
-        Ok((integrals, derivative))
+        Ok((integrals, derivative.expect("a tangent layout carries Φ")))
     }
 
     /// Move `phase` back by whole drive periods to τ in [0, T): the drive is periodic,
@@ -506,23 +466,10 @@ impl<L: ForceLaw> Simulation<'_, L> {
             return;
         }
         let (x_b, v_b) = self.osc.base_at(tau);
-        let at = |branch| {
-            self.cpl
-                .contact_state((y[X], y[V]), (x_b, v_b), branch, internal(y))
-        };
+        let at = |branch| self.cpl.contact_state((y[X], y[V]), (x_b, v_b), branch);
         let jump =
             -self.cpl.f_scale * (self.law.force_hat(&at(to)) - self.law.force_hat(&at(from)));
-        let kinds = internal_count(N);
-        let (rates_to, rates_from) = if kinds > 0 {
-            (
-                self.law.internal_rates_hat(&at(to)),
-                self.law.internal_rates_hat(&at(from)),
-            )
-        } else {
-            ([0.0; MAX_INTERNAL], [0.0; MAX_INTERNAL])
-        };
-        let rate_jumps = (0..kinds).any(|k| rates_to[k] != rates_from[k]);
-        if jump == 0.0 && !rate_jumps {
+        if jump == 0.0 {
             return;
         }
         let dim = section_dim(N);
@@ -533,9 +480,6 @@ impl<L: ForceLaw> Simulation<'_, L> {
             // δx + δq of this column: how far the switch moves.
             let shift = y[at] + if col == dim { 1.0 } else { 0.0 };
             y[at + 1] += k * shift;
-            for i in 0..kinds {
-                y[at + 2 * MODES + i] += (rates_to[i] - rates_from[i]) / speed * shift;
-            }
         }
     }
 
@@ -555,7 +499,6 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let mut y = State::<N>::zeros();
         y[X] = phase.x;
         y[V] = phase.v;
-        set_internal(&mut y, &phase.internal);
         if has_tangent(N) {
             reset_phi(&mut y);
         }
@@ -586,19 +529,12 @@ impl<L: ForceLaw> Simulation<'_, L> {
         let work_scale = self.cpl.f_scale / self.cpl.a1;
         let (mut e_ts, mut e_capillary) = (0.0, 0.0);
         let mut tau = phase.tau;
-        // An internal state evolves in free flight too: in closed form if the law says
-        // how it relaxes there, else integrated with the motion.
-        let relaxation = self.law.free_relaxation_rates();
         // (Closed-form free flight ends only falling to the jump-in, into contact.)
         let (jump_in, closed_form) = match self.law.exits(Branch::Free) {
             Exits {
                 below: Some((level, Branch::Contact)),
                 above: None,
-            } => (
-                level,
-                self.law.free_branch_is_force_free()
-                    && (internal_count(N) == 0 || relaxation.is_some()),
-            ),
+            } => (level, self.law.free_branch_is_force_free()),
             _ => (f64::NAN, false),
         };
         // Stop when the remaining time is round-off.
@@ -628,9 +564,6 @@ impl<L: ForceLaw> Simulation<'_, L> {
                     }
                 }
                 flight.advance(&mut y, tau, stop);
-                if let Some(rates) = &relaxation {
-                    relax_internal(&mut y, rates, stop - tau);
-                }
                 if let Some(surface) = &surface {
                     let view = surface_view(&self.osc, &self.cpl, stop, &y);
                     surface
@@ -713,7 +646,6 @@ impl<L: ForceLaw> Simulation<'_, L> {
         phase.tau = tau_end;
         phase.x = y[X];
         phase.v = y[V];
-        phase.internal = internal(&y);
         let integrals = CycleIntegrals {
             periods: u32::from(span == period),
             period: span,

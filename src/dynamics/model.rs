@@ -9,24 +9,21 @@
 //! where x_b is the support displacement of a base drive (zero for a force drive).
 
 use super::surface::{Surface, View};
-use crate::physics::law::{Branch, ContactState, ForceLaw, Internal, MAX_INTERNAL};
+use crate::physics::law::{Branch, ContactState, ForceLaw};
 use nalgebra::{DMatrix, SVector};
 use std::ops::{Index, IndexMut};
 
 /// ODE state: each cantilever mode's deflection and velocity, the per-cycle integrals
 /// carried along, and the drive phasor (cos Ωτ, sin Ωτ), integrated as a rotation so the
 /// right-hand side needs no trigonometric calls (it is reset to the exact values at every
-/// segment start). Six layouts, by `N`:
+/// segment start). Four layouts, by `N`:
 ///
 /// - [`BASE`]: just that, for a law whose force depends on the separation alone;
 /// - [`TANGENT`]: also the variational matrix Φ = ∂z/∂(z₀, q) after the base parts,
 ///   z the section state (x, x') and q = z_c/L the rest separation
 ///   (α̂ = a₁(q + x + x_b)), for the derivative of the period map;
 /// - [`RATE`] and [`RATE_TANGENT`]: the same with, last, the work done against a
-///   rate-dependent force ([`dissipative_work_index`]);
-/// - [`MEMORY`] and [`MEMORY_TANGENT`]: a rate-dependent law with internal state (a
-///   relaxing sample): its variables right after the base parts ([`Part::Internal`]),
-///   part of the section state z = (x, x', s) and so of Φ, and the work last.
+///   rate-dependent force ([`dissipative_work_index`]).
 ///
 /// The hot path of a law pays only for what it needs (the integrator's error norm, and
 /// so every number, of an elastic law is that of its nine components). Parts are
@@ -76,8 +73,6 @@ pub enum Part {
     DriveCos,
     /// sin Ωτ.
     DriveSin,
-    /// Internal state variable k of the law ([`MEMORY`] layouts only).
-    Internal(usize),
 }
 
 impl Part {
@@ -90,7 +85,6 @@ impl Part {
             Part::Carried(c) => 2 * MODES + c as usize,
             Part::DriveCos => 2 * MODES + Carried::COUNT,
             Part::DriveSin => 2 * MODES + Carried::COUNT + 1,
-            Part::Internal(k) => BASE + k,
         }
     }
 }
@@ -138,10 +132,6 @@ pub const TANGENT: usize = BASE + phi_len(2 * MODES);
 pub const RATE: usize = BASE + 1;
 /// Components of the state of a rate-dependent law with the variational matrix.
 pub const RATE_TANGENT: usize = TANGENT + 1;
-/// Components of the plain state of a law with internal state.
-pub const MEMORY: usize = BASE + MAX_INTERNAL + 1;
-/// Components of the state of a law with internal state, with the variational matrix.
-pub const MEMORY_TANGENT: usize = BASE + MAX_INTERNAL + phi_len(2 * MODES + MAX_INTERNAL) + 1;
 
 /// Entries of Φ for a section state of dimension `d`: d × (d + 1).
 const fn phi_len(d: usize) -> usize {
@@ -151,33 +141,21 @@ const fn phi_len(d: usize) -> usize {
 /// Whether layout `N` carries the variational matrix Φ.
 #[inline]
 pub const fn has_tangent(n: usize) -> bool {
-    n == TANGENT || n == RATE_TANGENT || n == MEMORY_TANGENT
+    n == TANGENT || n == RATE_TANGENT
 }
 
-/// How many internal state variables layout `N` carries.
+/// Dimension of the section state z (each mode's x and x'): what the period map maps.
 #[inline]
-pub const fn internal_count(n: usize) -> usize {
-    if n == MEMORY || n == MEMORY_TANGENT {
-        MAX_INTERNAL
-    } else {
-        0
-    }
-}
-
-/// Dimension of the section state z of layout `N` (each mode's x and x', then the
-/// internal state): what the period map maps.
-#[inline]
-pub const fn section_dim(n: usize) -> usize {
-    2 * MODES + internal_count(n)
+pub const fn section_dim(_n: usize) -> usize {
+    2 * MODES
 }
 
 /// Where layout `N` carries the work done against a rate-dependent force,
 /// ∫ T̂_d dα̂ (dimensionless, the contact's units; what a viscous or relaxing sample
-/// dissipates): the last component of the rate and memory layouts, nowhere in the
-/// others.
+/// dissipates): the last component of the rate layouts, nowhere in the others.
 #[inline]
 pub const fn dissipative_work_index(n: usize) -> Option<usize> {
-    if n == RATE || n == RATE_TANGENT || n == MEMORY || n == MEMORY_TANGENT {
+    if n == RATE || n == RATE_TANGENT {
         Some(n - 1)
     } else {
         None
@@ -186,48 +164,8 @@ pub const fn dissipative_work_index(n: usize) -> Option<usize> {
 
 /// First entry of Φ in layout `N`, stored column by column: ∂z/∂z₀ column by column,
 /// then ∂z/∂q.
-const fn phi_index(n: usize) -> usize {
-    BASE + internal_count(n)
-}
-
-/// The internal state carried in `y` (zeros where the layout carries none).
-#[inline]
-pub fn internal<const N: usize>(y: &State<N>) -> Internal {
-    let mut s = Internal::default();
-    for (k, s) in s.iter_mut().enumerate().take(internal_count(N)) {
-        *s = y[Part::Internal(k)];
-    }
-    s
-}
-
-/// Set the internal state carried in `y` (nothing where the layout carries none).
-#[inline]
-pub(crate) fn set_internal<const N: usize>(y: &mut State<N>, s: &Internal) {
-    for (k, s) in s.iter().enumerate().take(internal_count(N)) {
-        y[Part::Internal(k)] = *s;
-    }
-}
-
-/// Relax the internal state of `y` over a force-free flight of length `span`, each
-/// variable at its rate λ_k ([`ForceLaw::free_relaxation_rates`]): s_k ← s_k e^{−λ_k span},
-/// and its row of Φ alike (in free flight nothing else feeds it).
-pub(crate) fn relax_internal<const N: usize>(
-    y: &mut State<N>,
-    rates: &[f64; MAX_INTERNAL],
-    span: f64,
-) {
-    if internal_count(N) == 0 {
-        return;
-    }
-    for (k, rate) in rates.iter().enumerate().take(internal_count(N)) {
-        let factor = (-rate * span).exp();
-        y[Part::Internal(k)] *= factor;
-        if has_tangent(N) {
-            for col in 0..=section_dim(N) {
-                y[phi_column(N, col) + 2 * MODES + k] *= factor;
-            }
-        }
-    }
+const fn phi_index(_n: usize) -> usize {
+    BASE
 }
 
 /// Φ of a state with a tangent ([`has_tangent`]) as a d × (d + 1) matrix.
@@ -243,8 +181,7 @@ pub(crate) fn phi_start(d: usize) -> DMatrix<f64> {
     DMatrix::identity(d, d + 1)
 }
 
-/// Where column `col` of Φ begins in layout `N` (its rows follow: x, x', the internal
-/// state); the last column, `section_dim(N)`, is ∂z/∂q. Φ is updated in place through
+/// Where column `col` of Φ begins in layout `N` (its rows follow: x, x'); the last column, `section_dim(N)`, is ∂z/∂q. Φ is updated in place through
 /// these, with no matrix built, on the paths every shooting period takes.
 #[inline]
 pub(crate) const fn phi_column(n: usize, col: usize) -> usize {
@@ -424,21 +361,18 @@ impl Coupling {
     }
 
     /// What the law sees at deflection and velocity `(x, v)` with the support at
-    /// `(x_b, x_b')` and the law's internal state `internal`: α̂ and its rate
-    /// a₁(x' + x_b').
+    /// `(x_b, x_b')`: α̂ and its rate a₁(x' + x_b').
     #[inline]
     pub fn contact_state(
         &self,
         (x, v): (f64, f64),
         (x_b, v_b): (f64, f64),
         branch: Branch,
-        internal: Internal,
     ) -> ContactState {
         ContactState {
             alpha_hat: self.alpha_hat(x, x_b),
             rate_hat: self.a1 * (v + v_b),
             branch,
-            internal,
         }
     }
 
@@ -464,10 +398,9 @@ pub(crate) fn surface_view<const N: usize>(
 
 /// The right-hand side of the equation of motion and of the carried integrals; for a
 /// state with a tangent also of the variational equations δx'' + 2γδx' + δx =
-/// (∂f_ts/∂x)δx + (∂f_ts/∂x')δx' + Σ (∂f_ts/∂s_k)δs_k (+ ∂f_ts/∂q for the q column),
+/// (∂f_ts/∂x)δx + (∂f_ts/∂x')δx' (+ ∂f_ts/∂q for the q column),
 /// ∂f_ts/∂x = ∂f_ts/∂q = −f_scale·a₁·∂T̂/∂α̂, ∂f_ts/∂x' = −f_scale·a₁·∂T̂/∂(dα̂/dτ) (a
-/// rate-dependent law's), and for a law with internal state s also δs_k' = a₁(∂ṡ_k/∂α̂)
-/// (δx + δq) + a₁(∂ṡ_k/∂α̂')δx' + Σ (∂ṡ_k/∂s_j)δs_j.
+/// rate-dependent law's).
 ///
 /// A law with a surface ([`ForceLaw::surface`]) takes its rate-dependent force from
 /// `surface`, the step the integrator has open on it.
@@ -498,7 +431,6 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
             alpha_hat: alpha,
             rate_hat: cpl.a1 * (v + osc.base_from(tau, (s, c)).1),
             branch,
-            internal: internal(y),
         };
         state = Some(at);
         match surface {
@@ -518,42 +450,14 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
         let first = phi_index(N);
         // The q column's δx' row.
         let q_row = first + d * d + 1;
-        if internal_count(N) == 0 {
-            // Section (x, x'): the columns ∂/∂x₀, ∂/∂x₀', ∂/∂q (a fixed list, unrolled).
-            const _: () = assert!(MODES == 1, "the variational equations are one mode's");
-            for col in [first, first + d, first + 2 * d] {
-                let (dx, dv) = (y[col], y[col + 1]);
-                dy[col] = dv;
-                dy[col + 1] = -2.0 * osc.gamma * dv - dx + stiffness * dx + damping * dv;
-            }
-            dy[q_row] += stiffness;
-        } else if let Some(at) = state {
-            let slopes = law.internal_slopes_hat(&at);
-            let kinds = internal_count(N);
-            for j in 0..=d {
-                let col = first + d * j;
-                let (dx, dv) = (y[col], y[col + 1]);
-                let ds = |j: usize| y[col + 2 + j];
-                let mut accel = -2.0 * osc.gamma * dv - dx + stiffness * dx + damping * dv;
-                for j in 0..kinds {
-                    accel += -cpl.f_scale * slopes.force_d_internal[j] * ds(j);
-                }
-                dy[col] = dv;
-                dy[col + 1] = accel;
-                for i in 0..kinds {
-                    let mut rate =
-                        cpl.a1 * (slopes.rate_d_alpha[i] * dx + slopes.rate_d_rate[i] * dv);
-                    for j in 0..kinds {
-                        rate += slopes.rate_d_internal[i][j] * ds(j);
-                    }
-                    dy[col + 2 + i] = rate;
-                }
-            }
-            dy[q_row] += stiffness;
-            for i in 0..kinds {
-                dy[q_row + 1 + i] += cpl.a1 * slopes.rate_d_alpha[i];
-            }
+        // Section (x, x'): the columns ∂/∂x₀, ∂/∂x₀', ∂/∂q (a fixed list, unrolled).
+        const _: () = assert!(MODES == 1, "the variational equations are one mode's");
+        for col in [first, first + d, first + 2 * d] {
+            let (dx, dv) = (y[col], y[col + 1]);
+            dy[col] = dv;
+            dy[col + 1] = -2.0 * osc.gamma * dv - dx + stiffness * dx + damping * dv;
         }
+        dy[q_row] += stiffness;
     }
     dy[X] = v;
     dy[V] = -2.0 * osc.gamma * v - x + f + drive + osc.bias;
@@ -564,12 +468,6 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
     dy[Carried::Virial] = f * x;
     if let (Some(i), Some(at)) = (dissipative_work_index(N), state) {
         dy[i] = dissipative * at.rate_hat;
-        if internal_count(N) > 0 {
-            let rates = law.internal_rates_hat(&at);
-            for (k, rate) in rates.iter().enumerate().take(internal_count(N)) {
-                dy[Part::Internal(k)] = *rate;
-            }
-        }
     }
     dy[Part::DriveCos] = -osc.omega * s;
     dy[Part::DriveSin] = osc.omega * c;

@@ -69,8 +69,8 @@ pub(crate) const MIN_CYCLES: usize = 32;
 pub const MARCHING_TOLERANCE: f64 = 1e-5;
 
 /// Floquet multipliers of a periodic orbit: the eigenvalues of its monodromy matrix, one
-/// per dimension of the section state (two for a law without internal state; none for
-/// an orbit only marched to, on a relaxing sample's surface).
+/// per dimension of the section state (two; none for an orbit only marched to, on a
+/// relaxing sample's surface).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Multipliers {
     pub(super) values: [Complex<f64>; MAX_SECTION],

@@ -15,11 +15,10 @@
 use super::budget;
 use super::dopri5::{self, Settings, StepError, System};
 use super::model::{
-    BASE, Coupling, Oscillator, Part, State, V, X, has_tangent, internal_count, rhs, set_phasor,
-    surface_view,
+    BASE, Coupling, Oscillator, Part, State, V, X, has_tangent, rhs, set_phasor, surface_view,
 };
 pub(crate) use super::observer::hermite_turn_fraction;
-pub use super::observer::{Ignore, StepEnd, StepObserver, hermite, internal_at};
+pub use super::observer::{Ignore, StepEnd, StepObserver, hermite};
 use super::surface::Surface;
 use crate::error::{Error, Result};
 use crate::numeric::bracketed_root;
@@ -458,9 +457,7 @@ fn run<S: System<N>, const N: usize>(
         Branch::Contact => "contact",
         Branch::Necked => "capillary-neck",
     };
-    // (A law with internal state — a relaxing sample on Hertz or DMT — has no fold to
-    // stall at; its variational equations take steps of its relaxation time for good.)
-    let segment_cap = if has_tangent(N) && internal_count(N) == 0 {
+    let segment_cap = if has_tangent(N) {
         MAX_TANGENT_STEPS
     } else {
         MAX_SEGMENT_STEPS

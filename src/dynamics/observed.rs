@@ -5,11 +5,11 @@
 use super::free::FreeFlight;
 use super::march::CycleIntegrals;
 use super::model::{Carried, Coupling, Drive, Oscillator, V, X};
-use super::numeric::{StepEnd, StepObserver, hermite, internal_at};
+use super::numeric::{StepEnd, StepObserver, hermite};
 use super::setup::Prepared;
 use super::steady::{Motion, SteadyState};
 use crate::error::{Error, Result};
-use crate::physics::law::{Branch, ForceLaw, Internal};
+use crate::physics::law::{Branch, ForceLaw};
 use crate::physics::params::ELECTRONVOLT_J;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -371,7 +371,7 @@ impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
             let tau = from.tau + (to.tau - from.tau) * i as f64 / points as f64;
             let x = hermite(from, to, X, tau);
             let v = hermite(from, to, V, tau);
-            self.push(tau, (x, v), internal_at(from, to, tau), branch);
+            self.push(tau, (x, v), branch);
         }
     }
 
@@ -382,8 +382,7 @@ impl<L: ForceLaw> StepObserver for Recorder<'_, L> {
             .max(1.0) as usize;
         for i in self.first(Branch::Free, 0)..=n {
             let tau = from + (to - from) * i as f64 / n as f64;
-            // (Closed-form free flight is only taken for laws without internal state.)
-            self.push(tau, flight.at(tau), Internal::default(), Branch::Free);
+            self.push(tau, flight.at(tau), Branch::Free);
         }
     }
 }
@@ -420,10 +419,10 @@ impl<'a, L: ForceLaw> Recorder<'a, L> {
         }
     }
 
-    fn push(&mut self, tau: f64, (x, v): (f64, f64), internal: Internal, branch: Branch) {
+    fn push(&mut self, tau: f64, (x, v): (f64, f64), branch: Branch) {
         let state = self
             .cpl
-            .contact_state((x, v), self.osc.base_at(tau), branch, internal);
+            .contact_state((x, v), self.osc.base_at(tau), branch);
         // (+ 0.0 turns the −0 of a force-free branch into 0; a surface's law is
         // force-free in the free flights sampled here.)
         let f = if self.surface && branch == Branch::Free {

@@ -4,8 +4,8 @@
 //! feedback of the instrument), and the cubic Hermite interpolant on a step that
 //! observers read between its ends.
 
-use super::model::{BASE, Part, State, internal_count};
-use crate::physics::law::{Branch, Internal};
+use super::model::{BASE, State};
+use crate::physics::law::Branch;
 use std::ops::Index;
 
 /// A sample of the trajectory at the end of an accepted step.
@@ -101,14 +101,4 @@ pub(crate) fn hermite_turn_fraction(
     } else {
         0.5
     }
-}
-
-/// The law's internal state on the step [a, b] at τ, by cubic Hermite interpolation
-/// (zeros where the layout carries none).
-pub fn internal_at<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, tau: f64) -> Internal {
-    let mut s = Internal::default();
-    for (k, s) in s.iter_mut().enumerate().take(internal_count(N)) {
-        *s = hermite(a, b, Part::Internal(k), tau);
-    }
-    s
 }

@@ -118,7 +118,7 @@ pub struct FmScanner<'a> {
 }
 
 impl<'a> FmScanner<'a> {
-    /// The loops over `materials` (all on one cantilever, none with an internal state),
+    /// The loops over `materials` (all on one cantilever, none with a relaxing sample),
     /// the PLL and amplitude controller tuned to its quality factor
     /// ([`PhaseLockedLoop::for_quality`], [`AmplitudeController::for_quality`]), the z
     /// feedback `feedback`. Not yet engaged. Periods are taken as repeats once the
@@ -313,7 +313,6 @@ impl<'a> FmScanner<'a> {
     /// in units of [`SHIFT_UNIT_HZ`], F/F₀ and the rest separation `rest` in units of A.
     fn loop_state(&self, rest: f64) -> LoopState {
         let f0 = self.materials[0].setup.cantilever.resonance_hz;
-        let mut state = [0.0; STATE_LEN];
         let p = &self.phase;
         let parts = [
             p.x,
@@ -322,12 +321,8 @@ impl<'a> FmScanner<'a> {
             self.drive.excitation,
             rest,
         ];
-        for (o, v) in state
-            .iter_mut()
-            .zip(parts.into_iter().chain(p.internal.iter().copied()))
-        {
-            *o = v;
-        }
+        let mut state = [0.0; STATE_LEN];
+        state[..parts.len()].copy_from_slice(&parts);
         state
     }
 }

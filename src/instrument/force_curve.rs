@@ -24,7 +24,7 @@ use crate::dynamics::numeric::{Ignore, StepEnd, StepObserver};
 use crate::dynamics::observed::{Recorder, Sample, Sampling};
 use crate::dynamics::setup::{Cantilever, Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
-use crate::physics::law::{AnyLaw, Branch, ForceLaw, Internal};
+use crate::physics::law::{AnyLaw, Branch, ForceLaw};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -535,12 +535,9 @@ fn run<Lv: Lever>(
 fn at_rest(sim: &Simulation<'_, AnyLaw>, start: f64) -> Phase {
     let mut phase = Phase::at_rest();
     for _ in 0..8 {
-        let state = sim.cpl.contact_state(
-            (phase.x, 0.0),
-            (start, 0.0),
-            Branch::Free,
-            Internal::default(),
-        );
+        let state = sim
+            .cpl
+            .contact_state((phase.x, 0.0), (start, 0.0), Branch::Free);
         phase.x = -sim.cpl.f_scale * sim.law.force_hat(&state);
     }
     phase

@@ -22,7 +22,7 @@ use crate::dynamics::numeric::Ignore;
 use crate::dynamics::observed::{Recorder, Sample};
 use crate::dynamics::setup::{Cantilever, Numerics, Prepared, TapSetup};
 use crate::error::{Error, Result};
-use crate::physics::law::{AnyLaw, Branch, MAX_INTERNAL};
+use crate::physics::law::{AnyLaw, Branch};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -141,8 +141,8 @@ const QUIET_CYCLES: usize = 8;
 /// The longest repeat looked for, in modulation cycles.
 pub const LONGEST_REPEAT: usize = 8;
 
-/// March `sim` from rest until its state at the start of a cycle (deflection, velocity,
-/// a law's internal state) repeats itself after n ≤ [`LONGEST_REPEAT`] cycles: the
+/// March `sim` from rest until its state at the start of a cycle (deflection and
+/// velocity) repeats itself after n ≤ [`LONGEST_REPEAT`] cycles: the
 /// state there, n (None: irregular after [`MAX_SETTLE_CYCLES`]) and the cycles
 /// marched. Repeating means a return gap |s_k − s_{k−n}| below [`SETTLED`]/100 for
 /// [`QUIET_CYCLES`] cycles running: for motion contracting onto its cycle by any factor
@@ -153,7 +153,7 @@ pub const LONGEST_REPEAT: usize = 8;
 /// level shrink the region where its answer may be trusted to nothing.
 fn settle(sim: &Simulation<'_, AnyLaw>) -> Result<(Phase, Option<usize>, usize)> {
     let mut phase = Phase::at_rest();
-    let mut history: Vec<[f64; 2 + MAX_INTERNAL]> = Vec::with_capacity(MAX_SETTLE_CYCLES);
+    let mut history: Vec<[f64; 2]> = Vec::with_capacity(MAX_SETTLE_CYCLES);
     // Per repeat n: cycles running with the gap quiet, and with it no longer shrinking.
     let mut quiet = [0usize; LONGEST_REPEAT];
     let mut stalled = [0usize; LONGEST_REPEAT];
@@ -161,10 +161,7 @@ fn settle(sim: &Simulation<'_, AnyLaw>) -> Result<(Phase, Option<usize>, usize)>
     for marched in 1..=MAX_SETTLE_CYCLES {
         sim.rewind(&mut phase);
         sim.cycle(&mut phase, &mut Ignore)?;
-        let mut state = [0.0; 2 + MAX_INTERNAL];
-        state[0] = phase.x;
-        state[1] = phase.v;
-        state[2..].copy_from_slice(&phase.internal.0);
+        let state = [phase.x, phase.v];
         history.push(state);
         for n in 1..=LONGEST_REPEAT {
             let Some(before) = history.len().checked_sub(n + 1).map(|k| history[k]) else {

@@ -6,8 +6,8 @@
 //! recorded, as the instrument reads them.
 //!
 //! Cycles are marched one after another, each at the material and height under the tip
-//! at its start (the lever's state carried across, its law's internal state reset where
-//! the material changes). Once the loop repeats itself over a region — the lever's state
+//! at its start (the lever's state carried across, a relaxing sample's surface fresh
+//! where the material changes). Once the loop repeats itself over a region — the lever's state
 //! at the start of a cycle returning within 1e-9 of the free amplitude, the piezo moving
 //! by less than 1e-13 m, for 8 cycles running — the cycles up to the next region are
 //! repeats of the last, whose recorded channels every pixel there shows ([`Scanner::exact`]
@@ -24,7 +24,7 @@ use crate::dynamics::numeric::Ignore;
 use crate::dynamics::observed::Recorder;
 use crate::dynamics::setup::{Numerics, Prepared};
 use crate::error::{Error, Result};
-use crate::physics::law::{AnyLaw, Internal};
+use crate::physics::law::AnyLaw;
 use serde::{Deserialize, Serialize};
 
 /// What is recorded over one pixel.
@@ -158,7 +158,7 @@ impl<'a> Scanner<'a> {
     ) -> Result<(Option<Channels>, f64)> {
         if self.under != Some((material, height_m)) {
             if self.under.is_some_and(|(m, _)| m != material) {
-                self.phase.internal = Internal::default();
+                self.phase.surface = None;
             }
             self.under = Some((material, height_m));
             self.quiet = 0;

@@ -107,11 +107,6 @@ impl Probe for OneMode<'_> {
             return None;
         }
         let p = &*self.phase;
-        Some(
-            [p.x, p.v]
-                .into_iter()
-                .chain(p.internal.iter().copied())
-                .chain(self.lockin.state()),
-        )
+        Some([p.x, p.v].into_iter().chain(self.lockin.state()))
     }
 }

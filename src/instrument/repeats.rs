@@ -15,8 +15,8 @@
 //! a thermal force or one whose drives have no common period. The exact march is
 //! [`Repeats::exact`].
 
-/// The loop state watched: the probe's (deflection, velocity, a law's internal state,
-/// the lock-in's filter stages and last input) then the piezo and the controller's last
+/// The loop state watched: the probe's (deflection, velocity, the lock-in's filter
+/// stages and last input) then the piezo and the controller's last
 /// error, each in units of A₀ (or of the amplitude ratio).
 pub const STATE_LEN: usize = 48;
 

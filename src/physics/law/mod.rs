@@ -105,18 +105,6 @@ macro_rules! forward_to_inner {
         fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
             self.0.dissipative_slopes_hat(state)
         }
-        fn internal_states(&self) -> usize {
-            self.0.internal_states()
-        }
-        fn internal_rates_hat(&self, state: &ContactState) -> [f64; MAX_INTERNAL] {
-            self.0.internal_rates_hat(state)
-        }
-        fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
-            self.0.free_relaxation_rates()
-        }
-        fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
-            self.0.internal_slopes_hat(state)
-        }
         fn surface(&self, reach_hat: f64) -> Option<RelaxingHalfSpace> {
             self.0.surface(reach_hat)
         }
@@ -200,27 +188,6 @@ pub struct Exits {
     pub above: Option<(f64, Branch)>,
 }
 
-/// Most internal state variables a law may declare ([`ForceLaw::internal_states`]).
-pub const MAX_INTERNAL: usize = 1;
-
-/// A law's internal state variables ([`ForceLaw::internal_states`] of them are used,
-/// the rest are zero).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Internal(pub [f64; MAX_INTERNAL]);
-
-impl std::ops::Deref for Internal {
-    type Target = [f64; MAX_INTERNAL];
-    fn deref(&self) -> &Self::Target {
-        &self.0
-    }
-}
-
-impl std::ops::DerefMut for Internal {
-    fn deref_mut(&mut self) -> &mut Self::Target {
-        &mut self.0
-    }
-}
-
 /// What a law sees of the contact at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactState {
@@ -230,24 +197,6 @@ pub struct ContactState {
     pub rate_hat: f64,
     /// The branch.
     pub branch: Branch,
-    /// The law's internal state variables, as the integrator carries them (the first
-    /// [`ForceLaw::internal_states`] are the law's; the rest are zero).
-    pub internal: Internal,
-}
-
-/// The derivatives of a law's internal dynamics and of its force with respect to its
-/// internal state, for the variational equations ([`ForceLaw::internal_slopes_hat`]).
-/// Entry k belongs to internal variable k; entries past the law's count are zero.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct InternalSlopes {
-    /// ∂(ds_k/dτ)/∂α̂.
-    pub rate_d_alpha: [f64; MAX_INTERNAL],
-    /// ∂(ds_k/dτ)/∂(dα̂/dτ).
-    pub rate_d_rate: [f64; MAX_INTERNAL],
-    /// ∂(ds_k/dτ)/∂s_j, row k.
-    pub rate_d_internal: [[f64; MAX_INTERNAL]; MAX_INTERNAL],
-    /// ∂T̂_d/∂s_k.
-    pub force_d_internal: [f64; MAX_INTERNAL],
 }
 
 /// A two-branch tip–sample force law in dimensionless variables.
@@ -255,10 +204,8 @@ pub struct InternalSlopes {
 /// The force is T̂(α̂, branch) + T̂_d(state): an elastic (possibly hysteretic) part with a
 /// work function per branch, and a rate-dependent part, zero unless the law says
 /// otherwise, whose work the integrator carries as an integral (a viscous sample has no
-/// work function). The rate-dependent part may depend on internal state variables the
-/// law declares (a relaxing sample's memory, [`ForceLaw::internal_states`]): the
-/// integrator carries them with the motion, through free flight and contact alike, and
-/// the period map and its derivative include them.
+/// work function). A relaxing sample's rate-dependent part comes from a surface that
+/// remembers ([`ForceLaw::surface`]), which the integrator carries beside the state.
 pub trait ForceLaw: Send + Sync {
     /// Force T̂ (tensile positive) at separation α̂ on `branch`. Finite for every finite
     /// α̂, including past a branch's own end (integrator trial stages overshoot).
@@ -323,28 +270,6 @@ pub trait ForceLaw: Send + Sync {
     /// everywhere).
     fn dissipative_slopes_hat(&self, _state: &ContactState) -> (f64, f64) {
         (0.0, 0.0)
-    }
-    /// How many internal state variables the law declares (0 by default, at most
-    /// [`MAX_INTERNAL`]). A law that declares any is rate-dependent
-    /// ([`ForceLaw::is_rate_dependent`]), its internal force being part of T̂_d.
-    fn internal_states(&self) -> usize {
-        0
-    }
-    /// The rates ds_k/dτ of the internal state variables at `state` (zero by default).
-    fn internal_rates_hat(&self, _state: &ContactState) -> [f64; MAX_INTERNAL] {
-        [0.0; MAX_INTERNAL]
-    }
-    /// The rates λ_k at which the internal variables relax on the free branch of a law
-    /// whose free branch is force-free ([`ForceLaw::free_branch_is_force_free`]),
-    /// ds_k/dτ = −λ_k s_k there, so that free flight stays in closed form; `None` (the
-    /// default) if they do not relax so simply, and free flight is then integrated.
-    fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
-        None
-    }
-    /// The derivatives of the internal rates, and of T̂_d with respect to the internal
-    /// state, at `state` (zero by default), for the variational equations.
-    fn internal_slopes_hat(&self, _state: &ContactState) -> InternalSlopes {
-        InternalSlopes::default()
     }
     /// A fresh surface, relaxed and flat, whose nodes reach the indentation
     /// `reach_hat`, for a law whose sample remembers its deformation from one contact to
@@ -465,24 +390,12 @@ impl ForceLaw for Rheology {
     fn is_rate_dependent(&self) -> bool {
         true
     }
-    fn internal_states(&self) -> usize {
-        rheology!(self, l => l.internal_states())
-    }
     #[inline]
     fn dissipative_t_hat(&self, state: &ContactState) -> f64 {
         rheology!(self, l => l.dissipative_t_hat(state))
     }
     fn dissipative_slopes_hat(&self, state: &ContactState) -> (f64, f64) {
         rheology!(self, l => l.dissipative_slopes_hat(state))
-    }
-    fn internal_rates_hat(&self, state: &ContactState) -> [f64; MAX_INTERNAL] {
-        rheology!(self, l => l.internal_rates_hat(state))
-    }
-    fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
-        rheology!(self, l => l.free_relaxation_rates())
-    }
-    fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
-        rheology!(self, l => l.internal_slopes_hat(state))
     }
     fn surface(&self, reach_hat: f64) -> Option<RelaxingHalfSpace> {
         rheology!(self, l => l.surface(reach_hat))
@@ -598,34 +511,6 @@ impl ForceLaw for AnyLaw {
             AnyLaw::Viscous(_) => true,
             AnyLaw::Dyn(l) => l.is_rate_dependent(),
             _ => false,
-        }
-    }
-    fn internal_states(&self) -> usize {
-        match self {
-            AnyLaw::Viscous(l) => l.internal_states(),
-            AnyLaw::Dyn(l) => l.internal_states(),
-            _ => 0,
-        }
-    }
-    fn internal_rates_hat(&self, state: &ContactState) -> [f64; MAX_INTERNAL] {
-        match self {
-            AnyLaw::Viscous(l) => l.internal_rates_hat(state),
-            AnyLaw::Dyn(l) => l.internal_rates_hat(state),
-            _ => [0.0; MAX_INTERNAL],
-        }
-    }
-    fn internal_slopes_hat(&self, state: &ContactState) -> InternalSlopes {
-        match self {
-            AnyLaw::Viscous(l) => l.internal_slopes_hat(state),
-            AnyLaw::Dyn(l) => l.internal_slopes_hat(state),
-            _ => InternalSlopes::default(),
-        }
-    }
-    fn free_relaxation_rates(&self) -> Option<[f64; MAX_INTERNAL]> {
-        match self {
-            AnyLaw::Viscous(l) => l.free_relaxation_rates(),
-            AnyLaw::Dyn(l) => l.free_relaxation_rates(),
-            _ => None,
         }
     }
     #[inline]

@@ -199,7 +199,6 @@ mod tests {
             alpha_hat,
             rate_hat,
             branch,
-            internal: Default::default(),
         }
     }
 

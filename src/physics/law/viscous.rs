@@ -98,7 +98,6 @@ mod tests {
             alpha_hat,
             rate_hat,
             branch,
-            internal: crate::physics::law::Internal::default(),
         };
         // Indenting (α̂ falling): repulsive, T̂ < 0; withdrawing: attractive.
         assert!(law.dissipative_t_hat(&at(-0.5, -2.0, Branch::Contact)) < 0.0);
