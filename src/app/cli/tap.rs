@@ -196,7 +196,12 @@ pub fn run(args: TapArgs) -> Result<()> {
             .starts
             .map_or(Starts::WhereGrazing, |n| Starts::First(n as usize)),
     };
-    let run = tap(&setup, &numerics, observe)?;
+    // (Seconds on most samples; a relaxing sample's orbit is marched to, which can take
+    // a minute or more.)
+    let settling = Busy::new("tap: finding the steady state", args.quiet);
+    let run = tap(&setup, &numerics, observe);
+    settling.finish_and_clear();
+    let run = run?;
     if let Some(path) = &args.trajectory {
         output::write_bytes(path, &report::trajectory_csv(&run.trajectory)?)?;
     }
