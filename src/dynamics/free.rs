@@ -6,7 +6,7 @@
 //! x + B cos Ωτ, whose fall to the jump-in ends the flight (`FreeFlight::separation`);
 //! on a ramp's leg (the support moving at a constant speed u) it is x + p + uτ.
 
-use super::model::{Carried, Drive, Oscillator, State, V, X, has_tangent, phi_column, section_dim};
+use super::model::{Carried, Drive, Oscillator, SECTION_DIM, State, V, X, has_tangent, phi_column};
 use crate::numeric::newton_bracketed;
 use nalgebra::{Complex, Matrix2};
 
@@ -226,8 +226,8 @@ impl FreeFlight {
         if has_tangent(N) {
             // The rows of x and x', column by column.
             let t = self.transition(tau_b - tau_a);
-            for col in 0..=section_dim(N) {
-                let at = phi_column(N, col);
+            for col in 0..=SECTION_DIM {
+                let at = phi_column(col);
                 let (dx, dv) = (y[at], y[at + 1]);
                 y[at] = t[(0, 0)] * dx + t[(0, 1)] * dv;
                 y[at + 1] = t[(1, 0)] * dx + t[(1, 1)] * dv;

@@ -14,8 +14,8 @@ use super::budget;
 use super::free::FreeFlight;
 use super::grazing::{Margins, SwitchLevels};
 use super::model::{
-    BASE, Carried, Coupling, Drive, MODES, Oscillator, RATE, RATE_TANGENT, State, TANGENT, V, X,
-    dissipative_work_index, has_tangent, phi, phi_column, reset_phi, section_dim, surface_view,
+    BASE, Carried, Coupling, Drive, Oscillator, RATE, RATE_TANGENT, SECTION_DIM, State, TANGENT, V,
+    X, dissipative_work_index, has_tangent, phi, phi_column, reset_phi, surface_view,
 };
 use super::numeric::{
     self, Crossing, Events, StepEnd, StepObserver, Tolerances, hermite, hermite_turn_fraction,
@@ -27,7 +27,7 @@ use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
 
 /// The most dimensions a section state has: each mode's x and x'.
-pub const MAX_SECTION: usize = 2 * MODES;
+pub const MAX_SECTION: usize = SECTION_DIM;
 
 /// Where the oscillator is: time, deflection, velocity and the contact branch (and a
 /// relaxing sample's surface).
@@ -296,7 +296,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
 
     /// Dimension of the section state: x and x'.
     pub fn section_dim(&self) -> usize {
-        2 * MODES
+        SECTION_DIM
     }
 
     /// The section state of `phase`: (x, x'), lengths in units of L.
@@ -472,11 +472,11 @@ impl<L: ForceLaw> Simulation<'_, L> {
         if jump == 0.0 {
             return;
         }
-        let dim = section_dim(N);
+        let dim = SECTION_DIM;
         let speed = y[V] + v_b;
         let k = jump / speed;
         for col in 0..=dim {
-            let at = phi_column(N, col);
+            let at = phi_column(col);
             // δx + δq of this column: how far the switch moves.
             let shift = y[at] + if col == dim { 1.0 } else { 0.0 };
             y[at + 1] += k * shift;

@@ -30,7 +30,7 @@ use std::ops::{Index, IndexMut};
 /// addressed by name: `y[Part::Deflection(0)]` (or [`X`]), `y[Carried::Damping]`. One
 /// mode today ([`MODES`]); the layout places further modes' deflections and velocities
 /// before the carried integrals, and the section state grows with them
-/// ([`section_dim`]).
+/// ([`SECTION_DIM`]).
 ///
 /// The contact's elastic E_ts is not carried: it is exact from the branch work functions
 /// at the segment ends. The drive's work follows from the Fourier projections by parts
@@ -145,10 +145,7 @@ pub const fn has_tangent(n: usize) -> bool {
 }
 
 /// Dimension of the section state z (each mode's x and x'): what the period map maps.
-#[inline]
-pub const fn section_dim(_n: usize) -> usize {
-    2 * MODES
-}
+pub const SECTION_DIM: usize = 2 * MODES;
 
 /// Where layout `N` carries the work done against a rate-dependent force,
 /// ∫ T̂_d dα̂ (dimensionless, the contact's units; what a viscous or relaxing sample
@@ -162,17 +159,14 @@ pub const fn dissipative_work_index(n: usize) -> Option<usize> {
     }
 }
 
-/// First entry of Φ in layout `N`, stored column by column: ∂z/∂z₀ column by column,
-/// then ∂z/∂q.
-const fn phi_index(_n: usize) -> usize {
-    BASE
-}
+/// First entry of Φ in a layout with a tangent, stored column by column: ∂z/∂z₀ column
+/// by column, then ∂z/∂q (right after the base parts).
+const PHI_START: usize = BASE;
 
 /// Φ of a state with a tangent ([`has_tangent`]) as a d × (d + 1) matrix.
 pub fn phi<const N: usize>(y: &State<N>) -> DMatrix<f64> {
-    let d = section_dim(N);
-    let at = phi_index(N);
-    DMatrix::from_column_slice(d, d + 1, &y.as_slice()[at..at + phi_len(d)])
+    let d = SECTION_DIM;
+    DMatrix::from_column_slice(d, d + 1, &y.as_slice()[PHI_START..PHI_START + phi_len(d)])
 }
 
 /// Φ at the start of a span in a section of dimension `d`: the identity in z₀, nothing
@@ -181,19 +175,20 @@ pub(crate) fn phi_start(d: usize) -> DMatrix<f64> {
     DMatrix::identity(d, d + 1)
 }
 
-/// Where column `col` of Φ begins in layout `N` (its rows follow: x, x'); the last column, `section_dim(N)`, is ∂z/∂q. Φ is updated in place through
-/// these, with no matrix built, on the paths every shooting period takes.
+/// Where column `col` of Φ begins (its rows follow: x, x'); the last column,
+/// [`SECTION_DIM`], is ∂z/∂q. Φ is updated in place through these, with no matrix built,
+/// on the paths every shooting period takes.
 #[inline]
-pub(crate) const fn phi_column(n: usize, col: usize) -> usize {
-    phi_index(n) + section_dim(n) * col
+pub(crate) const fn phi_column(col: usize) -> usize {
+    PHI_START + SECTION_DIM * col
 }
 
 /// Set Φ of `y` to its start ([`phi_start`]) in place.
 pub(crate) fn reset_phi<const N: usize>(y: &mut State<N>) {
-    let d = section_dim(N);
+    let d = SECTION_DIM;
     for col in 0..=d {
         for row in 0..d {
-            y[phi_column(N, col) + row] = if row == col { 1.0 } else { 0.0 };
+            y[phi_column(col) + row] = if row == col { 1.0 } else { 0.0 };
         }
     }
 }
@@ -446,8 +441,8 @@ pub(crate) fn rhs<L: ForceLaw, const N: usize>(
         let k = -cpl.f_scale * cpl.a1;
         let stiffness = k * (slope + d_alpha);
         let damping = k * d_rate;
-        let d = section_dim(N);
-        let first = phi_index(N);
+        let d = SECTION_DIM;
+        let first = PHI_START;
         // The q column's δx' row.
         let q_row = first + d * d + 1;
         // Section (x, x'): the columns ∂/∂x₀, ∂/∂x₀', ∂/∂q (a fixed list, unrolled).

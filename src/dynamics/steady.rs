@@ -138,7 +138,7 @@ impl<L: ForceLaw> Simulation<'_, L> {
                         let gap = ring.gap(0, n).unwrap_or(0.0);
                         let mut on = phase.clone();
                         // (`None`: the orbit grazes a fold, see `period_map`: march on.)
-                        let settled = if self.has_surface() {
+                        let settled = if creep.is_some() {
                             Some(self.settle_marching(&mut on, n, gap, &mut spent)?)
                         } else {
                             self.settle(&mut on, n, gap, &mut spent)?
