@@ -543,6 +543,24 @@ fn fit(c: &mut Criterion) {
     group.finish();
 }
 
+/// The `tapsim` command of the build these benchmarks belong to (`target/release/tapsim`
+/// beside `target/release/deps/` where they run): `cargo build --release` makes it, as
+/// the benchmarks' package does not.
+fn tapsim_binary() -> String {
+    let exe = std::env::current_exe().expect("the benchmark knows where it runs");
+    let binary = exe
+        .parent()
+        .and_then(|deps| deps.parent())
+        .map(|dir| dir.join(format!("tapsim{}", std::env::consts::EXE_SUFFIX)))
+        .expect("the benchmark runs in target/<profile>/deps");
+    assert!(
+        binary.is_file(),
+        "{} is missing: run `cargo build --release` before these benchmarks",
+        binary.display()
+    );
+    binary.to_string_lossy().into_owned()
+}
+
 /// `tapsim tap` as a whole process (what a script pays per call): on the defaults and
 /// on issue 44's soft sample. With `TAPSIM_BEFORE` naming another build's binary (the
 /// one before the search for coexisting states, issue 44), that build side by side.
@@ -559,7 +577,7 @@ fn process(c: &mut Criterion) {
         "10nm",
     ];
     let cases: [(&str, &[&str]); 2] = [("defaults", &[]), ("soft sample, z_c 10 nm", &soft)];
-    let mut binaries = vec![("", env!("CARGO_BIN_EXE_tapsim").to_string())];
+    let mut binaries = vec![("", tapsim_binary())];
     if let Ok(before) = std::env::var("TAPSIM_BEFORE") {
         binaries.push((", before", before));
     }
@@ -628,6 +646,7 @@ fn qnm_image(c: &mut Criterion) {
         "2",
         "--quiet",
     ];
+    let binary = tapsim_binary();
     let mut group = c.benchmark_group("qnm_image");
     group.sample_size(10);
     for (name, extra) in [
@@ -638,7 +657,7 @@ fn qnm_image(c: &mut Criterion) {
         ),
     ] {
         let run = || {
-            let status = Command::new(env!("CARGO_BIN_EXE_tapsim"))
+            let status = Command::new(&binary)
                 .args(image)
                 .args(extra)
                 .stdout(Stdio::null())

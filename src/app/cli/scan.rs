@@ -355,7 +355,7 @@ pub fn run(args: ScanArgs) -> Result<()> {
         )));
     }
     // Under the thermal force no period repeats another: every one is marched, at some
-    // 42 µs each (`cargo bench --bench dynamics -- noise/`).
+    // 42 µs each (`cargo bench -p tapsim-benches --bench dynamics -- noise/`).
     if args.temperature.is_some_and(|t| t > 0.0) && total > MAX_NOISY_PERIODS {
         return Err(Error::OutOfRange(format!(
             "under the thermal force every drive period is marched: {total:.3e} in all, \
