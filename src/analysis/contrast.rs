@@ -203,6 +203,18 @@ pub fn contrast(
     noise: Option<&NoiseRequest>,
     mut progress: impl FnMut(&str),
 ) -> Result<(Vec<ContrastRow>, Vec<LawCurve>)> {
+    contrast_reporting(materials, laws, (ratios, points), noise, &mut progress)
+}
+
+/// [`contrast`] compiled once: `progress` is a trait object, so a caller's closure does
+/// not copy the whole computation into the caller's program.
+fn contrast_reporting(
+    materials: &[Material],
+    laws: &[LawKind],
+    (ratios, points): (&[f64], usize),
+    noise: Option<&NoiseRequest>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Vec<ContrastRow>, Vec<LawCurve>)> {
     if materials.len() < 2 {
         return Err(Error::NotApplicable(
             "phase contrast needs at least two materials".into(),

@@ -121,7 +121,7 @@ pub fn approach_curve_at(
     thermal: Option<&AverageRequest>,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Vec<SweepPoint>> {
-    sweep_points(setup, numerics, ramp, thermal, |i, _| {
+    sweep_points(setup, numerics, ramp, thermal, &mut |i, _| {
         progress(i + 1, ramp.len());
         true
     })
@@ -135,18 +135,20 @@ pub fn approach_curve_while(
     numerics: &Numerics,
     ramp: &[(f64, Direction)],
     thermal: Option<&AverageRequest>,
-    keep: impl FnMut(usize, &SweepPoint) -> bool,
+    mut keep: impl FnMut(usize, &SweepPoint) -> bool,
 ) -> Result<Vec<SweepPoint>> {
-    sweep_points(setup, numerics, ramp, thermal, keep)
+    sweep_points(setup, numerics, ramp, thermal, &mut keep)
 }
 
-/// The sweep behind [`approach_curve_at`] and [`approach_curve_while`].
+/// The sweep behind [`approach_curve_at`] and [`approach_curve_while`], compiled once:
+/// `keep` is a trait object, so a caller's closure does not copy the sweep and the
+/// marcher beneath it into the caller's program.
 fn sweep_points(
     setup: &TapSetup,
     numerics: &Numerics,
     ramp: &[(f64, Direction)],
     thermal: Option<&AverageRequest>,
-    mut keep: impl FnMut(usize, &SweepPoint) -> bool,
+    keep: &mut dyn FnMut(usize, &SweepPoint) -> bool,
 ) -> Result<Vec<SweepPoint>> {
     if let Some(request) = thermal {
         request.check(setup.cantilever.quality)?;
