@@ -102,31 +102,23 @@ pub(super) fn command() -> clap::Command {
 
 /// [`command`] with only the subcommand `only` summarised (`Some("")`: none): what a
 /// command line that runs `only` parses and prints. Summarising all thirty took 8.6
-/// of the 10.9 million instructions of `tapsim --version` (callgrind), some 3 ms that
+/// of the 10.9 million instructions of `tapsim --version` (callgrind), about 1 ms that
 /// every `tapsim tap` from a script paid.
 fn command_for(only: Option<&str>) -> clap::Command {
-    let root = <Cli as clap::CommandFactory>::command();
-    let names: Vec<String> = root
+    summarised(<Cli as clap::CommandFactory>::command(), only)
+}
+
+/// `command` with its options' help summarised ([`command`]), and the subcommands
+/// named `only` (all: `None`) with theirs, all the way down.
+fn summarised(command: clap::Command, only: Option<&str>) -> clap::Command {
+    let names: Vec<String> = command
         .get_subcommands()
         .map(|s| s.get_name().to_string())
         .filter(|name| only.is_none_or(|only| only == name))
         .collect();
-    let mut root = summarised_args(root);
-    for name in names {
-        root = root.mut_subcommand(name, summarised);
-    }
-    root
-}
-
-/// `command` and its subcommands with every option's help summarised ([`command`]).
-fn summarised(command: clap::Command) -> clap::Command {
-    let names: Vec<String> = command
-        .get_subcommands()
-        .map(|s| s.get_name().to_string())
-        .collect();
     let mut command = summarised_args(command);
     for name in names {
-        command = command.mut_subcommand(name, summarised);
+        command = command.mut_subcommand(name, |sub| summarised(sub, None));
     }
     command
 }
