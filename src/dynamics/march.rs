@@ -26,9 +26,6 @@ use crate::physics::law::{Branch, Exits, ForceLaw};
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
 
-/// The most dimensions a section state has: each mode's x and x'.
-pub const MAX_SECTION: usize = SECTION_DIM;
-
 /// Where the oscillator is: time, deflection, velocity and the contact branch (and a
 /// relaxing sample's surface).
 #[derive(Debug, Clone, PartialEq)]

@@ -4,7 +4,8 @@
 //! [`super::window`], the recurrence and capture tests) all speak these types and import
 //! them from here, so that none needs another's module for a type.
 
-use super::march::{CycleIntegrals, MAX_SECTION};
+use super::march::CycleIntegrals;
+use super::model::SECTION_DIM;
 use nalgebra::Complex;
 
 /// The longest period looked for; motion that repeats after no n ≤ this is `irregular`.
@@ -73,7 +74,7 @@ pub const MARCHING_TOLERANCE: f64 = 1e-5;
 /// relaxing sample's surface).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Multipliers {
-    pub(super) values: [Complex<f64>; MAX_SECTION],
+    pub(super) values: [Complex<f64>; SECTION_DIM],
     pub(super) len: usize,
 }
 

@@ -1,7 +1,7 @@
 //! The last states at the drive phase, kept to see after how many periods the motion
 //! repeats: the periods worth looking for an orbit of.
 
-use super::march::MAX_SECTION;
+use super::model::SECTION_DIM;
 use super::motion::{MAX_PERIOD, SHORT_PERIOD};
 use crate::physics::law::Branch;
 use nalgebra::DVector;
@@ -14,7 +14,7 @@ const LOCK_GAP: f64 = 1e-5;
 #[derive(Default)]
 pub(super) struct Recurrence {
     /// (section state, branch), newest last; at most 3 + [`MAX_PERIOD`].
-    states: std::collections::VecDeque<([f64; MAX_SECTION], Branch)>,
+    states: std::collections::VecDeque<([f64; SECTION_DIM], Branch)>,
     /// Long periods already looked for, with the return distance then
     /// ([`Recurrence::locked`]).
     tried: Vec<(usize, f64)>,
@@ -27,7 +27,7 @@ impl Recurrence {
         if self.states.len() == Self::KEEP {
             self.states.pop_front();
         }
-        let mut a = [0.0; MAX_SECTION];
+        let mut a = [0.0; SECTION_DIM];
         a[..z.len()].copy_from_slice(z.as_slice());
         self.states.push_back((a, branch));
     }

@@ -4,7 +4,8 @@
 //! multipliers (the eigenvalues of the monodromy matrix) say whether it is stable.
 
 use super::capture::Candidate;
-use super::march::{CycleIntegrals, MAX_SECTION, Phase, Simulation};
+use super::march::{CycleIntegrals, Phase, Simulation};
+use super::model::SECTION_DIM;
 use super::model::{chain, phi_start};
 pub use super::motion::Multipliers;
 use super::motion::{Motion, StdErr, SteadyOptions, SteadyState};
@@ -348,11 +349,11 @@ impl<L: ForceLaw> Simulation<'_, L> {
     }
 }
 
-/// Eigenvalues of a monodromy matrix (at most [`MAX_SECTION`] × [`MAX_SECTION`]): in
+/// Eigenvalues of a monodromy matrix (at most [`SECTION_DIM`] × [`SECTION_DIM`]): in
 /// closed form for 2×2, from the real Schur form otherwise.
 pub(crate) fn eigenvalues(m: &DMatrix<f64>) -> Multipliers {
-    let mut values = [Complex::new(0.0, 0.0); MAX_SECTION];
-    let len = m.nrows().min(MAX_SECTION);
+    let mut values = [Complex::new(0.0, 0.0); SECTION_DIM];
+    let len = m.nrows().min(SECTION_DIM);
     if len == 2 {
         let half_trace = 0.5 * m.trace();
         let disc = Complex::new(half_trace * half_trace - m.determinant(), 0.0).sqrt();
