@@ -26,6 +26,11 @@
 //! instrument mode a file in [`instrument`]; a way of using the simulations a file in
 //! [`analysis`]; a command a file in `app/cli/`.
 //!
+//! The library's own tests are in the test program, one file for each module they test
+//! (`tests/unit/<layer>/`), so that `cargo test` links the library the run built instead
+//! of compiling it again with them. What they test beneath the API is public but hidden
+//! from these pages (`#[doc(hidden)]`): not an API, and free to change.
+//!
 //! # Where to start
 //!
 //! The user guide is the book in `docs/` (by task: how-to guides, explanation,

@@ -6,7 +6,8 @@
 use crate::error::{Error, Result};
 
 /// Gauss–Legendre nodes and weights on [−1, 1], 4 points (exact to degree 7).
-pub(crate) const GAUSS_LEGENDRE_4: [(f64, f64); 4] = [
+#[doc(hidden)]
+pub const GAUSS_LEGENDRE_4: [(f64, f64); 4] = [
     (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
     (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
     (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
@@ -14,7 +15,8 @@ pub(crate) const GAUSS_LEGENDRE_4: [(f64, f64); 4] = [
 ];
 
 /// Gauss–Legendre nodes and weights on [−1, 1], 8 points (exact to degree 15).
-pub(crate) const GAUSS_LEGENDRE_8: [(f64, f64); 8] = [
+#[doc(hidden)]
+pub const GAUSS_LEGENDRE_8: [(f64, f64); 8] = [
     (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
     (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
     (-0.525_532_409_916_329, 0.313_706_645_877_887_3),
@@ -67,7 +69,8 @@ pub(crate) fn wrap_angle(d: f64) -> f64 {
 }
 
 /// The polynomial through `points` (distinct abscissae) at `x`, in Lagrange form.
-pub(crate) fn lagrange(points: &[(f64, f64)], x: f64) -> f64 {
+#[doc(hidden)]
+pub fn lagrange(points: &[(f64, f64)], x: f64) -> f64 {
     (0..points.len())
         .map(|i| {
             let weight: f64 = (0..points.len())
@@ -81,7 +84,8 @@ pub(crate) fn lagrange(points: &[(f64, f64)], x: f64) -> f64 {
 
 /// Distance from `x` to the interval [lo, hi] (0 inside it).
 #[inline]
-pub(crate) fn distance_to_interval(x: f64, lo: f64, hi: f64) -> f64 {
+#[doc(hidden)]
+pub fn distance_to_interval(x: f64, lo: f64, hi: f64) -> f64 {
     (lo - x).max(x - hi).max(0.0)
 }
 
@@ -89,7 +93,8 @@ pub(crate) fn distance_to_interval(x: f64, lo: f64, hi: f64) -> f64 {
 /// by the Illinois variant of regula falsi: bracketing like bisection, superlinear
 /// like the secant method. Stops when the bracket is below `x_tol`·(1 + |x|) or
 /// `f` is exactly zero.
-pub(crate) fn bracketed_root(
+#[doc(hidden)]
+pub fn bracketed_root(
     what: &str,
     mut f: impl FnMut(f64) -> f64,
     mut lo: f64,
@@ -149,7 +154,8 @@ pub(crate) fn bracketed_root(
 /// safeguarded with bisection; `f` returns the value and its derivative. Quadratic once
 /// close, never leaves the bracket. Ends at a step below `x_tol` (absolute) or after 100
 /// iterations, returning the best estimate.
-pub(crate) fn newton_bracketed(
+#[doc(hidden)]
+pub fn newton_bracketed(
     f: impl Fn(f64) -> (f64, f64),
     mut lo: f64,
     mut hi: f64,
@@ -191,72 +197,4 @@ pub(crate) fn newton_bracketed(
         x = next;
     }
     x
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn finds_cube_root_of_two() {
-        let r = bracketed_root("t", |x| x * x * x - 2.0, 0.0, 2.0, 1e-15).unwrap();
-        assert!((r - 2f64.cbrt()).abs() < 1e-14);
-    }
-
-    #[test]
-    fn gauss_legendre_rules_integrate_polynomials_exactly() {
-        let int =
-            |rule: &[(f64, f64)], p: i32| rule.iter().map(|(x, w)| w * x.powi(p)).sum::<f64>();
-        for p in 0..16 {
-            let exact = if p % 2 == 1 {
-                0.0
-            } else {
-                2.0 / (p as f64 + 1.0)
-            };
-            assert!(
-                (int(&GAUSS_LEGENDRE_8, p) - exact).abs() < 1e-14,
-                "GL8 x^{p}"
-            );
-            if p < 8 {
-                assert!(
-                    (int(&GAUSS_LEGENDRE_4, p) - exact).abs() < 1e-14,
-                    "GL4 x^{p}"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn newton_bracketed_stops_at_the_ulp_level_far_from_zero() {
-        // At x ≈ 11 the spacing of doubles (1.8e-15) exceeds the requested tolerance; a
-        // converged Newton step that lands on the bracket's end must stop, not bisect.
-        let root = 10.982_493_883_375_94;
-        let calls = std::cell::Cell::new(0);
-        let r = newton_bracketed(
-            |x| {
-                calls.set(calls.get() + 1);
-                // The exact root lies between two doubles: no double makes f vanish.
-                (x - root + 4.7e-16, 1.0)
-            },
-            10.2,
-            11.0,
-            1e-15,
-        );
-        assert!((r - root).abs() < 4e-15, "{r}");
-        assert!(calls.get() <= 8, "{} evaluations", calls.get());
-    }
-
-    #[test]
-    fn newton_bracketed_finds_roots_fast_and_safely() {
-        let r = newton_bracketed(|x| (x * x * x - 2.0, 3.0 * x * x), 0.0, 2.0, 1e-15);
-        assert!((r - 2f64.cbrt()).abs() < 1e-14);
-        // A derivative that would throw Newton out of the bracket.
-        let r = newton_bracketed(|x| (x.atan(), 1.0 / (1.0 + x * x)), -10.0, 3.0, 1e-15);
-        assert!(r.abs() < 1e-14);
-    }
-
-    #[test]
-    fn rejects_bracket_without_sign_change() {
-        assert!(bracketed_root("t", |x| x * x + 1.0, -1.0, 1.0, 1e-12).is_err());
-    }
 }

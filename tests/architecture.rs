@@ -7,7 +7,8 @@
 //!   in its messages.
 //!
 //! An import is any path through `crate::` or `super::` in the code (a `use`, or a path
-//! written inline), tests included; doc comments and strings are not code. Each path is
+//! written inline), tests included (the library's own, in tests/unit/, for the module each
+//! tests); doc comments and strings are not code. Each path is
 //! resolved to the deepest module it names. A module's re-exports of its own children
 //! are containment, not imports.
 
@@ -287,6 +288,16 @@ fn resolve(path: &Module, modules: &BTreeSet<Module>) -> Module {
         .unwrap_or_default()
 }
 
+/// The modules of `modules` that `code`, in module `here`, imports.
+fn imports(code: &str, here: &Module, modules: &BTreeSet<Module>) -> BTreeSet<Module> {
+    paths(code, here)
+        .iter()
+        .map(|path| resolve(path, modules))
+        // Itself, the root, or its own ancestors' re-exports of it: not an import.
+        .filter(|target| target != here && !target.is_empty() && !here.starts_with(target))
+        .collect()
+}
+
 /// The import graph of the crate under `src`: module → the modules it imports.
 fn graph(src: &Path) -> BTreeMap<Module, BTreeSet<Module>> {
     let mut files = Vec::new();
@@ -296,16 +307,35 @@ fn graph(src: &Path) -> BTreeMap<Module, BTreeSet<Module>> {
     for file in &files {
         let here = module_of(src, file);
         let code = code_only(&std::fs::read_to_string(file).unwrap());
-        let mut to = BTreeSet::new();
-        for path in paths(&code, &here) {
-            let target = resolve(&path, &modules);
-            // Itself, the root, or its own ancestors' re-exports of it: not an import.
-            let contains = |outer: &Module, inner: &Module| inner.starts_with(outer);
-            if target != here && !target.is_empty() && !contains(&target, &here) {
-                to.insert(target);
-            }
-        }
+        let to = imports(&code, &here, &modules);
         edges.insert(here, to);
+    }
+    // The library's own tests (tests/unit/) count for the module each tests, named by
+    // its first line; they reach it through `tapsim::`.
+    let mut tests = Vec::new();
+    let unit = src.join("../tests/unit");
+    if unit.is_dir() {
+        sources(&unit, &mut tests);
+    }
+    for file in &tests {
+        let text = std::fs::read_to_string(file).unwrap();
+        let Some(named) = text
+            .lines()
+            .next()
+            .and_then(|l| l.strip_prefix("//! Tests of `tapsim::"))
+            .and_then(|l| l.split('`').next())
+        else {
+            continue;
+        };
+        let here: Module = named.split("::").map(String::from).collect();
+        assert!(
+            modules.contains(&here),
+            "{}: no module {named}",
+            file.display()
+        );
+        let code = code_only(&text).replace("tapsim::", "crate::");
+        let to = imports(&code, &here, &modules);
+        edges.get_mut(&here).unwrap().extend(to);
     }
     edges
 }

@@ -46,3 +46,4 @@ mod steady;
 mod sweep;
 mod thermal;
 mod tour;
+mod unit;

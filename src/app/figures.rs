@@ -509,14 +509,3 @@ pub fn fig6(jump_in: JumpIn, lj: &[LjSolution]) -> Result<Chart> {
         legend: Corner::UpperRight,
     })
 }
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn the_figures_without_a_lennard_jones_solution_have_clear_legends() {
-        for n in [1, 5] {
-            let c = super::figure(n, &Default::default()).unwrap();
-            assert_eq!(crate::app::report::plot::legend_covers(&c), 0, "figure {n}");
-        }
-    }
-}

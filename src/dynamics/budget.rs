@@ -31,7 +31,8 @@ impl Drop for Reset {
 
 /// Run `f` with a budget of `steps`, unless it runs inside a budgeted computation
 /// already (then it spends from that one).
-pub(crate) fn budgeted<T>(steps: u64, f: impl FnOnce() -> Result<T>) -> Result<T> {
+#[doc(hidden)]
+pub fn budgeted<T>(steps: u64, f: impl FnOnce() -> Result<T>) -> Result<T> {
     if LEFT.get().is_some() {
         return f();
     }
@@ -42,12 +43,14 @@ pub(crate) fn budgeted<T>(steps: u64, f: impl FnOnce() -> Result<T>) -> Result<T
 }
 
 /// Steps left (unlimited outside a budgeted computation).
-pub(crate) fn left() -> u64 {
+#[doc(hidden)]
+pub fn left() -> u64 {
     LEFT.get().unwrap_or(u64::MAX)
 }
 
 /// Spend `steps`; an error once the budget is exhausted.
-pub(crate) fn spend(steps: u64) -> Result<()> {
+#[doc(hidden)]
+pub fn spend(steps: u64) -> Result<()> {
     if let Some(left) = LEFT.get() {
         if steps > left {
             LEFT.set(Some(0));
@@ -70,24 +73,4 @@ pub(crate) fn exhausted() -> Error {
          resonance, a Q far outside 1 to 10⁶, or a relative tolerance (rtol) near round-off",
         TOTAL.get()
     ))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_budget_is_spent_shared_when_nested_and_ended() {
-        assert_eq!(left(), u64::MAX);
-        let e = budgeted(STEPS, || {
-            spend(STEPS - 10)?;
-            budgeted(STEPS, || spend(5))?;
-            assert_eq!(left(), 5);
-            spend(6)
-        })
-        .unwrap_err();
-        assert!(e.to_string().contains("work budget"), "{e}");
-        assert_eq!(left(), u64::MAX);
-        budgeted(7, || spend(7)).unwrap();
-    }
 }

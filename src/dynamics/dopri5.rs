@@ -13,7 +13,8 @@
 use super::model::State;
 
 /// A right-hand side and an observer of accepted steps.
-pub(crate) trait System<const N: usize> {
+#[doc(hidden)]
+pub trait System<const N: usize> {
     /// dy/dt at (t, y).
     fn system(&self, t: f64, y: &State<N>, dy: &mut State<N>);
     /// Told each accepted step's end (t, y, dy/dt there); true stops the integration.
@@ -24,7 +25,8 @@ pub(crate) trait System<const N: usize> {
 
 /// Why an integration stopped short.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum StepError {
+#[doc(hidden)]
+pub enum StepError {
     /// The step fell to round-off of t.
     StepSizeUnderflow {
         /// Where.
@@ -41,7 +43,8 @@ pub(crate) enum StepError {
 
 /// Steps taken.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct Stats {
+#[doc(hidden)]
+pub struct Stats {
     /// Accepted steps.
     pub accepted_steps: u32,
     /// Rejected steps (after the first accepted one).
@@ -54,7 +57,8 @@ pub(crate) struct Stats {
 
 /// The settings of one integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Settings {
+#[doc(hidden)]
+pub struct Settings {
     /// Relative and absolute tolerance.
     pub rtol: f64,
     pub atol: f64,
@@ -108,13 +112,18 @@ const E: [f64; 7] = [
 ];
 
 /// Controller constants: safety factor, β, the bounds of the step ratio.
-const SAFETY: f64 = 0.9;
-const BETA: f64 = 0.04;
-const FAC_MIN: f64 = 0.2;
-const FAC_MAX: f64 = 10.0;
+#[doc(hidden)]
+pub const SAFETY: f64 = 0.9;
+#[doc(hidden)]
+pub const BETA: f64 = 0.04;
+#[doc(hidden)]
+pub const FAC_MIN: f64 = 0.2;
+#[doc(hidden)]
+pub const FAC_MAX: f64 = 10.0;
 
 /// Integrate from (`x`, `y`) to `x_end` (> x), each accepted step shown to `f.solout`.
-pub(crate) fn integrate<S: System<N>, const N: usize>(
+#[doc(hidden)]
+pub fn integrate<S: System<N>, const N: usize>(
     f: &mut S,
     mut x: f64,
     x_end: f64,
@@ -249,112 +258,4 @@ fn initial_step<S: System<N>, const N: usize>(
         (0.01 / d1.sqrt().max(d2)).powf(1.0 / 5.0)
     };
     (100.0 * h0.abs()).min(h1.min(s.h_max))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::dynamics::model::BASE;
-
-    /// A damped, driven Duffing oscillator in the first two components, every accepted
-    /// step recorded.
-    struct Duffing(Vec<(f64, State<BASE>)>);
-
-    impl System<BASE> for Duffing {
-        fn system(&self, t: f64, y: &State<BASE>, dy: &mut State<BASE>) {
-            *dy = State::zeros();
-            dy[0] = y[1];
-            dy[1] = -0.1 * y[1] - y[0] - 0.5 * y[0] * y[0] * y[0] + 0.3 * (1.2 * t).cos();
-        }
-        fn solout(&mut self, t: f64, y: &State<BASE>, _: &State<BASE>) -> bool {
-            self.0.push((t, *y));
-            false
-        }
-    }
-
-    impl ode_solvers::dop_shared::System<f64, State<BASE>> for Duffing {
-        fn system(&self, t: f64, y: &State<BASE>, dy: &mut State<BASE>) {
-            System::system(self, t, y, dy);
-        }
-    }
-
-    #[test]
-    fn steps_as_ode_solvers_dopri5_does_to_the_last_bit() {
-        let mut y0 = State::<BASE>::zeros();
-        y0[0] = 1.0;
-        for (rtol, h0) in [(1e-9, 0.0), (1e-6, 0.0), (1e-8, 0.05)] {
-            let settings = Settings {
-                rtol,
-                atol: 1e-2 * rtol,
-                h_max: 0.3,
-                h0,
-                max_steps: 100_000,
-            };
-            let mut ours = Duffing(Vec::new());
-            let stats = integrate(&mut ours, 0.0, 30.0, y0, &settings).unwrap();
-            let mut theirs = ode_solvers::dopri5::Dopri5::from_param(
-                Duffing(Vec::new()),
-                0.0,
-                30.0,
-                0.0,
-                y0,
-                rtol,
-                1e-2 * rtol,
-                SAFETY,
-                BETA,
-                FAC_MIN,
-                FAC_MAX,
-                0.3,
-                h0,
-                100_000,
-                u32::MAX,
-                ode_solvers::dop_shared::OutputType::Sparse,
-            );
-            let their_stats = theirs.integrate().unwrap();
-            assert_eq!(stats.accepted_steps, their_stats.accepted_steps);
-            assert_eq!(stats.rejected_steps, their_stats.rejected_steps);
-            // Theirs records the start too.
-            let (t, y) = (theirs.x_out(), theirs.y_out());
-            assert_eq!(ours.0.len() + 1, t.len());
-            for (k, (tk, yk)) in ours.0.iter().enumerate() {
-                assert_eq!(tk.to_bits(), t[k + 1].to_bits(), "rtol {rtol}, step {k}");
-                assert_eq!(yk, &y[k + 1], "rtol {rtol}, step {k}");
-            }
-        }
-    }
-
-    #[test]
-    fn a_harmonic_oscillator_keeps_to_its_closed_form() {
-        struct Harmonic;
-        impl System<BASE> for Harmonic {
-            fn system(&self, _: f64, y: &State<BASE>, dy: &mut State<BASE>) {
-                *dy = State::zeros();
-                dy[0] = y[1];
-                dy[1] = -y[0];
-            }
-        }
-        let mut y0 = State::<BASE>::zeros();
-        y0[0] = 1.0;
-        let settings = Settings {
-            rtol: 1e-10,
-            atol: 1e-12,
-            h_max: 1.0,
-            h0: 0.0,
-            max_steps: 100_000,
-        };
-        let mut end = y0;
-        struct Last<'a>(&'a mut State<BASE>);
-        impl System<BASE> for Last<'_> {
-            fn system(&self, t: f64, y: &State<BASE>, dy: &mut State<BASE>) {
-                Harmonic.system(t, y, dy);
-            }
-            fn solout(&mut self, _: f64, y: &State<BASE>, _: &State<BASE>) -> bool {
-                *self.0 = *y;
-                false
-            }
-        }
-        integrate(&mut Last(&mut end), 0.0, 10.0, y0, &settings).unwrap();
-        assert!((end[0] - 10f64.cos()).abs() < 1e-8, "{}", end[0]);
-        assert!((end[1] + 10f64.sin()).abs() < 1e-8, "{}", end[1]);
-    }
 }

@@ -256,7 +256,8 @@ impl<L: ForceLaw, O: StepObserver> StepObserver for Tracker<'_, L, O> {
 /// Step fraction in [0, 1] of the turning point of the deflection's Hermite cubic on a
 /// step where the velocity changes sign: its minimum (`rising`: from negative to
 /// positive) or its maximum.
-fn hermite_turn<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, rising: bool) -> f64 {
+#[doc(hidden)]
+pub fn hermite_turn<const N: usize>(a: &StepEnd<N>, b: &StepEnd<N>, rising: bool) -> f64 {
     let h = b.tau - a.tau;
     hermite_turn_fraction((a.y[X], h * a.y[V]), (b.y[X], h * b.y[V]), rising)
 }
@@ -685,37 +686,5 @@ impl<L: ForceLaw> Simulation<'_, L> {
             },
             ..*self
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn hermite_turn_finds_the_turning_points_of_parabolas() {
-        // x = (τ − 0.3)², sampled at τ = 0 and 1 with exact slopes: the cubic is exact.
-        let end = |tau: f64| {
-            let mut y = State::<BASE>::zeros();
-            y[X] = (tau - 0.3) * (tau - 0.3);
-            y[V] = 2.0 * (tau - 0.3);
-            StepEnd {
-                tau,
-                y,
-                dy: State::<BASE>::zeros(),
-            }
-        };
-        let t = hermite_turn(&end(0.0), &end(1.0), true);
-        assert!((t - 0.3).abs() < 1e-12, "{t}");
-        // And the top of x = −(τ − 0.6)².
-        let top = |tau: f64| {
-            let mut e = end(tau + 0.3 - 0.6);
-            e.tau = tau;
-            e.y[X] = -e.y[X];
-            e.y[V] = -e.y[V];
-            e
-        };
-        let t = hermite_turn(&top(0.0), &top(1.0), false);
-        assert!((t - 0.6).abs() < 1e-12, "{t}");
     }
 }

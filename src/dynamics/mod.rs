@@ -10,9 +10,11 @@
 pub mod attractors;
 pub mod base_drive;
 pub mod budget;
-mod capture;
+#[doc(hidden)]
+pub mod capture;
 pub mod continuation;
-mod dopri5;
+#[doc(hidden)]
+pub mod dopri5;
 pub mod free;
 pub mod free_steps;
 pub mod gradient;

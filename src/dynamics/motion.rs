@@ -64,7 +64,8 @@ impl Motion {
 
 /// The fewest periods a steady-state search may be given: enough to classify the motion
 /// and average irregular motion over a window of its own.
-pub(crate) const MIN_CYCLES: usize = 32;
+#[doc(hidden)]
+pub const MIN_CYCLES: usize = 32;
 /// Marched periods are integrated at this fraction of the averages' tolerance (the
 /// default of [`SteadyOptions::marching_fraction`]).
 pub const MARCHING_TOLERANCE: f64 = 1e-5;

@@ -75,11 +75,8 @@ where
 /// and scaled slopes (p₀, h·p₀′) and (p₁, h·p₁′) turns: the root of its derivative (a
 /// quadratic in t) where the derivative rises (`rising`: a minimum) or falls through zero;
 /// ½ where there is none.
-pub(crate) fn hermite_turn_fraction(
-    (p0, m0): (f64, f64),
-    (p1, m1): (f64, f64),
-    rising: bool,
-) -> f64 {
+#[doc(hidden)]
+pub fn hermite_turn_fraction((p0, m0): (f64, f64), (p1, m1): (f64, f64), rising: bool) -> f64 {
     // The cubic is p0 + m0 t + c2 t² + c3 t³; its derivative 3c3 t² + 2c2 t + m0.
     let c3 = 2.0 * p0 + m0 - 2.0 * p1 + m1;
     let c2 = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1;

@@ -174,7 +174,8 @@ impl Numerics {
 }
 
 /// `value` to four significant digits, without trailing zeros: 0.5, 1e-13, 3.333e-6.
-pub(crate) fn significant(value: f64) -> String {
+#[doc(hidden)]
+pub fn significant(value: f64) -> String {
     let magnitude = value.abs();
     if magnitude == 0.0 {
         "0".into()
@@ -195,7 +196,8 @@ pub(crate) fn significant(value: f64) -> String {
 }
 
 /// `value` with an SI prefix where it has a unit: 2e-8 m → "20 nm".
-fn with_prefix(value: f64, unit: &str) -> String {
+#[doc(hidden)]
+pub fn with_prefix(value: f64, unit: &str) -> String {
     const PREFIXES: [(f64, &str); 9] = [
         (1e12, "T"),
         (1e9, "G"),
@@ -274,7 +276,8 @@ fn separation_in_range(separation_m: f64, a0_m: f64) -> Result<()> {
 impl TapSetup {
     /// Refuse values outside what an AFM can be (SI slips like `--radius 20`, meaning
     /// 20 m) and regimes tapsim cannot resolve within seconds; the message explains.
-    pub(crate) fn check_plausible(&self) -> Result<()> {
+    #[doc(hidden)]
+    pub fn check_plausible(&self) -> Result<()> {
         let (c, k) = (&self.contact, &self.cantilever);
         let length = |what, lo, hi, why| Range {
             what,
@@ -482,35 +485,5 @@ impl Prepared {
         let mut sim = self.simulation();
         sim.cpl.a0 = separation_m / self.setup.contact.separation_scale_m();
         Ok(sim)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn values_in_messages_read_as_a_person_writes_them() {
-        assert_eq!(significant(0.0), "0");
-        assert_eq!(significant(0.5), "0.5");
-        assert_eq!(significant(1e-13), "1e-13");
-        assert_eq!(significant(1e7), "1e7");
-        assert_eq!(significant(-1.0 / 3e5), "-3.333e-6");
-        assert_eq!(with_prefix(2e-8, "m"), "20 nm");
-        assert_eq!(with_prefix(-2e-7, "m"), "-200 nm");
-        assert_eq!(with_prefix(1e300, "m"), "1e300 m");
-        assert_eq!(with_prefix(0.5, ""), "0.5");
-    }
-
-    #[test]
-    fn an_si_slip_is_refused_with_the_unit_it_probably_meant() {
-        let mut setup = default_setup();
-        setup.contact.radius_m = 20.0;
-        let e = setup.check_plausible().unwrap_err().to_string();
-        assert!(
-            e.contains("20 m") && e.contains("did you mean 20nm?"),
-            "{e}"
-        );
-        default_setup().check_plausible().unwrap();
     }
 }

@@ -10,7 +10,8 @@
 
 use super::budget;
 use super::march::{Phase, Simulation};
-pub(crate) use super::motion::MIN_CYCLES;
+#[doc(hidden)]
+pub use super::motion::MIN_CYCLES;
 pub use super::motion::{
     Grazing, MARCHING_TOLERANCE, MAX_PERIOD, Motion, SHORT_PERIOD, SteadyOptions, SteadyState,
 };

@@ -11,7 +11,8 @@ const JUMP_DEG: f64 = 10.0;
 const JUMP_AMPLITUDE: f64 = 0.02;
 /// Where an approach's first segment shows its features, in the data's positions.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Features {
+#[doc(hidden)]
+pub struct Features {
     /// The branch jump: between points i and i + 1 (the steepest fall of the phase, or
     /// jump of the amplitude, beyond its threshold).
     pub jump: Option<usize>,
@@ -52,7 +53,8 @@ impl Features {
 }
 
 /// Where the first approach of `data` ends.
-pub(crate) fn first_end(data: &Measured) -> usize {
+#[doc(hidden)]
+pub fn first_end(data: &Measured) -> usize {
     data.segments
         .get(1)
         .copied()
@@ -69,7 +71,8 @@ fn steepest(v: &[f64], step: impl Fn(f64, f64) -> f64) -> Option<(usize, f64)> {
 
 /// Where `v` first differs from `v[0]` by more than `threshold`, interpolated between
 /// the positions `z`.
-pub(crate) fn onset(z: &[f64], v: &[f64], threshold: f64) -> Option<f64> {
+#[doc(hidden)]
+pub fn onset(z: &[f64], v: &[f64], threshold: f64) -> Option<f64> {
     let i = v.iter().position(|x| (x - v[0]).abs() > threshold)?;
     let (d0, d1) = ((v[i - 1] - v[0]).abs(), (v[i] - v[0]).abs());
     let t = ((threshold - d0) / (d1 - d0)).clamp(0.0, 1.0);

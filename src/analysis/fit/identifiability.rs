@@ -64,7 +64,8 @@ pub struct Identifiability {
 /// cannot be (residuals at the simulation's own precision: no intervals then, the
 /// identifiability judged at the weights given; likewise where the fit does not
 /// describe its data), `physical` each coordinate's value in SI.
-pub(crate) fn assess(
+#[doc(hidden)]
+pub fn assess(
     params: &[Parameter],
     jacobian: &DMatrix<f64>,
     variance_factor: Option<f64>,

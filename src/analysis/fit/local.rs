@@ -15,7 +15,8 @@ use std::cell::{Cell, RefCell};
 /// 1e-4), 1e-3 of an offset's unit (1 pm, 0.001°) — far above the steady states' own
 /// error (their orbits are converged to 1e-7 of A₀ and better), far below the data's
 /// resolution.
-const LOG_STEP: f64 = 1e-4;
+#[doc(hidden)]
+pub const LOG_STEP: f64 = 1e-4;
 const OFFSET_STEP: f64 = 1e-3;
 /// The steps where the curve holds thermal averages ([`Measured::thermal`]): under the
 /// same noise (each point's seed fixed) an average still moves by about its standard
@@ -42,7 +43,8 @@ const CRAWL_ITERATIONS: usize = 3;
 const UNSIMULATED: f64 = 1e100;
 
 /// Where one local run ended.
-pub(crate) struct LocalRun {
+#[doc(hidden)]
+pub struct LocalRun {
     /// The setup and nuisance values at the end.
     pub setup: TapSetup,
     pub nuisance: Nuisance,
@@ -93,7 +95,8 @@ pub(crate) type Describes<'a> = &'a dyn Fn(&Curve, &[f64]) -> bool;
 /// What a local run may spend: at most `max_curves` simulated curves besides the
 /// final curve's, and, with `describes`, no crawling far from the data ([`run`]).
 #[derive(Clone, Copy)]
-pub(crate) struct Budget<'a> {
+#[doc(hidden)]
+pub struct Budget<'a> {
     pub max_curves: usize,
     pub describes: Option<Describes<'a>>,
 }
@@ -238,7 +241,8 @@ type Evaluated = (DVector<f64>, Curve, DVector<f64>);
 
 /// The least-squares problem the optimiser sees: x the fitted coordinates (0 at the
 /// start), the residuals a simulated curve's.
-struct Problem<'a> {
+#[doc(hidden)]
+pub struct Problem<'a> {
     setup: &'a TapSetup,
     /// The nuisance values where the fit does not adjust them.
     base: Nuisance,
@@ -266,7 +270,8 @@ impl<'a> Problem<'a> {
     /// The problem of fitting `params` to `data` from `start` (the setup, the nuisance
     /// values and the fitted parameters' values there: the origin of the coordinates),
     /// within `budget`.
-    fn new(
+    #[doc(hidden)]
+    pub fn new(
         (setup, base, starts): (&'a TapSetup, Nuisance, &'a [f64]),
         numerics: &'a Numerics,
         data: &'a Measured,
@@ -300,7 +305,8 @@ impl<'a> Problem<'a> {
 
     /// The weighted residuals at `x` (None, with the failure kept, where the curve
     /// cannot be simulated or the budget of curves is spent).
-    fn evaluate(&self, x: &DVector<f64>) -> Option<DVector<f64>> {
+    #[doc(hidden)]
+    pub fn evaluate(&self, x: &DVector<f64>) -> Option<DVector<f64>> {
         if let Some((at, _, r)) = self.cache.borrow().as_ref() {
             if at == x {
                 return Some(r.clone());
@@ -356,7 +362,13 @@ impl<'a> Problem<'a> {
     /// curve is `at`); backward where the forward step moves a point across a branch
     /// switch and the backward step does not (a difference across the switch is a
     /// jump, not a slope: the intervals would come out as narrow as the step).
-    fn jacobian_at(&self, x: &DVector<f64>, r0: &DVector<f64>, at: &Curve) -> Option<DMatrix<f64>> {
+    #[doc(hidden)]
+    pub fn jacobian_at(
+        &self,
+        x: &DVector<f64>,
+        r0: &DVector<f64>,
+        at: &Curve,
+    ) -> Option<DMatrix<f64>> {
         let averaged = at.averaged.contains(&true);
         let side = |x: &DVector<f64>, c: &Curve| branch_sides(&self.physical(x), c);
         let sides = side(x, at);
@@ -408,7 +420,8 @@ const BRANCH_BAND_DEG: f64 = 0.1;
 /// Each point's branch in `curve` simulated at `at` (a setup and its nuisance values):
 /// +1 where its phase lies above the free phase by more than [`BRANCH_BAND_DEG`] (the
 /// attractive branch), −1 below (the repulsive one), 0 near it.
-fn branch_sides(at: &(TapSetup, Nuisance), curve: &Curve) -> Vec<i8> {
+#[doc(hidden)]
+pub fn branch_sides(at: &(TapSetup, Nuisance), curve: &Curve) -> Vec<i8> {
     let free = crate::analysis::setpoint::free_phase_deg(&at.0) + at.1.phase_offset_deg;
     curve
         .phase_deg
@@ -426,7 +439,8 @@ fn branch_sides(at: &(TapSetup, Nuisance), curve: &Curve) -> Vec<i8> {
 }
 
 /// Whether some point lies on one branch in `a` and on the other in `b`.
-fn crosses_switch(a: &[i8], b: &[i8]) -> bool {
+#[doc(hidden)]
+pub fn crosses_switch(a: &[i8], b: &[i8]) -> bool {
     a.len() != b.len() || a.iter().zip(b).any(|(&x, &y)| x * y < 0)
 }
 
@@ -463,99 +477,5 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
             }
         }
         self.jacobian_at(&self.x, &r0, &at)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::dynamics::setup::default_setup;
-
-    /// A Jacobian taken just below the modulus at which a point of the issue-43 curve
-    /// (E* 0.8 GPa, Δγ 0.07 J/m²) jumps to the repulsive branch: the forward step
-    /// crosses the switch, so the column is the backward difference — within 2 % of a
-    /// backward difference of twice the step (a slope, not a jump), where the forward
-    /// one is a jump hundreds of times larger.
-    #[test]
-    fn a_step_across_a_branch_switch_is_taken_backward() {
-        let numerics = crate::analysis::sweep::sweep_numerics(Numerics::default(), (false, false));
-        let mut setup = default_setup();
-        setup.contact.modulus_pa = 0.8e9;
-        setup.contact.work_of_adhesion_j_m2 = 0.07;
-        let z: Vec<f64> = (0..25).map(|i| 24e-9 - 0.5e-9 * f64::from(i)).collect();
-        let side = |e: f64| {
-            let mut s = setup.clone();
-            s.contact.modulus_pa = e;
-            let c = super::super::model::curve(&s, &numerics, &z, 0.0).unwrap();
-            branch_sides(&(s, Nuisance::offset(0.0)), &c)
-        };
-        // Bisect in E* for where the curve's branches change, to well within a step.
-        let (mut lo, mut hi) = (0.4e9, 1.5e9);
-        let (s_lo, mut s_hi) = (side(lo), side(hi));
-        assert!(crosses_switch(&s_lo, &s_hi), "{s_lo:?} {s_hi:?}");
-        while hi / lo - 1.0 > 0.2 * LOG_STEP {
-            let mid = (lo * hi).sqrt();
-            let s_mid = side(mid);
-            if crosses_switch(&s_lo, &s_mid) {
-                (hi, s_hi) = (mid, s_mid);
-            } else {
-                lo = mid;
-            }
-        }
-        // Right at the switch the point that switches can be in transit between the
-        // branches (not a stable period-1 orbit, its value jumping within a step): step
-        // back from there, half a step at a time, while the forward step still crosses.
-        let switching: Vec<usize> = (0..z.len()).filter(|&i| s_lo[i] * s_hi[i] < 0).collect();
-        let mut c;
-        loop {
-            setup.contact.modulus_pa = lo;
-            c = super::super::model::curve(&setup, &numerics, &z, 0.0).unwrap();
-            if switching.iter().all(|&i| c.well_defined[i]) {
-                break;
-            }
-            lo *= (-0.5 * LOG_STEP).exp();
-            assert!(
-                hi / lo - 1.0 < 0.9 * LOG_STEP,
-                "in transit below {hi}: {switching:?}"
-            );
-        }
-        let data = Measured {
-            position_m: z.clone(),
-            setpoint_ratio: None,
-            segments: vec![0],
-            amplitude_m: Some(c.amplitude_m.clone()),
-            phase_deg: Some(c.phase_deg.iter().map(|p| p + 0.1).collect()),
-            sigma_amplitude_m: 0.02e-9,
-            sigma_phase_deg: 0.05,
-            second_mode: None,
-            thermal: None,
-        };
-        let report = |_: &crate::analysis::fit::Progress| {};
-        let tracker = Tracker::new(&report);
-        let params = [Parameter::Modulus];
-        let starts = [lo];
-        let problem = Problem::new(
-            (&setup, Nuisance::offset(0.0), &starts),
-            &numerics,
-            &data,
-            &params,
-            Budget::curves(100),
-            &tracker,
-        );
-        let x = DVector::zeros(1);
-        let r0 = problem.evaluate(&x).unwrap();
-        let j = problem.jacobian_at(&x, &r0, &c).unwrap();
-        let at = |h: f64| problem.evaluate(&DVector::from_element(1, h)).unwrap();
-        let forward = (at(LOG_STEP) - &r0) / LOG_STEP;
-        let wide = (at(-2.0 * LOG_STEP) - &r0) / (-2.0 * LOG_STEP);
-        let column = j.column(0).into_owned();
-        assert!(
-            (&column - &wide).norm() < 0.02 * wide.norm(),
-            "{column} against {wide}"
-        );
-        assert!(
-            forward.norm() > 100.0 * wide.norm(),
-            "{forward} against {wide}"
-        );
     }
 }

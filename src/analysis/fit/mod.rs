@@ -18,9 +18,11 @@
 //! (progress is reported to a callback).
 
 pub mod diagnose;
-mod features;
+#[doc(hidden)]
+pub mod features;
 pub mod identifiability;
-mod local;
+#[doc(hidden)]
+pub mod local;
 pub mod model;
 pub mod progress;
 pub mod search;

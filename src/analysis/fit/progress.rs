@@ -62,7 +62,8 @@ pub struct Progress {
 }
 
 /// The shared state behind [`Progress`] reports (used from the design's threads).
-pub(crate) struct Tracker<'a> {
+#[doc(hidden)]
+pub struct Tracker<'a> {
     state: Mutex<State>,
     report: &'a (dyn Fn(&Progress) + Sync),
     began: Instant,

@@ -96,7 +96,8 @@ pub struct Cli {
 /// the first clause of its help ([`first_clause`]), its value named by its unit or
 /// FILE, `--help` the whole text — so `-h` is a summary a screen holds, generated from
 /// the same definitions.
-pub(super) fn command() -> clap::Command {
+#[doc(hidden)]
+pub fn command() -> clap::Command {
     command_for(None)
 }
 
@@ -104,7 +105,8 @@ pub(super) fn command() -> clap::Command {
 /// command line that runs `only` parses and prints. Summarising all thirty took 8.6
 /// of the 10.9 million instructions of `tapsim --version` (callgrind), about 1 ms that
 /// every `tapsim tap` from a script paid.
-fn command_for(only: Option<&str>) -> clap::Command {
+#[doc(hidden)]
+pub fn command_for(only: Option<&str>) -> clap::Command {
     summarised(<Cli as clap::CommandFactory>::command(), only)
 }
 
@@ -167,7 +169,8 @@ fn summarised_args(command: clap::Command) -> clap::Command {
 
 /// The subcommand a command line (the program's name first) runs, or whose help it
 /// asks for (`tapsim help tap`): its first word that is not an option ("" if none).
-fn subcommand_named(args: &[std::ffi::OsString]) -> String {
+#[doc(hidden)]
+pub fn subcommand_named(args: &[std::ffi::OsString]) -> String {
     let mut words = args
         .iter()
         .skip(1)
@@ -198,7 +201,8 @@ fn first_bracket_short(text: &str) -> String {
 /// The summary of `help`: its first clause — up to the first `: `, `; ` or sentence end
 /// (`. ` before a capital) outside brackets, after at least 15 bytes — without its
 /// parenthetical remarks (` (…)`); the rest is for `--help`.
-fn first_clause(help: &str) -> String {
+#[doc(hidden)]
+pub fn first_clause(help: &str) -> String {
     let chars: Vec<char> = help.chars().collect();
     let (mut out, mut depth, mut i) = (String::new(), 0i32, 0);
     while i < chars.len() {
@@ -250,75 +254,6 @@ fn first_clause(help: &str) -> String {
     match out.strip_suffix('.') {
         Some(kept) if !kept.ends_with("..") || kept.ends_with("...") => kept.to_string(),
         _ => out,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    /// A command line summarises only the subcommand it runs, and that subcommand's
-    /// `-h` and `--help` read as they do from the whole summarised definition.
-    #[test]
-    fn the_running_subcommand_is_summarised_as_in_the_whole_definition() {
-        let words = |line: &str| -> Vec<std::ffi::OsString> {
-            line.split_whitespace().map(Into::into).collect()
-        };
-        assert_eq!(super::subcommand_named(&words("tapsim tap -h")), "tap");
-        assert_eq!(super::subcommand_named(&words("tapsim help scan")), "scan");
-        assert_eq!(super::subcommand_named(&words("tapsim --version")), "");
-        let mut whole = super::command();
-        for name in ["tap", "scan", "fit", "thermal"] {
-            let mut alone = super::command_for(Some(name));
-            let (a, w) = (
-                alone.find_subcommand_mut(name).unwrap(),
-                whole.find_subcommand_mut(name).unwrap(),
-            );
-            assert_eq!(a.render_help().to_string(), w.render_help().to_string());
-            assert_eq!(
-                a.render_long_help().to_string(),
-                w.render_long_help().to_string()
-            );
-        }
-    }
-
-    /// The summary keeps what says what a flag is and its default, and leaves the
-    /// remarks, the equation numbers and the next sentences to --help.
-    #[test]
-    fn a_summary_is_the_first_clause_without_remarks() {
-        for (help, summary) in [
-            (
-                "Dimensionless support stiffness k̂ = μεk/(RΔγ), eq. (23) [> 0]",
-                "Dimensionless support stiffness k̂ = μεk/(RΔγ) [> 0]",
-            ),
-            (
-                "Amplitude setpoint A/A₀ in place of a rest separation (between 0 and 1; as \
-                 an AFM's z feedback holds it): every stable state",
-                "Amplitude setpoint A/A₀ in place of a rest separation",
-            ),
-            (
-                "Quality factor Q [default 400]. (Also --Q.)",
-                "Quality factor Q [default 400]",
-            ),
-            (
-                "The branch whose states a setpoint lists [default: all]. Attractive: the \
-                 phase lag above",
-                "The branch whose states a setpoint lists [default: all]",
-            ),
-            (
-                "Cantilever eigenmodes [1 to 3; default 1]. 2 is bimodal AFM",
-                "Cantilever eigenmodes [1 to 3; default 1]",
-            ),
-            (
-                "A material, name:key=value,... (repeat; at least two).",
-                "A material, name:key=value,...",
-            ),
-            (
-                "Tabor parameter μ, eq. (8) [dimensionless]",
-                "Tabor parameter μ [dimensionless]",
-            ),
-            ("Print help", "Print help"),
-        ] {
-            assert_eq!(super::first_clause(help), summary, "{help}");
-        }
     }
 }
 

@@ -15,7 +15,8 @@ use std::sync::Once;
 pub const SIZE: (u32, u32) = (960, 720);
 
 /// Colour-blind-safe palette (Okabe–Ito).
-const PALETTE: [RGBColor; 8] = [
+#[doc(hidden)]
+pub const PALETTE: [RGBColor; 8] = [
     RGBColor(0, 0, 0),
     RGBColor(213, 94, 0),
     RGBColor(0, 114, 178),
@@ -64,13 +65,15 @@ pub fn render_svg(chart: &Chart, path: &Path) -> Result<()> {
 /// Where a panel was drawn: its plotting area (backend pixels, x and y ranges) and how
 /// much of its data its legend covers (0: none).
 #[derive(Debug, Clone, PartialEq)]
-struct Drawn {
-    area: (std::ops::Range<i32>, std::ops::Range<i32>),
-    legend_covers: usize,
+#[doc(hidden)]
+pub struct Drawn {
+    pub area: (std::ops::Range<i32>, std::ops::Range<i32>),
+    pub legend_covers: usize,
 }
 
 /// One panel of a figure: a chart or a heat map.
-trait Panel {
+#[doc(hidden)]
+pub trait Panel {
     /// Draw into `area`; where the plotting area went.
     fn draw_panel<DB: DrawingBackend>(
         &self,
@@ -148,13 +151,13 @@ fn render_stack_png<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Re
 }
 
 /// RGB pixels, their width and height, and where each panel went.
-#[cfg(test)]
-type Raster = (Vec<u8>, (u32, u32), Vec<Drawn>);
+#[doc(hidden)]
+pub type Raster = (Vec<u8>, (u32, u32), Vec<Drawn>);
 
 /// How many data points the legend of `chart`, drawn alone, covers (for the tests of
 /// the charts other modules build).
-#[cfg(test)]
-pub(crate) fn legend_covers(chart: &Chart) -> usize {
+#[doc(hidden)]
+pub fn legend_covers(chart: &Chart) -> usize {
     let (_, _, drawn) =
         rasterize(std::slice::from_ref(chart), Arrange::Stack).expect("the chart draws");
     drawn[0].legend_covers
@@ -163,8 +166,8 @@ pub(crate) fn legend_covers(chart: &Chart) -> usize {
 /// `panels` drawn into RGB pixels by plotters' bitmap backend ([`draw_stack`]): no
 /// anti-aliasing, so every pixel of a series is exactly its colour (what the layout
 /// tests count).
-#[cfg(test)]
-fn rasterize<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<Raster, String> {
+#[doc(hidden)]
+pub fn rasterize<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<Raster, String> {
     register_font();
     let (width, height) = stack_size(panels.len(), arrange);
     let mut pixels = vec![0u8; 3 * width as usize * height as usize];
@@ -192,7 +195,8 @@ fn svg_text<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<Str
 
 /// `panels` as anti-aliased RGB pixels and their size: the figure's SVG drawn by resvg
 /// on white, its text in the embedded DejaVu Sans (plotters writes `sans-serif`).
-fn rasterize_smooth<P: Panel>(
+#[doc(hidden)]
+pub fn rasterize_smooth<P: Panel>(
     panels: &[P],
     arrange: Arrange,
 ) -> std::result::Result<(Vec<u8>, (u32, u32)), String> {
@@ -253,7 +257,8 @@ pub fn render_side_by_side(maps: &[HeatMap], path: &Path) -> Result<()> {
 
 /// How the panels of a figure are laid out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Arrange {
+#[doc(hidden)]
+pub enum Arrange {
     /// One above the other up to three, else row by row in two columns.
     Stack,
     /// In one row.
@@ -276,7 +281,8 @@ fn render<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
 
 /// Ticks of a log axis over [lo, hi]: 1, 2 and 5 times each power of ten inside, or
 /// 1, 2, 3 and 5 times, or every integer multiple, the first that gives four or more.
-fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+#[doc(hidden)]
+pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let within = |multiples: &[f64]| -> Vec<f64> {
         let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
         (first..=last)
@@ -726,7 +732,8 @@ where
 /// A tick label: decades of a log axis as 0.1, 1, 10, then 10², 10³, … (10⁻², …);
 /// anything else with up to six decimals, trailing zeros dropped ("140", "0.25"), or
 /// far from 1 as a mantissa and exponent ("2.5e-18").
-fn tick_label(v: f64, scale: Scale) -> String {
+#[doc(hidden)]
+pub fn tick_label(v: f64, scale: Scale) -> String {
     if scale == Scale::Log && v > 0.0 {
         let k = v.log10().round();
         if (v.log10() - k).abs() < 1e-9 && !(-1.0..=1.0).contains(&k) {
@@ -859,13 +866,15 @@ where
 /// Clipping of polylines to the plotted box (plotters would clamp out-of-range points
 /// onto the border, bending straight lines). Works in the axes' own coordinates:
 /// log10 of the value on a log axis, so straight lines stay straight.
-struct Clip {
+#[doc(hidden)]
+pub struct Clip {
     x: (f64, f64, bool),
     y: (f64, f64, bool),
 }
 
 impl Clip {
-    fn new(x: (f64, f64, bool), y: (f64, f64, bool)) -> Self {
+    #[doc(hidden)]
+    pub fn new(x: (f64, f64, bool), y: (f64, f64, bool)) -> Self {
         Self { x, y }
     }
 
@@ -887,7 +896,8 @@ impl Clip {
     }
 
     /// The parts of the polyline inside the box, each a run of connected points.
-    fn runs(&self, points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+    #[doc(hidden)]
+    pub fn runs(&self, points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
         let (x0, y0) = self.data_to_axes((self.x.0, self.y.0));
         let (x1, y1) = self.data_to_axes((self.x.1, self.y.1));
         let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
@@ -956,258 +966,4 @@ fn liang_barsky(
         let at = |t: f64| (a.0 + t * dx, a.1 + t * dy);
         (at(t0), at(t1))
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn clipping_keeps_log_lines_straight() {
-        let clip = Clip::new((1.0, 100.0, true), (1.0, 100.0, true));
-        // y = 1000/x from x = 1 to 1e4 crosses the box from (10, 100) to (100, 10).
-        let runs = clip.runs(&[(1.0, 1000.0), (1e4, 0.1)]);
-        assert_eq!(runs.len(), 1);
-        let (p, q) = (runs[0][0], runs[0][1]);
-        assert!((p.0 - 10.0).abs() < 1e-9 && (p.1 - 100.0).abs() < 1e-9);
-        assert!((q.0 - 100.0).abs() < 1e-9 && (q.1 - 10.0).abs() < 1e-9);
-    }
-
-    use crate::app::report::chart::{Axis, Series};
-
-    fn chart(x: Axis, y: Axis, series: Vec<Series>, legend: Corner) -> Chart {
-        Chart {
-            name: "test".into(),
-            title: "test".into(),
-            x,
-            y,
-            series,
-            labels: Vec::new(),
-            legend,
-        }
-    }
-
-    /// Pixels of exactly `color` outside the drawn charts' plotting areas (grown by a
-    /// pixel for a line's half width).
-    fn strays(charts: &[Chart], color: RGBColor) -> usize {
-        let (pixels, (width, _), drawn) = rasterize(charts, Arrange::Stack).unwrap();
-        pixels
-            .chunks(3)
-            .enumerate()
-            .filter(|(_, p)| (p[0], p[1], p[2]) == (color.0, color.1, color.2))
-            .filter(|&(i, _)| {
-                let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
-                !drawn.iter().any(|d| {
-                    (d.area.0.start - 1..d.area.0.end + 1).contains(&x)
-                        && (d.area.1.start - 1..d.area.1.end + 1).contains(&y)
-                })
-            })
-            .count()
-    }
-
-    #[test]
-    fn no_drawn_pixel_of_a_series_leaves_its_plot_area() {
-        // Thick lines that run far outside fixed ranges, solid and dashed, on linear and
-        // log axes, one chart and a stack (plotters' bitmap backend draws wide strokes
-        // as polygons it does not clip).
-        let wild = vec![(-5.0, 3.0), (0.5, 0.5), (5.0, -3.0), (0.2, 9.0), (0.9, 0.1)];
-        let color = PALETTE[7];
-        let lines = |style| Series::new("wild", wild.clone(), style, 7);
-        let linear = chart(
-            Axis::linear("x", "x").with_range(0.0, 1.0),
-            Axis::linear("y", "y").with_range(0.0, 1.0),
-            vec![lines(Style::Line), lines(Style::Dashed)],
-            Corner::UpperRight,
-        );
-        let positive: Vec<(f64, f64)> = wild
-            .iter()
-            .map(|p| (p.0.abs() + 1e-3, p.1.abs() + 1e-3))
-            .collect();
-        let log = chart(
-            Axis::log("x", "x").with_range(0.1, 1.0),
-            Axis::log("y", "y").with_range(0.1, 1.0),
-            vec![Series::new("wild", positive, Style::Dotted, 7)],
-            Corner::LowerLeft,
-        );
-        assert!(strays(std::slice::from_ref(&linear), color) == 0);
-        assert!(strays(&[linear.clone(), log.clone(), linear], color) == 0);
-        // (Not vacuous: the series is drawn, in that colour.)
-        let (pixels, _, _) = rasterize(&[log], Arrange::Stack).unwrap();
-        assert!(
-            pixels
-                .chunks(3)
-                .any(|p| (p[0], p[1], p[2]) == (color.0, color.1, color.2))
-        );
-    }
-
-    #[test]
-    fn the_legend_goes_where_it_covers_no_data() {
-        // A line through the preferred (upper right) corner and markers in the upper left.
-        let diagonal: Vec<(f64, f64)> = (0..=50)
-            .map(|i| (i as f64 / 50.0, i as f64 / 50.0))
-            .collect();
-        let upper_left: Vec<(f64, f64)> = (0..10)
-            .map(|i| (0.02 * i as f64, 0.98 - 0.02 * i as f64))
-            .collect();
-        let busy = chart(
-            Axis::linear("x", "x").with_range(0.0, 1.0),
-            Axis::linear("y", "y").with_range(0.0, 1.0),
-            vec![
-                Series::new("diagonal", diagonal, Style::Line, 1),
-                Series::new("corner", upper_left, Style::Markers, 2),
-            ],
-            Corner::UpperRight,
-        );
-        let (_, _, drawn) = rasterize(&[busy], Arrange::Stack).unwrap();
-        assert_eq!(drawn[0].legend_covers, 0);
-    }
-
-    #[test]
-    fn tick_labels_read_as_people_write_them() {
-        let log = |v| tick_label(v, Scale::Log);
-        let lin = |v| tick_label(v, Scale::Linear);
-        assert_eq!(
-            [
-                log(0.01),
-                log(0.1),
-                log(1.0),
-                log(10.0),
-                log(100.0),
-                log(1e3),
-                log(2e3)
-            ],
-            ["10⁻²", "0.1", "1", "10", "10²", "10³", "2000"]
-        );
-        assert_eq!(
-            [
-                lin(140.0),
-                lin(0.25),
-                lin(0.1 + 0.2),
-                lin(-0.0),
-                lin(-2.5),
-                lin(2.5e-18)
-            ],
-            ["140", "0.25", "0.3", "0", "-2.5", "2.5e-18"]
-        );
-    }
-
-    #[test]
-    fn a_heat_map_colours_cells_greys_the_inapplicable_and_marks_the_irregular() {
-        let map = HeatMap {
-            title: "t".into(),
-            x_label: "x".into(),
-            y_label: "y".into(),
-            value_label: "v".into(),
-            empty_label: "law n/a".into(),
-            x: vec![1.0, 10.0],
-            y: vec![1.0, 10.0],
-            log_axes: true,
-            cells: vec![
-                vec![
-                    Cell::Value {
-                        value: 0.0,
-                        period_one: true,
-                        grazing: false,
-                    },
-                    Cell::Value {
-                        value: 1.0,
-                        period_one: false,
-                        grazing: false,
-                    },
-                ],
-                vec![
-                    Cell::NotApplicable,
-                    Cell::Value {
-                        value: 0.5,
-                        period_one: true,
-                        grazing: false,
-                    },
-                ],
-            ],
-        };
-        let (pixels, _, _) = rasterize(&[map], Arrange::Stack).unwrap();
-        let count = |c: (u8, u8, u8)| pixels.chunks(3).filter(|p| (p[0], p[1], p[2]) == c).count();
-        // A quarter of a ~600 x 500 plot each, and the ends of the colour bar.
-        assert!(count(viridis(0.0)) > 20_000, "{}", count(viridis(0.0)));
-        assert!(count(viridis(1.0)) > 20_000);
-        assert!(count(viridis(0.5)) > 20_000);
-        assert!(count((225, 225, 225)) > 20_000);
-        // The marked cell has a white disc in it.
-        assert!(count((255, 255, 255)) > 0);
-        assert_eq!(log_ticks(0.017, 0.23), [0.02, 0.05, 0.1, 0.2]);
-        assert_eq!(log_ticks(0.26, 3.5), [0.3, 0.5, 1.0, 2.0, 3.0]);
-    }
-
-    #[test]
-    fn clipping_splits_runs_that_leave_the_box() {
-        let clip = Clip::new((0.0, 1.0, false), (0.0, 1.0, false));
-        let runs = clip.runs(&[(0.1, 0.5), (0.5, 2.0), (0.9, 0.5), (0.95, 0.5)]);
-        assert_eq!(runs.len(), 2);
-    }
-
-    /// The PNG's pixels are the bitmap backend's geometry, anti-aliased and with its
-    /// text. Plotters' bitmap backend blends the edges of a wide line but draws a
-    /// marker's ring mostly pixel by pixel, in its colour or not at all; in the PNG the
-    /// rings' edges are blended into the white (three times the pixels only partly of the
-    /// colour), every
-    /// pixel of the colour lies within two pixels of where the bitmap backend drew it, and
-    /// the title is drawn (the embedded font was found: without it resvg would draw no
-    /// text at all).
-    #[test]
-    fn png_markers_are_anti_aliased_where_the_bitmap_draws_them() {
-        let points: Vec<(f64, f64)> = (1..20)
-            .map(|i| (i as f64 / 20.0, 0.3 * i as f64 / 20.0 + 0.1))
-            .collect();
-        let c = chart(
-            Axis::linear("x", "x").with_range(0.0, 1.0),
-            Axis::linear("y", "y").with_range(0.0, 1.0),
-            vec![Series::new("rings", points, Style::Markers, 2)],
-            Corner::UpperRight,
-        );
-        let color = PALETTE[2];
-        // The share t of the marker's colour over white in a pixel (None: another
-        // colour, to within 3 levels).
-        let coverage = |p: &[u8]| {
-            let t = (255.0 - p[0] as f64) / (255.0 - color.0 as f64);
-            let on_white = [color.0, color.1, color.2].iter().zip(p).all(|(&c, &v)| {
-                let expect = t * c as f64 + (1.0 - t) * 255.0;
-                (expect - v as f64).abs() <= 3.0
-            });
-            (t > 0.05 && on_white).then_some(t.min(1.0))
-        };
-        let (bitmap, (width, height), _) =
-            rasterize(std::slice::from_ref(&c), Arrange::Stack).unwrap();
-        let (smooth, size) = rasterize_smooth(std::slice::from_ref(&c), Arrange::Stack).unwrap();
-        assert_eq!(size, (width, height));
-        let partial = |px: &[u8]| {
-            px.chunks(3)
-                .filter(|p| coverage(p).is_some_and(|t| (0.15..0.85).contains(&t)))
-                .count()
-        };
-        let (soft, hard) = (partial(&smooth), partial(&bitmap));
-        // (668 against 212 when written.)
-        assert!(soft > 2 * hard, "partly covered: {soft} PNG, {hard} bitmap");
-        let pixel = |x: usize, y: usize| &smooth[3 * (y * width as usize + x)..][..3];
-        let title_ink = (0..40)
-            .flat_map(|y| (300..660).map(move |x| (x, y)))
-            .filter(|&(x, y)| pixel(x, y).iter().all(|&v| v < 80))
-            .count();
-        assert!(title_ink > 20, "no title: {title_ink} dark pixels");
-        let line: Vec<(i64, i64)> = bitmap
-            .chunks(3)
-            .enumerate()
-            .filter(|(_, p)| coverage(p).is_some())
-            .map(|(i, _)| ((i as u32 % width) as i64, (i as u32 / width) as i64))
-            .collect();
-        for (i, p) in smooth.chunks(3).enumerate() {
-            if coverage(p).is_some_and(|t| t > 0.3) {
-                let (x, y) = ((i as u32 % width) as i64, (i as u32 / width) as i64);
-                assert!(
-                    line.iter()
-                        .any(|&(u, v)| (u - x).abs() <= 2 && (v - y).abs() <= 2),
-                    "a pixel of a ring at ({x}, {y}) far from the bitmap's"
-                );
-            }
-        }
-    }
 }

@@ -45,7 +45,8 @@ pub fn central_displacement_over_range(h0_bar: f64, tabor_mu: f64, eighth: Eight
 
 /// Separation α/ε = h̄₀ − 1 + u(0)/ε, eq. (14).
 #[inline]
-pub(crate) fn separation_over_range(h0_bar: f64, tabor_mu: f64, eighth: EighthPower) -> f64 {
+#[doc(hidden)]
+pub fn separation_over_range(h0_bar: f64, tabor_mu: f64, eighth: EighthPower) -> f64 {
     h0_bar - 1.0 + central_displacement_over_range(h0_bar, tabor_mu, eighth)
 }
 

@@ -39,7 +39,8 @@ pub(super) const NONE: LawInfo = LawInfo {
 pub struct HertzLaw;
 
 #[inline]
-pub(super) fn hertz_t_hat(alpha_hat: f64) -> f64 {
+#[doc(hidden)]
+pub fn hertz_t_hat(alpha_hat: f64) -> f64 {
     if alpha_hat < 0.0 {
         let d = -alpha_hat;
         -4.0 / 3.0 * d * d.sqrt()

@@ -114,16 +114,26 @@ macro_rules! forward_to_inner {
     };
 }
 
-mod adhesive;
-mod capillary;
-mod conservative;
-mod fold_branch;
-mod registry;
-mod reversible;
-mod rigid;
-mod sls;
-mod table;
-mod viscous;
+#[doc(hidden)]
+pub mod adhesive;
+#[doc(hidden)]
+pub mod capillary;
+#[doc(hidden)]
+pub mod conservative;
+#[doc(hidden)]
+pub mod fold_branch;
+#[doc(hidden)]
+pub mod registry;
+#[doc(hidden)]
+pub mod reversible;
+#[doc(hidden)]
+pub mod rigid;
+#[doc(hidden)]
+pub mod sls;
+#[doc(hidden)]
+pub mod table;
+#[doc(hidden)]
+pub mod viscous;
 
 /// The registry: every law, in the order of the help. A new law is a file here (its
 /// force, implementing [`ForceLaw`], and its [`LawInfo`]), its `mod` line above and its
@@ -529,25 +539,5 @@ impl ForceLaw for AnyLaw {
     }
     fn surface_t_hat(&self, state: &ContactState, surface_force_hat: f64) -> f64 {
         dispatch!(self, l => l.surface_t_hat(state, surface_force_hat))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn every_law_is_registered_once_under_a_name_that_parses_back() {
-        for kind in LawKind::ALL {
-            assert_eq!(
-                LAWS.iter().filter(|l| l.name == kind.info().name).count(),
-                1,
-                "{kind:?}"
-            );
-            assert_eq!(LawKind::from_name(&kind.to_string()), Some(kind));
-        }
-        assert_eq!(LAWS.len(), LawKind::ALL.len());
-        assert_eq!(LawKind::from_name(" JKR "), Some(LawKind::Jkr));
-        assert_eq!(LawKind::from_name("jkr2"), None);
     }
 }

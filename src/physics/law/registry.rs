@@ -32,7 +32,8 @@ pub struct LawInfo {
 
 /// The refusal of a law `name` that does not apply at the contact's Tabor parameter
 /// `tabor_mu`, saying `why`.
-pub(super) fn not_applicable(name: &str, tabor_mu: f64, why: impl fmt::Display) -> Error {
+#[doc(hidden)]
+pub fn not_applicable(name: &str, tabor_mu: f64, why: impl fmt::Display) -> Error {
     Error::NotApplicable(format!(
         "the {name} law does not apply at Tabor parameter mu = {tabor_mu:.4}: {why}; \
          use the DMT law (small mu) or JKR"

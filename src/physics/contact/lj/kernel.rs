@@ -32,7 +32,8 @@ pub fn kernel(x: f64, y: f64) -> f64 {
 /// The regular part R = G + w ln|x − y| = w (K(k) − ln(4/k') + ln(4(x+y))), continuous at
 /// y = x (K − ln(4/k') → 0 as k' → 0).
 #[inline]
-fn regular(x: f64, y: f64) -> f64 {
+#[doc(hidden)]
+pub fn regular(x: f64, y: f64) -> f64 {
     let s = x + y;
     let kc = (x - y).abs() / s;
     let excess = if kc < 1e-4 {
@@ -64,7 +65,8 @@ fn t_log_antiderivative(t: f64, n: usize) -> f64 {
 }
 
 /// ∫_a^b g(y) ln|x − y| dy for g quadratic through (a, g_a), ((a+b)/2, g_m), (b, g_b).
-fn log_integral(x: f64, a: f64, b: f64, g_a: f64, g_m: f64, g_b: f64) -> f64 {
+#[doc(hidden)]
+pub fn log_integral(x: f64, a: f64, b: f64, g_a: f64, g_m: f64, g_b: f64) -> f64 {
     // g as c0 + c1 t + c2 t² in t = y − x.
     let h = b - a;
     let m = 0.5 * (a + b);
@@ -154,43 +156,4 @@ pub fn moment_weights(nodes: &[f64]) -> Vec<f64> {
         w[e + 1] += (b - a) * (a + 2.0 * b) / 6.0;
     }
     w
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn regular_part_is_the_kernel_plus_the_logarithm() {
-        for &(x, y) in &[(1.0, 0.5), (1.0, 0.999), (2.0, 2.1), (0.3, 3.0)] {
-            let r = regular(x, y);
-            let g = kernel(x, y);
-            assert!(
-                (r - (g + y / (x + y) * (x - y).abs().ln())).abs() < 1e-12,
-                "{x} {y}"
-            );
-        }
-        // Continuous across the diagonal.
-        let (a, b) = (regular(1.0, 1.0 - 1e-9), regular(1.0, 1.0 + 1e-9));
-        assert!((a - b).abs() < 1e-8);
-    }
-
-    #[test]
-    fn log_integral_is_exact_for_quadratics() {
-        let g = |y: f64| 0.3 + 1.7 * y - 0.4 * y * y;
-        let (x, a, b) = (0.37, 0.2, 0.6);
-        let exact = {
-            // Fine midpoint sum with the singular point excluded analytically enough.
-            let n = 2_000_000;
-            let h = (b - a) / n as f64;
-            (0..n)
-                .map(|i| {
-                    let y = a + h * (i as f64 + 0.5);
-                    g(y) * (x - y).abs().ln() * h
-                })
-                .sum::<f64>()
-        };
-        let got = log_integral(x, a, b, g(a), g(0.5 * (a + b)), g(b));
-        assert!((got - exact).abs() < 1e-6, "{got} {exact}");
-    }
 }

@@ -7,7 +7,8 @@ pub mod curve;
 pub mod kernel;
 pub mod moving;
 pub mod result;
-pub(crate) mod solver;
+#[doc(hidden)]
+pub mod solver;
 
 pub use moving::Reach;
 pub(crate) use result::obtain;

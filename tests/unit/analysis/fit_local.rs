@@ -1,0 +1,96 @@
+//! Tests of `tapsim::analysis::fit::local` (src/analysis/fit/local.rs).
+
+use nalgebra::DVector;
+use tapsim::analysis::fit::local::*;
+use tapsim::analysis::fit::model::{Measured, Nuisance, Parameter};
+use tapsim::analysis::fit::progress::Tracker;
+use tapsim::dynamics::setup::Numerics;
+use tapsim::dynamics::setup::default_setup;
+
+/// A Jacobian taken just below the modulus at which a point of the issue-43 curve
+/// (E* 0.8 GPa, Δγ 0.07 J/m²) jumps to the repulsive branch: the forward step
+/// crosses the switch, so the column is the backward difference — within 2 % of a
+/// backward difference of twice the step (a slope, not a jump), where the forward
+/// one is a jump hundreds of times larger.
+#[test]
+fn a_step_across_a_branch_switch_is_taken_backward() {
+    let numerics = tapsim::analysis::sweep::sweep_numerics(Numerics::default(), (false, false));
+    let mut setup = default_setup();
+    setup.contact.modulus_pa = 0.8e9;
+    setup.contact.work_of_adhesion_j_m2 = 0.07;
+    let z: Vec<f64> = (0..25).map(|i| 24e-9 - 0.5e-9 * f64::from(i)).collect();
+    let side = |e: f64| {
+        let mut s = setup.clone();
+        s.contact.modulus_pa = e;
+        let c = tapsim::analysis::fit::model::curve(&s, &numerics, &z, 0.0).unwrap();
+        branch_sides(&(s, Nuisance::offset(0.0)), &c)
+    };
+    // Bisect in E* for where the curve's branches change, to well within a step.
+    let (mut lo, mut hi) = (0.4e9, 1.5e9);
+    let (s_lo, mut s_hi) = (side(lo), side(hi));
+    assert!(crosses_switch(&s_lo, &s_hi), "{s_lo:?} {s_hi:?}");
+    while hi / lo - 1.0 > 0.2 * LOG_STEP {
+        let mid = (lo * hi).sqrt();
+        let s_mid = side(mid);
+        if crosses_switch(&s_lo, &s_mid) {
+            (hi, s_hi) = (mid, s_mid);
+        } else {
+            lo = mid;
+        }
+    }
+    // Right at the switch the point that switches can be in transit between the
+    // branches (not a stable period-1 orbit, its value jumping within a step): step
+    // back from there, half a step at a time, while the forward step still crosses.
+    let switching: Vec<usize> = (0..z.len()).filter(|&i| s_lo[i] * s_hi[i] < 0).collect();
+    let mut c;
+    loop {
+        setup.contact.modulus_pa = lo;
+        c = tapsim::analysis::fit::model::curve(&setup, &numerics, &z, 0.0).unwrap();
+        if switching.iter().all(|&i| c.well_defined[i]) {
+            break;
+        }
+        lo *= (-0.5 * LOG_STEP).exp();
+        assert!(
+            hi / lo - 1.0 < 0.9 * LOG_STEP,
+            "in transit below {hi}: {switching:?}"
+        );
+    }
+    let data = Measured {
+        position_m: z.clone(),
+        setpoint_ratio: None,
+        segments: vec![0],
+        amplitude_m: Some(c.amplitude_m.clone()),
+        phase_deg: Some(c.phase_deg.iter().map(|p| p + 0.1).collect()),
+        sigma_amplitude_m: 0.02e-9,
+        sigma_phase_deg: 0.05,
+        second_mode: None,
+        thermal: None,
+    };
+    let report = |_: &tapsim::analysis::fit::Progress| {};
+    let tracker = Tracker::new(&report);
+    let params = [Parameter::Modulus];
+    let starts = [lo];
+    let problem = Problem::new(
+        (&setup, Nuisance::offset(0.0), &starts),
+        &numerics,
+        &data,
+        &params,
+        Budget::curves(100),
+        &tracker,
+    );
+    let x = DVector::zeros(1);
+    let r0 = problem.evaluate(&x).unwrap();
+    let j = problem.jacobian_at(&x, &r0, &c).unwrap();
+    let at = |h: f64| problem.evaluate(&DVector::from_element(1, h)).unwrap();
+    let forward = (at(LOG_STEP) - &r0) / LOG_STEP;
+    let wide = (at(-2.0 * LOG_STEP) - &r0) / (-2.0 * LOG_STEP);
+    let column = j.column(0).into_owned();
+    assert!(
+        (&column - &wide).norm() < 0.02 * wide.norm(),
+        "{column} against {wide}"
+    );
+    assert!(
+        forward.norm() > 100.0 * wide.norm(),
+        "{forward} against {wide}"
+    );
+}
