@@ -138,11 +138,11 @@ fn stack_size(n: usize, arrange: Arrange) -> (u32, u32) {
 
 /// Drawn into memory and encoded there, then written like any other output: file
 /// errors are told as such, and a PNG can go to a device or a FIFO like a CSV. The
-/// pixels are the SVG's, anti-aliased ([`rasterize_smooth`]).
+/// pixels are the SVG's, anti-aliased ([`raster`]).
 fn render_stack_png<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
     use image::ImageEncoder;
-    let (pixels, (width, height)) =
-        rasterize_smooth(panels, arrange).map_err(|reason| fail(path, reason))?;
+    let (pixels, (width, height), _) =
+        raster(panels, arrange, true).map_err(|reason| fail(path, reason))?;
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(&pixels, width, height, image::ColorType::Rgb8)
@@ -163,43 +163,52 @@ pub fn legend_covers(chart: &Chart) -> usize {
     drawn[0].legend_covers
 }
 
-/// `panels` drawn into RGB pixels by plotters' bitmap backend ([`draw_stack`]): no
-/// anti-aliasing, so every pixel of a series is exactly its colour (what the layout
-/// tests count).
+/// `charts` drawn into RGB pixels as the PNGs are, from the figure's SVG, but without
+/// anti-aliasing (`shape-rendering: crispEdges`), so that every pixel of a series is
+/// exactly its colour (what the layout tests count). Not generic, so that the tests
+/// link the library's one compiled copy of the drawing.
 #[doc(hidden)]
-pub fn rasterize<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<Raster, String> {
+pub fn rasterize(charts: &[Chart], arrange: Arrange) -> std::result::Result<Raster, String> {
+    raster(charts, arrange, false)
+}
+
+/// Heat maps drawn as [`rasterize`] draws charts.
+#[doc(hidden)]
+pub fn rasterize_maps(maps: &[HeatMap], arrange: Arrange) -> std::result::Result<Raster, String> {
+    raster(maps, arrange, false)
+}
+
+/// `charts` as anti-aliased RGB pixels, as their PNG has them ([`raster`]).
+#[doc(hidden)]
+pub fn rasterize_smooth(charts: &[Chart], arrange: Arrange) -> std::result::Result<Raster, String> {
+    raster(charts, arrange, true)
+}
+
+/// The figure's SVG text and where each panel went ([`draw_stack`] into plotters' SVG
+/// backend).
+fn svg_text<P: Panel>(
+    panels: &[P],
+    arrange: Arrange,
+) -> std::result::Result<(String, Vec<Drawn>), String> {
     register_font();
-    let (width, height) = stack_size(panels.len(), arrange);
-    let mut pixels = vec![0u8; 3 * width as usize * height as usize];
+    let mut text = String::new();
     let drawn = {
-        let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut text, stack_size(panels.len(), arrange))
+            .into_drawing_area();
         let drawn = draw_stack(panels, &root, arrange)?;
         root.present().map_err(|e| e.to_string())?;
         drawn
     };
-    Ok((pixels, (width, height), drawn))
+    Ok((text, drawn))
 }
 
-/// The figure's SVG text ([`draw_stack`] into plotters' SVG backend).
-fn svg_text<P: Panel>(panels: &[P], arrange: Arrange) -> std::result::Result<String, String> {
-    register_font();
-    let mut text = String::new();
-    {
-        let root = SVGBackend::with_string(&mut text, stack_size(panels.len(), arrange))
-            .into_drawing_area();
-        draw_stack(panels, &root, arrange)?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    Ok(text)
-}
-
-/// `panels` as anti-aliased RGB pixels and their size: the figure's SVG drawn by resvg
-/// on white, its text in the embedded DejaVu Sans (plotters writes `sans-serif`).
-#[doc(hidden)]
-pub fn rasterize_smooth<P: Panel>(
+/// `panels` as RGB pixels: the figure's SVG drawn by resvg on white, anti-aliased if
+/// `smooth`, its text in the embedded DejaVu Sans (plotters writes `sans-serif`).
+fn raster<P: Panel>(
     panels: &[P],
     arrange: Arrange,
-) -> std::result::Result<(Vec<u8>, (u32, u32)), String> {
+    smooth: bool,
+) -> std::result::Result<Raster, String> {
     use resvg::{tiny_skia, usvg};
     // The embedded font's database, built once for every figure of the run.
     static FONTS: std::sync::OnceLock<std::sync::Arc<usvg::fontdb::Database>> =
@@ -210,12 +219,16 @@ pub fn rasterize_smooth<P: Panel>(
         fonts.set_sans_serif_family("DejaVu Sans");
         std::sync::Arc::new(fonts)
     });
-    let svg = svg_text(panels, arrange)?;
-    let options = usvg::Options {
+    let (svg, drawn) = svg_text(panels, arrange)?;
+    let mut options = usvg::Options {
         font_family: "DejaVu Sans".into(),
         fontdb: fonts.clone(),
         ..Default::default()
     };
+    if !smooth {
+        options.shape_rendering = usvg::ShapeRendering::CrispEdges;
+        options.text_rendering = usvg::TextRendering::OptimizeSpeed;
+    }
     let tree = usvg::Tree::from_str(&svg, &options).map_err(|e| e.to_string())?;
     let (width, height) = stack_size(panels.len(), arrange);
     let mut pixmap = tiny_skia::Pixmap::new(width, height).ok_or("an empty figure")?;
@@ -231,11 +244,11 @@ pub fn rasterize_smooth<P: Panel>(
         .chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])
         .collect();
-    Ok((rgb, (width, height)))
+    Ok((rgb, (width, height), drawn))
 }
 
 fn render_stack_svg<P: Panel>(panels: &[P], path: &Path, arrange: Arrange) -> Result<()> {
-    let text = svg_text(panels, arrange).map_err(|reason| fail(path, reason))?;
+    let (text, _) = svg_text(panels, arrange).map_err(|reason| fail(path, reason))?;
     output::write_bytes(path, text.as_bytes())
 }
 

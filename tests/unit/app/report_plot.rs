@@ -51,8 +51,8 @@ fn strays(charts: &[Chart], color: RGBColor) -> usize {
 #[test]
 fn no_drawn_pixel_of_a_series_leaves_its_plot_area() {
     // Thick lines that run far outside fixed ranges, solid and dashed, on linear and
-    // log axes, one chart and a stack (plotters' bitmap backend draws wide strokes
-    // as polygons it does not clip).
+    // log axes, one chart and a stack (the SVG does not clip: the series are clipped
+    // before they are drawn).
     let wild = vec![(-5.0, 3.0), (0.5, 0.5), (5.0, -3.0), (0.2, 9.0), (0.9, 0.1)];
     let color = PALETTE[7];
     let lines = |style| Series::new("wild", wild.clone(), style, 7);
@@ -168,7 +168,7 @@ fn a_heat_map_colours_cells_greys_the_inapplicable_and_marks_the_irregular() {
             ],
         ],
     };
-    let (pixels, _, _) = rasterize(&[map], Arrange::Stack).unwrap();
+    let (pixels, _, _) = rasterize_maps(&[map], Arrange::Stack).unwrap();
     let count = |c: (u8, u8, u8)| pixels.chunks(3).filter(|p| (p[0], p[1], p[2]) == c).count();
     // A quarter of a ~600 x 500 plot each, and the ends of the colour bar.
     assert!(count(viridis(0.0)) > 20_000, "{}", count(viridis(0.0)));
@@ -188,16 +188,13 @@ fn clipping_splits_runs_that_leave_the_box() {
     assert_eq!(runs.len(), 2);
 }
 
-/// The PNG's pixels are the bitmap backend's geometry, anti-aliased and with its
-/// text. Plotters' bitmap backend blends the edges of a wide line but draws a
-/// marker's ring mostly pixel by pixel, in its colour or not at all; in the PNG the
-/// rings' edges are blended into the white (three times the pixels only partly of the
-/// colour), every
-/// pixel of the colour lies within two pixels of where the bitmap backend drew it, and
-/// the title is drawn (the embedded font was found: without it resvg would draw no
-/// text at all).
+/// The PNG's pixels are the crisp drawing's geometry, anti-aliased and with its text:
+/// in the PNG the markers' rings' edges are blended into the white (the crisp drawing
+/// puts a pixel in the colour or not at all), every pixel of the colour lies within two
+/// pixels of where the crisp drawing put it, and the title is drawn (the embedded font
+/// was found: without it resvg would draw no text at all).
 #[test]
-fn png_markers_are_anti_aliased_where_the_bitmap_draws_them() {
+fn png_markers_are_anti_aliased_where_the_crisp_drawing_puts_them() {
     let points: Vec<(f64, f64)> = (1..20)
         .map(|i| (i as f64 / 20.0, 0.3 * i as f64 / 20.0 + 0.1))
         .collect();
@@ -218,24 +215,23 @@ fn png_markers_are_anti_aliased_where_the_bitmap_draws_them() {
         });
         (t > 0.05 && on_white).then_some(t.min(1.0))
     };
-    let (bitmap, (width, height), _) = rasterize(std::slice::from_ref(&c), Arrange::Stack).unwrap();
-    let (smooth, size) = rasterize_smooth(std::slice::from_ref(&c), Arrange::Stack).unwrap();
+    let (crisp, (width, height), _) = rasterize(std::slice::from_ref(&c), Arrange::Stack).unwrap();
+    let (smooth, size, _) = rasterize_smooth(std::slice::from_ref(&c), Arrange::Stack).unwrap();
     assert_eq!(size, (width, height));
     let partial = |px: &[u8]| {
         px.chunks(3)
             .filter(|p| coverage(p).is_some_and(|t| (0.15..0.85).contains(&t)))
             .count()
     };
-    let (soft, hard) = (partial(&smooth), partial(&bitmap));
-    // (668 against 212 when written.)
-    assert!(soft > 2 * hard, "partly covered: {soft} PNG, {hard} bitmap");
+    let (soft, hard) = (partial(&smooth), partial(&crisp));
+    assert!(soft > 2 * hard, "partly covered: {soft} PNG, {hard} crisp");
     let pixel = |x: usize, y: usize| &smooth[3 * (y * width as usize + x)..][..3];
     let title_ink = (0..40)
         .flat_map(|y| (300..660).map(move |x| (x, y)))
         .filter(|&(x, y)| pixel(x, y).iter().all(|&v| v < 80))
         .count();
     assert!(title_ink > 20, "no title: {title_ink} dark pixels");
-    let line: Vec<(i64, i64)> = bitmap
+    let line: Vec<(i64, i64)> = crisp
         .chunks(3)
         .enumerate()
         .filter(|(_, p)| coverage(p).is_some())
@@ -247,7 +243,7 @@ fn png_markers_are_anti_aliased_where_the_bitmap_draws_them() {
             assert!(
                 line.iter()
                     .any(|&(u, v)| (u - x).abs() <= 2 && (v - y).abs() <= 2),
-                "a pixel of a ring at ({x}, {y}) far from the bitmap's"
+                "a pixel of a ring at ({x}, {y}) far from the crisp drawing's"
             );
         }
     }
