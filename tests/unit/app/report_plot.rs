@@ -168,15 +168,44 @@ fn a_heat_map_colours_cells_greys_the_inapplicable_and_marks_the_irregular() {
             ],
         ],
     };
-    let (pixels, _, _) = rasterize_maps(&[map], Arrange::Stack).unwrap();
+    let (pixels, (width, _), _) = rasterize_maps(&[map], Arrange::Stack).unwrap();
     let count = |c: (u8, u8, u8)| pixels.chunks(3).filter(|p| (p[0], p[1], p[2]) == c).count();
     // A quarter of a ~600 x 500 plot each, and the ends of the colour bar.
     assert!(count(viridis(0.0)) > 20_000, "{}", count(viridis(0.0)));
     assert!(count(viridis(1.0)) > 20_000);
     assert!(count(viridis(0.5)) > 20_000);
     assert!(count((225, 225, 225)) > 20_000);
-    // The marked cell has a white disc in it.
-    assert!(count((255, 255, 255)) > 0);
+    // The marked cell (the one of value 1) has a white disc in it (radius 6, in a
+    // 2-pixel black ring): white pixels within the box its colour spans.
+    let at = |i: usize| ((i as u32 % width) as i32, (i as u32 / width) as i32);
+    let cell: Vec<(i32, i32)> = pixels
+        .chunks(3)
+        .enumerate()
+        .filter(|(_, p)| (p[0], p[1], p[2]) == viridis(1.0))
+        .map(|(i, _)| at(i))
+        .collect();
+    let (x0, x1) = (
+        cell.iter().map(|p| p.0).min(),
+        cell.iter().map(|p| p.0).max(),
+    );
+    let (y0, y1) = (
+        cell.iter().map(|p| p.1).min(),
+        cell.iter().map(|p| p.1).max(),
+    );
+    let (x0, x1, y0, y1) = (x0.unwrap(), x1.unwrap(), y0.unwrap(), y1.unwrap());
+    let disc = pixels
+        .chunks(3)
+        .enumerate()
+        .filter(|(_, p)| (p[0], p[1], p[2]) == (255, 255, 255))
+        .filter(|&(i, _)| {
+            let (x, y) = at(i);
+            (x0..=x1).contains(&x) && (y0..=y1).contains(&y)
+        })
+        .count();
+    assert!(
+        (20..200).contains(&disc),
+        "{disc} white pixels in the marked cell"
+    );
     assert_eq!(log_ticks(0.017, 0.23), [0.02, 0.05, 0.1, 0.2]);
     assert_eq!(log_ticks(0.26, 3.5), [0.3, 0.5, 1.0, 2.0, 3.0]);
 }
