@@ -561,7 +561,6 @@ impl<L: ForceLaw> Span<'_, L> {
     }
 
     /// [`Span::integrate`]; `land_on_switch`: whether to land on the switch.
-    #[doc(hidden)]
     pub fn integrate_landing<O: StepObserver, const N: usize>(
         &self,
         tau0: f64,

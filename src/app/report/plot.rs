@@ -158,8 +158,8 @@ pub type Raster = (Vec<u8>, (u32, u32), Vec<Drawn>);
 /// the charts other modules build).
 #[doc(hidden)]
 pub fn legend_covers(chart: &Chart) -> usize {
-    let (_, _, drawn) =
-        rasterize(std::slice::from_ref(chart), Arrange::Stack).expect("the chart draws");
+    let (_, drawn) =
+        svg_text(std::slice::from_ref(chart), Arrange::Stack).expect("the chart draws");
     drawn[0].legend_covers
 }
 
@@ -886,7 +886,6 @@ pub struct Clip {
 }
 
 impl Clip {
-    #[doc(hidden)]
     pub fn new(x: (f64, f64, bool), y: (f64, f64, bool)) -> Self {
         Self { x, y }
     }
@@ -909,7 +908,6 @@ impl Clip {
     }
 
     /// The parts of the polyline inside the box, each a run of connected points.
-    #[doc(hidden)]
     pub fn runs(&self, points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
         let (x0, y0) = self.data_to_axes((self.x.0, self.y.0));
         let (x1, y1) = self.data_to_axes((self.x.1, self.y.1));
