@@ -15,6 +15,11 @@ use super::model::State;
 /// A right-hand side and an observer of accepted steps.
 #[doc(hidden)]
 pub trait System<const N: usize> {
+    /// The components that are quadratures: integrals the right-hand side never reads
+    /// (their derivative depends on the other components alone). Only a step's solution
+    /// needs them, not its intermediate stages, which skip them (the same numbers, less
+    /// arithmetic).
+    const QUADRATURES: std::ops::Range<usize> = 0..0;
     /// dy/dt at (t, y).
     fn system(&self, t: f64, y: &State<N>, dy: &mut State<N>);
     /// Told each accepted step's end (t, y, dy/dt there); true stops the integration.
@@ -159,12 +164,23 @@ pub fn integrate<S: System<N>, const N: usize>(
         }
         n_step += 1;
         let mut y_next = y;
+        // The stages the right-hand side reads skip the quadratures; the last, the
+        // step's solution, has them all.
+        let skip = S::QUADRATURES;
+        let (read_to, read_from) = (skip.start.min(N), skip.end.clamp(skip.start.min(N), N));
         for stage in 1..7 {
             y_next = y;
+            let ranges = if stage < 6 {
+                [0..read_to, read_from..N]
+            } else {
+                [0..N, N..N]
+            };
             for (j, kj) in k.iter().enumerate().take(stage) {
                 let a = A[stage - 1][j];
-                for i in 0..N {
-                    y_next[i] += kj[i] * h * a;
+                for range in ranges.clone() {
+                    for i in range {
+                        y_next[i] += kj[i] * h * a;
+                    }
                 }
             }
             f.system(x + h * C[stage], &y_next, &mut k[stage]);

@@ -124,6 +124,12 @@ pub const X: Part = Part::Deflection(0);
 /// The first mode's velocity x'.
 pub const V: Part = Part::Velocity(0);
 
+/// Where the carried integrals live: quadratures, which the right-hand side never reads
+/// ([`super::dopri5::System::QUADRATURES`]).
+#[doc(hidden)]
+pub const CARRIED: std::ops::Range<usize> = Part::Carried(Carried::Damping).index()
+    ..Part::Carried(Carried::Damping).index() + Carried::COUNT;
+
 /// Components of the plain state.
 pub const BASE: usize = 2 * MODES + Carried::COUNT + 2;
 /// Components of the state with the variational matrix.

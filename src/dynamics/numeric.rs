@@ -15,7 +15,8 @@
 use super::budget;
 use super::dopri5::{self, Settings, StepError, System};
 use super::model::{
-    BASE, Coupling, Oscillator, Part, State, V, X, has_tangent, rhs, set_phasor, surface_view,
+    BASE, CARRIED, Coupling, Oscillator, Part, State, V, X, has_tangent, rhs, set_phasor,
+    surface_view,
 };
 #[doc(hidden)]
 pub use super::observer::hermite_turn_fraction;
@@ -196,6 +197,7 @@ fn approach_rate(
 }
 
 impl<L: ForceLaw, O: StepObserver, const N: usize> System<N> for Segment<'_, L, O, N> {
+    const QUADRATURES: std::ops::Range<usize> = CARRIED;
     #[inline]
     fn system(&self, tau: f64, y: &State<N>, dy: &mut State<N>) {
         let surface = self.surface.map(RefCell::borrow);
@@ -301,6 +303,7 @@ impl<L: ForceLaw, const N: usize> Approach<'_, L, N> {
 }
 
 impl<L: ForceLaw, const N: usize> System<N> for Approach<'_, L, N> {
+    const QUADRATURES: std::ops::Range<usize> = CARRIED;
     #[inline]
     fn system(&self, w: f64, y: &State<N>, dy: &mut State<N>) {
         let (tau, z) = self.tau_form(w, y);

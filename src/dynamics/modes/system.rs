@@ -261,6 +261,8 @@ struct Segment<'m, 'a, 'o, L, const M: usize, const S: usize, O> {
 impl<L: ForceLaw, const M: usize, const S: usize, O: StepObserver> System<S>
     for Segment<'_, '_, '_, L, M, S, O>
 {
+    // The integrals and ∫f, which the right-hand side never reads.
+    const QUADRATURES: std::ops::Range<usize> = integral(M, 0, ModeIntegral::Damping)..plain_len(M);
     #[inline]
     fn system(&self, tau: f64, y: &State<S>, dy: &mut State<S>) {
         self.modes.rhs(self.branch, tau, y, dy);

@@ -4,15 +4,22 @@ use tapsim::dynamics::dopri5::*;
 use tapsim::dynamics::model::BASE;
 use tapsim::dynamics::model::State;
 
-/// A damped, driven Duffing oscillator in the first two components, every accepted
+/// A damped, driven Duffing oscillator in the first two components and quadratures of
+/// it in the next five (which the stages skip, [`System::QUADRATURES`]), every accepted
 /// step recorded.
 struct Duffing(Vec<(f64, State<BASE>)>);
 
 impl System<BASE> for Duffing {
+    const QUADRATURES: std::ops::Range<usize> = 2..7;
     fn system(&self, t: f64, y: &State<BASE>, dy: &mut State<BASE>) {
         *dy = State::zeros();
         dy[0] = y[1];
         dy[1] = -0.1 * y[1] - y[0] - 0.5 * y[0] * y[0] * y[0] + 0.3 * (1.2 * t).cos();
+        dy[2] = y[1] * y[1];
+        dy[3] = y[0] * (1.2 * t).cos();
+        dy[4] = y[0] * (1.2 * t).sin();
+        dy[5] = y[0] * y[0] * y[0];
+        dy[6] = y[0] * y[1];
     }
     fn solout(&mut self, t: f64, y: &State<BASE>, _: &State<BASE>) -> bool {
         self.0.push((t, *y));
