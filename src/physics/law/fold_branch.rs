@@ -1,11 +1,11 @@
 //! A force branch T̂(α̂) that ends at a fold (α̂₀, T̂₀), where T̂ has a square-root
 //! singularity in α̂. Tabulated against u = √(σ(α̂ − α̂₀)) — smooth through the fold — on
-//! a uniform grid (O(1) look-up), with its work function (antiderivative) from cumulative
-//! Gauss–Legendre sums, continued past the fold by point reflection (so overshooting trial
+//! a uniform grid (O(1) look-up), with its work function (antiderivative) the exact
+//! integral of the interpolant (cumulative over whole intervals, in closed form within
+//! the last: [`UniformTable::weighted_integral`]), continued past the fold by point reflection (so overshooting trial
 //! stages see a continuous force) and beyond the table by an analytic far field.
 
 use super::table::UniformTable;
-use crate::numeric::GAUSS_LEGENDRE_4;
 use crate::physics::contact::jkr;
 
 /// Which side of the fold the branch lives on.
@@ -71,11 +71,10 @@ impl FoldBranch {
             fold_t_hat: fold.1,
             far,
         };
-        let h = branch.table.step();
         let mut sum = 0.0;
         for i in 0..branch.table.len() {
             if i > 0 {
-                sum += branch.work_in_table(h * (i - 1) as f64, h * i as f64);
+                sum += branch.work_in_table(i - 1, 1.0);
             }
             branch.cumulative.push(sum);
         }
@@ -95,17 +94,9 @@ impl FoldBranch {
         self.fold_alpha_hat + self.sign() * u * u
     }
 
-    /// ∫ T̂ dα̂ over u in [a, b] (within one interval): dα̂ = σ 2u du.
-    fn work_in_table(&self, a: f64, b: f64) -> f64 {
-        let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
-        self.sign()
-            * GAUSS_LEGENDRE_4
-                .iter()
-                .map(|&(x, w)| {
-                    let u = mid + half * x;
-                    w * half * self.table.eval(u) * 2.0 * u
-                })
-                .sum::<f64>()
+    /// ∫ T̂ dα̂ from node `i` to the fraction `t` of its interval: dα̂ = σ 2u du.
+    fn work_in_table(&self, i: usize, t: f64) -> f64 {
+        self.sign() * self.table.weighted_integral(i, t)
     }
 
     /// T̂ at α̂.
@@ -202,7 +193,7 @@ impl FoldBranch {
         let end = self.table.end();
         if u <= end {
             let i = ((u / h) as usize).min(self.table.len() - 2);
-            return self.cumulative[i] + self.work_in_table(h * i as f64, u);
+            return self.cumulative[i] + self.work_in_table(i, u / h - i as f64);
         }
         let last = self.cumulative[self.table.len() - 1];
         let (alpha_end, t_end) = (self.alpha_at(end), self.table.eval(end));
