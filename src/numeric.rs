@@ -155,27 +155,18 @@ pub fn bracketed_root(
 /// close, never leaves the bracket. Ends at a step below `x_tol` (absolute) or after 100
 /// iterations, returning the best estimate.
 #[doc(hidden)]
-pub fn newton_bracketed(f: impl Fn(f64) -> (f64, f64), lo: f64, hi: f64, x_tol: f64) -> f64 {
+pub fn newton_bracketed(
+    f: impl Fn(f64) -> (f64, f64),
+    mut lo: f64,
+    mut hi: f64,
+    x_tol: f64,
+) -> f64 {
     let (f_lo, _) = f(lo);
     if f_lo == 0.0 {
         return lo;
     }
-    newton_bracketed_from(f, (lo, f_lo < 0.0), hi, 0.5 * (lo + hi), x_tol)
-}
-
-/// [`newton_bracketed`] where the sign of `f` at `lo` is known (`lo_negative`; f(lo) is
-/// not evaluated) and Newton's method starts from `guess` (the middle of the bracket
-/// where it is not inside).
-#[doc(hidden)]
-pub fn newton_bracketed_from(
-    f: impl Fn(f64) -> (f64, f64),
-    (mut lo, lo_negative): (f64, bool),
-    mut hi: f64,
-    guess: f64,
-    x_tol: f64,
-) -> f64 {
-    let inside = guess > lo.min(hi) && guess < lo.max(hi);
-    let mut x = if inside { guess } else { 0.5 * (lo + hi) };
+    let lo_negative = f_lo < 0.0;
+    let mut x = 0.5 * (lo + hi);
     for _ in 0..100 {
         let (fx, dfx) = f(x);
         if fx == 0.0 {

@@ -7,7 +7,7 @@
 //! on a ramp's leg (the support moving at a constant speed u) it is x + p + uτ.
 
 use super::model::{Carried, Drive, Oscillator, SECTION_DIM, State, V, X, has_tangent, phi_column};
-use crate::numeric::newton_bracketed_from;
+use crate::numeric::newton_bracketed;
 use nalgebra::{Complex, Matrix2};
 
 /// What [`FreeFlight::first_fall_to`] found.
@@ -299,24 +299,15 @@ impl FreeFlight {
         };
         let mut samples = self.samples(tau_a, h);
         let (mut t0, (mut x0, mut v0)) = (tau_a, samples.next().expect("endless"));
-        // Where x' crosses zero between samples (v_a, v_b of opposite signs), Newton's
-        // method started from the secant's root.
-        let zero_velocity = |a: f64, b: f64, v_a: f64, v_b: f64| {
-            newton_bracketed_from(
-                |t| self.velocity_and_acceleration(t),
-                (a, v_a < 0.0),
-                b,
-                a + (b - a) * v_a / (v_a - v_b),
-                1e-14,
-            )
-        };
+        let zero_velocity =
+            |a, b| newton_bracketed(|t| self.velocity_and_acceleration(t), a, b, 1e-14);
         for i in 1..=n {
             let t1 = if i == n { tau_b } else { tau_a + h * i as f64 };
             let (x1, v1) = samples.next().expect("endless");
             // The lowest point inside, where x' changes from negative to positive.
             let turning = v0 < 0.0 && v1 > 0.0;
             let (t_low, x_low) = if turning {
-                let t = zero_velocity(t0, t1, v0, v1);
+                let t = zero_velocity(t0, t1);
                 (t, self.at(t).0)
             } else if x1 < x0 {
                 (t1, x1)
@@ -325,16 +316,13 @@ impl FreeFlight {
             };
             fall.min_x = fall.min_x.min(x_low);
             if x_low <= level && x0 > level {
-                // (x − level is positive at t0 and not at t_low; the secant's root
-                // starts Newton's method.)
-                let hit = newton_bracketed_from(
+                let hit = newton_bracketed(
                     |t| {
                         let (x, v) = self.at(t);
                         (x - level, v)
                     },
-                    (t0, false),
+                    t0,
                     t_low,
-                    t0 + (t_low - t0) * (x0 - level) / (x0 - x_low),
                     1e-14,
                 );
                 // (A turning point here lies past the hit, where the flight ends.)
@@ -346,9 +334,7 @@ impl FreeFlight {
                 fall.lowest_turn = fall.lowest_turn.min(x_low);
             }
             if v0 > 0.0 && v1 < 0.0 {
-                fall.highest_turn = fall
-                    .highest_turn
-                    .max(self.at(zero_velocity(t0, t1, v0, v1)).0);
+                fall.highest_turn = fall.highest_turn.max(self.at(zero_velocity(t0, t1)).0);
             }
             (t0, x0, v0) = (t1, x1, v1);
         }

@@ -60,32 +60,6 @@ fn newton_bracketed_finds_roots_fast_and_safely() {
 }
 
 #[test]
-fn newton_from_a_good_guess_takes_fewer_evaluations_and_stays_in_the_bracket() {
-    // cos x on [1, 2] (root π/2): from the secant's root against from the middle.
-    let count = |guess: Option<f64>| {
-        let calls = std::cell::Cell::new(0);
-        let f = |x: f64| {
-            calls.set(calls.get() + 1);
-            (x.cos(), -x.sin())
-        };
-        let r = match guess {
-            Some(g) => newton_bracketed_from(f, (1.0, false), 2.0, g, 1e-14),
-            None => newton_bracketed(f, 1.0, 2.0, 1e-14),
-        };
-        assert!((r - std::f64::consts::FRAC_PI_2).abs() < 1e-14, "{r}");
-        calls.get()
-    };
-    let secant = 1.0 + 1.0f64.cos() / (1.0f64.cos() - 2.0f64.cos());
-    let (from_guess, from_middle) = (count(Some(secant)), count(None));
-    assert!(
-        from_guess < from_middle,
-        "{from_guess} against {from_middle}"
-    );
-    // A guess outside the bracket starts from its middle instead.
-    assert_eq!(count(Some(7.0)), from_middle - 1);
-}
-
-#[test]
 fn rejects_bracket_without_sign_change() {
     assert!(bracketed_root("t", |x| x * x + 1.0, -1.0, 1.0, 1e-12).is_err());
 }
