@@ -41,7 +41,7 @@ const AVERAGED_OFFSET_STEP: f64 = 3e-2;
 /// the log of a viscosity the tip never meets moved the hybrid defaults' attractive
 /// approach by up to 1e-21 m and 1.3e-11° (5e-11 and 2.6e-10 of the 0.02 nm and
 /// 0.05° the test gives), and a parameter that moved the data by 1e-8 σ over that
-/// step would have a standard error of some 1e4 in its logarithm, no value either
+/// step would have a standard error in its logarithm in the thousands: no value either
 /// way. Without it, whether such a column counted as a null direction turned on its
 /// round-off staying below 1e-8 of the largest singular value.
 const UNRESOLVED: f64 = 1e-8;

@@ -2,8 +2,9 @@
 //! singularity in α̂. Tabulated against u = √(σ(α̂ − α̂₀)) — smooth through the fold — on
 //! a uniform grid (O(1) look-up), with its work function (antiderivative) the exact
 //! integral of the interpolant (cumulative over whole intervals, in closed form within
-//! the last: [`UniformTable::weighted_integral`]), continued past the fold by point reflection (so overshooting trial
-//! stages see a continuous force) and beyond the table by an analytic far field.
+//! the last: [`UniformTable::weighted_integral`]), continued past the fold by point
+//! reflection (so overshooting trial stages see a continuous force) and beyond the
+//! table by an analytic far field.
 
 use super::table::UniformTable;
 use crate::physics::contact::jkr;

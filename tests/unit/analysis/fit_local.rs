@@ -94,3 +94,50 @@ fn a_step_across_a_branch_switch_is_taken_backward() {
         "{forward} against {wide}"
     );
 }
+
+/// A parameter the data cannot see gets a column of exact zeros, not its round-off: a
+/// viscosity on the hybrid defaults' attractive approach (the tip never indents) moves
+/// the curve by round-off alone when stepped — nonzero, far below a standard
+/// deviation — and the column is zero, where the modulus's is not.
+#[test]
+fn a_step_that_moves_the_curve_by_round_off_gives_a_zero_column() {
+    let numerics = tapsim::analysis::sweep::sweep_numerics(Numerics::default(), (false, false));
+    let mut setup = default_setup();
+    setup.law.viscosity_pa_s = Some(10.0);
+    let z: Vec<f64> = (0..16).map(|i| 18.5e-9 - 0.7e-9 * f64::from(i)).collect();
+    let c = tapsim::analysis::fit::model::curve(&setup, &numerics, &z, 0.0).unwrap();
+    let data = Measured {
+        position_m: z.clone(),
+        setpoint_ratio: None,
+        segments: vec![0],
+        amplitude_m: Some(c.amplitude_m.clone()),
+        phase_deg: Some(c.phase_deg.clone()),
+        sigma_amplitude_m: 0.02e-9,
+        sigma_phase_deg: 0.05,
+        second_mode: None,
+        thermal: None,
+    };
+    let report = |_: &tapsim::analysis::fit::Progress| {};
+    let tracker = Tracker::new(&report);
+    let params = [Parameter::Modulus, Parameter::Viscosity];
+    let starts = [setup.contact.modulus_pa, 10.0];
+    let problem = Problem::new(
+        (&setup, Nuisance::offset(0.0), &starts),
+        &numerics,
+        &data,
+        &params,
+        Budget::curves(100),
+        &tracker,
+    );
+    let x = DVector::zeros(2);
+    let r0 = problem.evaluate(&x).unwrap();
+    // The step itself: round-off, not nothing.
+    let moved = problem
+        .evaluate(&DVector::from_vec(vec![0.0, LOG_STEP]))
+        .unwrap()
+        - &r0;
+    assert!(moved.amax() > 0.0 && moved.amax() < 1e-8, "{moved}");
+    let j = problem.jacobian_at(&x, &r0, &c).unwrap();
+    assert!(j.column(1).iter().all(|&v| v == 0.0), "{}", j.column(1));
+    assert!(j.column(0).amax() > 1.0, "{}", j.column(0));
+}
