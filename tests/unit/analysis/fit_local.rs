@@ -141,3 +141,49 @@ fn a_step_that_moves_the_curve_by_round_off_gives_a_zero_column() {
     assert!(j.column(1).iter().all(|&v| v == 0.0), "{}", j.column(1));
     assert!(j.column(0).amax() > 1.0, "{}", j.column(0));
 }
+
+/// The crawl cut, on its own: a run whose χ² has fallen by less than 1 % over three
+/// iterations (here not at all: the Jacobian asked for at one point four times) is cut
+/// — its fourth Jacobian refused — where its curve does not describe the data, and goes
+/// on where it does. (The integration test in tests/fit_global.rs meets a crawl in a
+/// real fit, a path that turns on the global stage's ranking.)
+#[test]
+fn a_run_that_crawls_far_from_the_data_is_cut_and_one_that_describes_them_is_not() {
+    use levenberg_marquardt::LeastSquaresProblem;
+    let numerics = tapsim::analysis::sweep::sweep_numerics(Numerics::default(), (false, false));
+    let setup = default_setup();
+    let z: Vec<f64> = (0..8).map(|i| 18.5e-9 - 1.3e-9 * f64::from(i)).collect();
+    let c = tapsim::analysis::fit::model::curve(&setup, &numerics, &z, 0.0).unwrap();
+    let data = Measured {
+        position_m: z,
+        setpoint_ratio: None,
+        segments: vec![0],
+        amplitude_m: Some(c.amplitude_m.iter().map(|a| a + 1e-9).collect()),
+        phase_deg: Some(c.phase_deg.clone()),
+        sigma_amplitude_m: 0.02e-9,
+        sigma_phase_deg: 0.05,
+        second_mode: None,
+        thermal: None,
+    };
+    let report = |_: &tapsim::analysis::fit::Progress| {};
+    let tracker = Tracker::new(&report);
+    let params = [Parameter::Modulus];
+    let starts = [setup.contact.modulus_pa];
+    let jacobians = |describes: bool| -> Vec<bool> {
+        let verdict = move |_: &tapsim::analysis::fit::model::Curve, _: &[f64]| describes;
+        let problem = Problem::new(
+            (&setup, Nuisance::offset(0.0), &starts),
+            &numerics,
+            &data,
+            &params,
+            Budget {
+                max_curves: 100,
+                describes: Some(&verdict),
+            },
+            &tracker,
+        );
+        (0..4).map(|_| problem.jacobian().is_some()).collect()
+    };
+    assert_eq!(jacobians(false), [true, true, true, false]);
+    assert_eq!(jacobians(true), [true, true, true, true]);
+}
