@@ -7,6 +7,39 @@ use tapsim::analysis::fit::progress::Tracker;
 use tapsim::dynamics::setup::Numerics;
 use tapsim::dynamics::setup::default_setup;
 
+/// A measured curve at piezo positions `z` with 0.02 nm and 0.05° of stated noise.
+fn measured(z: Vec<f64>, amplitude_m: Vec<f64>, phase_deg: Vec<f64>) -> Measured {
+    Measured {
+        position_m: z,
+        setpoint_ratio: None,
+        segments: vec![0],
+        amplitude_m: Some(amplitude_m),
+        phase_deg: Some(phase_deg),
+        sigma_amplitude_m: 0.02e-9,
+        sigma_phase_deg: 0.05,
+        second_mode: None,
+        thermal: None,
+    }
+}
+
+/// The local problem from `setup` at `starts` (offset 0), within 100 curves.
+fn problem<'a>(
+    (setup, starts): (&'a tapsim::dynamics::setup::TapSetup, &'a [f64]),
+    numerics: &'a Numerics,
+    data: &'a Measured,
+    params: &'a [Parameter],
+    tracker: &'a Tracker<'a>,
+) -> Problem<'a> {
+    Problem::new(
+        (setup, Nuisance::offset(0.0), starts),
+        numerics,
+        data,
+        params,
+        Budget::curves(100),
+        tracker,
+    )
+}
+
 /// A Jacobian taken just below the modulus at which a point of the issue-43 curve
 /// (E* 0.8 GPa, Δγ 0.07 J/m²) jumps to the repulsive branch: the forward step
 /// crosses the switch, so the column is the backward difference — within 2 % of a
@@ -55,29 +88,16 @@ fn a_step_across_a_branch_switch_is_taken_backward() {
             "in transit below {hi}: {switching:?}"
         );
     }
-    let data = Measured {
-        position_m: z.clone(),
-        setpoint_ratio: None,
-        segments: vec![0],
-        amplitude_m: Some(c.amplitude_m.clone()),
-        phase_deg: Some(c.phase_deg.iter().map(|p| p + 0.1).collect()),
-        sigma_amplitude_m: 0.02e-9,
-        sigma_phase_deg: 0.05,
-        second_mode: None,
-        thermal: None,
-    };
+    let data = measured(
+        z.clone(),
+        c.amplitude_m.clone(),
+        c.phase_deg.iter().map(|p| p + 0.1).collect(),
+    );
     let report = |_: &tapsim::analysis::fit::Progress| {};
     let tracker = Tracker::new(&report);
     let params = [Parameter::Modulus];
     let starts = [lo];
-    let problem = Problem::new(
-        (&setup, Nuisance::offset(0.0), &starts),
-        &numerics,
-        &data,
-        &params,
-        Budget::curves(100),
-        &tracker,
-    );
+    let problem = problem((&setup, &starts), &numerics, &data, &params, &tracker);
     let x = DVector::zeros(1);
     let r0 = problem.evaluate(&x).unwrap();
     let j = problem.jacobian_at(&x, &r0, &c).unwrap();
@@ -106,29 +126,12 @@ fn a_step_that_moves_the_curve_by_round_off_gives_a_zero_column() {
     setup.law.viscosity_pa_s = Some(10.0);
     let z: Vec<f64> = (0..16).map(|i| 18.5e-9 - 0.7e-9 * f64::from(i)).collect();
     let c = tapsim::analysis::fit::model::curve(&setup, &numerics, &z, 0.0).unwrap();
-    let data = Measured {
-        position_m: z.clone(),
-        setpoint_ratio: None,
-        segments: vec![0],
-        amplitude_m: Some(c.amplitude_m.clone()),
-        phase_deg: Some(c.phase_deg.clone()),
-        sigma_amplitude_m: 0.02e-9,
-        sigma_phase_deg: 0.05,
-        second_mode: None,
-        thermal: None,
-    };
+    let data = measured(z, c.amplitude_m.clone(), c.phase_deg.clone());
     let report = |_: &tapsim::analysis::fit::Progress| {};
     let tracker = Tracker::new(&report);
     let params = [Parameter::Modulus, Parameter::Viscosity];
     let starts = [setup.contact.modulus_pa, 10.0];
-    let problem = Problem::new(
-        (&setup, Nuisance::offset(0.0), &starts),
-        &numerics,
-        &data,
-        &params,
-        Budget::curves(100),
-        &tracker,
-    );
+    let problem = problem((&setup, &starts), &numerics, &data, &params, &tracker);
     let x = DVector::zeros(2);
     let r0 = problem.evaluate(&x).unwrap();
     // The step itself: round-off, not nothing.
@@ -154,17 +157,11 @@ fn a_run_that_crawls_far_from_the_data_is_cut_and_one_that_describes_them_is_not
     let setup = default_setup();
     let z: Vec<f64> = (0..8).map(|i| 18.5e-9 - 1.3e-9 * f64::from(i)).collect();
     let c = tapsim::analysis::fit::model::curve(&setup, &numerics, &z, 0.0).unwrap();
-    let data = Measured {
-        position_m: z,
-        setpoint_ratio: None,
-        segments: vec![0],
-        amplitude_m: Some(c.amplitude_m.iter().map(|a| a + 1e-9).collect()),
-        phase_deg: Some(c.phase_deg.clone()),
-        sigma_amplitude_m: 0.02e-9,
-        sigma_phase_deg: 0.05,
-        second_mode: None,
-        thermal: None,
-    };
+    let data = measured(
+        z,
+        c.amplitude_m.iter().map(|a| a + 1e-9).collect(),
+        c.phase_deg.clone(),
+    );
     let report = |_: &tapsim::analysis::fit::Progress| {};
     let tracker = Tracker::new(&report);
     let params = [Parameter::Modulus];
