@@ -388,8 +388,7 @@ impl<'a> Problem<'a> {
         r0: &DVector<f64>,
         at: &Curve,
     ) -> Option<DMatrix<f64>> {
-        let unsettled = at.well_defined.iter().filter(|w| !**w).count();
-        let wide = at.averaged.contains(&true) || 4 * unsettled > at.well_defined.len();
+        let wide = at.averaged.contains(&true) || at.mostly_unsettled();
         let side = |x: &DVector<f64>, c: &Curve| branch_sides(&self.physical(x), c);
         let sides = side(x, at);
         let mut j = DMatrix::zeros(r0.len(), self.params.len());

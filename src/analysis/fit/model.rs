@@ -734,6 +734,20 @@ pub struct Curve {
     pub phase2_deg: Vec<f64>,
 }
 
+impl Curve {
+    /// The points that are not [`Curve::well_defined`]: mode locks and grazing touches.
+    pub fn unsettled(&self) -> usize {
+        self.well_defined.iter().filter(|w| !**w).count()
+    }
+
+    /// Whether more than a quarter of the points are unsettled: their values step as the
+    /// parameters move, so a fit differences such a curve over wide steps and gives no
+    /// linearised intervals at it.
+    pub fn mostly_unsettled(&self) -> bool {
+        4 * self.unsettled() > self.well_defined.len()
+    }
+}
+
 /// The approach curve of `setup` at the piezo positions `position_m` shifted by
 /// `offset_m` (each point's steady state started from the last one's, as an approach
 /// goes).

@@ -455,8 +455,8 @@ fn fit_reporting(
     // the law's switches (mode locks, grazing touches) step as the parameters move:
     // past a quarter of the curve the linearised intervals would claim a precision the
     // fit does not have.
-    let unsettled = fitted.well_defined.iter().filter(|w| !**w).count();
-    let locked = 4 * unsettled > data.len();
+    let unsettled = fitted.unsettled();
+    let locked = fitted.mostly_unsettled();
     // Likewise thermal averages: each carries noise that changes as the parameters move
     // (the same seeds, other trajectories), a χ² surface rippled at the scale of their
     // standard errors. On the defaults' JKR approach at 300 K (9 of 12 points averaged,

@@ -265,13 +265,13 @@ pub fn report(r: &FitReport, law: &str, data: &Measured) -> String {
              instrument reads them), their standard errors added to the data's"
         );
     }
-    if r.fitted.well_defined.iter().any(|w| !w) {
+    let unsettled = r.fitted.unsettled();
+    if unsettled > 0 {
         let _ = writeln!(
             s,
-            "note: {} of the fitted curve's points are not stable period-1 orbits clear of \
+            "note: {unsettled} of the fitted curve's points are not stable period-1 orbits clear of \
              the law's switches: their values are averages perturbations can change, and \
-             the fit there is less sure than its intervals say",
-            r.fitted.well_defined.iter().filter(|w| !**w).count()
+             the fit there is less sure than its intervals say"
         );
     }
     s
